@@ -1,0 +1,129 @@
+// The height grid: cols x rows samples of a soil surface over a rectangle of
+// the ground plane (X-Z), with three layers: current height, removed material
+// and initial height.
+//
+// Sample placement (cell-centred): the terrain covers
+//   x in [origin.x, origin.x + size_x_m],  z in [origin.z, origin.z + size_z_m]
+// and is divided into cols x rows equal cells of cell_x_m x cell_z_m. Sample
+// (c, r) describes cell c along +X and row r along +Z; its point lies at the
+// cell centre (origin.x + (c + 0.5) * cell_x_m, origin.z + (r + 0.5) * cell_z_m).
+// Image column index runs along +X and image row index along +Z, so the first
+// pixel is the cell at the origin corner.
+//
+// Heights are metres above the ground level origin.y; material occupies
+// origin.y <= y <= origin.y + height. Below the ground is a rigid floor that is
+// neither cut nor counted as contact. A sample stands for the volume
+// height * cell_x_m * cell_z_m.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "terracut/core/math.hpp"
+
+namespace terracut {
+
+/// Parameters of a height grid; read-only during a run.
+struct GridSpec {
+  int cols = 0;               ///< samples along +X, in [1, kMaxGridSide]
+  int rows = 0;               ///< samples along +Z, in [1, kMaxGridSide]
+  double size_x_m = 1.0;      ///< metres covered along X, > 0
+  double size_z_m = 1.0;      ///< metres covered along Z, > 0
+  Vec3 origin_m{};            ///< world position of the origin corner; origin_m.y is the ground level
+  double full_scale_m = 1.0;  ///< height of a full-white image pixel, metres, > 0
+
+  double cell_x_m() const { return size_x_m / cols; }
+  double cell_z_m() const { return size_z_m / rows; }
+  double cell_area_m2() const { return cell_x_m() * cell_z_m(); }
+  std::int64_t sample_count() const { return std::int64_t(cols) * rows; }
+};
+
+/// Largest accepted grid side (65536 samples); larger grids are refused as absurd.
+inline constexpr int kMaxGridSide = 65536;
+/// Largest accepted sample count (2^30, 12 GiB of layers).
+inline constexpr std::int64_t kMaxGridSamples = std::int64_t(1) << 30;
+
+/// Returns an empty string when spec is valid, else a message naming the bad field.
+std::string validate(const GridSpec& spec);
+
+/// A half-open rectangle of samples [c0, c1) x [r0, r1); empty when c0 >= c1 or r0 >= r1.
+struct Rect {
+  int c0 = 0;
+  int r0 = 0;
+  int c1 = 0;
+  int r1 = 0;
+
+  bool empty() const { return c0 >= c1 || r0 >= r1; }
+  std::int64_t area() const { return empty() ? 0 : std::int64_t(c1 - c0) * (r1 - r0); }
+  /// Grows the rectangle to include sample (c, r).
+  void include(int c, int r);
+  /// Grows the rectangle to include other.
+  void include(const Rect& other);
+  bool operator==(const Rect&) const = default;
+};
+
+/// The soil state: three layers of rows x cols float samples, row-major,
+/// index = r * cols + c, metres. Invariant, per sample and to float rounding:
+/// height + removed = initial.
+class HeightGrid {
+ public:
+  /// Builds a grid from initial heights (rows x cols, metres >= 0, finite).
+  /// Throws std::invalid_argument naming the bad field or sample.
+  HeightGrid(const GridSpec& spec, std::vector<float> initial_heights_m);
+
+  const GridSpec& spec() const { return spec_; }
+  int cols() const { return spec_.cols; }
+  int rows() const { return spec_.rows; }
+  std::int64_t index(int c, int r) const { return std::int64_t(r) * spec_.cols + c; }
+
+  /// Current height above ground, rows x cols, metres. The array is stable for
+  /// the grid's lifetime, so an engine (Bullet, a renderer) can read it in place.
+  const float* heights() const { return height_.data(); }
+  /// Material removed so far (initial - height), rows x cols, metres.
+  const float* removed() const { return removed_.data(); }
+  /// Heights at construction, rows x cols, metres.
+  const float* initial() const { return initial_.data(); }
+
+  float height(int c, int r) const { return height_[index(c, r)]; }
+
+  /// Lowers sample i to new_height_m if that is lower than its height (and not
+  /// below 0). Returns the height removed, metres (0 when nothing changed).
+  float lower(std::int64_t i, float new_height_m) {
+    float old = height_[i];
+    float h = new_height_m > 0.0f ? new_height_m : 0.0f;
+    if (!(h < old)) return 0.0f;
+    height_[i] = h;
+    removed_[i] = initial_[i] - h;
+    return old - h;
+  }
+
+  /// Replaces the heights of a rectangle (values rows-of-rect x cols-of-rect,
+  /// row-major) and returns the rectangle that changed. removed is updated.
+  Rect set_heights(const Rect& rect, const float* values_m);
+
+  /// Restores every sample to its initial height.
+  void reset();
+
+  /// World X of sample column c's centre, and world Z of row r's centre.
+  double sample_x(int c) const { return spec_.origin_m.x + (c + 0.5) * spec_.cell_x_m(); }
+  double sample_z(int r) const { return spec_.origin_m.z + (r + 0.5) * spec_.cell_z_m(); }
+  /// Continuous cell coordinates of a world point: cell c covers [c, c+1).
+  double cell_u(double x) const { return (x - spec_.origin_m.x) / spec_.cell_x_m(); }
+  double cell_v(double z) const { return (z - spec_.origin_m.z) / spec_.cell_z_m(); }
+
+  /// Total material volume above ground, cubic metres (sum of height * cell area).
+  double volume_m3() const;
+  /// Largest |height + removed - initial| over all samples, metres.
+  double conservation_error_m() const;
+  /// A 64-bit FNV-1a hash of the three layers (bitwise), for determinism checks.
+  std::uint64_t state_hash() const;
+
+ private:
+  GridSpec spec_;
+  std::vector<float> height_;
+  std::vector<float> removed_;
+  std::vector<float> initial_;
+};
+
+}  // namespace terracut

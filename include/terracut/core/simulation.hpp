@@ -1,0 +1,98 @@
+// The fixed-step cutting simulation: parameters (read-only during a run) apart
+// from state (heights, blade pose, time, counters, timers).
+//
+// One step, at the fixed rate:
+//   1. begin_step(pose): the blade moves to `pose`; contact is measured against
+//      the terrain as it was before this step's cut, so a cut never hides the
+//      contact that caused it.
+//   2. finish_step(): the region the edge swept since the previous pose is cut.
+// step(pose) does both. A step allocates nothing.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "terracut/core/cut.hpp"
+
+namespace terracut {
+
+/// Simulation parameters; validated at construction, read-only during a run.
+struct SimParams {
+  GridSpec grid{};
+  Representation representation = Representation::kSurface;
+  double rate_hz = 1000.0;  ///< fixed step rate, Hz, in (0, 1e6]
+  BladeSpec blade{};
+  /// A step whose rotation would move a blade end off its straight path by
+  /// more than this fraction of a cell is split into sub-steps (slerp), so a
+  /// fast rotation still sweeps its true arc. In (0, 1].
+  double max_arc_error_cells = 0.25;
+};
+
+/// Returns an empty string when params are valid, else a message naming the field.
+std::string validate(const SimParams& params);
+
+/// Wall-clock time of each phase of the last step, seconds.
+struct StepTimers {
+  double contact_s = 0.0;
+  double cut_s = 0.0;
+  double total_s = 0.0;
+};
+
+/// The outcome of the last step.
+struct StepOutput {
+  std::int64_t step = 0;     ///< index of the step, from 0
+  double t_s = 0.0;          ///< simulation time of the step, seconds (step / rate)
+  BladePose pose{};          ///< blade pose during the step
+  Segment edge{};            ///< cutting edge during the step, world metres
+  ContactResult contact{};   ///< measured before the cut
+  CutResult cut{};           ///< what the sweep since the previous pose removed
+  int substeps = 0;          ///< sweep sub-steps used (0 when the blade was lifted)
+  StepTimers timers{};
+};
+
+class Simulation {
+ public:
+  /// Throws InputError naming the bad field when params or heights are invalid.
+  Simulation(const SimParams& params, std::vector<float> initial_heights_m);
+
+  const SimParams& params() const { return params_; }
+  const HeightGrid& grid() const { return grid_; }
+  HeightGrid& grid() { return grid_; }
+
+  /// Lifts the blade out of the soil: the next step starts a new stroke and
+  /// sweeps nothing from the previous pose (used between separate cuts).
+  void lift() { has_previous_ = false; }
+
+  /// Phase 1: move the blade and measure contact before any cut.
+  const StepOutput& begin_step(const BladePose& pose);
+  /// Phase 2: cut what the edge swept since the previous pose; advance time.
+  const StepOutput& finish_step();
+  /// Both phases.
+  const StepOutput& step(const BladePose& pose) {
+    begin_step(pose);
+    return finish_step();
+  }
+
+  const StepOutput& last() const { return out_; }
+  std::int64_t step_count() const { return step_count_; }
+  double time_s() const { return double(step_count_) / params_.rate_hz; }
+  /// Total volume cut since construction or reset, cubic metres.
+  double removed_volume_m3() const { return removed_volume_m3_; }
+
+  /// Restores the initial terrain, time and counters.
+  void reset();
+
+ private:
+  SimParams params_;
+  HeightGrid grid_;
+  BladePose previous_pose_{};
+  bool has_previous_ = false;
+  bool in_step_ = false;
+  std::int64_t step_count_ = 0;
+  double removed_volume_m3_ = 0.0;
+  StepOutput out_{};
+  double begin_clock_s_ = 0.0;
+};
+
+}  // namespace terracut
