@@ -1,0 +1,164 @@
+// Internal geometry shared by the traversal code and the brute-force oracle:
+// the per-piece contact measure, segment clipping, the grid frame, and small
+// fixed-size polygon clipping. Not part of the public API.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "terracut/core/blade.hpp"
+#include "terracut/core/contact.hpp"
+#include "terracut/core/grid.hpp"
+
+namespace terracut::detail {
+
+/// The grid's mapping from world to continuous cell coordinates, cached for
+/// the hot path: u = (x - x0) * inv_cx, v = (z - z0) * inv_cz; cell (c, r)
+/// covers [c, c+1) x [r, r+1).
+struct GridFrame {
+  double x0, z0, ground_y;
+  double cx, cz, inv_cx, inv_cz;
+  int cols, rows;
+  /// Depths below this are treated as no material: a blade resting on a
+  /// surface it has just cut is not in contact (float rounding of heights).
+  double depth_epsilon_m;
+
+  explicit GridFrame(const HeightGrid& grid)
+      : x0(grid.spec().origin_m.x),
+        z0(grid.spec().origin_m.z),
+        ground_y(grid.spec().origin_m.y),
+        cx(grid.spec().cell_x_m()),
+        cz(grid.spec().cell_z_m()),
+        inv_cx(1.0 / grid.spec().cell_x_m()),
+        inv_cz(1.0 / grid.spec().cell_z_m()),
+        cols(grid.cols()),
+        rows(grid.rows()),
+        depth_epsilon_m(std::ldexp(grid.spec().full_scale_m + std::abs(grid.spec().origin_m.y), -20)) {}
+};
+
+/// Keeps the part of [t0, t1] where the linear function f(t) = fa + (fb - fa) t
+/// is > 0 (strict) or >= 0. Returns false when nothing is left.
+inline bool clip_linear(double fa, double fb, bool strict, double& t0, double& t1) {
+  double f0 = fa + (fb - fa) * t0;
+  double f1 = fa + (fb - fa) * t1;
+  bool in0 = strict ? f0 > 0.0 : f0 >= 0.0;
+  bool in1 = strict ? f1 > 0.0 : f1 >= 0.0;
+  if (in0 && in1) return true;
+  if (!in0 && !in1) return false;
+  double root = fa / (fa - fb);
+  if (in0) {
+    t1 = std::min(t1, root);
+  } else {
+    t0 = std::max(t0, root);
+  }
+  return t1 > t0;
+}
+
+/// Adds the contact of one piece of the edge, [sa, sb] in edge parameter,
+/// over which both the material top and the edge height are linear: inside
+/// material where ground <= y < top (depth above epsilon). seg_length_m is the
+/// edge's 3-D length.
+inline void accumulate_piece(double sa, double sb, double top_a, double top_b, double y_a,
+                             double y_b, const GridFrame& frame, double seg_length_m,
+                             ContactResult& out) {
+  if (!(sb > sa)) return;
+  double t0 = 0.0, t1 = 1.0;
+  double da = top_a - y_a, db = top_b - y_b;
+  if (!clip_linear(da - frame.depth_epsilon_m, db - frame.depth_epsilon_m, true, t0, t1)) return;
+  if (!clip_linear(y_a - frame.ground_y, y_b - frame.ground_y, false, t0, t1)) return;
+  double d0 = da + (db - da) * t0;
+  double d1 = da + (db - da) * t1;
+  double len = (t1 - t0) * (sb - sa) * seg_length_m;
+  out.length_m += len;
+  out.section_area_m2 += len * 0.5 * (d0 + d1);
+  out.max_depth_m = std::max(out.max_depth_m, std::max(d0, d1));
+}
+
+/// Clips the parameter range [s0, s1] of p(s) = p0 + s * dp to lo <= p <= hi
+/// (one axis of a Liang-Barsky clip). Returns false when nothing is left.
+inline bool clip_axis(double p0, double dp, double lo, double hi, double& s0, double& s1) {
+  if (dp == 0.0) return p0 >= lo && p0 <= hi;
+  double a = (lo - p0) / dp;
+  double b = (hi - p0) / dp;
+  if (a > b) std::swap(a, b);
+  s0 = std::max(s0, a);
+  s1 = std::min(s1, b);
+  return s1 >= s0;
+}
+
+/// Height of the surface representation inside node square (i, j) at local
+/// coordinates (a, b) in [0,1]^2, from its corner heights. Split along the
+/// diagonal from (1, 0) to (0, 1), as Bullet's heightfield.
+inline double surface_in_square(double h00, double h10, double h01, double h11, double a,
+                                double b, bool lower_triangle) {
+  if (lower_triangle) return h00 + a * (h10 - h00) + b * (h01 - h00);
+  return h11 + (1.0 - a) * (h01 - h11) + (1.0 - b) * (h10 - h11);
+}
+
+/// Height of sample (c, r) with indices clamped to the grid (the surface's
+/// flat extension over the half-cell border).
+inline double clamped_height(const float* h, int cols, int rows, int c, int r) {
+  c = std::clamp(c, 0, cols - 1);
+  r = std::clamp(r, 0, rows - 1);
+  return h[std::int64_t(r) * cols + c];
+}
+
+/// A convex polygon of at most kMax vertices in 3-D (a triangle clipped by up
+/// to four axis-aligned planes).
+struct Polygon {
+  static constexpr int kMax = 8;
+  Vec3 v[kMax];
+  int n = 0;
+};
+
+/// Keeps the part of poly with sign * (coordinate axis - bound) >= 0, axis 0 = x, 2 = z.
+inline void clip_polygon(const Polygon& in, int axis, double bound, double sign, Polygon& out) {
+  out.n = 0;
+  if (in.n == 0) return;
+  auto dist = [&](const Vec3& p) { return sign * ((axis == 0 ? p.x : p.z) - bound); };
+  for (int k = 0; k < in.n; ++k) {
+    const Vec3& p = in.v[k];
+    const Vec3& q = in.v[(k + 1) % in.n];
+    double dp = dist(p), dq = dist(q);
+    if (dp >= 0.0 && out.n < Polygon::kMax) out.v[out.n++] = p;
+    if ((dp >= 0.0) != (dq >= 0.0) && out.n < Polygon::kMax) {
+      double t = dp / (dp - dq);
+      out.v[out.n++] = lerp(p, q, t);
+    }
+  }
+}
+
+/// Clips a triangle to the closed strip z0 <= z <= z1.
+inline void clip_to_strip_z(const Vec3& a, const Vec3& b, const Vec3& c, double z0, double z1,
+                            Polygon& out) {
+  Polygon tri, tmp;
+  tri.v[0] = a;
+  tri.v[1] = b;
+  tri.v[2] = c;
+  tri.n = 3;
+  clip_polygon(tri, 2, z0, 1.0, tmp);
+  clip_polygon(tmp, 2, z1, -1.0, out);
+}
+
+/// Lowest y of the part of poly with x0 <= x <= x1; +inf when none.
+inline double min_y_in_strip_x(const Polygon& poly, double x0, double x1) {
+  Polygon a, b;
+  clip_polygon(poly, 0, x0, 1.0, a);
+  clip_polygon(a, 0, x1, -1.0, b);
+  double lowest = INFINITY;
+  for (int k = 0; k < b.n; ++k) lowest = std::min(lowest, b.v[k].y);
+  return lowest;
+}
+
+/// The number of sweep sub-steps and the swept triangles of one sub-step.
+inline void sweep_triangles(const Segment& from, const Segment& to, Vec3 tri[2][3]) {
+  tri[0][0] = from.a;
+  tri[0][1] = from.b;
+  tri[0][2] = to.b;
+  tri[1][0] = from.a;
+  tri[1][1] = to.b;
+  tri[1][2] = to.a;
+}
+
+}  // namespace terracut::detail

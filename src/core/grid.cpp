@@ -1,0 +1,132 @@
+#include "terracut/core/grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "terracut/core/error.hpp"
+
+namespace terracut {
+
+std::string validate(const GridSpec& spec) {
+  std::ostringstream msg;
+  if (spec.cols < 1 || spec.cols > kMaxGridSide) {
+    msg << "grid.cols must be in [1, " << kMaxGridSide << "], got " << spec.cols;
+  } else if (spec.rows < 1 || spec.rows > kMaxGridSide) {
+    msg << "grid.rows must be in [1, " << kMaxGridSide << "], got " << spec.rows;
+  } else if (spec.sample_count() > kMaxGridSamples) {
+    msg << "grid has " << spec.sample_count() << " samples, more than the limit " << kMaxGridSamples;
+  } else if (!(std::isfinite(spec.size_x_m) && spec.size_x_m > 0.0)) {
+    msg << "grid.size_x_m must be finite and > 0, got " << spec.size_x_m;
+  } else if (!(std::isfinite(spec.size_z_m) && spec.size_z_m > 0.0)) {
+    msg << "grid.size_z_m must be finite and > 0, got " << spec.size_z_m;
+  } else if (!is_finite(spec.origin_m)) {
+    msg << "grid.origin_m must be finite";
+  } else if (!(std::isfinite(spec.full_scale_m) && spec.full_scale_m > 0.0)) {
+    msg << "grid.full_scale_m must be finite and > 0, got " << spec.full_scale_m;
+  }
+  return msg.str();
+}
+
+void Rect::include(int c, int r) {
+  if (empty()) {
+    *this = {c, r, c + 1, r + 1};
+    return;
+  }
+  c0 = std::min(c0, c);
+  r0 = std::min(r0, r);
+  c1 = std::max(c1, c + 1);
+  r1 = std::max(r1, r + 1);
+}
+
+void Rect::include(const Rect& other) {
+  if (other.empty()) return;
+  if (empty()) {
+    *this = other;
+    return;
+  }
+  c0 = std::min(c0, other.c0);
+  r0 = std::min(r0, other.r0);
+  c1 = std::max(c1, other.c1);
+  r1 = std::max(r1, other.r1);
+}
+
+HeightGrid::HeightGrid(const GridSpec& spec, std::vector<float> initial_heights_m) : spec_(spec) {
+  if (std::string error = validate(spec); !error.empty()) throw InputError(error);
+  if (std::int64_t(initial_heights_m.size()) != spec.sample_count()) {
+    std::ostringstream msg;
+    msg << "initial heights have " << initial_heights_m.size() << " values, expected cols x rows = "
+        << spec.cols << " x " << spec.rows << " = " << spec.sample_count();
+    throw InputError(msg.str());
+  }
+  for (std::int64_t i = 0; i < spec.sample_count(); ++i) {
+    float h = initial_heights_m[size_t(i)];
+    if (!std::isfinite(h) || h < 0.0f) {
+      std::ostringstream msg;
+      msg << "initial height at sample (col " << i % spec.cols << ", row " << i / spec.cols
+          << ") must be finite and >= 0, got " << h;
+      throw InputError(msg.str());
+    }
+  }
+  initial_ = std::move(initial_heights_m);
+  height_ = initial_;
+  removed_.assign(initial_.size(), 0.0f);
+}
+
+Rect HeightGrid::set_heights(const Rect& rect, const float* values_m) {
+  Rect clipped{std::max(rect.c0, 0), std::max(rect.r0, 0), std::min(rect.c1, cols()),
+               std::min(rect.r1, rows())};
+  if (clipped.empty()) return {};
+  int width = rect.c1 - rect.c0;
+  for (int r = clipped.r0; r < clipped.r1; ++r) {
+    for (int c = clipped.c0; c < clipped.c1; ++c) {
+      float h = values_m[std::int64_t(r - rect.r0) * width + (c - rect.c0)];
+      if (!std::isfinite(h) || h < 0.0f) h = 0.0f;
+      std::int64_t i = index(c, r);
+      height_[size_t(i)] = h;
+      removed_[size_t(i)] = initial_[size_t(i)] - h;
+    }
+  }
+  return clipped;
+}
+
+void HeightGrid::reset() {
+  height_ = initial_;
+  std::fill(removed_.begin(), removed_.end(), 0.0f);
+}
+
+double HeightGrid::volume_m3() const {
+  double sum = 0.0;
+  for (float h : height_) sum += h;
+  return sum * spec_.cell_area_m2();
+}
+
+double HeightGrid::conservation_error_m() const {
+  double worst = 0.0;
+  for (size_t i = 0; i < height_.size(); ++i) {
+    double e = std::abs(double(height_[i]) + double(removed_[i]) - double(initial_[i]));
+    worst = std::max(worst, e);
+  }
+  return worst;
+}
+
+std::uint64_t HeightGrid::state_hash() const {
+  std::uint64_t hash = 1469598103934665603ull;
+  auto mix = [&hash](const std::vector<float>& layer) {
+    for (float v : layer) {
+      std::uint32_t bits;
+      std::memcpy(&bits, &v, sizeof bits);
+      for (int k = 0; k < 4; ++k) {
+        hash ^= (bits >> (8 * k)) & 0xffu;
+        hash *= 1099511628211ull;
+      }
+    }
+  };
+  mix(height_);
+  mix(removed_);
+  mix(initial_);
+  return hash;
+}
+
+}  // namespace terracut

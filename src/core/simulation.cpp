@@ -1,0 +1,120 @@
+#include "terracut/core/simulation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "terracut/core/error.hpp"
+
+namespace terracut {
+
+namespace {
+
+double now_s() {
+  using clock = std::chrono::steady_clock;
+  return std::chrono::duration<double>(clock::now().time_since_epoch()).count();
+}
+
+/// Largest number of sweep sub-steps in one step (bounds the step's cost).
+constexpr int kMaxSubsteps = 64;
+
+}  // namespace
+
+std::string validate(const SimParams& params) {
+  if (std::string e = validate(params.grid); !e.empty()) return e;
+  std::ostringstream msg;
+  if (!(std::isfinite(params.rate_hz) && params.rate_hz > 0.0 && params.rate_hz <= 1e6)) {
+    msg << "rate_hz must be in (0, 1e6], got " << params.rate_hz;
+  } else if (!(std::isfinite(params.blade.length_m) && params.blade.length_m > 0.0)) {
+    msg << "blade.length_m must be finite and > 0, got " << params.blade.length_m;
+  } else if (!(params.max_arc_error_cells > 0.0 && params.max_arc_error_cells <= 1.0)) {
+    msg << "max_arc_error_cells must be in (0, 1], got " << params.max_arc_error_cells;
+  } else if (params.representation != Representation::kColumns &&
+             params.representation != Representation::kSurface) {
+    msg << "representation must be columns or surface";
+  }
+  return msg.str();
+}
+
+static const SimParams& checked(const SimParams& params) {
+  if (std::string e = validate(params); !e.empty()) throw InputError(e);
+  return params;
+}
+
+Simulation::Simulation(const SimParams& params, std::vector<float> initial_heights_m)
+    : params_(checked(params)), grid_(params.grid, std::move(initial_heights_m)) {}
+
+const StepOutput& Simulation::begin_step(const BladePose& pose) {
+  begin_clock_s_ = now_s();
+  in_step_ = true;
+  out_.step = step_count_;
+  out_.t_s = time_s();
+  // A non-finite or zero pose is unusable: the blade stays where it was and
+  // nothing is measured or cut; the caller (haptic loop) counts the sample.
+  BladePose p = pose;
+  p.orientation = normalized(pose.orientation);
+  bool valid = is_finite(pose.position_m) && is_finite(pose.orientation);
+  out_.pose = valid ? p : previous_pose_;
+  out_.edge = blade_segment(params_.blade, out_.pose);
+  out_.contact = valid ? measure_contact(grid_, params_.representation, out_.edge) : ContactResult{};
+  out_.cut = {};
+  out_.substeps = 0;
+  out_.timers = {};
+  out_.timers.contact_s = now_s() - begin_clock_s_;
+  if (!valid) has_previous_ = false;
+  return out_;
+}
+
+const StepOutput& Simulation::finish_step() {
+  if (!in_step_) return out_;
+  double cut_start = now_s();
+  // The blade cuts where it rests even when it has just been put down.
+  BladePose from = has_previous_ ? previous_pose_ : out_.pose;
+  // Split a step with a large rotation so the blade ends follow their arc to
+  // within max_arc_error_cells of a cell (sagitta of each sub-step's chord).
+  double half_length = params_.blade.length_m / 2.0;
+  double tolerance = params_.max_arc_error_cells *
+                     std::min(params_.grid.cell_x_m(), params_.grid.cell_z_m());
+  double angle = angle_between(from.orientation, out_.pose.orientation);
+  int substeps = 1;
+  if (angle > 0.0 && tolerance < half_length) {
+    double max_angle = 2.0 * std::acos(1.0 - tolerance / half_length);
+    substeps = std::clamp(int(std::ceil(angle / max_angle)), 1, kMaxSubsteps);
+  }
+  Segment previous = blade_segment(params_.blade, from);
+  for (int k = 1; k <= substeps; ++k) {
+    double t = double(k) / substeps;
+    BladePose pose = k == substeps ? out_.pose
+                                   : BladePose{lerp(from.position_m, out_.pose.position_m, t),
+                                               slerp(from.orientation, out_.pose.orientation, t)};
+    Segment next = blade_segment(params_.blade, pose);
+    CutResult part = cut_sweep(grid_, params_.representation, previous, next);
+    out_.cut.removed_volume_m3 += part.removed_volume_m3;
+    out_.cut.cells_visited += part.cells_visited;
+    out_.cut.changed.include(part.changed);
+    previous = next;
+  }
+  out_.substeps = substeps;
+  removed_volume_m3_ += out_.cut.removed_volume_m3;
+  previous_pose_ = out_.pose;
+  has_previous_ = true;
+  in_step_ = false;
+  ++step_count_;
+  double end = now_s();
+  out_.timers.cut_s = end - cut_start;
+  out_.timers.total_s = end - begin_clock_s_;
+  return out_;
+}
+
+void Simulation::reset() {
+  grid_.reset();
+  has_previous_ = false;
+  in_step_ = false;
+  step_count_ = 0;
+  removed_volume_m3_ = 0.0;
+  out_ = {};
+}
+
+}  // namespace terracut

@@ -1,0 +1,252 @@
+// Swept cutting: no tunnelling, conservation, order independence, and
+// equality with the brute-force oracle.
+#include "terracut/core/cut.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "terracut/core/brute_force.hpp"
+#include "terracut/core/simulation.hpp"
+#include "test_terrains.hpp"
+
+namespace terracut {
+namespace {
+
+constexpr Representation kBoth[] = {Representation::kColumns, Representation::kSurface};
+
+// Float rounding of one height, relative to the full scale.
+constexpr double kFloatTol = 4.0 * 1.2e-7;
+
+Segment horizontal_edge(double x0, double x1, double y, double z) { return {{x0, y, z}, {x1, y, z}}; }
+
+// A blade moving 3.7 cells per step along +Z at height y0 cuts every sample
+// it passed over down to y0, and nothing else.
+TEST(Cut, FastBladeCutsEverythingItPassesThrough) {
+  const int n = 60;
+  GridSpec s = test::square_spec(n, n);
+  const double y0 = 0.3, step = 3.7 * s.cell_z_m();
+  // Ends placed off the cell boundaries (a touch exactly on a boundary is decided by rounding).
+  const double x0 = 0.2 + 0.3 / n, x1 = 0.8 + 0.4 / n, z_start = 0.05 + 0.2 / n, z_end = 0.9 + 0.1 / n;
+  for (Representation rep : kBoth) {
+    HeightGrid grid(s, std::vector<float>(n * n, 0.7f));
+    Segment previous = horizontal_edge(x0, x1, y0, z_start);
+    double z = z_start;
+    while (z < z_end) {
+      z = std::min(z + step, z_end);
+      Segment next = horizontal_edge(x0, x1, y0, z);
+      cut_sweep(grid, rep, previous, next);
+      previous = next;
+    }
+    for (int r = 0; r < n; ++r) {
+      for (int c = 0; c < n; ++c) {
+        double h = grid.height(c, r);
+        bool swept;
+        if (rep == Representation::kSurface) {
+          // Sample points inside the swept rectangle.
+          double x = grid.sample_x(c), zc = grid.sample_z(r);
+          swept = x >= x0 && x <= x1 && zc >= z_start && zc <= z_end;
+        } else {
+          // Cells the swept rectangle overlaps.
+          double cx0 = c * s.cell_x_m(), cz0 = r * s.cell_z_m();
+          swept = cx0 + s.cell_x_m() >= x0 && cx0 <= x1 && cz0 + s.cell_z_m() >= z_start && cz0 <= z_end;
+        }
+        if (swept) {
+          EXPECT_NEAR(h, y0, kFloatTol) << to_string(rep) << " c=" << c << " r=" << r;
+        } else {
+          EXPECT_EQ(h, 0.7f) << to_string(rep) << " c=" << c << " r=" << r;
+        }
+      }
+    }
+  }
+}
+
+// A blade spinning 40 degrees per step about the vertical axis through its
+// centre sweeps a disc sector: sub-steps make it follow the arc, so every
+// sample well inside the sector is cut and every sample well outside the
+// disc is not.
+TEST(Cut, FastRotationFollowsTheArc) {
+  const int n = 80;
+  GridSpec s = test::square_spec(n, n);
+  SimParams p;
+  p.grid = s;
+  p.blade.length_m = 0.8;
+  for (Representation rep : kBoth) {
+    p.representation = rep;
+    Simulation sim(p, std::vector<float>(n * n, 0.5f));
+    const double y0 = 0.2, step_deg = 40.0, total_deg = 160.0;
+    for (double a = 0.0; a <= total_deg + 1e-9; a += step_deg) {
+      sim.step({{0.5, y0, 0.5}, quat_from_axis_angle({0, 1, 0}, a * std::numbers::pi / 180.0)});
+    }
+    EXPECT_GT(sim.last().substeps, 1);
+    const double margin = 1.5 * s.cell_x_m();
+    for (int r = 0; r < n; ++r) {
+      for (int c = 0; c < n; ++c) {
+        double dx = sim.grid().sample_x(c) - 0.5, dz = sim.grid().sample_z(r) - 0.5;
+        double radius = std::hypot(dx, dz);
+        // Blade along local X rotated about +Y by a: direction (cos a, 0, -sin a);
+        // either end, so the swept angle is taken modulo 180 degrees.
+        double angle = std::fmod(std::atan2(-dz, dx) * 180.0 / std::numbers::pi + 360.0, 180.0);
+        double h = sim.grid().height(c, r);
+        if (radius > 0.4 + margin) {
+          EXPECT_EQ(h, 0.5f) << to_string(rep);
+        } else if (radius < 0.4 - margin && radius > margin && angle > 3.0 && angle < 157.0) {
+          EXPECT_NEAR(h, y0, kFloatTol) << to_string(rep) << " r=" << radius << " angle=" << angle;
+        }
+      }
+    }
+  }
+}
+
+// A sweep above the material changes nothing.
+TEST(Cut, SweepAboveMaterialChangesNothing) {
+  GridSpec s = test::square_spec(20, 20);
+  for (Representation rep : kBoth) {
+    HeightGrid grid(s, std::vector<float>(400, 0.3f));
+    CutResult r = cut_sweep(grid, rep, horizontal_edge(0, 1, 0.5, 0.1), horizontal_edge(0, 1, 0.5, 0.9));
+    EXPECT_EQ(r.removed_volume_m3, 0.0);
+    EXPECT_TRUE(r.changed.empty());
+    for (int i = 0; i < 400; ++i) EXPECT_EQ(grid.heights()[i], 0.3f);
+  }
+}
+
+// A cut below the ground stops at the rigid floor (height 0), never below.
+TEST(Cut, NeverBelowTheFloor) {
+  GridSpec s = test::square_spec(20, 20);
+  for (Representation rep : kBoth) {
+    HeightGrid grid(s, std::vector<float>(400, 0.3f));
+    cut_sweep(grid, rep, horizontal_edge(0, 1, -0.5, 0.1), horizontal_edge(0, 1, -0.5, 0.9));
+    for (int i = 0; i < 400; ++i) EXPECT_GE(grid.heights()[i], 0.0f);
+    EXPECT_EQ(grid.height(10, 10), 0.0f);
+  }
+}
+
+// Random cuts on a random terrain: height + removed = initial for every sample,
+// and the volume booked per cut adds up to the volume lost.
+TEST(Cut, ConservationAfterRandomCuts) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (Representation rep : kBoth) {
+    GridSpec s = test::square_spec(64, 48, 1.0, 1.0);
+    std::vector<float> h(size_t(s.sample_count()));
+    for (float& v : h) v = float(unit(rng));
+    HeightGrid grid(s, h);
+    double initial_volume = grid.volume_m3(), booked = 0.0;
+    for (int k = 0; k < 200; ++k) {
+      auto point = [&] { return Vec3{unit(rng) * 1.4 - 0.2, unit(rng), unit(rng) * 1.4 - 0.2}; };
+      Segment a{point(), point()};
+      Segment b{a.a + Vec3{0.05, 0.0, 0.05} * (unit(rng) - 0.5), a.b + Vec3{0.03, -0.02, 0.08} * (unit(rng) - 0.5)};
+      booked += cut_sweep(grid, rep, a, b).removed_volume_m3;
+    }
+    for (std::int64_t i = 0; i < s.sample_count(); ++i) {
+      double sum = double(grid.heights()[i]) + double(grid.removed()[i]);
+      ASSERT_NEAR(sum, grid.initial()[i], kFloatTol) << to_string(rep) << " sample " << i;
+    }
+    EXPECT_LE(grid.conservation_error_m(), kFloatTol);
+    EXPECT_NEAR(initial_volume - grid.volume_m3(), booked, 1e-9 * initial_volume + 1e-12) << to_string(rep);
+    EXPECT_GT(booked, 0.0);
+  }
+}
+
+// The paper's three cuts (experiment 2) applied in all six orders give the same final heights.
+TEST(Cut, FinalShapeDoesNotDependOnOrder) {
+  GridSpec s = test::square_spec(35, 35);
+  auto keyframes = [](double y0, double y1, double z0, double z1, double rz1) {
+    Motion m;
+    m.keyframes = {{0.0, {{0.5, y0, z0}, Quat{}}},
+                   {2.0, {{0.5, y1, z1}, quat_from_euler_deg({0, 0, rz1})}}};
+    return m;
+  };
+  std::array<Motion, 3> cuts = {keyframes(0.75, 0.70, -0.1, 1.1, 45.0),
+                                keyframes(0.5, 0.5, 1.1, -0.1, 0.0),
+                                keyframes(0.75, 0.70, -0.1, 1.1, -26.57)};
+  for (Representation rep : kBoth) {
+    SimParams p;
+    p.grid = s;
+    p.representation = rep;
+    p.blade.length_m = 1.6;
+    std::array<int, 3> order = {0, 1, 2};
+    std::vector<float> reference;
+    double reference_removed = 0.0;
+    do {
+      Simulation sim(p, std::vector<float>(35 * 35, 1.0f));
+      for (int k : order) {
+        sim.lift();
+        for (int i = 0; i <= 2000; ++i) sim.step(cuts[size_t(k)].sample(i / 1000.0));
+      }
+      std::vector<float> final(sim.grid().heights(), sim.grid().heights() + 35 * 35);
+      if (reference.empty()) {
+        reference = final;
+        reference_removed = sim.removed_volume_m3();
+        EXPECT_GT(reference_removed, 0.1);
+      } else {
+        EXPECT_EQ(final, reference) << to_string(rep) << " order " << order[0] << order[1] << order[2];
+        EXPECT_NEAR(sim.removed_volume_m3(), reference_removed, 1e-9);
+      }
+    } while (std::next_permutation(order.begin(), order.end()));
+  }
+}
+
+// The traversal cut equals the brute-force cut on random terrains and sweeps.
+TEST(Cut, TraversalEqualsBruteForceOnRandomCases) {
+  std::mt19937 rng(1234);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 150; ++trial) {
+    GridSpec s;
+    s.cols = 1 + int(unit(rng) * 25);
+    s.rows = 1 + int(unit(rng) * 25);
+    s.size_x_m = 0.5 + unit(rng);
+    s.size_z_m = 0.5 + unit(rng);
+    s.origin_m = {unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5};
+    std::vector<float> h(size_t(s.sample_count()));
+    for (float& v : h) v = float(unit(rng));
+    auto point = [&] {
+      return Vec3{s.origin_m.x + (unit(rng) * 1.6 - 0.3) * s.size_x_m, s.origin_m.y + unit(rng),
+                  s.origin_m.z + (unit(rng) * 1.6 - 0.3) * s.size_z_m};
+    };
+    for (Representation rep : kBoth) {
+      HeightGrid fast(s, h), slow(s, h);
+      for (int k = 0; k < 5; ++k) {
+        Segment from{point(), point()};
+        // Small moves (a haptic step) and large jumps (tunnelling cases).
+        double reach = k % 2 == 0 ? 0.05 : 0.6;
+        Vec3 shift{(unit(rng) - 0.5) * reach, (unit(rng) - 0.5) * reach, (unit(rng) - 0.5) * reach};
+        Segment to{from.a + shift, from.b + shift * (0.5 + unit(rng))};
+        CutResult a = cut_sweep(fast, rep, from, to);
+        CutResult b = cut_sweep_brute_force(slow, rep, from, to);
+        ASSERT_NEAR(a.removed_volume_m3, b.removed_volume_m3, 1e-6 * s.size_x_m * s.size_z_m)
+            << to_string(rep) << " trial " << trial;
+        if (!b.changed.empty()) {
+          Rect both = a.changed;
+          both.include(b.changed);
+          EXPECT_EQ(both, a.changed) << "the traversal's changed rectangle must hold every change";
+        }
+      }
+      for (std::int64_t i = 0; i < s.sample_count(); ++i) {
+        ASSERT_NEAR(fast.heights()[i], slow.heights()[i], 1e-6) << to_string(rep) << " trial " << trial;
+      }
+    }
+  }
+}
+
+// The columns cut with the blade at rest is the paper's rule: each column the
+// line passes through is lowered until its top is at the line.
+TEST(Cut, ColumnsAtRestLowerToTheLine) {
+  GridSpec s = test::square_spec(10, 10);
+  HeightGrid grid(s, std::vector<float>(100, 1.0f));
+  // A line along X tilted from y = 0.2 at x = 0 to y = 0.7 at x = 1, at z = 0.55 (row 5).
+  Segment edge{{0.0, 0.2, 0.55}, {1.0, 0.7, 0.55}};
+  cut_sweep(grid, Representation::kColumns, edge, edge);
+  for (int c = 0; c < 10; ++c) {
+    EXPECT_NEAR(grid.height(c, 5), 0.2 + 0.05 * c, 1e-6) << "column " << c;  // lowest point in the cell
+    EXPECT_EQ(grid.height(c, 4), 1.0f);
+    EXPECT_EQ(grid.height(c, 6), 1.0f);
+  }
+}
+
+}  // namespace
+}  // namespace terracut
