@@ -1,0 +1,79 @@
+// A wait-free exchange of terrain snapshots from the real-time loop (one
+// writer) to a viewer or network sender (one reader), so the reader never
+// blocks the loop and never sees a torn frame.
+//
+// Triple buffering: the writer fills its back frame and swaps it with the
+// shared middle frame; the reader swaps its front frame with the middle one
+// when a newer frame is there. Only the samples that changed are copied: each
+// frame remembers the rectangle changed since it was last written, and each
+// published frame carries `dirty`, a rectangle that holds every sample changed
+// since the frame the reader took before (conservative: it may be larger), so
+// a renderer uploads just that region.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "terracut/core/simulation.hpp"
+
+namespace terracut::haptics {
+
+/// One consistent picture of the simulation.
+struct ViewFrame {
+  int cols = 0;
+  int rows = 0;
+  std::vector<float> heights;  ///< rows x cols, row-major, metres above ground
+  Rect dirty{};                ///< samples changed since the reader's previous frame (may be larger)
+  std::uint64_t sequence = 0;  ///< publish count, from 1
+  double t_s = 0.0;            ///< simulation time, seconds
+  std::int64_t step = 0;       ///< simulation step
+  BladePose pose{};            ///< blade pose, world
+  Segment edge{};              ///< cutting edge, world metres
+  ContactResult contact{};     ///< contact measured at that step
+  Vec3 device_position_m{};    ///< device (operator) point mapped to world, metres
+  Vec3 proxy_position_m{};     ///< surface proxy, world metres
+  Vec3 force_world_n{};        ///< force on the tool in the world, newtons
+  Vec3 force_device_n{};       ///< force sent to the device, newtons
+  double step_time_s = 0.0;    ///< compute time of the step, seconds
+  double period_s = 0.0;       ///< measured loop period before the step, seconds
+};
+
+class SnapshotExchange {
+ public:
+  /// Allocates three frames holding the grid's current heights.
+  explicit SnapshotExchange(const HeightGrid& grid);
+
+  // --- writer side (one thread) ---
+
+  /// Records that the samples in rect changed in the grid (call after each step).
+  void note_changed(const Rect& rect);
+  /// The frame being written: fill its scalar fields, then publish().
+  ViewFrame& back() { return frames_[back_]; }
+  /// Copies the changed samples of grid into the back frame and makes it the
+  /// newest frame. Never blocks and never allocates.
+  void publish(const HeightGrid& grid);
+
+  // --- reader side (one thread) ---
+
+  /// Takes the newest frame if one was published since the last call and
+  /// returns it, else nullptr. The frame stays valid and unchanged until the
+  /// next call.
+  const ViewFrame* acquire();
+  /// The frame the reader holds (initially the starting heights).
+  const ViewFrame& front() const { return frames_[front_]; }
+
+ private:
+  static constexpr unsigned kFresh = 4u;  // bit set in middle_ when the reader has not taken it
+
+  ViewFrame frames_[3];
+  Rect pending_[3];  // per frame: samples changed since that frame was last written (writer only)
+  Rect dirty_since_publish_{};
+  Rect last_published_dirty_{};
+  std::uint64_t sequence_ = 0;
+  unsigned back_ = 0;
+  unsigned front_ = 2;
+  std::atomic<unsigned> middle_{1};
+};
+
+}  // namespace terracut::haptics

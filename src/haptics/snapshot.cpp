@@ -1,0 +1,56 @@
+#include "terracut/haptics/snapshot.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+namespace terracut::haptics {
+
+SnapshotExchange::SnapshotExchange(const HeightGrid& grid) {
+  for (ViewFrame& f : frames_) {
+    f.cols = grid.cols();
+    f.rows = grid.rows();
+    f.heights.assign(grid.heights(), grid.heights() + grid.spec().sample_count());
+  }
+  // The reader's first frame counts as having seen everything.
+  frames_[front_].dirty = {0, 0, grid.cols(), grid.rows()};
+}
+
+void SnapshotExchange::note_changed(const Rect& rect) {
+  if (rect.empty()) return;
+  for (Rect& p : pending_) p.include(rect);
+  dirty_since_publish_.include(rect);
+}
+
+void SnapshotExchange::publish(const HeightGrid& grid) {
+  ViewFrame& f = frames_[back_];
+  // Bring this frame up to date: copy what changed since it was last written.
+  Rect& p = pending_[back_];
+  if (!p.empty()) {
+    const float* src = grid.heights();
+    size_t width = size_t(p.c1 - p.c0);
+    for (int r = p.r0; r < p.r1; ++r) {
+      std::int64_t i = std::int64_t(r) * f.cols + p.c0;
+      std::memcpy(f.heights.data() + i, src + i, width * sizeof(float));
+    }
+    p = {};
+  }
+  // If the reader has not taken the previous frame, it will skip it, so this
+  // frame's dirty region must also hold the previous one's.
+  Rect dirty = dirty_since_publish_;
+  if (middle_.load(std::memory_order_acquire) & kFresh) dirty.include(last_published_dirty_);
+  f.dirty = dirty;
+  last_published_dirty_ = dirty;
+  dirty_since_publish_ = {};
+  f.sequence = ++sequence_;
+  unsigned old = middle_.exchange(back_ | kFresh, std::memory_order_acq_rel);
+  back_ = old & ~kFresh;
+}
+
+const ViewFrame* SnapshotExchange::acquire() {
+  if (!(middle_.load(std::memory_order_acquire) & kFresh)) return nullptr;
+  unsigned old = middle_.exchange(front_, std::memory_order_acq_rel);
+  front_ = old & ~kFresh;
+  return &frames_[front_];
+}
+
+}  // namespace terracut::haptics
