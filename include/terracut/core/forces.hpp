@@ -1,0 +1,379 @@
+// Force models: what the operator feels when the blade cuts soil.
+//
+// Three models, each a pure function of read-only parameters and the sample's
+// inputs (no state, no allocation, no exceptions on the hot path):
+//   - contact drag (the paper's proposal): a drag against the tool's motion,
+//     proportional to the length of the blade in contact;
+//   - earthmoving: the Fundamental Earthmoving Equation (Reece 1964) in
+//     McKyes' formulation (McKyes 1985, "Soil Cutting and Tillage", ch. 4):
+//     the passive force of a planar soil wedge ahead of a flat blade;
+//   - surface: a proxy (god-object) kept on the terrain surface and a
+//     spring-damper between the proxy and the device point, so the tool
+//     cannot sink into the soil without resistance.
+// ForceModel combines one cutting model with the surface model, checks once
+// at construction that the device can render the result stably (Colgate &
+// Brown 1994) and scales world forces to the device.
+//
+// Frames and units: SI throughout; world frame right-handed, Y up, ground
+// plane X-Z. Forces are the forces ON the tool (and so on the operator's hand
+// after scaling). See docs/forces.md for the derivations and sources.
+#pragma once
+
+#include <numbers>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "terracut/core/contact.hpp"
+#include "terracut/core/grid.hpp"
+#include "terracut/core/math.hpp"
+
+namespace terracut {
+
+// ---------------------------------------------------------------------------
+// Low-speed regularisation shared by the cutting models
+// ---------------------------------------------------------------------------
+
+/// Magnitude of a force that opposes motion, regularised at low speed as a
+/// saturated damper: min(force_n, low_speed_damping * speed). A force that
+/// flips direction with the sign of the velocity would chatter at rest; below
+/// force_n / low_speed_damping the force grows linearly with speed instead,
+/// with a slope the device can render. Returns 0 at zero speed, never NaN for
+/// finite inputs. force_n >= 0, speed >= 0, low_speed_damping > 0 (N s/m).
+double saturated_drag_n(double force_n, double speed_m_per_s,
+                        double low_speed_damping_n_s_per_m) noexcept;
+
+// ---------------------------------------------------------------------------
+// Contact drag (the paper's proposal)
+// ---------------------------------------------------------------------------
+
+/// Parameters of the contact-drag model; read-only during a run.
+struct ContactDragParams {
+  /// k_drag: drag per metre of blade in contact, N/m, finite, >= 0.
+  double drag_n_per_m = 400.0;
+  /// c_viscous: extra viscous drag per metre of contact per m/s of speed,
+  /// N/(m * m/s) = N s/m^2, finite, >= 0. 0 disables the viscous term.
+  double viscous_n_s_per_m2 = 0.0;
+};
+
+/// Returns an empty string when params are valid, else a message naming the field.
+std::string validate(const ContactDragParams& params);
+
+/// World force on the tool from the contact-drag model:
+///   F = -saturated_drag_n(k_drag * L, |v|, low_speed_damping) * v/|v| - c_viscous * L * v
+/// with L = contact_length_m (>= 0; negative counts as 0) and v the tool's
+/// velocity (world, m/s). Zero velocity gives zero force (no NaN). Above the
+/// saturation speed k_drag * L / low_speed_damping the force is exactly
+/// linear in L. low_speed_damping_n_s_per_m > 0. Parameters are trusted
+/// (validate once before the run).
+Vec3 contact_drag_force(const ContactDragParams& params, double contact_length_m,
+                        Vec3 velocity_m_per_s, double low_speed_damping_n_s_per_m) noexcept;
+
+// ---------------------------------------------------------------------------
+// Earthmoving: the Fundamental Earthmoving Equation (McKyes' formulation)
+// ---------------------------------------------------------------------------
+
+/// Mohr-Coulomb soil and soil-tool interface properties; read-only.
+struct SoilParams {
+  // Defaults: the kDrySand preset.
+  double unit_weight_n_per_m3 = 16.25e3;  ///< gamma: soil unit weight, N/m^3, finite, > 0
+  double cohesion_pa = 1.3e3;             ///< c: soil cohesion, Pa, finite, >= 0
+  double adhesion_pa = 0.0;               ///< c_a: soil-tool adhesion, Pa, finite, >= 0
+  /// phi: internal friction angle, rad, [0, pi/2).
+  double internal_friction_rad = 31.1 * std::numbers::pi / 180.0;
+  /// delta: soil-tool friction angle, rad, [0, pi/2).
+  double soil_tool_friction_rad = (2.0 / 3.0) * 31.1 * std::numbers::pi / 180.0;
+  double surcharge_pa = 0.0;  ///< q: surcharge on the soil surface, Pa, finite, >= 0
+};
+
+/// Built-in soils with cited values (docs/forces.md lists the sources).
+enum class SoilPreset {
+  kDrySand,    ///< medium-dense dry sand (Wong's LETE sand strength; Das' unit weights)
+  kLooseSand,  ///< loose dry sand (Wong's "dry sand, LLL"; Das' loose uniform sand)
+  kClay,       ///< clayey soil (Wong's "clayey soil, Thailand", 38 % moisture; Das' soft clay)
+};
+
+/// The soil of a preset.
+SoilParams soil_preset(SoilPreset preset);
+/// "dry_sand", "loose_sand" or "clay".
+std::string_view to_string(SoilPreset preset);
+/// Inverse of to_string; nullopt for anything else.
+std::optional<SoilPreset> parse_soil_preset(std::string_view name);
+
+/// Parameters of the earthmoving model; read-only during a run.
+struct EarthmovingParams {
+  SoilParams soil{};
+  /// alpha: rake angle of the blade face from the horizontal, rad, in
+  /// (0, pi); pi/2 is a vertical plate. The tip leads and the face leans back
+  /// over the cut soil for alpha < pi/2. Needs alpha + delta + phi < pi
+  /// (otherwise no planar failure wedge exists).
+  double rake_angle_rad = std::numbers::pi / 2.0;
+};
+
+/// Returns an empty string when params are valid, else a message naming the field.
+std::string validate(const SoilParams& soil);
+std::string validate(const EarthmovingParams& params);
+
+/// McKyes' dimensionless factors at one failure-plane angle beta (rad, from
+/// the horizontal). With D = cos(alpha+delta) + sin(alpha+delta) cot(beta+phi):
+///   N_gamma = (cot alpha + cot beta) / (2 D)
+///   N_c     = (1 + cot beta cot(beta+phi)) / D
+///   N_a     = (1 - cot alpha cot(beta+phi)) / D
+///   N_q     = (cot alpha + cot beta) / D
+struct EarthmovingFactors {
+  double n_gamma = 0.0;
+  double n_c = 0.0;
+  double n_a = 0.0;
+  double n_q = 0.0;
+};
+
+/// The factors of params at failure-plane angle beta_rad (no minimisation).
+EarthmovingFactors earthmoving_factors(const EarthmovingParams& params, double beta_rad) noexcept;
+
+/// The passive force of the wedge at one failure-plane angle:
+///   P(beta) = (gamma d^2 N_gamma + c d N_c + c_a d N_a + q d N_q) w, newtons.
+double earthmoving_total_n(const EarthmovingParams& params, double width_m, double depth_m,
+                           double beta_rad) noexcept;
+
+/// Open range of failure-plane angles with a valid wedge, rad:
+/// (0, min(pi/2, pi - alpha - delta - phi)).
+struct BetaRange {
+  double lo_rad = 0.0;
+  double hi_rad = 0.0;
+};
+BetaRange earthmoving_beta_range(const EarthmovingParams& params) noexcept;
+
+/// The earthmoving force on the blade for one cut.
+struct EarthmovingResult {
+  /// P: the soil's resultant on the blade face (McKyes' "F"/"P"), at angle
+  /// delta to the face normal, excluding adhesion; N, >= 0 in valid cases.
+  double total_n = 0.0;
+  /// H = P sin(alpha+delta) + c_a d w cot(alpha): horizontal force resisting
+  /// the blade's motion (on the blade it points against the motion), N.
+  double horizontal_n = 0.0;
+  /// V = P cos(alpha+delta) - c_a d w: vertical force, positive when it
+  /// pushes the blade DOWN into the soil (McKyes' sign), N. For a vertical
+  /// rough blade V < 0: the rising wedge lifts the blade.
+  double vertical_n = 0.0;
+  /// beta*: failure-plane angle from the horizontal that minimises P, rad.
+  double beta_rad = 0.0;
+  EarthmovingFactors factors{};  ///< the factors at beta*
+};
+
+/// FEE force for a blade of engaged width width_m (the contact length) at
+/// cutting depth depth_m (material depth ahead of the edge). beta* is found by
+/// minimising P(beta) over earthmoving_beta_range: a 48-point scan, then a
+/// golden-section search in the bracket around the best sample, to 1e-10 rad;
+/// the open ends of the range are kept 1e-4 rad away (the pi/2 end is included).
+/// Width or depth <= 0 gives all zeros (beta_rad = 0). Allocates nothing;
+/// parameters are trusted (validate once).
+EarthmovingResult earthmoving_force(const EarthmovingParams& params, double width_m,
+                                    double depth_m) noexcept;
+
+/// World force on the blade from an earthmoving result and the blade's world
+/// velocity: -H_s * u - V_s * Y, where u is the unit horizontal (X-Z) direction
+/// of motion and (H_s, V_s) = (H, V) * s with
+/// s = saturated_drag_n(H, |v_xz|, low_speed_damping) / H (the low-speed
+/// regularisation scales both components, keeping the force's direction).
+/// No horizontal motion gives zero force. low_speed_damping_n_s_per_m > 0.
+Vec3 earthmoving_world_force(const EarthmovingResult& result, Vec3 velocity_m_per_s,
+                             double low_speed_damping_n_s_per_m) noexcept;
+
+// ---------------------------------------------------------------------------
+// Surface: proxy on the terrain and a spring-damper to the device point
+// ---------------------------------------------------------------------------
+
+/// Height of the terrain surface above the ground level (origin_m.y) at world
+/// (x, z), metres, as the representation reads the samples: kColumns, the
+/// height of the cell containing the point; kSurface, the triangulated surface
+/// through the cell centres (same split as contact.hpp), flat over the
+/// half-cell border. Outside the terrain rectangle: 0 (the rigid ground).
+double surface_height_m(const HeightGrid& grid, Representation representation, double x,
+                        double z) noexcept;
+
+/// World Y of the terrain surface at (x, z): origin_m.y + surface_height_m.
+double surface_y_m(const HeightGrid& grid, Representation representation, double x,
+                   double z) noexcept;
+
+/// Parameters of the surface model, world units; read-only during a run.
+struct SurfaceParams {
+  /// K: spring between proxy and device point, N/m (world), finite, > 0.
+  double stiffness_n_per_m = 100e3;
+  /// B: damping of the device's vertical velocity while below the surface,
+  /// N s/m (world), finite, >= 0.
+  double damping_n_s_per_m = 12.5;
+};
+
+/// Returns an empty string when params are valid, else a message naming the field.
+std::string validate(const SurfaceParams& params);
+
+/// What the surface model computed for one sample.
+struct SurfaceForce {
+  Vec3 force_n{};              ///< world force on the device point, N
+  Vec3 proxy_m{};              ///< proxy position (on or above the surface), world metres
+  double penetration_m = 0.0;  ///< depth of the device point below the surface, metres, >= 0
+  bool in_contact = false;     ///< the device point is below the surface
+};
+
+/// The proxy sits at the device point lifted vertically onto the surface
+/// (proxy = (x, max(y, surface_y), z)); below the surface
+///   F = K (proxy - device) - B v_y Y = (K * depth - B * v_y) Y,
+/// and above it F = 0. The force is vertical and continuous in position
+/// wherever the surface is (kSurface). velocity: device point, world m/s.
+SurfaceForce surface_force(const SurfaceParams& params, Vec3 device_point_m, Vec3 velocity_m_per_s,
+                           double surface_y_m) noexcept;
+
+// ---------------------------------------------------------------------------
+// Device limits and the passivity rule
+// ---------------------------------------------------------------------------
+
+/// What the haptic device can render; defaults: the Novint Falcon figures of
+/// CHAI3D's device table (DEPENDENCIES.md). Device units (device metres,
+/// device newtons).
+struct DeviceLimits {
+  double max_force_n = 8.0;               ///< largest force, N, finite, > 0
+  double max_stiffness_n_per_m = 3000.0;  ///< largest stable stiffness at 1 kHz, N/m, finite, > 0
+  double max_damping_n_s_per_m = 20.0;    ///< largest stable virtual damping, N s/m, finite, > 0
+  /// b: inherent (physical) damping the passivity rule may count on, N s/m,
+  /// finite, > 0. The default 1.5 is what Colgate & Brown's condition needs
+  /// for CHAI3D's 3000 N/m at 1 kHz with no virtual damping (K T / 2); set
+  /// the measured value of your device.
+  double inherent_damping_n_s_per_m = 1.5;
+};
+
+/// Returns an empty string when limits are valid, else a message naming the field.
+std::string validate(const DeviceLimits& limits);
+
+/// Colgate & Brown (1994): a sampled virtual wall of stiffness K and damping
+/// B on a device of inherent damping b at sample period T is passive when
+/// b > K T / 2 + |B|. This returns the largest passive stiffness,
+/// 2 (b - |B|) / T = 2 (b - |B|) * rate_hz, N/m (<= 0 when |B| >= b).
+double passive_stiffness_limit_n_per_m(double inherent_damping_n_s_per_m,
+                                       double virtual_damping_n_s_per_m, double rate_hz) noexcept;
+
+// ---------------------------------------------------------------------------
+// Combination
+// ---------------------------------------------------------------------------
+
+/// Which cutting model drives the resistance to motion.
+enum class CuttingModel {
+  kNone,
+  kContactDrag,  ///< the paper's proposal
+  kEarthmoving,  ///< the Fundamental Earthmoving Equation
+};
+/// "none", "contact_drag" or "earthmoving".
+std::string_view to_string(CuttingModel model);
+std::optional<CuttingModel> parse_cutting_model(std::string_view name);
+
+/// What to do when the requested rendering is beyond the device (stiffness or
+/// damping above the limits or the passivity rule).
+enum class LimitPolicy {
+  kRefuse,  ///< the ForceModel constructor throws InputError naming the field and the bound
+  /// Values are lowered to the bound and RenderingCheck records what was
+  /// limited. A surface damping that leaves no passive stiffness (|B| >= b)
+  /// is lowered to b / 2 first.
+  kClamp,
+};
+/// "refuse" or "clamp".
+std::string_view to_string(LimitPolicy policy);
+std::optional<LimitPolicy> parse_limit_policy(std::string_view name);
+
+/// Parameters of the combined force model; read-only during a run.
+struct ForceModelParams {
+  CuttingModel cutting = CuttingModel::kContactDrag;
+  ContactDragParams contact_drag{};
+  EarthmovingParams earthmoving{};
+  bool surface_enabled = true;  ///< add the surface (proxy) model
+  SurfaceParams surface{};
+  /// Slope of the cutting force at low speed (saturated damper), N s/m
+  /// (world), finite, > 0. Shared by both cutting models.
+  double low_speed_damping_n_s_per_m = 1000.0;
+  /// Earthmoving only: use the engaged width projected across the motion,
+  /// width = contact length * |sin(angle between edge and horizontal motion)|,
+  /// when the input gives the edge direction. A blade sliding along its own
+  /// edge cuts nothing.
+  bool project_width_on_motion = true;
+  /// Device newtons per world newton, finite, > 0. World forces of a real
+  /// blade are hundreds of newtons; the default maps 400 N to 8 N.
+  double force_scale = 0.02;
+  /// World metres per device metre of the loop's workspace mapping, finite,
+  /// > 0. Needed only to express world stiffness and damping on the device:
+  /// K_device = K_world * force_scale * workspace_scale.
+  double workspace_scale = 1.0;
+  /// Longest possible contact (the blade length), metres, finite, > 0; bounds
+  /// the viscous term's damping for the device check.
+  double max_contact_length_m = 1.0;
+  /// Haptic loop rate, Hz, finite, in (0, 1e6]; T = 1 / rate in the passivity rule.
+  double loop_rate_hz = 1000.0;
+  DeviceLimits device{};
+  LimitPolicy policy = LimitPolicy::kClamp;
+};
+
+/// Returns an empty string when the fields are in range (not the device
+/// check, which the ForceModel constructor applies), else a message naming
+/// the field.
+std::string validate(const ForceModelParams& params);
+
+/// The device check made at construction, all in device units.
+struct RenderingCheck {
+  double surface_stiffness_n_per_m = 0.0;  ///< K on the device after limiting
+  double surface_damping_n_s_per_m = 0.0;  ///< B on the device after limiting
+  double passive_stiffness_n_per_m = 0.0;  ///< 2 (b - |B|) / T with the B above
+  /// Low-speed slope plus the viscous term at the longest contact, after limiting.
+  double cutting_damping_n_s_per_m = 0.0;
+  bool surface_stiffness_limited = false;  ///< K was lowered (kClamp)
+  bool surface_damping_limited = false;    ///< B was lowered (kClamp)
+  bool cutting_damping_limited = false;    ///< low-speed damping / viscous were lowered (kClamp)
+  bool any_limited() const {
+    return surface_stiffness_limited || surface_damping_limited || cutting_damping_limited;
+  }
+};
+
+/// Inputs of one force sample (world frame).
+struct ForceInput {
+  Vec3 velocity_m_per_s{};        ///< tool (and device point) velocity, world m/s
+  double contact_length_m = 0.0;  ///< blade length in material (ContactResult::length_m), m
+  /// Material depth ahead of the edge, m (e.g. section_area_m2 / length_m).
+  double cut_depth_m = 0.0;
+  /// Direction of the cutting edge (any length; zero = unknown, no projection).
+  Vec3 edge_direction{};
+  Vec3 device_point_m{};     ///< point held on the surface by the proxy, world metres
+  double surface_y_m = 0.0;  ///< world Y of the terrain surface below device_point_m
+};
+
+/// Outputs of one force sample.
+struct ForceOutput {
+  Vec3 cutting_n{};                 ///< cutting model's world force, N
+  Vec3 surface_n{};                 ///< surface model's world force, N
+  Vec3 world_n{};                   ///< cutting + surface, world force on the tool, N
+  Vec3 device_n{};                  ///< world_n * force_scale: device newtons, world axes
+  SurfaceForce surface{};           ///< proxy, penetration, contact (zero when disabled)
+  EarthmovingResult earthmoving{};  ///< the FEE solution (zero unless kEarthmoving)
+  double engaged_width_m = 0.0;     ///< width used by the cutting model, m
+};
+
+/// The combined model: validated and device-checked once, then a pure const
+/// compute() per sample.
+class ForceModel {
+ public:
+  /// Throws InputError naming the bad field, or (kRefuse) the rendering that
+  /// exceeds the device with the bound it broke.
+  explicit ForceModel(const ForceModelParams& params);
+
+  /// Parameters as requested.
+  const ForceModelParams& requested() const { return requested_; }
+  /// Parameters in use (after kClamp limiting).
+  const ForceModelParams& params() const { return params_; }
+  const RenderingCheck& rendering() const { return check_; }
+
+  /// One sample: allocates nothing, never throws. Non-finite inputs give
+  /// non-finite outputs, for the safety limiter to catch and count.
+  ForceOutput compute(const ForceInput& input) const noexcept;
+
+ private:
+  ForceModelParams requested_;
+  ForceModelParams params_;
+  RenderingCheck check_;
+};
+
+}  // namespace terracut

@@ -1,0 +1,553 @@
+// Force models: contact drag, the Fundamental Earthmoving Equation (McKyes'
+// formulation), the surface proxy, and their device-checked combination.
+// Derivations and sources: docs/forces.md.
+#include "terracut/core/forces.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "geometry.hpp"
+#include "terracut/core/error.hpp"
+
+namespace terracut {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+
+// A number in messages: shortest round-trip-ish form ("0.02", "3000", "1e+06").
+std::string num(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", value);
+  return buffer;
+}
+
+// "field must be ... (got value)" checks, returning the message or "".
+std::string check_nonnegative(const std::string& field, double value) {
+  if (std::isfinite(value) && value >= 0.0) return {};
+  return field + " must be finite and >= 0 (got " + num(value) + ")";
+}
+std::string check_positive(const std::string& field, double value) {
+  if (std::isfinite(value) && value > 0.0) return {};
+  return field + " must be finite and > 0 (got " + num(value) + ")";
+}
+std::string check_angle(const std::string& field, double value_rad, double hi_rad,
+                        bool include_zero) {
+  bool ok = std::isfinite(value_rad) && (include_zero ? value_rad >= 0.0 : value_rad > 0.0) &&
+            value_rad < hi_rad;
+  if (ok) return {};
+  return field + " must be in " + (include_zero ? "[0, " : "(0, ") + num(hi_rad) + ") rad (got " +
+         num(value_rad) + " rad = " + num(value_rad / kDeg) + " deg)";
+}
+
+// Prefixes a sub-structure's message with its field name.
+std::string nested(const std::string& prefix, const std::string& message) {
+  return message.empty() ? message : prefix + "." + message;
+}
+
+double cot(double angle_rad) { return std::cos(angle_rad) / std::sin(angle_rad); }
+
+// The pieces of P(beta) that do not depend on beta, computed once per cut.
+struct WedgeConstants {
+  double cot_alpha;
+  double sin_ad;  // sin(alpha + delta)
+  double cos_ad;  // cos(alpha + delta)
+  double phi;
+  double weight;    // (gamma d^2 / 2 + q d) w: multiplies (cot alpha + cot beta)
+  double cohesion;  // c d w: multiplies (1 + cot beta cot(beta + phi))
+  double adhesion;  // c_a d w: multiplies (1 - cot alpha cot(beta + phi))
+
+  WedgeConstants(const EarthmovingParams& p, double width_m, double depth_m)
+      : cot_alpha(cot(p.rake_angle_rad)),
+        sin_ad(std::sin(p.rake_angle_rad + p.soil.soil_tool_friction_rad)),
+        cos_ad(std::cos(p.rake_angle_rad + p.soil.soil_tool_friction_rad)),
+        phi(p.soil.internal_friction_rad),
+        weight((0.5 * p.soil.unit_weight_n_per_m3 * depth_m * depth_m +
+                p.soil.surcharge_pa * depth_m) *
+               width_m),
+        cohesion(p.soil.cohesion_pa * depth_m * width_m),
+        adhesion(p.soil.adhesion_pa * depth_m * width_m) {}
+
+  // P(beta) = [weight (cot a + cot b) + cohesion (1 + cot b cot(b+phi))
+  //            + adhesion (1 - cot a cot(b+phi))] / D,
+  // D = cos(a+d) + sin(a+d) cot(b+phi).
+  double total(double beta) const {
+    double cot_b = cot(beta);
+    double cot_bp = cot(beta + phi);
+    double d = cos_ad + sin_ad * cot_bp;
+    return (weight * (cot_alpha + cot_b) + cohesion * (1.0 + cot_b * cot_bp) +
+            adhesion * (1.0 - cot_alpha * cot_bp)) /
+           d;
+  }
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// Low-speed regularisation and contact drag
+// ---------------------------------------------------------------------------
+
+double saturated_drag_n(double force_n, double speed_m_per_s,
+                        double low_speed_damping_n_s_per_m) noexcept {
+  if (speed_m_per_s == 0.0) return 0.0;
+  double ramp = low_speed_damping_n_s_per_m * speed_m_per_s;
+  return ramp < force_n ? ramp : force_n;
+}
+
+std::string validate(const ContactDragParams& params) {
+  if (auto m = check_nonnegative("drag_n_per_m", params.drag_n_per_m); !m.empty()) return m;
+  return check_nonnegative("viscous_n_s_per_m2", params.viscous_n_s_per_m2);
+}
+
+Vec3 contact_drag_force(const ContactDragParams& params, double contact_length_m,
+                        Vec3 velocity_m_per_s, double low_speed_damping_n_s_per_m) noexcept {
+  // Negative lengths count as no contact; NaN passes through to the output.
+  double contact = contact_length_m < 0.0 ? 0.0 : contact_length_m;
+  double speed = length(velocity_m_per_s);
+  if (speed == 0.0) return {};
+  double drag = saturated_drag_n(params.drag_n_per_m * contact, speed, low_speed_damping_n_s_per_m);
+  return velocity_m_per_s * (-drag / speed - params.viscous_n_s_per_m2 * contact);
+}
+
+// ---------------------------------------------------------------------------
+// Earthmoving
+// ---------------------------------------------------------------------------
+
+SoilParams soil_preset(SoilPreset preset) {
+  SoilParams soil;
+  switch (preset) {
+    case SoilPreset::kDrySand:
+      // Strength of Wong's LETE sand; unit weight midway between Das' loose
+      // (14.5) and dense (18.0) uniform sand.
+      soil.unit_weight_n_per_m3 = 16.25e3;
+      soil.cohesion_pa = 1.3e3;
+      soil.adhesion_pa = 0.0;
+      soil.internal_friction_rad = 31.1 * kDeg;
+      break;
+    case SoilPreset::kLooseSand:
+      // Wong's "dry sand (Land Locomotion Lab.)"; Das' loose uniform sand.
+      soil.unit_weight_n_per_m3 = 14.5e3;
+      soil.cohesion_pa = 1.04e3;
+      soil.adhesion_pa = 0.0;
+      soil.internal_friction_rad = 28.0 * kDeg;
+      break;
+    case SoilPreset::kClay:
+      // Wong's "clayey soil (Thailand)" at 38 % moisture; moist unit weight
+      // from Das' soft-clay dry unit weight (11.5-14.5, midpoint 13.0) times
+      // (1 + 0.38); adhesion assumed half the cohesion.
+      soil.unit_weight_n_per_m3 = 13.0e3 * 1.38;
+      soil.cohesion_pa = 4.14e3;
+      soil.adhesion_pa = 0.5 * 4.14e3;
+      soil.internal_friction_rad = 13.0 * kDeg;
+      break;
+  }
+  // Soil-tool friction: two thirds of the internal friction (rough steel face).
+  soil.soil_tool_friction_rad = (2.0 / 3.0) * soil.internal_friction_rad;
+  soil.surcharge_pa = 0.0;
+  return soil;
+}
+
+std::string_view to_string(SoilPreset preset) {
+  switch (preset) {
+    case SoilPreset::kDrySand:
+      return "dry_sand";
+    case SoilPreset::kLooseSand:
+      return "loose_sand";
+    case SoilPreset::kClay:
+      return "clay";
+  }
+  return "dry_sand";
+}
+
+std::optional<SoilPreset> parse_soil_preset(std::string_view name) {
+  if (name == "dry_sand") return SoilPreset::kDrySand;
+  if (name == "loose_sand") return SoilPreset::kLooseSand;
+  if (name == "clay") return SoilPreset::kClay;
+  return std::nullopt;
+}
+
+std::string validate(const SoilParams& soil) {
+  if (auto m = check_positive("unit_weight_n_per_m3", soil.unit_weight_n_per_m3); !m.empty())
+    return m;
+  if (auto m = check_nonnegative("cohesion_pa", soil.cohesion_pa); !m.empty()) return m;
+  if (auto m = check_nonnegative("adhesion_pa", soil.adhesion_pa); !m.empty()) return m;
+  if (auto m = check_angle("internal_friction_rad", soil.internal_friction_rad, kPi / 2, true);
+      !m.empty())
+    return m;
+  if (auto m = check_angle("soil_tool_friction_rad", soil.soil_tool_friction_rad, kPi / 2, true);
+      !m.empty())
+    return m;
+  return check_nonnegative("surcharge_pa", soil.surcharge_pa);
+}
+
+std::string validate(const EarthmovingParams& params) {
+  if (auto m = nested("soil", validate(params.soil)); !m.empty()) return m;
+  if (auto m = check_angle("rake_angle_rad", params.rake_angle_rad, kPi, false); !m.empty())
+    return m;
+  // A planar wedge needs a failure-plane angle with D > 0: beta < pi - alpha - delta - phi.
+  // Ask for at least one degree of room.
+  double room = kPi - params.rake_angle_rad - params.soil.soil_tool_friction_rad -
+                params.soil.internal_friction_rad;
+  if (!(room >= 1.0 * kDeg)) {
+    return "rake_angle_rad + soil.soil_tool_friction_rad + soil.internal_friction_rad must be "
+           "below 179 deg (got " +
+           num((kPi - room) / kDeg) + " deg): no planar failure wedge exists";
+  }
+  return {};
+}
+
+EarthmovingFactors earthmoving_factors(const EarthmovingParams& params, double beta_rad) noexcept {
+  double alpha = params.rake_angle_rad;
+  double delta = params.soil.soil_tool_friction_rad;
+  double phi = params.soil.internal_friction_rad;
+  double cot_a = cot(alpha), cot_b = cot(beta_rad), cot_bp = cot(beta_rad + phi);
+  double d = std::cos(alpha + delta) + std::sin(alpha + delta) * cot_bp;
+  EarthmovingFactors f;
+  f.n_gamma = (cot_a + cot_b) / (2.0 * d);
+  f.n_c = (1.0 + cot_b * cot_bp) / d;
+  f.n_a = (1.0 - cot_a * cot_bp) / d;
+  f.n_q = (cot_a + cot_b) / d;
+  return f;
+}
+
+double earthmoving_total_n(const EarthmovingParams& params, double width_m, double depth_m,
+                           double beta_rad) noexcept {
+  return WedgeConstants(params, width_m, depth_m).total(beta_rad);
+}
+
+BetaRange earthmoving_beta_range(const EarthmovingParams& params) noexcept {
+  double hi = std::min(kPi / 2, kPi - params.rake_angle_rad - params.soil.soil_tool_friction_rad -
+                                    params.soil.internal_friction_rad);
+  return {0.0, hi};
+}
+
+EarthmovingResult earthmoving_force(const EarthmovingParams& params, double width_m,
+                                    double depth_m) noexcept {
+  EarthmovingResult out;
+  if (width_m <= 0.0 || depth_m <= 0.0) return out;
+  const WedgeConstants wedge(params, width_m, depth_m);
+
+  // Search inside the open range; P grows without bound at both ends in the
+  // usual cases (cot beta -> inf at 0, D -> 0 at pi - alpha - delta - phi),
+  // but may be smallest at the pi/2 end, which the closed search includes.
+  BetaRange range = earthmoving_beta_range(params);
+  constexpr double kEdge = 1e-4;  // rad kept clear of the open ends (rounding near 0/0)
+  double lo = range.lo_rad + kEdge;
+  double hi = range.hi_rad == kPi / 2 ? range.hi_rad : range.hi_rad - kEdge;
+
+  // Coarse scan for the basin of the global minimum.
+  constexpr int kScan = 48;
+  double step = (hi - lo) / (kScan - 1);
+  int best = 0;
+  double best_p = wedge.total(lo);
+  for (int k = 1; k < kScan; ++k) {
+    double p = wedge.total(lo + k * step);
+    if (p < best_p) {
+      best_p = p;
+      best = k;
+    }
+  }
+
+  // Golden-section search in the bracket of the best sample's neighbours.
+  double a = lo + std::max(best - 1, 0) * step;
+  double b = lo + std::min(best + 1, kScan - 1) * step;
+  constexpr double kInvPhi = 0.6180339887498949;  // (sqrt(5) - 1) / 2
+  double x1 = b - kInvPhi * (b - a), x2 = a + kInvPhi * (b - a);
+  double f1 = wedge.total(x1), f2 = wedge.total(x2);
+  for (int iter = 0; iter < 200 && b - a > 1e-10; ++iter) {
+    if (f1 <= f2) {
+      b = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = b - kInvPhi * (b - a);
+      f1 = wedge.total(x1);
+    } else {
+      a = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = a + kInvPhi * (b - a);
+      f2 = wedge.total(x2);
+    }
+  }
+  double beta = f1 <= f2 ? x1 : x2;
+  double p = std::min(f1, f2);
+  // The scan's best sample can beat the bracket's interior at a range end.
+  if (best_p < p) {
+    p = best_p;
+    beta = lo + best * step;
+  }
+
+  // Resolve the face force and the adhesion (c_a w d / sin alpha along the
+  // face) into horizontal and vertical components (docs/forces.md).
+  double adhesion = params.soil.adhesion_pa * depth_m * width_m;
+  out.total_n = p;
+  out.beta_rad = beta;
+  out.factors = earthmoving_factors(params, beta);
+  out.horizontal_n = p * wedge.sin_ad + adhesion * wedge.cot_alpha;
+  out.vertical_n = p * wedge.cos_ad - adhesion;
+  return out;
+}
+
+Vec3 earthmoving_world_force(const EarthmovingResult& result, Vec3 velocity_m_per_s,
+                             double low_speed_damping_n_s_per_m) noexcept {
+  double speed = std::hypot(velocity_m_per_s.x, velocity_m_per_s.z);
+  double h = std::abs(result.horizontal_n);
+  if (speed == 0.0 || h == 0.0) return {};
+  double scale = saturated_drag_n(h, speed, low_speed_damping_n_s_per_m) / h;
+  double ux = velocity_m_per_s.x / speed, uz = velocity_m_per_s.z / speed;
+  double hs = result.horizontal_n * scale;
+  return {-hs * ux, -result.vertical_n * scale, -hs * uz};
+}
+
+// ---------------------------------------------------------------------------
+// Surface
+// ---------------------------------------------------------------------------
+
+double surface_height_m(const HeightGrid& grid, Representation representation, double x,
+                        double z) noexcept {
+  const int cols = grid.cols(), rows = grid.rows();
+  double u = grid.cell_u(x), v = grid.cell_v(z);
+  if (!(u >= 0.0 && u <= cols && v >= 0.0 && v <= rows)) return 0.0;
+  const float* h = grid.heights();
+  if (representation == Representation::kColumns) {
+    int c = std::min(int(u), cols - 1), r = std::min(int(v), rows - 1);
+    return h[grid.index(c, r)];
+  }
+  // Node coordinates (sample (c, r) at integer (c, r)), clamped to the outer
+  // samples: the half-cell border is flat.
+  double us = std::clamp(u - 0.5, 0.0, double(cols - 1));
+  double vs = std::clamp(v - 0.5, 0.0, double(rows - 1));
+  int i = std::clamp(int(us), 0, std::max(cols - 2, 0));
+  int j = std::clamp(int(vs), 0, std::max(rows - 2, 0));
+  double a = us - i, b = vs - j;
+  double h00 = detail::clamped_height(h, cols, rows, i, j);
+  double h10 = detail::clamped_height(h, cols, rows, i + 1, j);
+  double h01 = detail::clamped_height(h, cols, rows, i, j + 1);
+  double h11 = detail::clamped_height(h, cols, rows, i + 1, j + 1);
+  return detail::surface_in_square(h00, h10, h01, h11, a, b, a + b <= 1.0);
+}
+
+double surface_y_m(const HeightGrid& grid, Representation representation, double x,
+                   double z) noexcept {
+  return grid.spec().origin_m.y + surface_height_m(grid, representation, x, z);
+}
+
+std::string validate(const SurfaceParams& params) {
+  if (auto m = check_positive("stiffness_n_per_m", params.stiffness_n_per_m); !m.empty()) return m;
+  return check_nonnegative("damping_n_s_per_m", params.damping_n_s_per_m);
+}
+
+SurfaceForce surface_force(const SurfaceParams& params, Vec3 device_point_m, Vec3 velocity_m_per_s,
+                           double surface_y_m) noexcept {
+  SurfaceForce out;
+  out.proxy_m = device_point_m;
+  double depth = surface_y_m - device_point_m.y;
+  if (depth <= 0.0) return out;  // above the surface (NaN falls through to a NaN force)
+  out.in_contact = true;
+  out.penetration_m = depth;
+  out.proxy_m.y = surface_y_m;
+  // Spring-damper along Y, never pulling the device into the surface: a
+  // negative push would make the surface sticky; dropping it only dissipates.
+  double push = params.stiffness_n_per_m * depth - params.damping_n_s_per_m * velocity_m_per_s.y;
+  out.force_n = {0.0, push < 0.0 ? 0.0 : push, 0.0};
+  return out;
+}
+
+// ---------------------------------------------------------------------------
+// Device limits
+// ---------------------------------------------------------------------------
+
+std::string validate(const DeviceLimits& limits) {
+  if (auto m = check_positive("max_force_n", limits.max_force_n); !m.empty()) return m;
+  if (auto m = check_positive("max_stiffness_n_per_m", limits.max_stiffness_n_per_m); !m.empty())
+    return m;
+  if (auto m = check_positive("max_damping_n_s_per_m", limits.max_damping_n_s_per_m); !m.empty())
+    return m;
+  return check_positive("inherent_damping_n_s_per_m", limits.inherent_damping_n_s_per_m);
+}
+
+double passive_stiffness_limit_n_per_m(double inherent_damping_n_s_per_m,
+                                       double virtual_damping_n_s_per_m, double rate_hz) noexcept {
+  return 2.0 * (inherent_damping_n_s_per_m - std::abs(virtual_damping_n_s_per_m)) * rate_hz;
+}
+
+// ---------------------------------------------------------------------------
+// Combination
+// ---------------------------------------------------------------------------
+
+std::string_view to_string(CuttingModel model) {
+  switch (model) {
+    case CuttingModel::kNone:
+      return "none";
+    case CuttingModel::kContactDrag:
+      return "contact_drag";
+    case CuttingModel::kEarthmoving:
+      return "earthmoving";
+  }
+  return "none";
+}
+
+std::optional<CuttingModel> parse_cutting_model(std::string_view name) {
+  if (name == "none") return CuttingModel::kNone;
+  if (name == "contact_drag") return CuttingModel::kContactDrag;
+  if (name == "earthmoving") return CuttingModel::kEarthmoving;
+  return std::nullopt;
+}
+
+std::string_view to_string(LimitPolicy policy) {
+  return policy == LimitPolicy::kRefuse ? "refuse" : "clamp";
+}
+
+std::optional<LimitPolicy> parse_limit_policy(std::string_view name) {
+  if (name == "refuse") return LimitPolicy::kRefuse;
+  if (name == "clamp") return LimitPolicy::kClamp;
+  return std::nullopt;
+}
+
+std::string validate(const ForceModelParams& params) {
+  if (auto m = nested("contact_drag", validate(params.contact_drag)); !m.empty()) return m;
+  if (auto m = nested("earthmoving", validate(params.earthmoving)); !m.empty()) return m;
+  if (auto m = nested("surface", validate(params.surface)); !m.empty()) return m;
+  if (auto m = check_positive("low_speed_damping_n_s_per_m", params.low_speed_damping_n_s_per_m);
+      !m.empty())
+    return m;
+  if (auto m = check_positive("force_scale", params.force_scale); !m.empty()) return m;
+  if (auto m = check_positive("workspace_scale", params.workspace_scale); !m.empty()) return m;
+  if (auto m = check_positive("max_contact_length_m", params.max_contact_length_m); !m.empty())
+    return m;
+  if (!(std::isfinite(params.loop_rate_hz) && params.loop_rate_hz > 0.0 &&
+        params.loop_rate_hz <= 1e6)) {
+    return "loop_rate_hz must be in (0, 1e6] (got " + num(params.loop_rate_hz) + ")";
+  }
+  return nested("device", validate(params.device));
+}
+
+ForceModel::ForceModel(const ForceModelParams& params) : requested_(params), params_(params) {
+  if (auto m = validate(params); !m.empty()) throw InputError(m);
+  const bool refuse = params.policy == LimitPolicy::kRefuse;
+  const DeviceLimits& dev = params.device;
+  // World N/m (or N s/m) -> device N/m (or N s/m).
+  const double gain = params.force_scale * params.workspace_scale;
+  const std::string scaling = " (x force_scale " + num(params.force_scale) + " x workspace_scale " +
+                              num(params.workspace_scale) + ")";
+
+  // Surface: damping within the device's figure, then stiffness within both
+  // the device's figure and Colgate & Brown's passivity bound for that damping.
+  if (params.surface_enabled) {
+    double damping = params.surface.damping_n_s_per_m * gain;
+    if (damping > dev.max_damping_n_s_per_m) {
+      if (refuse) {
+        throw InputError(
+            "surface.damping_n_s_per_m = " + num(params.surface.damping_n_s_per_m) +
+            " N s/m (world) is " + num(damping) + " N s/m on the device" + scaling +
+            ", above device.max_damping_n_s_per_m = " + num(dev.max_damping_n_s_per_m));
+      }
+      damping = dev.max_damping_n_s_per_m;
+      params_.surface.damping_n_s_per_m = damping / gain;
+      check_.surface_damping_limited = true;
+    }
+    if (!refuse && damping >= dev.inherent_damping_n_s_per_m) {
+      // No stiffness would be passive: halve the budget between damping and stiffness.
+      damping = 0.5 * dev.inherent_damping_n_s_per_m;
+      params_.surface.damping_n_s_per_m = damping / gain;
+      check_.surface_damping_limited = true;
+    }
+    double passive = passive_stiffness_limit_n_per_m(dev.inherent_damping_n_s_per_m, damping,
+                                                     params.loop_rate_hz);
+    if (!(passive > 0.0)) {
+      throw InputError(
+          "surface.damping_n_s_per_m = " + num(params_.surface.damping_n_s_per_m) +
+          " N s/m (world) is " + num(damping) + " N s/m on the device" + scaling +
+          ", not below device.inherent_damping_n_s_per_m = " + num(dev.inherent_damping_n_s_per_m) +
+          ": no stiffness is passive (Colgate & Brown: b > K T / 2 + |B|)");
+    }
+    double limit = std::min(dev.max_stiffness_n_per_m, passive);
+    double stiffness = params.surface.stiffness_n_per_m * gain;
+    if (stiffness > limit) {
+      if (refuse) {
+        throw InputError(
+            "surface.stiffness_n_per_m = " + num(params.surface.stiffness_n_per_m) +
+            " N/m (world) is " + num(stiffness) + " N/m on the device" + scaling +
+            ", above the limit " + num(limit) + " N/m = min(device.max_stiffness_n_per_m = " +
+            num(dev.max_stiffness_n_per_m) + ", passivity 2 (b - |B|) / T = 2 (" +
+            num(dev.inherent_damping_n_s_per_m) + " - " + num(damping) + ") * " +
+            num(params.loop_rate_hz) + " Hz = " + num(passive) + ") (Colgate & Brown 1994)");
+      }
+      stiffness = limit;
+      params_.surface.stiffness_n_per_m = limit / gain;
+      check_.surface_stiffness_limited = true;
+    }
+    check_.surface_stiffness_n_per_m = stiffness;
+    check_.surface_damping_n_s_per_m = damping;
+    check_.passive_stiffness_n_per_m = passive;
+  }
+
+  // Cutting: the low-speed slope (and the viscous term at the longest
+  // contact) is a virtual damping, within the device's figure.
+  if (params.cutting != CuttingModel::kNone) {
+    double viscous = params.cutting == CuttingModel::kContactDrag
+                         ? params.contact_drag.viscous_n_s_per_m2 * params.max_contact_length_m
+                         : 0.0;
+    double damping = (params.low_speed_damping_n_s_per_m + viscous) * gain;
+    if (damping > dev.max_damping_n_s_per_m) {
+      if (refuse) {
+        throw InputError(
+            "low_speed_damping_n_s_per_m = " + num(params.low_speed_damping_n_s_per_m) +
+            " N s/m (world)" +
+            (viscous > 0.0
+                 ? " + contact_drag.viscous_n_s_per_m2 * max_contact_length_m = " + num(viscous)
+                 : std::string()) +
+            " is " + num(damping) + " N s/m on the device" + scaling +
+            ", above device.max_damping_n_s_per_m = " + num(dev.max_damping_n_s_per_m));
+      }
+      double factor = dev.max_damping_n_s_per_m / damping;
+      params_.low_speed_damping_n_s_per_m *= factor;
+      params_.contact_drag.viscous_n_s_per_m2 *= factor;
+      damping = dev.max_damping_n_s_per_m;
+      check_.cutting_damping_limited = true;
+    }
+    check_.cutting_damping_n_s_per_m = damping;
+  }
+}
+
+ForceOutput ForceModel::compute(const ForceInput& input) const noexcept {
+  ForceOutput out;
+  const Vec3 v = input.velocity_m_per_s;
+  if (params_.surface_enabled) {
+    out.surface = surface_force(params_.surface, input.device_point_m, v, input.surface_y_m);
+    out.surface_n = out.surface.force_n;
+  }
+  switch (params_.cutting) {
+    case CuttingModel::kNone:
+      break;
+    case CuttingModel::kContactDrag:
+      out.engaged_width_m = input.contact_length_m;
+      out.cutting_n = contact_drag_force(params_.contact_drag, input.contact_length_m, v,
+                                         params_.low_speed_damping_n_s_per_m);
+      break;
+    case CuttingModel::kEarthmoving: {
+      double width = input.contact_length_m;
+      // Engaged width across the horizontal motion: L |e x u|.
+      double edge_len = length(input.edge_direction);
+      double speed_xz = std::hypot(v.x, v.z);
+      if (params_.project_width_on_motion && edge_len > 0.0 && speed_xz > 0.0) {
+        Vec3 e = input.edge_direction * (1.0 / edge_len);
+        Vec3 u{v.x / speed_xz, 0.0, v.z / speed_xz};
+        width *= length(cross(e, u));
+      }
+      out.engaged_width_m = width;
+      out.earthmoving = earthmoving_force(params_.earthmoving, width, input.cut_depth_m);
+      out.cutting_n =
+          earthmoving_world_force(out.earthmoving, v, params_.low_speed_damping_n_s_per_m);
+      break;
+    }
+  }
+  out.world_n = out.cutting_n + out.surface_n;
+  out.device_n = out.world_n * params_.force_scale;
+  return out;
+}
+
+}  // namespace terracut
