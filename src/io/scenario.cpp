@@ -1,0 +1,684 @@
+// Scenario files: YAML -> validated Scenario. See scenario.hpp and
+// docs/scenario-format.md.
+#include "terracut/io/scenario.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <system_error>
+
+#include "terracut/core/error.hpp"
+#include "terracut/io/bodies_yaml.hpp"
+
+namespace terracut::io {
+namespace {
+
+// Largest scenario file read (a scenario is a few kilobytes; this only stops a
+// wrong path to a huge file from being read into memory).
+constexpr std::uintmax_t kMaxScenarioFileBytes = 64u << 20;
+// Largest number of steps one cut may take (duration * rate); a longer cut
+// would write a contact.csv of more than ~10 GB.
+constexpr double kMaxStepsPerCut = 1e8;
+constexpr double kMaxRateHz = 1e6;
+
+std::string join(const std::vector<std::string>& items, std::string_view sep = ", ") {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (i) out += sep;
+    out += items[i];
+  }
+  return out;
+}
+
+std::string format_number(double v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
+// Where an error is reported: the file and the 1-based line of a YAML mark.
+struct Context {
+  std::string file;
+
+  std::string where(const YAML::Mark& mark) const {
+    if (mark.is_null() || mark.line < 0) return file;
+    return file + ":" + std::to_string(mark.line + 1);
+  }
+  [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path,
+                         const std::string& what) const {
+    throw InputError(where(mark) + ": " + (path.empty() ? std::string() : path + ": ") + what);
+  }
+};
+
+std::string child_path(const std::string& parent, std::string_view key) {
+  return parent.empty() ? std::string(key) : parent + "." + std::string(key);
+}
+
+std::string describe_kind(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Null:
+      return "nothing";
+    case YAML::NodeType::Scalar:
+      return "'" + node.Scalar() + "'";
+    case YAML::NodeType::Sequence:
+      return "a list";
+    case YAML::NodeType::Map:
+      return "a mapping";
+    default:
+      return "an undefined value";
+  }
+}
+
+// One value in the document with its field path and a line to report (its own
+// mark, or the mark of its key when the value has none).
+class Field {
+ public:
+  // fallback: the mark of the key that introduced the value (or of the list
+  // holding it), used when the value has no mark of its own and for errors
+  // about fields missing inside it.
+  Field(const Context& ctx, YAML::Node node, std::string path, YAML::Mark fallback)
+      : ctx_(&ctx), node_(std::move(node)), path_(std::move(path)), fallback_(fallback) {}
+
+  const YAML::Node& node() const { return node_; }
+  const std::string& path() const { return path_; }
+  const Context& ctx() const { return *ctx_; }
+  YAML::Mark mark() const {
+    YAML::Mark m = node_.Mark();
+    return m.is_null() ? fallback_ : m;
+  }
+  // Where the field is introduced: its key's line for a mapping value.
+  YAML::Mark key_mark() const { return fallback_.is_null() ? mark() : fallback_; }
+  [[noreturn]] void fail(const std::string& what) const { ctx_->fail(mark(), path_, what); }
+
+  bool is_sequence() const { return node_.IsSequence(); }
+  bool is_scalar() const { return node_.IsScalar(); }
+
+  std::string string() const {
+    if (!node_.IsScalar()) fail("expected a text value, got " + describe_kind(node_));
+    return node_.Scalar();
+  }
+
+  double number() const {
+    if (!node_.IsScalar()) fail("expected a number, got " + describe_kind(node_));
+    double v = 0.0;
+    try {
+      v = node_.as<double>();
+    } catch (const YAML::Exception&) {
+      fail("expected a number, got " + describe_kind(node_));
+    }
+    if (!std::isfinite(v)) fail("must be a finite number, got " + describe_kind(node_));
+    return v;
+  }
+
+  double positive() const {
+    const double v = number();
+    if (!(v > 0.0)) fail("must be > 0, got " + format_number(v));
+    return v;
+  }
+
+  double non_negative() const {
+    const double v = number();
+    if (!(v >= 0.0)) fail("must be >= 0, got " + format_number(v));
+    return v;
+  }
+
+  long long integer() const {
+    if (!node_.IsScalar()) fail("expected a whole number, got " + describe_kind(node_));
+    const std::string& s = node_.Scalar();
+    long long v = 0;
+    const char* first = s.data();
+    const char* last = s.data() + s.size();
+    if (first != last && *first == '+') ++first;
+    const auto [ptr, ec] = std::from_chars(first, last, v);
+    if (ec == std::errc::result_out_of_range) fail("whole number " + describe_kind(node_) + " is out of range");
+    if (ec != std::errc() || ptr != last || first == last)
+      fail("expected a whole number, got " + describe_kind(node_));
+    return v;
+  }
+
+  // Elements of a list, each with its path "path[i]".
+  std::vector<Field> elements() const {
+    if (!node_.IsSequence()) fail("expected a list, got " + describe_kind(node_));
+    std::vector<Field> out;
+    std::size_t i = 0;
+    for (const auto& element : node_) {
+      const YAML::Mark m = element.Mark().is_null() ? mark() : element.Mark();
+      out.emplace_back(*ctx_, element, path_ + "[" + std::to_string(i) + "]", m);
+      ++i;
+    }
+    return out;
+  }
+
+  // A list of exactly n finite numbers.
+  std::vector<double> numbers(std::size_t n) const {
+    if (!node_.IsSequence())
+      fail("expected a list of " + std::to_string(n) + " numbers, got " + describe_kind(node_));
+    const std::vector<Field> items = elements();
+    if (items.size() != n)
+      fail("expected a list of " + std::to_string(n) + " numbers, got " +
+           std::to_string(items.size()));
+    std::vector<double> out;
+    for (const Field& f : items) out.push_back(f.number());
+    return out;
+  }
+
+ private:
+  const Context* ctx_;
+  YAML::Node node_;
+  std::string path_;
+  YAML::Mark fallback_;
+};
+
+// A mapping with a fixed set of allowed keys. Unknown and repeated keys are
+// refused at construction. Values are looked up without yaml-cpp's operator[]
+// (which would invent missing nodes).
+class Map {
+ public:
+  Map(const Field& field, std::vector<std::string_view> allowed)
+      : field_(field), allowed_(std::move(allowed)) {
+    const YAML::Node& node = field.node();
+    if (!node.IsMap())
+      field.fail("expected a mapping with keys " + allowed_list() + ", got " +
+                 describe_kind(node));
+    for (const auto& kv : node) {
+      const YAML::Node& key = kv.first;
+      YAML::Mark key_mark = key.Mark().is_null() ? field.mark() : key.Mark();
+      if (!key.IsScalar())
+        field.ctx().fail(key_mark, field.path(), "keys must be plain names, got " +
+                                                     describe_kind(key));
+      const std::string name = key.Scalar();
+      const std::string path = child_path(field.path(), name);
+      if (std::find(allowed_.begin(), allowed_.end(), name) == allowed_.end())
+        field.ctx().fail(key_mark, path, "unknown key '" + name + "'; allowed keys here: " +
+                                             allowed_list());
+      for (const Entry& e : entries_)
+        if (e.name == name)
+          field.ctx().fail(key_mark, path,
+                           "key given twice (first at line " + std::to_string(e.key_mark.line + 1) +
+                               ")");
+      entries_.push_back({name, key_mark, kv.second});
+    }
+  }
+
+  const Field& field() const { return field_; }
+
+  bool has(std::string_view key) const { return find(key) != nullptr; }
+
+  // The value of key, or nullopt. A key given with no value ("key:") is an error.
+  std::optional<Field> get(std::string_view key) const {
+    const Entry* e = find(key);
+    if (!e) return std::nullopt;
+    const std::string path = child_path(field_.path(), key);
+    if (e->value.IsNull()) field_.ctx().fail(e->key_mark, path, "no value given");
+    return Field(field_.ctx(), e->value, path, e->key_mark);
+  }
+
+  Field require(std::string_view key) const {
+    std::optional<Field> f = get(key);
+    if (!f)
+      field_.ctx().fail(field_.key_mark(), child_path(field_.path(), key),
+                        "missing required field '" + std::string(key) + "'" +
+                            (field_.path().empty() ? std::string()
+                                                   : " in '" + field_.path() + "'"));
+    return *f;
+  }
+
+ private:
+  struct Entry {
+    std::string name;
+    YAML::Mark key_mark;
+    YAML::Node value;
+  };
+
+  const Entry* find(std::string_view key) const {
+    for (const Entry& e : entries_)
+      if (e.name == key) return &e;
+    return nullptr;
+  }
+
+  std::string allowed_list() const {
+    std::vector<std::string> names(allowed_.begin(), allowed_.end());
+    return join(names);
+  }
+
+  Field field_;
+  std::vector<std::string_view> allowed_;
+  std::vector<Entry> entries_;
+};
+
+void check_resolution(const Field& f, long long cols, long long rows) {
+  if (cols < 1 || rows < 1)
+    f.fail("resolution must be at least 1 sample per side, got " + std::to_string(cols) + "x" +
+           std::to_string(rows));
+  if (cols > kMaxGridSide || rows > kMaxGridSide)
+    f.fail("resolution " + std::to_string(cols) + "x" + std::to_string(rows) +
+           " is absurd: at most " + std::to_string(kMaxGridSide) + " samples per side");
+  if (cols * rows > kMaxScenarioSamples)
+    f.fail("resolution " + std::to_string(cols) + "x" + std::to_string(rows) +
+           " is absurd: more than 2^28 samples in total");
+}
+
+Resolution parse_resolution_field(const Field& f) {
+  long long cols = 0;
+  long long rows = 0;
+  if (f.is_sequence()) {
+    const std::vector<Field> items = f.elements();
+    if (items.size() != 2)
+      f.fail("expected N or [cols, rows], got a list of " + std::to_string(items.size()));
+    cols = items[0].integer();
+    rows = items[1].integer();
+  } else {
+    cols = rows = f.integer();
+  }
+  check_resolution(f, cols, rows);
+  return {int(cols), int(rows)};
+}
+
+bool valid_cut_name(const std::string& name) {
+  if (name.empty()) return false;
+  for (char ch : name) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (!(std::isalnum(c) || c == '_' || c == '-' || c == '.')) return false;
+  }
+  return true;
+}
+
+void parse_terrain(const Context& ctx, const Field& field, const std::filesystem::path& base_dir,
+                   Scenario& sc) {
+  const Map terrain(field, {"image", "generator", "resolution", "size_m", "origin_m",
+                            "full_scale_m", "mound", "box", "plane"});
+  const std::optional<Field> image = terrain.get("image");
+  const std::optional<Field> generator = terrain.get("generator");
+  if (image && generator)
+    ctx.fail(field.key_mark(), field.path(), "give either 'image' or 'generator', not both");
+  if (!image && !generator)
+    ctx.fail(field.key_mark(), field.path(),
+             "missing 'image' or 'generator' (one of them is required)");
+
+  // Extent, origin and full scale.
+  const std::vector<double> size = terrain.require("size_m").numbers(2);
+  for (int i = 0; i < 2; ++i)
+    if (!(size[i] > 0.0))
+      terrain.require("size_m").elements()[i].fail("must be > 0, got " + format_number(size[i]));
+  sc.size_x_m = size[0];
+  sc.size_z_m = size[1];
+  if (const auto origin = terrain.get("origin_m")) {
+    const std::vector<double> o = origin->numbers(3);
+    sc.origin_m = {o[0], o[1], o[2]};
+  }
+  sc.full_scale_m = terrain.require("full_scale_m").positive();
+
+  std::optional<Resolution> resolution;
+  if (const auto res = terrain.get("resolution")) resolution = parse_resolution_field(*res);
+
+  std::optional<GeneratorKind> kind;
+  if (generator) {
+    const std::string kind_name = generator->string();
+    kind = parse_generator_kind(kind_name);
+    if (!kind) generator->fail("unknown generator '" + kind_name + "'; allowed: mound, box, plane");
+  }
+
+  // Generator parameter blocks are only accepted with their generator.
+  for (std::string_view block : {"mound", "box", "plane"}) {
+    if (!terrain.has(block)) continue;
+    const Field f = *terrain.get(block);
+    if (!kind || to_string(*kind) != block)
+      ctx.fail(f.key_mark(), f.path(),
+               "the '" + std::string(block) + "' block is only allowed with 'generator: " +
+                   std::string(block) + "'");
+  }
+
+  if (generator) {
+    if (!resolution)
+      ctx.fail(field.key_mark(), child_path(field.path(), "resolution"),
+               "missing required field 'resolution' (required with a generator)");
+    sc.resolution = *resolution;
+    Generator gen = default_generator(*kind, grid_spec(sc));
+    if (const auto m = terrain.get("mound")) {
+      const Map mound(*m, {"centre_m", "radius_m"});
+      if (const auto c = mound.get("centre_m")) {
+        const std::vector<double> v = c->numbers(2);
+        gen.mound.centre_x_m = v[0];
+        gen.mound.centre_z_m = v[1];
+      }
+      if (const auto r = mound.get("radius_m")) gen.mound.radius_m = r->positive();
+    }
+    if (const auto b = terrain.get("box")) {
+      const Map box(*b, {"min_m", "max_m"});
+      if (const auto lo = box.get("min_m")) {
+        const std::vector<double> v = lo->numbers(2);
+        gen.box.min_x_m = v[0];
+        gen.box.min_z_m = v[1];
+      }
+      if (const auto hi = box.get("max_m")) {
+        const std::vector<double> v = hi->numbers(2);
+        gen.box.max_x_m = v[0];
+        gen.box.max_z_m = v[1];
+      }
+      if (!(gen.box.min_x_m <= gen.box.max_x_m) || !(gen.box.min_z_m <= gen.box.max_z_m))
+        b->fail("min_m must be <= max_m in X and in Z");
+    }
+    if (const auto p = terrain.get("plane")) {
+      const Map plane(*p, {"height_m"});
+      if (const auto h = plane.get("height_m")) gen.plane.height_m = h->non_negative();
+    }
+    const std::string problem = validate(gen);
+    if (!problem.empty()) generator->fail(problem);
+    sc.generator = gen;
+    return;
+  }
+
+  // Image terrain: the path is relative to the scenario's folder.
+  const std::string relative = image->string();
+  if (relative.empty()) image->fail("the image path is empty");
+  std::filesystem::path path(relative);
+  if (path.is_relative()) path = base_dir / path;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    image->fail("image file '" + path.string() + "' not found (relative paths are read from the "
+                "scenario file's folder)");
+  if (!std::filesystem::is_regular_file(path, ec))
+    image->fail("image '" + path.string() + "' is not a regular file");
+  try {
+    sc.image = read_png(path);
+  } catch (const InputError& e) {
+    image->fail(std::string("cannot read image: ") + e.what());
+  }
+  sc.image_path = path;
+  if (resolution) {
+    sc.resolution = *resolution;
+  } else {
+    const Field f = *image;
+    check_resolution(f, sc.image.cols, sc.image.rows);
+    sc.resolution = {sc.image.cols, sc.image.rows};
+  }
+}
+
+// One parsed cut, with the fields that later checks report against.
+struct ParsedCut {
+  Motion motion;
+  Field name;
+  Field last_t;
+};
+
+ParsedCut parse_cut(const Field& field) {
+  const Map cut(field, {"name", "keyframes"});
+  Motion motion;
+  const Field name = cut.require("name");
+  motion.name = name.string();
+  if (!valid_cut_name(motion.name))
+    name.fail("cut name '" + motion.name +
+              "' must be non-empty and use only letters, digits, '_', '-' and '.'");
+
+  const Field frames = cut.require("keyframes");
+  const std::vector<Field> items = frames.elements();
+  if (items.empty()) frames.fail("a cut needs at least one keyframe");
+  std::optional<Field> last_t;
+  for (const Field& item : items) {
+    const Map kf(item, {"t_s", "position_m", "rotation_deg"});
+    Keyframe k;
+    const Field t = kf.require("t_s");
+    k.t_s = t.non_negative();
+    if (!motion.keyframes.empty() && !(k.t_s > motion.keyframes.back().t_s))
+      t.fail("t_s " + format_number(k.t_s) + " is not after the previous keyframe's " +
+             format_number(motion.keyframes.back().t_s) + " (times must strictly increase)");
+    const std::vector<double> p = kf.require("position_m").numbers(3);
+    k.pose.position_m = {p[0], p[1], p[2]};
+    Vec3 euler{};
+    if (const auto r = kf.get("rotation_deg")) {
+      const std::vector<double> v = r->numbers(3);
+      euler = {v[0], v[1], v[2]};
+    }
+    k.pose.orientation = quat_from_euler_deg(euler);
+    motion.keyframes.push_back(k);
+    last_t = t;
+  }
+  return {std::move(motion), name, *last_t};
+}
+
+Scenario parse_document(const Context& ctx, const YAML::Node& root,
+                        const std::filesystem::path& source_name) {
+  Scenario sc;
+  sc.source_path = source_name;
+  sc.name = source_name.stem().string();
+
+  const Field top_field(ctx, root, "", YAML::Mark());
+  if (root.IsNull() || !root.IsDefined())
+    ctx.fail(YAML::Mark(), "", "the scenario is empty; expected a mapping with 'terrain', "
+                                      "'blade' and 'cuts'");
+  const Map top(top_field, {"name", "description", "terrain", "representation", "rate_hz", "blade",
+                            "cuts", "sequence", "reference", "bodies"});
+
+  if (const auto f = top.get("name")) {
+    sc.name = f->string();
+    if (sc.name.empty()) f->fail("the name is empty");
+  }
+  if (const auto f = top.get("description")) sc.description = f->string();
+
+  if (const auto f = top.get("representation")) {
+    const std::string rep = f->string();
+    const std::optional<Representation> parsed = parse_representation(rep);
+    if (!parsed) f->fail("unknown representation '" + rep + "'; allowed: surface, columns");
+    sc.representation = *parsed;
+  }
+  if (const auto f = top.get("rate_hz")) {
+    sc.rate_hz = f->positive();
+    if (sc.rate_hz > kMaxRateHz) f->fail("rate_hz above 1e6 is absurd, got " + format_number(sc.rate_hz));
+  }
+
+  const Map blade(top.require("blade"), {"length_m"});
+  sc.blade.length_m = blade.require("length_m").positive();
+
+  parse_terrain(ctx, top.require("terrain"), source_name.parent_path(), sc);
+
+  // Cuts: unique names, and a bounded number of steps each.
+  const Field cuts = top.require("cuts");
+  const std::vector<Field> cut_fields = cuts.elements();
+  if (cut_fields.empty()) cuts.fail("the list of cuts is empty; give at least one cut");
+  std::vector<YAML::Mark> name_marks;
+  for (const Field& cf : cut_fields) {
+    ParsedCut cut = parse_cut(cf);
+    const int existing = sc.find_cut(cut.motion.name);
+    if (existing >= 0)
+      cut.name.fail("duplicate cut name '" + cut.motion.name + "' (first defined at line " +
+                    std::to_string(name_marks[std::size_t(existing)].line + 1) + ")");
+    const double steps = std::round(cut.motion.duration_s() * sc.rate_hz);
+    if (steps > kMaxStepsPerCut)
+      cut.last_t.fail("the cut lasts " + format_number(cut.motion.duration_s()) + " s, " +
+                      format_number(steps) + " steps at rate_hz; more than 1e8 steps is absurd");
+    name_marks.push_back(cut.name.mark());
+    sc.cuts.push_back(std::move(cut.motion));
+  }
+
+  if (const auto f = top.get("sequence")) {
+    const std::vector<Field> items = f->elements();
+    if (items.empty()) f->fail("the sequence is empty; leave it out to run the cuts as listed");
+    for (const Field& item : items) {
+      const std::string name = item.string();
+      const int index = sc.find_cut(name);
+      if (index < 0) {
+        std::vector<std::string> names;
+        for (const Motion& m : sc.cuts) names.push_back(m.name);
+        item.fail("unknown cut '" + name + "'; cuts defined: " + join(names));
+      }
+      sc.sequence.push_back(index);
+    }
+  } else {
+    for (std::size_t i = 0; i < sc.cuts.size(); ++i) sc.sequence.push_back(int(i));
+  }
+
+  // Rigid bodies (format in bodies_yaml.hpp); an empty list is allowed.
+  if (const auto f = top.get("bodies")) sc.bodies = parse_bodies(f->node(), ctx.file);
+
+  if (const auto f = top.get("reference")) {
+    const Map reference(*f, {"mound"});
+    const Map mound(reference.require("mound"), {"centre_m", "radius_m", "height_m"});
+    MoundShape shape;
+    const std::vector<double> c = mound.require("centre_m").numbers(2);
+    shape.centre_x_m = c[0];
+    shape.centre_z_m = c[1];
+    shape.radius_m = mound.require("radius_m").positive();
+    shape.height_m = mound.require("height_m").positive();
+    sc.reference_mound = shape;
+  }
+  return sc;
+}
+
+[[noreturn]] void fail_option(std::string_view option, const std::string& what) {
+  throw InputError(std::string(option) + ": " + what);
+}
+
+}  // namespace
+
+int Scenario::find_cut(std::string_view cut_name) const {
+  for (std::size_t i = 0; i < cuts.size(); ++i)
+    if (cuts[i].name == cut_name) return int(i);
+  return -1;
+}
+
+std::vector<std::string> Scenario::sequence_names() const {
+  std::vector<std::string> names;
+  for (int i : sequence) names.push_back(cuts[std::size_t(i)].name);
+  return names;
+}
+
+Scenario parse_scenario(const std::string& text, const std::filesystem::path& source_name) {
+  const Context ctx{source_name.string()};
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    ctx.fail(e.mark, "", "malformed YAML: " + e.msg);
+  }
+  try {
+    return parse_document(ctx, root, source_name);
+  } catch (const YAML::Exception& e) {
+    // Any yaml-cpp error not caught field by field (not expected) still names the place.
+    ctx.fail(e.mark, "", "invalid scenario: " + e.msg);
+  }
+}
+
+Scenario load_scenario(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw InputError(path.string() + ": scenario file not found");
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InputError(path.string() + ": not a regular file");
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (ec) throw InputError(path.string() + ": cannot read the file size: " + ec.message());
+  if (bytes > kMaxScenarioFileBytes)
+    throw InputError(path.string() + ": the file is " + std::to_string(bytes) +
+                     " bytes; a scenario file is at most 64 MiB");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open the scenario file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InputError(path.string() + ": error while reading the scenario file");
+  return parse_scenario(text.str(), path);
+}
+
+Resolution parse_resolution(std::string_view text, std::string_view option_name) {
+  auto parse_side = [&](std::string_view s) -> long long {
+    long long v = 0;
+    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
+      fail_option(option_name, "expected N or COLSxROWS (e.g. 50 or 64x32), got '" +
+                                   std::string(text) + "'");
+    return v;
+  };
+  const std::size_t x = text.find_first_of("xX");
+  const long long cols = parse_side(x == std::string_view::npos ? text : text.substr(0, x));
+  const long long rows = x == std::string_view::npos ? cols : parse_side(text.substr(x + 1));
+  if (cols < 1 || rows < 1)
+    fail_option(option_name, "each side must be at least 1, got '" + std::string(text) + "'");
+  if (cols > kMaxGridSide || rows > kMaxGridSide)
+    fail_option(option_name, "'" + std::string(text) + "' is absurd: at most " +
+                                 std::to_string(kMaxGridSide) + " samples per side");
+  if (cols * rows > kMaxScenarioSamples)
+    fail_option(option_name, "'" + std::string(text) + "' is absurd: more than 2^28 samples");
+  return {int(cols), int(rows)};
+}
+
+std::vector<std::string> parse_name_list(std::string_view text, std::string_view option_name) {
+  std::vector<std::string> names;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    std::string_view item =
+        text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+    while (!item.empty() && std::isspace(static_cast<unsigned char>(item.front()))) item.remove_prefix(1);
+    while (!item.empty() && std::isspace(static_cast<unsigned char>(item.back()))) item.remove_suffix(1);
+    if (item.empty())
+      fail_option(option_name, "empty name in '" + std::string(text) +
+                                   "'; expected names separated by commas, e.g. A,B,C");
+    names.emplace_back(item);
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return names;
+}
+
+void apply_overrides(Scenario& scenario, std::optional<Resolution> resolution,
+                     std::optional<Representation> representation,
+                     std::optional<std::vector<std::string>> sequence) {
+  if (resolution) {
+    const long long cols = resolution->cols;
+    const long long rows = resolution->rows;
+    if (cols < 1 || rows < 1 || cols > kMaxGridSide || rows > kMaxGridSide ||
+        cols * rows > kMaxScenarioSamples)
+      fail_option("--resolution", std::to_string(cols) + "x" + std::to_string(rows) +
+                                      " is outside [1, 65536] per side or 2^28 in total");
+    scenario.resolution = *resolution;
+  }
+  if (representation) scenario.representation = *representation;
+  if (sequence) {
+    if (sequence->empty()) fail_option("--sequence", "the sequence is empty");
+    std::vector<int> indices;
+    for (const std::string& name : *sequence) {
+      const int index = scenario.find_cut(name);
+      if (index < 0) {
+        std::vector<std::string> names;
+        for (const Motion& m : scenario.cuts) names.push_back(m.name);
+        fail_option("--sequence", "unknown cut '" + name + "' (scenario " +
+                                      scenario.source_path.string() + " defines: " + join(names) +
+                                      ")");
+      }
+      indices.push_back(index);
+    }
+    scenario.sequence = std::move(indices);
+  }
+}
+
+GridSpec grid_spec(const Scenario& scenario) {
+  GridSpec spec;
+  spec.cols = scenario.resolution.cols;
+  spec.rows = scenario.resolution.rows;
+  spec.size_x_m = scenario.size_x_m;
+  spec.size_z_m = scenario.size_z_m;
+  spec.origin_m = scenario.origin_m;
+  spec.full_scale_m = scenario.full_scale_m;
+  return spec;
+}
+
+std::vector<float> build_initial_heights(const Scenario& scenario) {
+  const GridSpec spec = grid_spec(scenario);
+  if (scenario.generator) return generate_heights(spec, *scenario.generator);
+
+  // Image terrain: resample to the grid, then scale brightness to metres.
+  const Image& source = scenario.image;
+  const Image resized = (source.cols == spec.cols && source.rows == spec.rows)
+                            ? source
+                            : resample(source, spec.cols, spec.rows);
+  std::vector<float> heights(resized.values.size());
+  const float scale = static_cast<float>(scenario.full_scale_m);
+  for (std::size_t i = 0; i < heights.size(); ++i) heights[i] = resized.values[i] * scale;
+  return heights;
+}
+
+}  // namespace terracut::io

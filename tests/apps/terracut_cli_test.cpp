@@ -1,0 +1,293 @@
+// The `terracut` command-line tool, run as a separate process: help texts,
+// a successful run, bad input giving a message and exit code 1 (never a
+// crash), heightmap, and reproduce with and without figures.
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "terracut/core/generators.hpp"
+#include "terracut/io/image.hpp"
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  bool exited = false;  // false: killed by a signal (a crash)
+  int code = -1;
+  int signal = 0;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("terracut_cli_test_" + std::to_string(getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs a program with stdout and stderr captured in files.
+  Result exec(std::vector<std::string> argv) {
+    const fs::path out = dir_ / "stdout.txt";
+    const fs::path err = dir_ / "stderr.txt";
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    std::vector<char*> args;
+    for (std::string& a : argv) args.push_back(a.data());
+    args.push_back(nullptr);
+    pid_t pid = 0;
+    Result r;
+    const int rc = posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0) {
+      ADD_FAILURE() << "cannot start " << argv[0];
+      return r;
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    r.exited = WIFEXITED(status);
+    r.code = r.exited ? WEXITSTATUS(status) : -1;
+    r.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+
+  Result terracut(std::vector<std::string> args) {
+    args.insert(args.begin(), TERRACUT_BIN);
+    return exec(std::move(args));
+  }
+
+  fs::path write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+    return dir_ / name;
+  }
+
+  static std::string scenario(const char* name) {
+    return (fs::path(TERRACUT_SOURCE_DIR) / "scenarios" / name).string();
+  }
+
+  fs::path dir_;
+};
+
+// A failure that is reported, not a crash: exit code 1 and a message.
+void expect_clean_failure(const Result& r, const std::vector<std::string>& fragments, int code = 1) {
+  EXPECT_TRUE(r.exited) << "killed by signal " << r.signal;
+  EXPECT_EQ(r.code, code) << r.err;
+  for (const std::string& f : fragments)
+    EXPECT_NE(r.err.find(f), std::string::npos) << "stderr lacks '" << f << "':\n" << r.err;
+}
+
+TEST_F(CliTest, HelpOfEveryCommandSucceedsAndDescribesTheOptions) {
+  const Result top = terracut({"--help"});
+  EXPECT_EQ(top.code, 0);
+  for (const char* word : {"run", "heightmap", "reproduce", "Exit codes"})
+    EXPECT_NE(top.out.find(word), std::string::npos) << word;
+
+  const Result run = terracut({"run", "--help"});
+  EXPECT_EQ(run.code, 0);
+  for (const char* word : {"--out", "--resolution", "COLSxROWS", "--representation", "columns",
+                           "--sequence", "--quiet", "contact.csv", "contact_length",
+                           "removed_volume", "height.npy", "removed.png", "summary.json"})
+    EXPECT_NE(run.out.find(word), std::string::npos) << word;
+
+  const Result hm = terracut({"heightmap", "--help"});
+  EXPECT_EQ(hm.code, 0);
+  for (const char* word : {"mound", "box", "plane", "--resolution", "--out", "--size",
+                           "--full-scale", "--height", "--centre", "--radius", "--box-min",
+                           "--box-max", "metres"})
+    EXPECT_NE(hm.out.find(word), std::string::npos) << word;
+
+  const Result rep = terracut({"reproduce", "--help"});
+  EXPECT_EQ(rep.code, 0);
+  for (const char* word : {"--out", "--scenarios", "--tools-dir", "--python", "--no-plots",
+                           "report.md", "fig8_", "fig9_", "fig13_", "fig14_", "convergence.png"})
+    EXPECT_NE(rep.out.find(word), std::string::npos) << word;
+
+  EXPECT_EQ(terracut({"--version"}).code, 0);
+}
+
+TEST_F(CliTest, RunWritesEveryOutput) {
+  const fs::path out = dir_ / "out";
+  const Result r = terracut({"run", scenario("mound_generator.yaml"), "--out", out.string(),
+                             "--resolution", "16", "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "");  // --quiet
+  for (const char* name : {"contact.csv", "height.npy", "removed.npy", "height.png",
+                           "removed.png", "summary.json"}) {
+    EXPECT_TRUE(fs::exists(out / name)) << name;
+    EXPECT_GT(fs::file_size(out / name), 0u) << name;
+  }
+  EXPECT_EQ(slurp(out / "contact.csv").rfind("t,cut,x,y,z,qw,qx,qy,qz,contact_length,", 0), 0u);
+}
+
+TEST_F(CliTest, RunOptionsOverrideTheScenario) {
+  const fs::path out = dir_ / "out";
+  const Result r = terracut({"run", scenario("mound_generator.yaml"), "--out", out.string(),
+                             "--resolution", "10x6", "--representation", "columns",
+                             "--sequence", "pass2,pass2"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("mound_generator"), std::string::npos) << r.out;  // the summary line
+  const std::string summary = slurp(out / "summary.json");
+  EXPECT_NE(summary.find("\"representation\": \"columns\""), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"resolution\": [\n        10,\n        6\n      ]"), std::string::npos)
+      << summary;
+  const std::string csv = slurp(out / "contact.csv");
+  EXPECT_EQ(csv.find(",pass1,"), std::string::npos);
+  EXPECT_NE(csv.find(",pass2,"), std::string::npos);
+}
+
+TEST_F(CliTest, BadScenarioExitsWithTheMessageOnStderr) {
+  const fs::path bad = write("bad.yaml",
+                             "terrain:\n  generator: plane\n  resolution: 4\n  size_m: [1, 1]\n"
+                             "  full_scale_m: 1\nblade: {length_m: 1, width_m: 2}\n"
+                             "cuts: [{name: a, keyframes: [{t_s: 0, position_m: [0, 0, 0]}]}]\n");
+  expect_clean_failure(terracut({"run", bad.string(), "--out", (dir_ / "o").string()}),
+                       {bad.string() + ":6: blade.width_m: unknown key"});
+  EXPECT_FALSE(fs::exists(dir_ / "o" / "contact.csv"));
+
+  const fs::path malformed = write("malformed.yaml", "terrain: {generator: plane\n");
+  expect_clean_failure(terracut({"run", malformed.string(), "--out", (dir_ / "o").string()}),
+                       {malformed.string() + ":", "malformed YAML"});
+
+  const fs::path nan = write("nan.yaml",
+                             "terrain:\n  generator: plane\n  resolution: 4\n  size_m: [1, .nan]\n"
+                             "  full_scale_m: 1\nblade: {length_m: 1}\n"
+                             "cuts: [{name: a, keyframes: [{t_s: 0, position_m: [0, 0, 0]}]}]\n");
+  expect_clean_failure(terracut({"run", nan.string(), "--out", (dir_ / "o").string()}),
+                       {nan.string() + ":4: terrain.size_m[1]", "finite"});
+
+  const fs::path no_image = write("noimage.yaml",
+                                  "terrain:\n  image: missing.png\n  size_m: [1, 1]\n"
+                                  "  full_scale_m: 1\nblade: {length_m: 1}\n"
+                                  "cuts: [{name: a, keyframes: [{t_s: 0, position_m: [0, 0, 0]}]}]\n");
+  expect_clean_failure(terracut({"run", no_image.string(), "--out", (dir_ / "o").string()}),
+                       {":2: terrain.image", (dir_ / "missing.png").string()});
+
+  expect_clean_failure(
+      terracut({"run", (dir_ / "nothing.yaml").string(), "--out", (dir_ / "o").string()}),
+      {(dir_ / "nothing.yaml").string(), "not found"});
+}
+
+TEST_F(CliTest, BadOptionsAreReported) {
+  const std::string sc = scenario("mound_generator.yaml");
+  const std::string out = (dir_ / "o").string();
+  expect_clean_failure(terracut({"run", sc, "--out", out, "--resolution", "0"}), {"--resolution"});
+  expect_clean_failure(terracut({"run", sc, "--out", out, "--resolution", "100000"}),
+                       {"--resolution", "absurd"});
+  expect_clean_failure(terracut({"run", sc, "--out", out, "--sequence", "pass1,nope"}),
+                       {"--sequence", "'nope'"});
+  // Command-line usage errors exit with 2.
+  expect_clean_failure(terracut({"run", sc, "--out", out, "--representation", "voxels"}),
+                       {"--representation"}, 2);
+  expect_clean_failure(terracut({"run", sc}), {"--out"}, 2);
+  expect_clean_failure(terracut({}), {"subcommand"}, 2);
+  // An output folder that cannot be made.
+  write("file", "x");
+  expect_clean_failure(terracut({"run", sc, "--out", (dir_ / "file" / "sub").string()}),
+                       {(dir_ / "file" / "sub").string()});
+}
+
+TEST_F(CliTest, HeightmapWritesTheGeneratorAsA16BitPng) {
+  const fs::path png = dir_ / "mound.png";
+  const Result r = terracut({"heightmap", "mound", "--resolution", "9x7", "--size", "2,1",
+                             "--full-scale", "0.5", "--radius", "0.45", "--out", png.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const terracut::io::Image image = terracut::io::read_png(png);
+  ASSERT_EQ(image.cols, 9);
+  ASSERT_EQ(image.rows, 7);
+  EXPECT_EQ(image.bit_depth, 16);
+  terracut::GridSpec spec;
+  spec.cols = 9;
+  spec.rows = 7;
+  spec.size_x_m = 2.0;
+  spec.size_z_m = 1.0;
+  spec.full_scale_m = 0.5;
+  terracut::Generator gen = terracut::default_generator(terracut::GeneratorKind::kMound, spec);
+  gen.mound.radius_m = 0.45;
+  const std::vector<float> h = terracut::generate_heights(spec, gen);
+  for (std::size_t i = 0; i < h.size(); ++i)
+    EXPECT_NEAR(image.values[i], h[i] / 0.5, 0.6 / 65535.0) << i;
+
+  expect_clean_failure(terracut({"heightmap", "box", "--resolution", "4", "--radius", "1",
+                                 "--out", (dir_ / "b.png").string()}),
+                       {"--radius", "mound"});
+  expect_clean_failure(terracut({"heightmap", "plane", "--resolution", "4", "--full-scale", "0",
+                                 "--out", (dir_ / "p.png").string()}),
+                       {"--full-scale"});
+  expect_clean_failure(terracut({"heightmap", "plane", "--resolution", "4", "--out",
+                                 (dir_ / "no" / "such" / "p.png").string()}),
+                       {"p.png"});
+}
+
+TEST_F(CliTest, ReproduceWithoutPlotsWritesTheReport) {
+  const fs::path out = dir_ / "rep";
+  const Result r = terracut({"reproduce", "--out", out.string(), "--no-plots", "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string report = slurp(out / "report.md");
+  for (const char* word : {"Experiment 1", "RMS error", "drop-out", "Experiment 2",
+                           "(C,A,B)", "(B,C,A)", "final shapes match"})
+    EXPECT_NE(report.find(word), std::string::npos) << word;
+  for (const char* rep : {"columns", "surface"}) {
+    for (const char* n : {"5", "15", "25", "35", "50", "100", "200"})
+      EXPECT_TRUE(fs::exists(out / "exp1" / rep / n / "contact.csv")) << rep << " " << n;
+    for (const char* seq : {"ABC", "CAB", "BCA", "AB"})
+      EXPECT_TRUE(fs::exists(out / "exp2" / rep / seq / "height.npy")) << rep << " " << seq;
+  }
+  EXPECT_TRUE(fs::exists(out / "exp1" / "exact.csv"));
+  EXPECT_TRUE(fs::exists(out / "exp1" / "errors.csv"));
+  EXPECT_TRUE(fs::exists(out / "reproduce.json"));
+}
+
+TEST_F(CliTest, ReproduceWithoutPythonStillWritesTheReportAndFails) {
+  const fs::path out = dir_ / "rep";
+  const Result r = terracut(
+      {"reproduce", "--out", out.string(), "--python", "/nonexistent/python3", "--quiet"});
+  expect_clean_failure(r, {"/nonexistent/python3", "figures not made"}, 3);
+  const std::string report = slurp(out / "report.md");
+  EXPECT_NE(report.find("could not be made"), std::string::npos);
+  EXPECT_NE(report.find("Experiment 1"), std::string::npos);
+  EXPECT_EQ(report.find("fig8_"), std::string::npos);  // no links to figures that do not exist
+}
+
+TEST_F(CliTest, ReproduceDrawsEveryFigure) {
+  const Result probe = exec({"/usr/bin/python3", "-c", "import numpy, matplotlib"});
+  if (probe.code != 0) GTEST_SKIP() << "/usr/bin/python3 with numpy and matplotlib not available";
+  const fs::path out = dir_ / "rep";
+  const Result r = terracut({"reproduce", "--out", out.string(), "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* name :
+       {"fig8_columns.png", "fig8_surface.png", "fig9_columns.png", "fig9_surface.png",
+        "fig13_columns.png", "fig13_surface.png", "fig14_columns.png", "fig14_surface.png",
+        "convergence.png"}) {
+    ASSERT_TRUE(fs::exists(out / name)) << name;
+    EXPECT_EQ(slurp(out / name).substr(1, 3), "PNG") << name;
+    EXPECT_NE(slurp(out / "report.md").find(std::string("](") + name + ")"), std::string::npos)
+        << name << " not embedded in report.md";
+  }
+}
+
+}  // namespace

@@ -1,0 +1,280 @@
+// Running a scenario: determinism of every output file, conservation in the
+// outputs, the CSV layout, progress lines, and failures that leave nothing
+// behind.
+#include "terracut/io/run.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "terracut/core/error.hpp"
+#include "terracut/io/image.hpp"
+#include "terracut/io/scenario.hpp"
+
+namespace terracut::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A small mound cut twice (a rolling pass, then a level pass back), plus a
+// repeat of the first: 3 cuts, 24 x 20 samples, 200 Hz.
+const std::string kScenario = R"(name: small
+terrain:
+  generator: mound
+  resolution: [24, 20]
+  size_m: [1.2, 1.0]
+  origin_m: [-0.6, 0.0, -0.5]
+  full_scale_m: 0.3
+  mound: {centre_m: [0.0, 0.0], radius_m: 0.45}
+representation: surface
+rate_hz: 200
+blade: {length_m: 0.9}
+cuts:
+  - name: roll
+    keyframes:
+      - {t_s: 0.0, position_m: [0.0, 0.25, -0.6], rotation_deg: [0, 0, 0]}
+      - {t_s: 1.0, position_m: [0.05, 0.18, 0.6], rotation_deg: [0, 15, 25]}
+  - name: back
+    keyframes:
+      - {t_s: 0.0, position_m: [0.0, 0.12, 0.6]}
+      - {t_s: 0.8, position_m: [0.0, 0.12, -0.6]}
+sequence: [roll, back, roll]
+)";
+
+class RunTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("terracut_run_test_" + std::to_string(getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Scenario scenario(Representation rep = Representation::kSurface) {
+    Scenario sc = parse_scenario(kScenario, dir_ / "small.yaml");
+    apply_overrides(sc, std::nullopt, rep, std::nullopt);
+    return sc;
+  }
+
+  RunResult run(const Scenario& sc, const fs::path& out, bool keep = false) {
+    RunOptions options;
+    options.out_dir = out;
+    options.keep_records = keep;
+    return run_scenario(sc, options);
+  }
+
+  fs::path dir_;
+};
+
+std::string read_bytes(const fs::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  EXPECT_TRUE(f.good()) << path;
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::istringstream in(line);
+  for (std::string cell; std::getline(in, cell, ',');) out.push_back(cell);
+  return out;
+}
+
+TEST_F(RunTest, SameScenarioTwiceGivesBitwiseIdenticalOutputs) {
+  for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
+    const Scenario sc = scenario(rep);
+    const std::string tag(to_string(rep));
+    run(sc, dir_ / (tag + "_one"));
+    run(sc, dir_ / (tag + "_two"));
+    for (const char* name : {"contact.csv", "height.npy", "removed.npy", "height.png",
+                             "removed.png"}) {
+      const std::string a = read_bytes(dir_ / (tag + "_one") / name);
+      const std::string b = read_bytes(dir_ / (tag + "_two") / name);
+      EXPECT_FALSE(a.empty()) << name;
+      EXPECT_TRUE(a == b) << tag << " " << name << " differs between two runs";
+    }
+    // summary.json: identical except the "timing" object.
+    auto summary = [&](const char* which) {
+      nlohmann::json j = nlohmann::json::parse(read_bytes(dir_ / (tag + which) / "summary.json"));
+      EXPECT_TRUE(j.contains("timing"));
+      j.erase("timing");
+      return j.dump();
+    };
+    EXPECT_EQ(summary("_one"), summary("_two")) << tag;
+  }
+}
+
+TEST_F(RunTest, OutputsConserveMaterial) {
+  const Scenario sc = scenario();
+  const RunResult result = run(sc, dir_ / "out");
+  const std::vector<float> initial = build_initial_heights(sc);
+  int rows = 0;
+  int cols = 0;
+  const std::vector<float> height = read_npy(dir_ / "out" / "height.npy", &rows, &cols);
+  const std::vector<float> removed = read_npy(dir_ / "out" / "removed.npy", &rows, &cols);
+  ASSERT_EQ(rows, 20);
+  ASSERT_EQ(cols, 24);
+  ASSERT_EQ(height.size(), initial.size());
+  // Per sample, to float rounding of the full scale (removed = initial - height in float).
+  const double tol = 4.0 * 0.3 * 1.2e-7;
+  double removed_sum = 0.0;
+  int cut_samples = 0;
+  for (std::size_t i = 0; i < initial.size(); ++i) {
+    EXPECT_NEAR(double(height[i]) + removed[i], initial[i], tol) << "sample " << i;
+    EXPECT_GE(height[i], 0.0f);
+    EXPECT_GE(removed[i], 0.0f);
+    removed_sum += removed[i];
+    if (removed[i] > 0.0f) ++cut_samples;
+  }
+  EXPECT_GT(cut_samples, 10);  // the cuts did cut
+
+  const double cell_area = (1.2 / 24) * (1.0 / 20);
+  EXPECT_NEAR(removed_sum * cell_area, result.removed_volume_m3, initial.size() * tol * cell_area);
+  EXPECT_NEAR(result.initial_volume_m3 - result.final_volume_m3, result.removed_volume_m3,
+              initial.size() * tol * cell_area);
+  EXPECT_LE(result.max_sample_error_m, tol);
+
+  // The same numbers in summary.json, and the per-step volumes of contact.csv add up.
+  const nlohmann::json j = nlohmann::json::parse(read_bytes(dir_ / "out" / "summary.json"));
+  EXPECT_EQ(j["removed_volume_m3"].get<double>(), result.removed_volume_m3);
+  EXPECT_LE(j["conservation"]["max_sample_error_m"].get<double>(), tol);
+  EXPECT_NEAR(j["conservation"]["volume_error_m3"].get<double>(), 0.0,
+              initial.size() * tol * cell_area);
+  double csv_sum = 0.0;
+  const std::vector<std::string> lines = lines_of(read_bytes(dir_ / "out" / "contact.csv"));
+  for (std::size_t i = 1; i < lines.size(); ++i) csv_sum += std::stod(split(lines[i])[10]);
+  EXPECT_NEAR(csv_sum, result.removed_volume_m3, 1e-8 * (1.0 + result.removed_volume_m3));
+}
+
+TEST_F(RunTest, ContactCsvHasOneRowPerStepInSequenceOrder) {
+  const Scenario sc = scenario();
+  const RunResult result = run(sc, dir_ / "out", true);
+  const std::vector<std::string> lines = lines_of(read_bytes(dir_ / "out" / "contact.csv"));
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0],
+            "t,cut,x,y,z,qw,qx,qy,qz,contact_length,removed_volume,section_area,max_depth,"
+            "cells_visited");
+  // roll: round(1.0*200)+1 = 201 steps, back: 161, roll again: 201.
+  const std::int64_t expected_steps = 201 + 161 + 201;
+  EXPECT_EQ(result.steps, expected_steps);
+  ASSERT_EQ(std::int64_t(lines.size()) - 1, expected_steps);
+  ASSERT_EQ(std::int64_t(result.records.size()), expected_steps);
+  for (std::int64_t i = 0; i < expected_steps; ++i) {
+    const std::vector<std::string> cells = split(lines[std::size_t(i + 1)]);
+    ASSERT_EQ(cells.size(), 14u) << lines[std::size_t(i + 1)];
+    // Global time advances one step of 1/rate per row.
+    EXPECT_NEAR(std::stod(cells[0]), double(i) / 200.0, 1e-9);
+    const char* want = i < 201 ? "roll" : (i < 362 ? "back" : "roll");
+    EXPECT_EQ(cells[1], want) << i;
+    EXPECT_NEAR(std::stod(cells[9]), result.records[std::size_t(i)].contact.length_m,
+                1e-8 * (1.0 + result.records[std::size_t(i)].contact.length_m));
+  }
+  // A cut starts at its first keyframe and ends at its last.
+  EXPECT_EQ(split(lines[1])[4], "-0.6");
+  EXPECT_EQ(split(lines[201])[4], "0.6");
+  EXPECT_EQ(split(lines[202])[3], "0.12");
+  // Per-cut statistics agree with the records.
+  ASSERT_EQ(result.cuts.size(), 3u);
+  std::int64_t first = 0;
+  for (const CutStats& c : result.cuts) {
+    double peak = 0.0;
+    double volume = 0.0;
+    for (std::int64_t i = first; i < first + c.steps; ++i) {
+      peak = std::max(peak, result.records[std::size_t(i)].contact.length_m);
+      volume += result.records[std::size_t(i)].removed_volume_m3;
+    }
+    EXPECT_EQ(c.peak_contact_m, peak) << c.name;
+    EXPECT_NEAR(c.removed_volume_m3, volume, 1e-15) << c.name;
+    EXPECT_NEAR(c.start_t_s, double(first) / 200.0, 1e-12) << c.name;
+    first += c.steps;
+  }
+  EXPECT_GT(result.cuts[0].peak_contact_m, 0.0);
+  // The repeated pass meets only what the others left: less than the first time.
+  EXPECT_LT(result.cuts[2].removed_volume_m3, result.cuts[0].removed_volume_m3);
+}
+
+TEST_F(RunTest, PngOutputsAreTheLayersOverFullScale) {
+  const Scenario sc = scenario();
+  run(sc, dir_ / "out");
+  int rows = 0;
+  int cols = 0;
+  const std::vector<float> height = read_npy(dir_ / "out" / "height.npy", &rows, &cols);
+  const Image png = read_png(dir_ / "out" / "height.png");
+  ASSERT_EQ(png.cols, 24);
+  ASSERT_EQ(png.rows, 20);
+  EXPECT_EQ(png.bit_depth, 16);
+  for (std::size_t i = 0; i < height.size(); ++i)
+    EXPECT_NEAR(png.values[i] * 0.3, height[i], 0.3 / 65535.0) << i;
+}
+
+TEST_F(RunTest, ProgressLinesOnlyForLongRuns) {
+  const Scenario sc = scenario();
+  std::ostringstream quiet;
+  RunOptions options;
+  options.out_dir = dir_ / "a";
+  options.progress = &quiet;
+  options.progress_after_s = 1e9;  // never reached
+  run_scenario(sc, options);
+  EXPECT_EQ(quiet.str(), "");
+
+  std::ostringstream loud;
+  options.out_dir = dir_ / "b";
+  options.progress = &loud;
+  options.progress_after_s = 0.0;  // every run is "long"
+  options.progress_label = "label";
+  run_scenario(sc, options);
+  EXPECT_NE(loud.str().find("label: "), std::string::npos) << loud.str();
+  EXPECT_NE(loud.str().find("steps/s"), std::string::npos) << loud.str();
+  EXPECT_NE(loud.str().find("%"), std::string::npos) << loud.str();
+}
+
+TEST_F(RunTest, UnwritableOutputNamesTheFileAndLeavesNothingBehind) {
+  const Scenario sc = scenario();
+  // A folder where height.npy should go: writing it fails after contact.csv.
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out / "height.npy" / "blocker");
+  std::ofstream(out / "summary.json") << "stale";  // from an older run
+  try {
+    run(sc, out);
+    FAIL() << "the run did not report the unwritable file";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("height.npy"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(out / "contact.csv"));
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+  EXPECT_FALSE(fs::exists(out / "removed.npy"));
+}
+
+TEST_F(RunTest, OutputFolderThatIsAFileIsNamed) {
+  const Scenario sc = scenario();
+  std::ofstream(dir_ / "plainfile") << "x";
+  try {
+    run(sc, dir_ / "plainfile" / "sub");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("plainfile"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(RunTest, MissingFoldersAreCreated) {
+  const Scenario sc = scenario();
+  run(sc, dir_ / "deep" / "er" / "out");
+  for (const char* name : kRunOutputFiles) EXPECT_TRUE(fs::exists(dir_ / "deep/er/out" / name)) << name;
+}
+
+}  // namespace
+}  // namespace terracut::io
