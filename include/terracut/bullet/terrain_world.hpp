@@ -1,0 +1,208 @@
+// A Bullet rigid-body world that shares the deformable terrain.
+//
+// TerrainWorld owns a btDiscreteDynamicsWorld whose ground is a
+// btHeightfieldTerrainShape reading the HeightGrid's own heights() array in
+// place (no copy): cuts made by the Simulation are seen by Bullet at once and
+// the shape is never recreated. Loose rigid bodies (BodySpec: box, sphere,
+// cylinder) rest on it, and the blade is a kinematic plate that pushes them.
+//
+// Placement (see docs/bullet.md): Bullet vertex (x, j) of the heightfield is
+// grid sample (c, r) = (x, j), at world
+//   (sample_x(c), origin_m.y + height(c, r), sample_z(r)).
+// Bullet triangulates each square of four neighbouring samples along the
+// diagonal from sample (c+1, r) to (c, r+1), which is terracut's `surface`
+// representation; the surface's flat half-cell border around the grid is not
+// part of the Bullet shape (a static floor plane at the ground level catches
+// whatever leaves the terrain).
+//
+// Height bounds: Bullet needs every height inside [min, max] fixed at
+// construction. min = 0 (the rigid floor: HeightGrid never goes below it);
+// max = TerrainWorldParams::max_height_m, or by default
+// max(2 * full_scale_m, highest initial height + full_scale_m): room for
+// piles at least one full scale above the initial terrain. After an edit,
+// terrain_changed() lowers any sample above max to max and counts it
+// (BoundsReport); it is never silent.
+//
+// After an edit of a rectangle of samples, terrain_changed() wakes the bodies
+// whose bounding box overlaps the triangles touching that rectangle and drops
+// their cached contact points with the terrain, so they fall at once instead
+// of hovering on stale contacts.
+//
+// One step (step(out)) after each Simulation::step: terrain_changed(changed
+// rectangle), move the tool plate to the blade pose, advance Bullet by exactly
+// 1 / rate_hz (one fixed sub-step: deterministic), and sum the tool's contact
+// impulses into a force. After the first steps (Bullet's internal arrays grow
+// to their working size) a step allocates nothing.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "terracut/core/bodies.hpp"
+#include "terracut/core/simulation.hpp"
+
+class btDiscreteDynamicsWorld;
+class btRigidBody;
+class btHeightfieldTerrainShape;
+
+namespace terracut::bullet {
+
+/// The kinematic tool: a thin box plate whose bottom long edge is the cutting
+/// edge. In the blade frame it spans x in [-L/2, L/2] (L = blade length),
+/// y in [0, height_m] (rising from the edge along the blade's local +Y) and
+/// z in [-thickness_m/2, thickness_m/2].
+struct ToolPlateSpec {
+  bool enabled = true;         ///< false: no tool body (bodies only meet the terrain)
+  double height_m = 0.1;       ///< extent above the edge along blade local +Y, metres, in (0, 100]
+  double thickness_m = 0.02;   ///< extent along blade local Z, metres, in (0, 100]
+  double friction = 0.5;       ///< Coulomb friction coefficient, [0, 10]
+};
+
+/// Parameters of the Bullet world; validated at construction, read-only during a run.
+struct TerrainWorldParams {
+  /// Gravitational acceleration along -Y, m/s^2, in [0, 1000].
+  double gravity_m_s2 = 9.81;
+  /// Upper bound of heights given to Bullet, metres above ground; 0 = automatic
+  /// (max(2 * full_scale_m, highest initial height + full_scale_m)). When
+  /// given, it must be finite and >= the highest initial height.
+  double max_height_m = 0.0;
+  /// Friction coefficient of the soil surface, [0, 10].
+  double terrain_friction = 0.8;
+  /// Restitution of the soil surface, [0, 1].
+  double terrain_restitution = 0.0;
+  /// Adds a static plane at the ground level (origin_m.y), the rigid floor
+  /// under the soil; it holds bodies that leave the terrain's extent.
+  bool floor = true;
+  /// Collision margin of box and cylinder bodies, metres, in [0, 0.1]; each
+  /// body's margin is at most 0.2 x its smallest half extent. The outer shape
+  /// keeps its size (Bullet rounds the corners by the margin). A sphere's
+  /// margin is its radius.
+  double convex_margin_m = 0.005;
+  /// Constraint solver iterations per step, in [1, 1000].
+  int solver_iterations = 10;
+  ToolPlateSpec tool{};
+};
+
+/// Returns an empty string when params are valid, else a message naming the field.
+std::string validate(const TerrainWorldParams& params);
+
+/// Height bounds of the Bullet heightfield and what was clamped to them.
+struct BoundsReport {
+  double min_height_m = 0.0;             ///< lower bound, metres above ground (always 0)
+  double max_height_m = 0.0;             ///< upper bound, metres above ground
+  std::int64_t clamped_total = 0;        ///< samples lowered to max_height_m since construction
+  /// Samples lowered by the terrain changes of the last step (those made
+  /// between the previous advance() and the last one).
+  std::int64_t clamped_last_step = 0;
+  double highest_clamped_m = 0.0;        ///< largest height ever found above the bound, metres (0 if none)
+};
+
+/// A body's state after the last step, world frame, SI.
+struct BodyState {
+  Vec3 position_m{};            ///< centre of the body, metres
+  Quat orientation{};           ///< body frame -> world (unit quaternion)
+  Vec3 velocity_m_s{};          ///< linear velocity, m/s
+  Vec3 angular_velocity_rad_s{};  ///< angular velocity, rad/s
+  bool active = true;           ///< false when Bullet has put it to sleep
+};
+
+/// What the last step did.
+struct WorldStepInfo {
+  std::int64_t step = 0;            ///< index of the last step, from 0 (-1 before any step)
+  double t_s = 0.0;                 ///< simulated time after the last step, seconds
+  /// Force the bodies exert on the tool plate, world frame, newtons: the sum
+  /// over the tool's contact points of (normal + friction impulses) / dt.
+  /// Zero when nothing touches the tool. The operator feels this force.
+  Vec3 tool_force_n{};
+  int tool_contact_points = 0;      ///< contact points between the tool and bodies
+  int bodies_woken = 0;             ///< bodies woken by the last terrain change
+  double physics_s = 0.0;           ///< wall-clock time of Bullet's step, seconds
+  double total_s = 0.0;             ///< wall-clock time of the whole step(), seconds
+};
+
+class TerrainWorld {
+ public:
+  /// Builds the world over `grid` (which must outlive the world and keep its
+  /// heights array: HeightGrid guarantees that). rate_hz is the simulation's
+  /// fixed rate (Bullet advances 1 / rate_hz per step); blade gives the tool
+  /// plate's length. Throws terracut::InputError naming the bad field when
+  /// params or bodies are invalid, or the grid has fewer than 2 samples along
+  /// a side (Bullet's heightfield needs 2 x 2).
+  TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& blade,
+               std::vector<BodySpec> bodies, const TerrainWorldParams& params = {});
+  /// The same over a simulation's grid, rate and blade.
+  TerrainWorld(Simulation& sim, std::vector<BodySpec> bodies,
+               const TerrainWorldParams& params = {});
+  ~TerrainWorld();
+  TerrainWorld(const TerrainWorld&) = delete;
+  TerrainWorld& operator=(const TerrainWorld&) = delete;
+
+  const TerrainWorldParams& params() const { return params_; }
+  double dt_s() const { return dt_s_; }
+
+  /// One step after Simulation::step: terrain_changed(out.cut.changed),
+  /// set_tool_pose(out.pose), advance(). Allocation-free once warm; never throws.
+  void step(const StepOutput& out);
+
+  /// Tells the world that heights inside `changed` were edited (any rectangle;
+  /// clipped to the grid): clamps them to the bounds (counted), wakes the
+  /// bodies over the affected triangles and drops their cached terrain
+  /// contacts. Call it after every edit made outside step() (set_heights,
+  /// Simulation::reset with the whole grid's rectangle).
+  void terrain_changed(const Rect& changed);
+
+  /// Moves the tool plate to the blade pose (takes effect in the next
+  /// advance). The plate's velocity is the pose change over dt, so it pushes
+  /// what it meets; the first pose, and the first after lift_tool(), places
+  /// the plate without a velocity.
+  void set_tool_pose(const BladePose& pose);
+  /// The next set_tool_pose jumps to its pose (use with Simulation::lift():
+  /// between separate cuts the blade does not sweep through the air).
+  void lift_tool() { tool_teleport_ = true; }
+
+  /// Advances Bullet by dt_s() and updates last().
+  void advance();
+
+  int body_count() const { return int(specs_.size()); }
+  const BodySpec& body_spec(int i) const { return specs_[std::size_t(i)]; }
+  BodyState body_state(int i) const;
+  const WorldStepInfo& last() const { return info_; }
+  const BoundsReport& bounds() const { return bounds_; }
+  std::int64_t step_count() const { return steps_; }
+  double time_s() const { return double(steps_) * dt_s_; }
+
+  /// World pose of the tool plate's centre (meaningful after the first set_tool_pose).
+  BladePose tool_plate_pose() const;
+
+  /// Bullet access for tests, renderers and ray queries. Do not add or remove
+  /// objects, and do not change the terrain shape.
+  btDiscreteDynamicsWorld& dynamics_world();
+  const btDiscreteDynamicsWorld& dynamics_world() const;
+  btRigidBody& body(int i);
+  /// The tool plate's body; only when params().tool.enabled.
+  btRigidBody& tool_body();
+  btRigidBody& terrain_body();
+  const btHeightfieldTerrainShape& terrain_shape() const;
+  /// Number of collision shapes this world owns (terrain, floor, tool, one per body).
+  int shape_count() const;
+
+ private:
+  struct Impl;
+
+  HeightGrid& grid_;
+  TerrainWorldParams params_;
+  BladeSpec blade_;
+  std::vector<BodySpec> specs_;
+  double dt_s_ = 0.0;
+  std::unique_ptr<Impl> impl_;
+  BoundsReport bounds_{};
+  WorldStepInfo info_{};
+  std::int64_t steps_ = 0;
+  bool tool_teleport_ = true;
+  int pending_woken_ = 0;
+  std::int64_t pending_clamped_ = 0;
+};
+
+}  // namespace terracut::bullet

@@ -1,0 +1,80 @@
+// Rigid bodies of a scenario: plain data describing loose objects (rocks,
+// blocks, debris) that rest on or in the soil. The core does not simulate
+// them; a physics engine adapter (terracut::bullet::TerrainWorld) does.
+//
+// Every body is a box, a sphere or a cylinder whose centre is at
+// `position_m` and whose local axes are rotated by `rotation_deg` (Euler
+// angles in degrees, extrinsic X then Y then Z, the same convention as the
+// blade keyframes: quat_from_euler_deg). A cylinder's axis is its local Y.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "terracut/core/math.hpp"
+
+namespace terracut {
+
+/// The collision shape of a rigid body.
+enum class BodyShape {
+  kBox,       ///< a box of full edge lengths size_m (local X, Y, Z)
+  kSphere,    ///< a sphere of radius radius_m
+  kCylinder,  ///< a cylinder of radius radius_m and full height height_m along local Y
+};
+
+/// "box", "sphere" or "cylinder".
+std::string_view to_string(BodyShape shape);
+/// The shape named by name; nullopt for anything else.
+std::optional<BodyShape> parse_body_shape(std::string_view name);
+
+/// Longest accepted body name, characters.
+inline constexpr std::size_t kMaxBodyNameLength = 64;
+/// Largest accepted body dimension (edge, radius, height), metres; more is refused as absurd.
+inline constexpr double kMaxBodyDimensionM = 1e3;
+
+/// One rigid body: shape, size, mass, initial pose and surface properties.
+/// Parameters, read-only during a run; the body's moving pose is engine state.
+struct BodySpec {
+  /// Name used in outputs (bodies.csv): 1 to kMaxBodyNameLength characters
+  /// among letters, digits, '_', '-' and '.'.
+  std::string name = "body";
+  BodyShape shape = BodyShape::kBox;
+  /// Box only: FULL edge lengths along the body's local X, Y, Z (not half
+  /// extents), metres, each in (0, kMaxBodyDimensionM].
+  Vec3 size_m{0.1, 0.1, 0.1};
+  /// Sphere and cylinder: radius, metres, in (0, kMaxBodyDimensionM].
+  double radius_m = 0.05;
+  /// Cylinder only: full height along the local Y axis, metres, in (0, kMaxBodyDimensionM].
+  double height_m = 0.1;
+  /// Mass, kilograms, >= 0 and finite; 0 makes the body static (it never moves).
+  double mass_kg = 1.0;
+  /// Initial world position of the body's centre (centre of mass), metres.
+  Vec3 position_m{};
+  /// Initial rotation, degrees, extrinsic X then Y then Z (see quat_from_euler_deg).
+  Vec3 rotation_deg{};
+  /// Coulomb friction coefficient, in [0, 10]. The engine combines two
+  /// touching surfaces' coefficients by multiplying them.
+  double friction = 0.6;
+  /// Coefficient of restitution (bounciness), in [0, 1]; combined by multiplying.
+  double restitution = 0.0;
+};
+
+/// Returns an empty string when spec is valid, else a message naming the bad
+/// field, e.g. "radius_m must be > 0, got -1" (the caller adds which body).
+std::string validate(const BodySpec& spec);
+
+/// Checks a list of bodies: each one (validate above) and that names are
+/// unique. Returns an empty string when valid, else a message naming the body
+/// as "bodies[i] (NAME): problem".
+std::string validate(const std::vector<BodySpec>& bodies);
+
+/// The initial orientation of the body: quat_from_euler_deg(spec.rotation_deg).
+Quat initial_orientation(const BodySpec& spec);
+
+/// Half of the body's extent along its local axes, metres: the box's half
+/// sizes, (r, r, r) for a sphere, (r, h/2, r) for a cylinder.
+Vec3 half_extents_m(const BodySpec& spec);
+
+}  // namespace terracut

@@ -1,0 +1,36 @@
+// The `bodies:` list of a scenario file: rigid bodies resting on the terrain.
+//
+//   bodies:
+//     - name: block_a              # optional, default "body<i>"; letters, digits, _ - .
+//       shape: box                 # box | sphere | cylinder (required)
+//       size_m: [0.3, 0.2, 0.3]    # box: FULL edge lengths along local X, Y, Z (required for box)
+//       radius_m: 0.1              # sphere, cylinder (required for them)
+//       height_m: 0.2              # cylinder: full height along its local Y (required)
+//       mass_kg: 20                # required, >= 0; 0 = static
+//       position_m: [1.0, 0.4, 0.6]  # centre, world metres (required)
+//       rotation_deg: [0, 30, 0]   # optional, extrinsic X-Y-Z degrees like keyframes
+//       friction: 0.6              # optional, [0, 10]
+//       restitution: 0.0           # optional, [0, 1]
+//
+// A field that does not belong to the shape (radius_m on a box, size_m on a
+// sphere) is refused, as are unknown keys and repeated names.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "terracut/core/bodies.hpp"
+
+namespace YAML {
+class Node;
+}
+
+namespace terracut::io {
+
+/// Parses the value of a scenario's `bodies:` key (a list of mappings, may be
+/// empty). `file` names the scenario in error messages. Every error is a
+/// terracut::InputError reading "FILE:LINE: bodies[i].field: what is wrong"
+/// (LINE 1-based). The returned list passes terracut::validate(bodies).
+std::vector<BodySpec> parse_bodies(const YAML::Node& node, const std::string& file);
+
+}  // namespace terracut::io

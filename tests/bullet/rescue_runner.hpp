@@ -1,0 +1,82 @@
+// Runs a scenario with rigid bodies end to end, the way `terracut run` will
+// once it drives the Bullet world: load_scenario reads `bodies:` into
+// Scenario::bodies; then a TerrainWorld over the Simulation,
+// world.lift_tool() next to sim.lift(), world.step(out) after each sim.step,
+// and a BodiesCsvWriter for DIR/bodies.csv. Shared by the rescue test and the
+// bullet_rescue_run program.
+#pragma once
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "terracut/bullet/bodies_csv.hpp"
+#include "terracut/bullet/terrain_world.hpp"
+#include "terracut/io/run.hpp"
+#include "terracut/io/scenario.hpp"
+
+namespace terracut::test {
+
+/// What a run with bodies produced, kept in memory for checks.
+struct BodiesRun {
+  std::vector<BodySpec> bodies;
+  std::int64_t steps = 0;
+  std::vector<double> t_s;                   ///< steps + 1 (the initial state first)
+  std::vector<int> sequence_index;           ///< per step + 1 (-1 for the initial state)
+  std::vector<bullet::BodyState> states;     ///< (steps + 1) x bodies, row-major
+  std::vector<Vec3> tool_force_n;            ///< per step + 1
+  std::vector<double> physics_s;             ///< per step: wall time of Bullet's step, seconds
+  bullet::BoundsReport bounds{};
+  std::int64_t csv_rows = 0;
+
+  const bullet::BodyState& state(std::int64_t k, int body) const {
+    return states[std::size_t(k) * bodies.size() + std::size_t(body)];
+  }
+};
+
+/// Runs the scenario's sequence with its bodies; writes out_dir/bodies.csv
+/// when out_dir is not empty.
+inline BodiesRun run_with_bodies(const io::Scenario& sc, const std::filesystem::path& out_dir,
+                                 const bullet::TerrainWorldParams& params = {}) {
+  Simulation sim(io::sim_params(sc), io::build_initial_heights(sc));
+  bullet::TerrainWorld world(sim, sc.bodies, params);
+
+  std::unique_ptr<bullet::BodiesCsvWriter> csv;
+  if (!out_dir.empty()) {
+    std::filesystem::create_directories(out_dir);
+    csv = std::make_unique<bullet::BodiesCsvWriter>(out_dir / "bodies.csv");
+  }
+  BodiesRun run;
+  run.bodies = sc.bodies;
+  auto record = [&](int sequence_index) {
+    run.t_s.push_back(world.time_s());
+    run.sequence_index.push_back(sequence_index);
+    for (int i = 0; i < world.body_count(); ++i) run.states.push_back(world.body_state(i));
+    run.tool_force_n.push_back(world.last().tool_force_n);
+    if (csv) csv->write_step(world);
+  };
+  record(-1);
+  for (std::size_t k = 0; k < sc.sequence.size(); ++k) {
+    const Motion& motion = sc.cuts[std::size_t(sc.sequence[k])];
+    const std::int64_t n = std::llround(motion.duration_s() * sc.rate_hz) + 1;
+    // Each cut is a separate stroke: the blade and its plate jump to its start.
+    sim.lift();
+    world.lift_tool();
+    for (std::int64_t i = 0; i < n; ++i) {
+      const StepOutput& out = sim.step(motion.sample(double(i) / sc.rate_hz));
+      world.step(out);
+      run.physics_s.push_back(world.last().physics_s);
+      record(int(k));
+      ++run.steps;
+    }
+  }
+  run.bounds = world.bounds();
+  if (csv) {
+    run.csv_rows = csv->rows_written();
+    csv->close();
+  }
+  return run;
+}
+
+}  // namespace terracut::test
