@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "bodies_observer.hpp"
 #include "commands.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/io/run.hpp"
@@ -79,6 +80,9 @@ Command add_run_command(CLI::App& app) {
       "  removed.npy   removed material, float32 (rows, cols), m\n"
       "  height.png    final heights, 16-bit grey, pixel = height / full_scale_m\n"
       "  removed.png   removed material, 16-bit grey, pixel = removed / full_scale_m\n"
+      "  bodies.csv    only when the scenario has bodies: one row per body per step,\n"
+      "                t,body,name,x,y,z,qw,qx,qy,qz,vx,vy,vz (SI; Bullet rigid bodies\n"
+      "                on the same terrain; plot with tools/plot_bodies.py DIR)\n"
       "  summary.json  inputs, steps, initial/final/removed volume (m^3), conservation\n"
       "                error, per-cut peak/mean contact and removed volume, and per-step\n"
       "                timing percentiles (us; the only part that differs between runs)\n"
@@ -105,6 +109,12 @@ Command add_run_command(CLI::App& app) {
     run_options.out_dir = opt->out;
     run_options.progress = opt->quiet ? nullptr : &std::cerr;
     run_options.progress_label = "terracut run " + scenario.name;
+    // Rigid bodies: a Bullet world shares the terrain and writes bodies.csv.
+    std::unique_ptr<io::RunObserver> bodies;
+    if (!scenario.bodies.empty()) {
+      bodies = make_bodies_observer(scenario.bodies);
+      run_options.observers.push_back(bodies.get());
+    }
     const io::RunResult result = io::run_scenario(scenario, run_options);
 
     if (!opt->quiet) {

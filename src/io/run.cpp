@@ -71,7 +71,8 @@ class CsvWriter {
 
 // Removes the named outputs from the folder (ignoring ones that do not exist).
 void remove_outputs(const std::filesystem::path& dir) {
-  for (const char* name : kRunOutputFiles) {
+  for (const char* name : {"contact.csv", "height.npy", "removed.npy", "height.png", "removed.png",
+                           "summary.json", "bodies.csv"}) {
     std::error_code ec;
     std::filesystem::remove(dir / name, ec);
   }
@@ -249,6 +250,7 @@ RunResult run_into(const Scenario& sc, const RunOptions& options) {
   cut_s.reserve(std::size_t(total_steps));
   step_s.reserve(std::size_t(total_steps));
 
+  for (RunObserver* o : options.observers) o->start(sim, dir);
   CsvWriter csv(dir / "contact.csv");
   Progress progress(options, total_steps);
   const Clock::time_point loop_start = Clock::now();
@@ -265,9 +267,12 @@ RunResult run_into(const Scenario& sc, const RunOptions& options) {
 
     // Each cut is a separate stroke: nothing is swept from the previous cut's end.
     sim.lift();
+    for (RunObserver* o : options.observers) o->lifted();
     for (std::int64_t i = 0; i < cut_steps[k]; ++i) {
       const BladePose pose = motion.sample(double(i) / sc.rate_hz);
+      for (RunObserver* o : options.observers) o->before_step();
       const StepOutput& out = sim.step(pose);
+      for (RunObserver* o : options.observers) o->stepped(out);
       StepRecord rec;
       rec.t_s = out.t_s;
       rec.cut = cut_index;
@@ -310,7 +315,12 @@ RunResult run_into(const Scenario& sc, const RunOptions& options) {
   write_npy(dir / "removed.npy", grid.removed(), grid.rows(), grid.cols());
   write_png16(dir / "height.png", grid.heights(), grid.cols(), grid.rows(), sc.full_scale_m);
   write_png16(dir / "removed.png", grid.removed(), grid.cols(), grid.rows(), sc.full_scale_m);
-  write_text(dir / "summary.json", summary_json(sc, result).dump(2) + "\n");
+  for (RunObserver* o : options.observers) o->finish();
+  nlohmann::json summary = summary_json(sc, result);
+  for (RunObserver* o : options.observers) {
+    if (!o->summary_key().empty()) summary[o->summary_key()] = nlohmann::json::parse(o->summary_json());
+  }
+  write_text(dir / "summary.json", summary.dump(2) + "\n");
   return result;
 }
 

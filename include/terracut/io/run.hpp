@@ -32,6 +32,28 @@ namespace terracut::io {
 inline constexpr const char* kRunOutputFiles[] = {"contact.csv", "height.npy", "removed.npy",
                                                   "height.png",  "removed.png", "summary.json"};
 
+/// An engine that follows the run step by step (the Bullet world, a
+/// real-time pacer). Its hooks are called on the run's thread, in order:
+/// start once, then per cut lifted and per step before_step / stepped, then
+/// finish, which writes its own files into the output folder.
+class RunObserver {
+ public:
+  virtual ~RunObserver() = default;
+  /// Before the first step; the simulation lives until finish() returns.
+  virtual void start(Simulation& sim, const std::filesystem::path& out_dir) = 0;
+  /// The blade was lifted: the next step starts a new cut.
+  virtual void lifted() {}
+  /// Just before a step.
+  virtual void before_step() {}
+  /// Just after a step.
+  virtual void stepped(const StepOutput& out) = 0;
+  /// After the last step: write files; throw terracut::InputError naming a file on failure.
+  virtual void finish() {}
+  /// Key and JSON object text added to summary.json (empty key: nothing added).
+  virtual std::string summary_key() const { return {}; }
+  virtual std::string summary_json() const { return "{}"; }
+};
+
 /// How to run.
 struct RunOptions {
   /// Output folder; created (with parents) when missing. Output files of the
@@ -46,6 +68,8 @@ struct RunOptions {
   std::string progress_label = "terracut run";
   /// Keep every step's record in RunResult::records (memory ~ 150 bytes/step).
   bool keep_records = false;
+  /// Engines that follow the run (not owned; may be empty).
+  std::vector<RunObserver*> observers;
 };
 
 /// One step: one row of contact.csv.
