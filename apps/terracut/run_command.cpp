@@ -7,6 +7,7 @@
 
 #include "bodies_observer.hpp"
 #include "commands.hpp"
+#include "realtime_observer.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/io/run.hpp"
 #include "terracut/io/scenario.hpp"
@@ -21,6 +22,7 @@ Command add_run_command(CLI::App& app) {
     std::string representation;
     std::string sequence;
     bool quiet = false;
+    bool realtime = false;
   };
   auto opt = std::make_shared<Options>();
 
@@ -54,6 +56,12 @@ Command add_run_command(CLI::App& app) {
                   "repeat), overriding the scenario's sequence. Default: the scenario's\n"
                   "sequence, or its cuts in the order listed")
       ->type_name("A,B,C");
+  sub->add_flag("--realtime", opt->realtime,
+                "Pace the steps to the wall clock at the scenario's rate_hz (absolute\n"
+                "deadlines, sleep then a short spin), as a haptic loop would, and add a\n"
+                "\"realtime\" entry to summary.json: step time and period jitter (p50, p99,\n"
+                "max, us) and the number of missed deadlines, so you can see whether your\n"
+                "terrain and blade fit the budget on this machine. Default: as fast as possible");
   sub->add_flag("--quiet,-q", opt->quiet,
                 "No progress lines on stderr and no summary line on stdout (errors are still\n"
                 "printed)");
@@ -85,7 +93,9 @@ Command add_run_command(CLI::App& app) {
       "                on the same terrain; plot with tools/plot_bodies.py DIR)\n"
       "  summary.json  inputs, steps, initial/final/removed volume (m^3), conservation\n"
       "                error, per-cut peak/mean contact and removed volume, and per-step\n"
-      "                timing percentiles (us; the only part that differs between runs)\n"
+      "                timing percentiles (us; the only part that differs between runs);\n"
+      "                with --realtime also \"realtime\": missed_deadlines, step_time and\n"
+      "                period_jitter {p50_us, p99_us, max_us, mean_us}\n"
       "\n"
       "Progress is printed to stderr about once a second for runs longer than 2 s.\n"
       "Plot a run with: /usr/bin/python3 tools/plot_run.py DIR\n"
@@ -115,6 +125,11 @@ Command add_run_command(CLI::App& app) {
       bodies = make_bodies_observer(scenario.bodies);
       run_options.observers.push_back(bodies.get());
     }
+    std::unique_ptr<io::RunObserver> pacing;
+    if (opt->realtime) {
+      pacing = make_realtime_observer(scenario.rate_hz);
+      run_options.observers.push_back(pacing.get());
+    }
     const io::RunResult result = io::run_scenario(scenario, run_options);
 
     if (!opt->quiet) {
@@ -127,6 +142,7 @@ Command add_run_command(CLI::App& app) {
                     result.max_sample_error_m, result.volume_error_m3,
                     result.step_timing.p99_us, opt->out.c_str());
       std::cout << line;
+      if (pacing) std::cout << "realtime: " << pacing->summary_json() << "\n";
     }
     return kExitOk;
   };

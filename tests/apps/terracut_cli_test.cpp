@@ -190,6 +190,20 @@ cuts:
   EXPECT_NE(slurp(out / "summary.json").find("\"bodies\""), std::string::npos);
 }
 
+// --realtime paces the steps to the wall clock and reports the loop's timing.
+// Only the presence and consistency of the figures is checked: their values
+// depend on the machine's load.
+TEST_F(CliTest, RealtimeRunReportsStepTimeJitterAndMissedDeadlines) {
+  const fs::path out = dir_ / "out";
+  const Result r = terracut({"run", scenario("mound_generator.yaml"), "--out", out.string(),
+                             "--resolution", "16", "--realtime", "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string summary = slurp(out / "summary.json");
+  for (const char* key : {"\"realtime\"", "\"missed_deadlines\"", "\"period_jitter\"",
+                          "\"step_time\"", "\"p50_us\"", "\"p99_us\"", "\"max_us\""})
+    EXPECT_NE(summary.find(key), std::string::npos) << key;
+}
+
 TEST_F(CliTest, RunOptionsOverrideTheScenario) {
   const fs::path out = dir_ / "out";
   const Result r = terracut({"run", scenario("mound_generator.yaml"), "--out", out.string(),
