@@ -151,7 +151,7 @@ def heightmap_figure(out_dir, meta, rep, seq, name, title, compare_seq, show_dif
               (removed, "removed material (m)", "magma", r_range)]
     if show_difference:
         diff = other[0] - height
-        panels.append((diff, f"removed after ({', '.join(compare_seq)}) (m)", "Greens",
+        panels.append((diff, f"removed after ({', '.join(compare_seq)}) by the rest (m)", "Greens",
                        (0.0, max(float(diff.max()), 1e-9))))
     fig, axes = plt.subplots(1, len(panels), figsize=(5.6 * len(panels), 4.8))
     for ax, (data, label, cmap, (lo, hi)) in zip(axes, panels):
