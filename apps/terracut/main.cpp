@@ -6,6 +6,7 @@
 #include <new>
 
 #include "commands.hpp"
+#include "haptics_command.hpp"
 #include "terracut/core/error.hpp"
 
 int main(int argc, char** argv) {
@@ -27,6 +28,7 @@ int main(int argc, char** argv) {
   const terracut::cli::Command run = terracut::cli::add_run_command(app);
   const terracut::cli::Command heightmap = terracut::cli::add_heightmap_command(app);
   const terracut::cli::Command reproduce = terracut::cli::add_reproduce_command(app);
+  const terracut::cli::Command haptics = terracut::cli::add_haptics_command(app);
 
   try {
     app.parse(argc, argv);
@@ -40,6 +42,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("run")) return run();
     if (app.got_subcommand("heightmap")) return heightmap();
     if (app.got_subcommand("reproduce")) return reproduce();
+    if (app.got_subcommand("haptics")) return haptics();
   } catch (const terracut::InputError& e) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
@@ -50,6 +53,6 @@ int main(int argc, char** argv) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
   }
-  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce)\n";
+  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, haptics)\n";
   return 2;
 }

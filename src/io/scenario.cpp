@@ -14,6 +14,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/io/bodies_yaml.hpp"
+#include "terracut/io/haptics_yaml.hpp"
 
 namespace terracut::io {
 namespace {
@@ -453,7 +454,7 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     ctx.fail(YAML::Mark(), "", "the scenario is empty; expected a mapping with 'terrain', "
                                       "'blade' and 'cuts'");
   const Map top(top_field, {"name", "description", "terrain", "representation", "rate_hz", "blade",
-                            "cuts", "sequence", "reference", "bodies"});
+                            "cuts", "sequence", "reference", "bodies", "haptics"});
 
   if (const auto f = top.get("name")) {
     sc.name = f->string();
@@ -515,6 +516,8 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
 
   // Rigid bodies (format in bodies_yaml.hpp); an empty list is allowed.
   if (const auto f = top.get("bodies")) sc.bodies = parse_bodies(f->node(), ctx.file);
+  // The haptic loop's settings (format in haptics_yaml.hpp).
+  if (const auto f = top.get("haptics")) sc.haptics = parse_haptics(f->node(), ctx.file);
 
   if (const auto f = top.get("reference")) {
     const Map reference(*f, {"mound"});

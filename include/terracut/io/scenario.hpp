@@ -16,6 +16,7 @@
 #include "terracut/core/bodies.hpp"
 #include "terracut/core/contact.hpp"
 #include "terracut/core/generators.hpp"
+#include "terracut/core/haptic_settings.hpp"
 #include "terracut/core/grid.hpp"
 #include "terracut/io/image.hpp"
 
@@ -73,6 +74,11 @@ struct Scenario {
   /// terracut/io/bodies_yaml.hpp); empty when not given. The core simulation
   /// ignores them; an engine (the Bullet world) simulates them.
   std::vector<BodySpec> bodies;
+
+  /// Settings of the haptic loop (`haptics:`, format in
+  /// terracut/io/haptics_yaml.hpp); nullopt when not given (the loop then
+  /// uses HapticSettings' defaults). Only `terracut haptics` reads them.
+  std::optional<HapticSettings> haptics;
 
   /// The exact shape the terrain was made from, for error reports
   /// (`reference: mound:`); nullopt when not given.

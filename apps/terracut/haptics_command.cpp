@@ -1,0 +1,225 @@
+// `terracut haptics`: one haptic session, outputs into a folder.
+#include "haptics_command.hpp"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "terracut/core/error.hpp"
+#include "terracut/haptics/session.hpp"
+
+namespace terracut::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Set by SIGINT / SIGTERM while a session runs: the loop stops and the
+// outputs of what ran are written.
+std::atomic<bool> g_interrupt{false};
+extern "C" void on_interrupt(int) { g_interrupt.store(true); }
+
+// Runs a program (no shell); its exit code, or -1 when it could not be run.
+int run_program(const std::vector<std::string>& argv) {
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  std::cout.flush();
+  std::cerr.flush();
+  const pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    execv(args[0], args.data());
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+Command add_haptics_command(CLI::App& app) {
+  struct Options {
+    std::string scenario;
+    std::string out;
+    std::string device;
+    double duration_s = 0.0;
+    std::string clock;
+    bool no_realtime = false;
+    bool no_plot = false;
+    std::string python = "/usr/bin/python3";
+    std::string tools = TERRACUT_TOOLS_DIR;
+    bool quiet = false;
+  };
+  auto opt = std::make_shared<Options>();
+
+  CLI::App* sub = app.add_subcommand(
+      "haptics",
+      "Run the haptic loop on a scenario: a device (scripted, a simulated hand, or a real one\n"
+      "over UDP) drives the blade at the loop rate (default 1 kHz) and feels the cutting force.\n"
+      "Writes the per-tick log, a summary and a force plot into an output folder.");
+  sub->add_option("scenario", opt->scenario,
+                  "Scenario file (YAML) with a `haptics:` section (docs/haptics.md; without one\n"
+                  "the defaults apply)")
+      ->required()
+      ->type_name("SCENARIO.yaml");
+  sub->add_option("--out,-o", opt->out, "Output folder; created if missing, files replaced")
+      ->required()
+      ->type_name("DIR");
+  sub->add_option(
+         "--device,-d", opt->device,
+         "Device backend, overriding haptics.device:\n"
+         "  script          the tool follows the cut's keyframes exactly; forces recorded\n"
+         "  sim             a simulated hand pulled along the cut feels the force\n"
+         "  udp[:ADDR:PORT] a device process over the UDP bridge protocol\n"
+         "                  (docs/bridge-protocol.md); default haptics.udp (127.0.0.1:47000);\n"
+         "                  udp:PORT keeps the address; IPv6 as udp:[::1]:PORT")
+      ->type_name("script|sim|udp[:ADDR:PORT]");
+  sub->add_option("--duration", opt->duration_s,
+                  "Session length in seconds, overriding haptics.duration_s. Default: the cut's\n"
+                  "duration plus haptics.settle_s (script, sim), 30 s (udp)")
+      ->type_name("S")
+      ->check(CLI::Range(1e-6, 86400.0));
+  sub->add_option("--clock", opt->clock,
+                  "'real': the loop runs on its own thread paced by the wall clock (default for\n"
+                  "sim and udp); 'fake': synchronously, no sleeping, t = i / rate, so the same\n"
+                  "scenario gives the same haptics.csv (default for script; not for udp)")
+      ->check(CLI::IsMember({"real", "fake"}))
+      ->type_name("real|fake");
+  sub->add_flag("--no-realtime", opt->no_realtime,
+                "Do not ask for SCHED_FIFO scheduling and locked memory (real clock). By\n"
+                "default they are asked for; where refused, a one-line message says so and the\n"
+                "loop runs at normal priority");
+  sub->add_flag("--no-plot", opt->no_plot, "Do not draw haptics.png");
+  sub->add_option("--python", opt->python,
+                  "Python interpreter for the plot (needs numpy and matplotlib)")
+      ->type_name("PATH")
+      ->capture_default_str();
+  sub->add_option("--tools-dir", opt->tools, "Folder of plot_haptics.py")
+      ->type_name("DIR")
+      ->capture_default_str();
+  sub->add_flag("--quiet,-q", opt->quiet, "No messages except errors and warnings");
+  sub->footer(
+      "Each tick: read the device -> map its workspace to the world (haptics.workspace) ->\n"
+      "set the tool pose -> contact, cut -> force models (haptics.forces) -> safety limiter\n"
+      "(haptics.safety) -> map the force to the device and send it -> record.\n"
+      "\n"
+      "Outputs in DIR:\n"
+      "  haptics.csv   one row per tick (SI units):\n"
+      "                  t, tick                   loop time (s), tick index\n"
+      "                  dev_x,dev_y,dev_z         device handle, device frame, m\n"
+      "                  tool_x..tool_z, qw..qz    tool pose, world (m, unit quaternion)\n"
+      "                  contact_length, cut_depth blade length in soil, depth cut (m)\n"
+      "                  removed_volume            volume cut this tick (m^3)\n"
+      "                  vel_x,vel_y,vel_z         estimated tool velocity, world m/s\n"
+      "                  fw_x,fw_y,fw_z            force models' world force on the tool (N)\n"
+      "                  fd_x,fd_y,fd_z            force sent to the device, device frame (N)\n"
+      "                  clamped,rate_limited,watchdog,ramping,nonfinite  safety flags (0/1)\n"
+      "                  bad_sample,silent,missed_deadline                loop flags (0/1)\n"
+      "                  period, compute           time since the previous tick, compute (s)\n"
+      "  summary.json  settings used, period jitter and compute percentiles (p50, p99, max,\n"
+      "                us), missed deadlines, loop and safety counters, rejected packets by\n"
+      "                reason (udp), device figures, forces, cutting totals, warnings\n"
+      "  haptics.png   force and contact over time (tools/plot_haptics.py)\n"
+      "\n"
+      "Exit codes: 0 done; 1 bad input or failed output; 2 bad command line; 3 outputs\n"
+      "written but the plot could not be made. Ctrl-C ends the session early and still\n"
+      "writes the outputs.\n"
+      "\n"
+      "Examples:\n"
+      "  terracut haptics scenarios/trench_dry_sand.yaml --out out/trench\n"
+      "  terracut haptics scenarios/trench_dry_sand.yaml --device script --out out/trench_script\n"
+      "  terracut haptics scenarios/trench_dry_sand.yaml --device udp:127.0.0.1:47000 \\\n"
+      "      --duration 10 --out out/trench_udp    # then run terracut-device in another shell\n"
+      "Docs: docs/haptics.md (what you feel and why), docs/bridge-protocol.md (the bridge).");
+
+  return [opt]() {
+    haptics::SessionOptions so;
+    if (!opt->device.empty()) {
+      const haptics::DeviceOption d = haptics::parse_device_option(opt->device);
+      so.device = d.kind;
+      so.udp_address = d.address;
+      so.udp_port = d.port;
+    }
+    if (opt->duration_s > 0.0) so.duration_s = opt->duration_s;
+    if (!opt->clock.empty())
+      so.clock = opt->clock == "fake" ? haptics::ClockMode::kFake : haptics::ClockMode::kReal;
+    so.realtime = !opt->no_realtime;
+    so.log = &std::cerr;
+    so.interrupt = &g_interrupt;
+    const auto say = [&](const std::string& line) {
+      if (!opt->quiet) std::cerr << "terracut haptics: " << line << "\n";
+    };
+
+    const haptics::HapticScenario input = haptics::load_haptic_scenario(opt->scenario);
+    haptics::Session session(input, so);
+    if (session.device_kind() == DeviceKind::kUdp)
+      say("waiting for a device on udp " + session.loop().settings().udp.address + ":" +
+          std::to_string(session.udp_port()));
+    char what[160];
+    std::snprintf(what, sizeof what, "running the %s device for %g s (%s clock)",
+                  std::string(to_string(session.device_kind())).c_str(), session.duration_s(),
+                  session.clock() == haptics::ClockMode::kFake ? "fake" : "real");
+    say(what);
+
+    g_interrupt.store(false);
+    struct sigaction action {};
+    struct sigaction old_int {
+    }, old_term{};
+    action.sa_handler = on_interrupt;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &old_int);
+    sigaction(SIGTERM, &action, &old_term);
+    session.run();
+    sigaction(SIGINT, &old_int, nullptr);
+    sigaction(SIGTERM, &old_term, nullptr);
+
+    session.write_outputs(opt->out);
+    // (The real-time line was printed when the loop started.)
+    for (const std::string& w : session.warnings())
+      if (w.rfind("real-time:", 0) != 0) std::cerr << "terracut haptics: warning: " << w << "\n";
+    if (!opt->quiet) std::cout << session.summary_line() << " -> " << opt->out << "\n";
+    if (opt->no_plot) return kExitOk;
+
+    // The plot, by the plot script; a failure leaves the outputs in place.
+    const fs::path script = fs::path(opt->tools) / "plot_haptics.py";
+    std::string problem;
+    if (access(opt->python.c_str(), X_OK) != 0) {
+      problem = "the Python interpreter " + opt->python +
+                " is missing (on Debian: apt-get install python3 python3-matplotlib python3-numpy)";
+    } else if (!fs::exists(script)) {
+      problem = "the plot script " + script.string() + " is missing (use --tools-dir)";
+    } else {
+      std::vector<std::string> argv{opt->python, script.string(), opt->out};
+      if (opt->quiet) argv.push_back("--quiet");
+      const int code = run_program(argv);
+      if (code == 3)
+        problem =
+            "Python modules are missing (on Debian: apt-get install python3-matplotlib "
+            "python3-numpy)";
+      else if (code != 0)
+        problem = "the plot script " + script.string() + " failed (exit code " +
+                  std::to_string(code) + ")";
+    }
+    if (!problem.empty()) {
+      std::cerr << "terracut haptics: error: plot not made: " << problem
+                << "\nThe other outputs are in " << opt->out << "\n";
+      return kExitNoFigures;
+    }
+    say("plot: " + (fs::path(opt->out) / "haptics.png").string());
+    return kExitOk;
+  };
+}
+
+}  // namespace terracut::cli

@@ -1,0 +1,299 @@
+// Settings of a haptic session: the `haptics:` section of a scenario file as
+// plain data (the YAML reader is terracut/io/haptics_yaml.hpp). Read-only
+// during a run; validated once by validate(HapticSettings) and by the objects
+// built from it (ForceModel, SafetyLimiter, the haptic loop).
+//
+// Frames. The world frame is right-handed with Y up (ground plane X-Z). A
+// haptic device reports positions in its own frame; terracut uses CHAI3D's
+// convention for it (DEPENDENCIES.md): origin at the workspace centre,
+// x toward the operator, y to the operator's right, z up, metres. With
+// yaw_deg = 0 the operator stands on the +Z side of the scene looking along
+// -Z (as an OpenGL camera does), so
+//
+//   device x (toward operator) -> world +Z
+//   device y (right)           -> world +X
+//   device z (up)              -> world +Y
+//
+// i.e. world = offset + scale * Ry(yaw) * P * device, with P the cyclic
+// permutation (x, y, z) -> (y, z, x) written out above and Ry(yaw) a rotation
+// of yaw_deg about world +Y (positive turns +X toward -Z). Forces go back
+// the other way: device force = P^T * Ry(yaw)^T * (device-newton force along
+// world axes). The scale applies to positions only; forces are scaled by
+// ForceModelParams::force_scale.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "terracut/core/forces.hpp"
+#include "terracut/core/math.hpp"
+#include "terracut/core/safety.hpp"
+
+namespace terracut {
+
+/// Which device drives the tool.
+enum class DeviceKind {
+  kScript,  ///< the tool follows the scenario's cut keyframes exactly
+  kSim,     ///< a simulated operator hand pulled along the cut's path; feels the force
+  kUdp,     ///< an external device process over the UDP bridge protocol
+};
+/// "script", "sim" or "udp".
+std::string_view to_string(DeviceKind kind);
+/// Inverse of to_string; nullopt for anything else.
+std::optional<DeviceKind> parse_device_kind(std::string_view name);
+
+/// Mapping between the device's workspace and the world (see the file comment).
+struct WorkspaceMapping {
+  /// World metres per device metre, finite, > 0. A Novint Falcon's workspace
+  /// has a radius of about 0.04 m, so 12 maps it to about +-0.5 m of world.
+  double scale = 10.0;
+  /// World position of the device's workspace centre (device origin), metres, finite.
+  Vec3 offset_m{};
+  /// Where the operator faces: rotation of the device frame about world +Y,
+  /// degrees, finite, in [-360, 360]. 0: operator looks along world -Z.
+  double yaw_deg = 0.0;
+};
+
+/// Where the surface (proxy) model holds the tool point.
+enum class SurfaceReference {
+  /// The rigid ground under the soil (world y = terrain origin y): the blade
+  /// cuts soil, and the proxy spring stops it at the floor it cannot cut.
+  /// The default, because the blade removes whatever it passes through.
+  kGround,
+  /// The terrain surface after the step's cut (surface_y_m at the tool point).
+  /// While a blade advances at depth d, the uncut sample just ahead of it
+  /// lifts this surface by up to d above the blade (a sawtooth of period one
+  /// cell), so use it to feel shapes, not while cutting deep.
+  kTerrain,
+};
+/// "ground" or "terrain".
+std::string_view to_string(SurfaceReference reference);
+std::optional<SurfaceReference> parse_surface_reference(std::string_view name);
+
+/// How the loop measures the cut depth d given to the earthmoving model.
+enum class CutDepthMeasure {
+  /// The material depth ahead of the edge along its horizontal motion
+  /// (terracut/haptics/cut_depth.hpp): steady for a steady cut. The default.
+  kAhead,
+  /// ContactResult::section_area_m2 / length_m at the edge. On the surface
+  /// representation it falls to nearly zero once per cell crossed (the
+  /// samples behind the edge are already cut): a sawtooth force.
+  kSection,
+};
+/// "ahead" or "section".
+std::string_view to_string(CutDepthMeasure measure);
+std::optional<CutDepthMeasure> parse_cut_depth_measure(std::string_view name);
+
+/// The simulated operator hand of the `sim` device: a point mass held by the
+/// device, pulled by a spring-damper toward a target that moves along the
+/// cut's path; the rendered force acts on it. Device units and frame.
+struct SimHandParams {
+  /// Mass of the hand plus the device's moving parts, kg, finite, > 0.
+  double mass_kg = 0.15;
+  /// Stiffness of the arm pulling the hand toward the target, N/m, finite, > 0.
+  double stiffness_n_per_m = 400.0;
+  /// Damping of the arm relative to the target's velocity, N s/m, finite, >= 0.
+  double damping_n_s_per_m = 8.0;
+  /// Integration sub-steps per loop period (semi-implicit Euler; the force
+  /// is held over the period, as a device driver does), in [1, 1000].
+  int substeps = 20;
+  /// Start position of the hand relative to the path's first point, device
+  /// metres, finite (0: start on the path).
+  Vec3 start_offset_m{};
+};
+
+/// The UDP bridge endpoint (the loop side binds it; terracut-device sends to it).
+struct UdpSettings {
+  /// IPv4 or IPv6 address to bind, text. Default loopback only: a bridge on
+  /// another host is an explicit choice.
+  std::string address = "127.0.0.1";
+  /// UDP port, in [1, 65535].
+  int port = 47000;
+};
+
+/// Everything a haptic session needs besides the scenario's terrain and blade.
+struct HapticSettings {
+  /// Loop rate, Hz, finite, in [10, 10000]. Also the simulation's step rate
+  /// during the session and the rate of the passivity rule
+  /// (forces.loop_rate_hz is set from it).
+  double rate_hz = 1000.0;
+  /// Device backend.
+  DeviceKind device = DeviceKind::kSim;
+  /// Name of the scenario cut whose keyframes the script and sim devices
+  /// follow; empty: the first cut of the scenario's sequence.
+  std::string cut;
+  /// Session length, seconds, finite, > 0, at most 86400; nullopt: the path's
+  /// duration plus settle_s for script and sim, 30 s for udp.
+  std::optional<double> duration_s;
+  /// Extra time after the path's end (script, sim default duration), seconds, finite, >= 0.
+  double settle_s = 0.5;
+  WorkspaceMapping workspace{};
+  /// Fixed tool orientation, Euler degrees (extrinsic X-Y-Z, as keyframes);
+  /// nullopt: the device's orientation when it reports one (script, sim:
+  /// the cut's keyframes; udp: when the bridge sets the orientation flag),
+  /// else the cut's first keyframe.
+  std::optional<Vec3> tool_rotation_deg;
+  /// Cut-off of the first-order low-pass on the backward-difference velocity,
+  /// Hz, finite, >= 0 and below rate_hz / 2; 0 disables the filter.
+  double velocity_cutoff_hz = 100.0;
+  SurfaceReference surface_reference = SurfaceReference::kGround;
+  CutDepthMeasure cut_depth = CutDepthMeasure::kAhead;
+  /// Force models and device limits. forces.workspace_scale and
+  /// forces.loop_rate_hz are derived (from workspace.scale and rate_hz) and
+  /// forces.max_contact_length_m from the blade length when the loop is built.
+  ForceModelParams forces{};
+  /// Safety limits; safety.max_force_n must not exceed forces.device.max_force_n.
+  SafetyParams safety{};
+  SimHandParams hand{};
+  UdpSettings udp{};
+};
+
+// ---------------------------------------------------------------------------
+// Inline definitions (the header is plain data; core has no source file for it)
+// ---------------------------------------------------------------------------
+
+inline std::string_view to_string(DeviceKind kind) {
+  switch (kind) {
+    case DeviceKind::kScript:
+      return "script";
+    case DeviceKind::kSim:
+      return "sim";
+    case DeviceKind::kUdp:
+      return "udp";
+  }
+  return "unknown";
+}
+
+inline std::optional<DeviceKind> parse_device_kind(std::string_view name) {
+  if (name == "script") return DeviceKind::kScript;
+  if (name == "sim") return DeviceKind::kSim;
+  if (name == "udp") return DeviceKind::kUdp;
+  return std::nullopt;
+}
+
+inline std::string_view to_string(SurfaceReference reference) {
+  return reference == SurfaceReference::kGround ? "ground" : "terrain";
+}
+
+inline std::optional<SurfaceReference> parse_surface_reference(std::string_view name) {
+  if (name == "ground") return SurfaceReference::kGround;
+  if (name == "terrain") return SurfaceReference::kTerrain;
+  return std::nullopt;
+}
+
+inline std::string_view to_string(CutDepthMeasure measure) {
+  return measure == CutDepthMeasure::kAhead ? "ahead" : "section";
+}
+
+inline std::optional<CutDepthMeasure> parse_cut_depth_measure(std::string_view name) {
+  if (name == "ahead") return CutDepthMeasure::kAhead;
+  if (name == "section") return CutDepthMeasure::kSection;
+  return std::nullopt;
+}
+
+namespace detail {
+inline std::string haptic_num(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", value);
+  return buffer;
+}
+// "FIELD must be WHAT (got VALUE)" when ok is false, else "".
+inline std::string haptic_check(bool ok, const char* field, const char* what, double value) {
+  if (ok) return {};
+  return std::string(field) + " must be " + what + " (got " + haptic_num(value) + ")";
+}
+}  // namespace detail
+
+/// Returns an empty string when the settings are valid, else a message that
+/// starts with the field's path (e.g. "workspace.scale must be ..."). Checks
+/// every field, including forces and safety (not the device-rendering check,
+/// which the ForceModel constructor makes).
+inline std::string validate(const HapticSettings& s) {
+  using detail::haptic_check;
+  const auto finite = [](double v) { return std::isfinite(v); };
+  std::string m;
+  if (!(m = haptic_check(finite(s.rate_hz) && s.rate_hz >= 10.0 && s.rate_hz <= 10000.0, "rate_hz",
+                         "finite and in [10, 10000]", s.rate_hz))
+           .empty())
+    return m;
+  if (s.device != DeviceKind::kScript && s.device != DeviceKind::kSim &&
+      s.device != DeviceKind::kUdp)
+    return "device must be script, sim or udp";
+  if (s.duration_s &&
+      !(m = haptic_check(finite(*s.duration_s) && *s.duration_s > 0.0 && *s.duration_s <= 86400.0,
+                         "duration_s", "finite and in (0, 86400]", *s.duration_s))
+           .empty())
+    return m;
+  if (!(m = haptic_check(finite(s.settle_s) && s.settle_s >= 0.0 && s.settle_s <= 3600.0,
+                         "settle_s", "finite and in [0, 3600]", s.settle_s))
+           .empty())
+    return m;
+  if (!(m = haptic_check(finite(s.workspace.scale) && s.workspace.scale > 0.0, "workspace.scale",
+                         "finite and > 0", s.workspace.scale))
+           .empty())
+    return m;
+  if (!is_finite(s.workspace.offset_m)) return "workspace.offset_m must be finite";
+  if (!(m = haptic_check(finite(s.workspace.yaw_deg) && std::abs(s.workspace.yaw_deg) <= 360.0,
+                         "workspace.yaw_deg", "finite and in [-360, 360]", s.workspace.yaw_deg))
+           .empty())
+    return m;
+  if (s.tool_rotation_deg && !is_finite(*s.tool_rotation_deg))
+    return "tool.rotation_deg must be finite";
+  if (!(m = haptic_check(finite(s.velocity_cutoff_hz) && s.velocity_cutoff_hz >= 0.0 &&
+                             s.velocity_cutoff_hz < s.rate_hz / 2.0,
+                         "velocity_cutoff_hz", "finite, >= 0 and below rate_hz / 2",
+                         s.velocity_cutoff_hz))
+           .empty())
+    return m;
+  if (s.surface_reference != SurfaceReference::kGround &&
+      s.surface_reference != SurfaceReference::kTerrain)
+    return "surface_reference must be ground or terrain";
+  if (s.cut_depth != CutDepthMeasure::kAhead && s.cut_depth != CutDepthMeasure::kSection)
+    return "cut_depth must be ahead or section";
+  if (std::string f = validate(s.forces); !f.empty()) return "forces." + f;
+  if (std::string f = validate(s.safety); !f.empty()) return "safety." + f;
+  if (s.safety.max_force_n > s.forces.device.max_force_n)
+    return "safety.max_force_n must not exceed forces.device.max_force_n (" +
+           detail::haptic_num(s.safety.max_force_n) + " > " +
+           detail::haptic_num(s.forces.device.max_force_n) + ")";
+  const SimHandParams& h = s.hand;
+  if (!(m = haptic_check(finite(h.mass_kg) && h.mass_kg > 0.0, "hand.mass_kg", "finite and > 0",
+                         h.mass_kg))
+           .empty())
+    return m;
+  if (!(m = haptic_check(finite(h.stiffness_n_per_m) && h.stiffness_n_per_m > 0.0,
+                         "hand.stiffness_n_per_m", "finite and > 0", h.stiffness_n_per_m))
+           .empty())
+    return m;
+  if (!(m = haptic_check(finite(h.damping_n_s_per_m) && h.damping_n_s_per_m >= 0.0,
+                         "hand.damping_n_s_per_m", "finite and >= 0", h.damping_n_s_per_m))
+           .empty())
+    return m;
+  if (!(m = haptic_check(h.substeps >= 1 && h.substeps <= 1000, "hand.substeps", "in [1, 1000]",
+                         h.substeps))
+           .empty())
+    return m;
+  if (!is_finite(h.start_offset_m)) return "hand.start_offset_m must be finite";
+  if (s.udp.address.empty()) return "udp.address must not be empty";
+  if (!(m = haptic_check(s.udp.port >= 1 && s.udp.port <= 65535, "udp.port", "in [1, 65535]",
+                         s.udp.port))
+           .empty())
+    return m;
+  return {};
+}
+
+/// The settings with the derived force fields filled in: forces.workspace_scale
+/// = workspace.scale, forces.loop_rate_hz = rate_hz and
+/// forces.max_contact_length_m = blade_length_m (> 0).
+inline HapticSettings with_derived_fields(HapticSettings settings, double blade_length_m) {
+  settings.forces.workspace_scale = settings.workspace.scale;
+  settings.forces.loop_rate_hz = settings.rate_hz;
+  settings.forces.max_contact_length_m = blade_length_m;
+  return settings;
+}
+
+}  // namespace terracut

@@ -1,0 +1,400 @@
+// The haptic loop (loop.hpp): one tick = step1 (device -> pose -> contact)
+// then step2 (cut -> force -> safety -> device -> record).
+#include "terracut/haptics/loop.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <future>
+#include <numbers>
+#include <stdexcept>
+
+#include "terracut/core/error.hpp"
+#include "terracut/haptics/cut_depth.hpp"
+#include "terracut/haptics/pacer.hpp"
+
+namespace terracut::haptics {
+namespace {
+
+const HapticSettings& checked(const HapticSettings& settings) {
+  if (std::string m = validate(settings); !m.empty()) throw InputError("haptics." + m);
+  return settings;
+}
+
+SimParams at_rate(SimParams sim, double rate_hz) {
+  sim.rate_hz = rate_hz;
+  return sim;
+}
+
+ForceModelParams model_params(const HapticSettings& s) {
+  try {
+    ForceModel probe(s.forces);  // validates and applies the device check
+  } catch (const InputError& e) {
+    throw InputError(std::string("haptics.forces.") + e.what());
+  }
+  return s.forces;
+}
+
+}  // namespace
+
+HapticLoop::HapticLoop(const HapticSettings& settings, const SimParams& sim,
+                       std::vector<float> heights, Quat default_orientation, Device& device,
+                       const LoopOptions& options)
+    : settings_(with_derived_fields(checked(settings), sim.blade.length_m)),
+      device_(device),
+      options_(options),
+      workspace_(settings_.workspace),
+      model_(model_params(settings_)),
+      safety_(settings_.safety),
+      sim_(at_rate(sim, settings_.rate_hz), std::move(heights)),
+      default_orientation_(normalized(default_orientation)) {
+  if (options_.ticks < 1) throw InputError("haptics: the loop needs at least one tick");
+  if (settings_.tool_rotation_deg) {
+    fixed_orientation_ = quat_from_euler_deg(*settings_.tool_rotation_deg);
+    has_fixed_orientation_ = true;
+  }
+  lookahead_m_ = depth_lookahead_m(sim_.grid().spec());
+  if (settings_.velocity_cutoff_hz > 0.0)
+    filter_rc_s_ = 1.0 / (2.0 * std::numbers::pi * settings_.velocity_cutoff_hz);
+  if (options_.snapshot) {
+    const ViewFrame& f = options_.snapshot->front();
+    if (f.cols != sim_.grid().cols() || f.rows != sim_.grid().rows())
+      throw InputError("haptics: the snapshot exchange was built for another grid size");
+  }
+  // Everything a tick touches is allocated here, never during the run.
+  records_.resize(options_.record_capacity);
+}
+
+HapticLoop::~HapticLoop() {
+  request_stop();
+  if (thread_.joinable()) thread_.join();
+}
+
+// ---------------------------------------------------------------------------
+// One tick
+// ---------------------------------------------------------------------------
+
+void HapticLoop::step1(double t_s) noexcept {
+  t_s_ = t_s;
+  tick_flags_ = 0;
+  if (!started_) {
+    started_ = true;
+    device_.start(t_s);
+    safety_.restart(t_s);
+  }
+
+  // Read the device; count a non-finite sample and keep the last good one.
+  DeviceSample fresh = sample_;
+  fresh.reconnected = false;
+  bool bad = false;
+  if (device_.read(t_s, fresh)) {
+    ++counters_.samples;
+    const bool finite =
+        is_finite(fresh.position_m) && (!fresh.has_orientation || is_finite(fresh.orientation));
+    if (finite) {
+      sample_ = fresh;
+      device_position_m_ = fresh.position_m;
+      has_sample_ = true;
+      last_sample_t_s_ = t_s;
+      if (fresh.reconnected) {
+        ++counters_.reconnects;
+        tick_flags_ |= kFlagReconnected;
+        safety_.restart(t_s);
+        has_previous_tool_ = false;  // the handle may be anywhere now
+      }
+    } else {
+      bad = true;
+      ++counters_.bad_samples;
+      tick_flags_ |= kFlagBadSample;
+    }
+  } else {
+    ++counters_.silent_ticks;
+    tick_flags_ |= kFlagSilent;
+  }
+
+  // The tool pose: position from the device, orientation fixed, from the
+  // device, or the default. Without a usable sample (none yet, or a bad one)
+  // the simulation is not stepped: nothing is measured or cut.
+  stepped_ = has_sample_ && !bad;
+  if (!stepped_) {
+    velocity_m_per_s_ = {};
+    has_previous_tool_ = false;  // start the estimate afresh
+    return;
+  }
+  if (tick_flags_ & kFlagReconnected) sim_.lift();  // the handle may be anywhere: no sweep
+  BladePose pose;
+  {
+    pose.position_m = workspace_.to_world(sample_.position_m);
+    if (has_fixed_orientation_)
+      pose.orientation = fixed_orientation_;
+    else if (sample_.has_orientation)
+      pose.orientation = workspace_.orientation_to_world(sample_.orientation);
+    else
+      pose.orientation = default_orientation_;
+  }
+
+  // Velocity: filtered backward difference, updated only on new good samples
+  // (a device slower than the loop does not read as stop-and-go).
+  if (!(tick_flags_ & kFlagSilent)) {
+    if (has_previous_tool_ && t_s > previous_tool_t_s_) {
+      const double dt = t_s - previous_tool_t_s_;
+      const Vec3 raw = (pose.position_m - previous_tool_m_) * (1.0 / dt);
+      const double alpha = filter_rc_s_ > 0.0 ? 1.0 - std::exp(-dt / filter_rc_s_) : 1.0;
+      velocity_m_per_s_ = velocity_m_per_s_ + (raw - velocity_m_per_s_) * alpha;
+    } else {
+      velocity_m_per_s_ = {};
+    }
+    previous_tool_m_ = pose.position_m;
+    previous_tool_t_s_ = t_s;
+    has_previous_tool_ = true;
+  }
+  sim_.begin_step(pose);
+}
+
+const LoopRecord& HapticLoop::step2(double period_s, double compute_s,
+                                    bool missed_deadline) noexcept {
+  const StepOutput& out = stepped_ ? sim_.finish_step() : not_stepped_;
+  const bool usable = stepped_;
+
+  // Force in the world from the contact and the motion.
+  ForceOutput force{};
+  if (usable) {
+    ForceInput in;
+    in.velocity_m_per_s = velocity_m_per_s_;
+    in.contact_length_m = out.contact.length_m;
+    in.cut_depth_m = cut_depth(out);
+    in.edge_direction = out.edge.b - out.edge.a;
+    in.device_point_m = out.pose.position_m;
+    in.surface_y_m = settings_.surface_reference == SurfaceReference::kGround
+                         ? sim_.grid().spec().origin_m.y
+                         : surface_y_m(sim_.grid(), sim_.params().representation,
+                                       out.pose.position_m.x, out.pose.position_m.z);
+    force = model_.compute(in);
+  }
+
+  // Safety: a bad sample or no sample yet asks for zero force (shrinking to
+  // zero is immediate); the watchdog looks at the last good sample's time.
+  const Vec3 request = usable ? force.device_n : Vec3{};
+  const SafetyOutput safe = safety_.update(t_s_, request, last_sample_t_s_);
+  std::uint32_t flags = tick_flags_ | safe.flags.bits();
+  if (missed_deadline) {
+    flags |= kFlagMissedDeadline;
+    ++counters_.missed_deadlines;
+  }
+
+  // To the device frame, and out.
+  DeviceCommand command;
+  command.force_n = workspace_.direction_to_device(safe.force_n);
+  command.flags = flags;
+  command.t_s = t_s_;
+  device_.write(command);
+
+  LoopRecord& r = last_;
+  r.tick = counters_.ticks;
+  r.t_s = t_s_;
+  r.device_position_m = device_position_m_;
+  r.tool = stepped_ ? out.pose : sim_.last().pose;
+  r.contact_length_m = out.contact.length_m;
+  r.cut_depth_m = usable ? cut_depth(out) : 0.0;
+  r.removed_volume_m3 = out.cut.removed_volume_m3;
+  r.velocity_m_per_s = velocity_m_per_s_;
+  r.force_world_n = force.world_n;
+  r.force_device_n = command.force_n;
+  r.flags = flags;
+  r.period_s = period_s;
+  r.compute_s = compute_s;
+  max_device_force_n_ = std::max(max_device_force_n_, length(command.force_n));
+  ++counters_.ticks;
+  record(r);
+
+  // The viewer's picture of this tick.
+  if (options_.snapshot) {
+    SnapshotExchange& x = *options_.snapshot;
+    x.note_changed(out.cut.changed);
+    ViewFrame& f = x.back();
+    f.t_s = t_s_;
+    f.step = out.step;
+    f.pose = out.pose;
+    f.edge = out.edge;
+    f.contact = out.contact;
+    f.device_position_m = out.pose.position_m;
+    f.proxy_position_m = force.surface.in_contact ? force.surface.proxy_m : out.pose.position_m;
+    f.force_world_n = force.world_n;
+    f.force_device_n = command.force_n;
+    f.step_time_s = compute_s;
+    f.period_s = period_s;
+    x.publish(sim_.grid());
+  }
+  return last_;
+}
+
+double HapticLoop::cut_depth(const StepOutput& out) const noexcept {
+  if (out.contact.length_m <= 0.0) return 0.0;
+  if (settings_.cut_depth == CutDepthMeasure::kSection)
+    return out.contact.section_area_m2 / out.contact.length_m;
+  return depth_ahead_m(sim_.grid(), sim_.params().representation, out.edge, velocity_m_per_s_,
+                       lookahead_m_);
+}
+
+void HapticLoop::record(const LoopRecord& r) noexcept {
+  if (records_.empty()) return;
+  if (records_wrapped_) ++counters_.records_dropped;
+  records_[next_record_] = r;
+  if (++next_record_ == records_.size()) {
+    next_record_ = 0;
+    records_wrapped_ = true;
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Running
+// ---------------------------------------------------------------------------
+
+namespace {
+
+// The fake clock of run_deterministic: time moves only when the pacer sleeps,
+// and then exactly to the deadline, so every tick starts on its deadline.
+class FakeClock final : public PacerClock {
+ public:
+  double now_s() override { return now_s_; }
+  void sleep_until(double t_s) override { now_s_ = std::max(now_s_, t_s); }
+  void relax() override {}
+
+ private:
+  double now_s_ = 0.0;
+};
+
+}  // namespace
+
+void HapticLoop::patch_compute(double compute_s) noexcept {
+  last_.compute_s = compute_s;
+  if (!records_.empty())
+    records_[next_record_ == 0 ? records_.size() - 1 : next_record_ - 1].compute_s = compute_s;
+}
+
+// One paced tick of either mode: the pacer's tick gives the loop time and the
+// period; the compute time is measured on `measure` (the pacer's clock in
+// real time; the steady clock with the fake clock, whose time stands still)
+// and handed to the pacer for its statistics.
+void HapticLoop::paced_tick(Pacer& pacer, PacerClock& measure, const Tick& tick, double origin_s,
+                            bool fake) noexcept {
+  const double begin = fake ? measure.now_s() : tick.start_s;
+  const double t = (fake ? tick.deadline_s : tick.start_s) - origin_s;
+  step1(t);
+  // The fake clock's periods are nominal (its deadlines differ from it by rounding only).
+  const double period = tick.index == 0 ? 0.0 : fake ? 1.0 / settings_.rate_hz : tick.period_s;
+  step2(period, measure.now_s() - begin, tick.after_overrun);
+  // step2's own cost belongs to the tick too.
+  const double compute = measure.now_s() - begin;
+  patch_compute(compute);
+  pacer.record_compute(compute);
+}
+
+void HapticLoop::run_deterministic() {
+  realtime_ = {};
+  realtime_.message = "real-time: not used (fake clock)";
+  PacerSettings ps;
+  ps.rate_hz = settings_.rate_hz;
+  ps.spin_s = 0.0;
+  Pacer pacer(ps, std::make_shared<FakeClock>());
+  const std::shared_ptr<PacerClock> measure = steady_pacer_clock();
+  Tick tick = pacer.start();
+  const double origin = tick.deadline_s;
+  for (std::int64_t i = 0; i < options_.ticks; ++i) {
+    if (stop_requested_.load(std::memory_order_relaxed)) break;
+    if (i > 0) tick = pacer.wait_next();
+    paced_tick(pacer, *measure, tick, origin, true);
+  }
+  pacer_stats_ = pacer.stats();
+  device_.stop();
+}
+
+void HapticLoop::start() {
+  if (running_.load() || thread_.joinable())
+    throw std::logic_error("HapticLoop::start: the loop is already running or was not joined");
+  stop_requested_.store(false);
+  running_.store(true, std::memory_order_release);
+  // Wait until the thread has set up its scheduling, so that
+  // realtime_status() may be read as soon as start() returns.
+  std::promise<void> ready;
+  std::future<void> set_up = ready.get_future();
+  thread_ = std::thread([this, &ready] { thread_main(ready); });
+  set_up.wait();
+}
+
+void HapticLoop::join() {
+  if (thread_.joinable()) thread_.join();
+}
+
+void HapticLoop::thread_main(std::promise<void>& ready) {
+  // Real-time scheduling and locked memory for this thread, where permitted.
+  if (options_.realtime) {
+    realtime_ = enable_realtime(options_.realtime_priority, options_.lock_memory);
+  } else {
+    realtime_ = {};
+    realtime_.message = "real-time: not asked (normal scheduling, memory not locked)";
+  }
+  ready.set_value();  // `ready` lives in start(), which returns after this
+  {
+    PacerSettings ps;
+    ps.rate_hz = settings_.rate_hz;
+    const std::shared_ptr<PacerClock> clock =
+        options_.clock ? options_.clock : steady_pacer_clock();
+    Pacer pacer(ps, clock);
+    Tick tick = pacer.start();
+    const double origin = tick.start_s;
+    for (std::int64_t i = 0; i < options_.ticks; ++i) {
+      if (stop_requested_.load(std::memory_order_relaxed)) break;
+      if (i > 0) tick = pacer.wait_next();
+      paced_tick(pacer, *clock, tick, origin, false);
+    }
+    pacer_stats_ = pacer.stats();
+  }
+  device_.stop();
+  release_realtime(realtime_);
+  running_.store(false, std::memory_order_release);
+}
+
+std::vector<LoopRecord> HapticLoop::records() const {
+  std::vector<LoopRecord> out;
+  if (records_.empty()) return out;
+  if (records_wrapped_) {
+    out.insert(out.end(), records_.begin() + std::ptrdiff_t(next_record_), records_.end());
+    out.insert(out.end(), records_.begin(), records_.begin() + std::ptrdiff_t(next_record_));
+  } else {
+    out.insert(out.end(), records_.begin(), records_.begin() + std::ptrdiff_t(next_record_));
+  }
+  return out;
+}
+
+TimePercentiles HapticLoop::percentiles(double LoopRecord::*field, bool deviation) const {
+  const std::vector<LoopRecord> rs = records();
+  std::vector<double> v;
+  v.reserve(rs.size());
+  const double nominal = 1.0 / settings_.rate_hz;
+  // The first tick has no period.
+  for (const LoopRecord& r : rs) {
+    if (field == &LoopRecord::period_s && r.tick == 0) continue;
+    const double x = r.*field;
+    v.push_back((deviation ? std::abs(x - nominal) : x) * 1e6);
+  }
+  TimePercentiles p;
+  if (v.empty()) return p;
+  std::sort(v.begin(), v.end());
+  const auto at = [&](double q) {
+    const std::size_t i = std::min(v.size() - 1, std::size_t(std::ceil(q * double(v.size()))) - 1);
+    return v[i];
+  };
+  p.p50_us = at(0.50);
+  p.p99_us = at(0.99);
+  p.max_us = v.back();
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  p.mean_us = sum / double(v.size());
+  return p;
+}
+
+TimePercentiles HapticLoop::jitter() const { return percentiles(&LoopRecord::period_s, true); }
+TimePercentiles HapticLoop::period() const { return percentiles(&LoopRecord::period_s, false); }
+TimePercentiles HapticLoop::compute() const { return percentiles(&LoopRecord::compute_s, false); }
+
+}  // namespace terracut::haptics

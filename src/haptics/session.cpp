@@ -1,0 +1,466 @@
+// A haptic session: scenario + settings -> device + loop -> run -> outputs.
+#include "terracut/haptics/session.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "terracut/core/error.hpp"
+#include "terracut/haptics/script_device.hpp"
+#include "terracut/haptics/sim_hand.hpp"
+#include "terracut/haptics/udp_device.hpp"
+#include "terracut/io/haptics_yaml.hpp"
+#include "terracut/io/run.hpp"
+
+namespace terracut::haptics {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string fmt(const char* format, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, value);
+  return buffer;
+}
+
+// The cut the script and sim devices follow: the one named in
+// haptics.cut, else the first cut of the scenario's sequence; nullptr when
+// there is no such cut.
+const Motion* find_followed_cut(const io::Scenario& sc, const std::string& name) {
+  if (!name.empty()) {
+    const int index = sc.find_cut(name);
+    return index < 0 ? nullptr : &sc.cuts[std::size_t(index)];
+  }
+  if (!sc.sequence.empty()) return &sc.cuts[std::size_t(sc.sequence.front())];
+  return sc.cuts.empty() ? nullptr : &sc.cuts.front();
+}
+
+// JSON text of a string: quoted, with quotes, backslashes and control
+// characters escaped.
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (const char ch : text) {
+    const unsigned char u = static_cast<unsigned char>(ch);
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (u < 0x20) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof buffer, "\\u%04x", unsigned(u));
+      out += buffer;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+// JSON text of a number; null for NaN or infinity (JSON has neither).
+std::string json_number(double value) {
+  return std::isfinite(value) ? fmt("%.9g", value) : std::string("null");
+}
+
+// {"p50", "p99", "max", "mean"} in microseconds.
+std::string json_percentiles(const TimeStats& s) {
+  return "{\"p50\": " + json_number(s.p50_s * 1e6) + ", \"p99\": " + json_number(s.p99_s * 1e6) +
+         ", \"max\": " + json_number(s.max_s * 1e6) + ", \"mean\": " + json_number(s.mean_s * 1e6) +
+         "}";
+}
+std::string json_percentiles(const TimePercentiles& s) {
+  return "{\"p50\": " + json_number(s.p50_us) + ", \"p99\": " + json_number(s.p99_us) +
+         ", \"max\": " + json_number(s.max_us) + ", \"mean\": " + json_number(s.mean_us) + "}";
+}
+
+void write_text_file(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw InputError(path.string() + ": cannot write the file");
+  out << text;
+  out.flush();
+  if (!out) throw InputError(path.string() + ": cannot write the file (disk full?)");
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// Loading
+// ---------------------------------------------------------------------------
+
+HapticScenario load_haptic_scenario(const fs::path& path) {
+  HapticScenario out;
+  out.scenario = io::load_scenario(path);
+  out.haptics = out.scenario.haptics.value_or(HapticSettings{});
+  return out;
+}
+
+// ---------------------------------------------------------------------------
+// Building
+// ---------------------------------------------------------------------------
+
+Session::Session(const HapticScenario& input, const SessionOptions& options)
+    : source_(input.scenario.source_path), name_(input.scenario.name), options_(options) {
+  const io::Scenario& sc = input.scenario;
+  HapticSettings settings = input.haptics;
+  if (options.device) settings.device = *options.device;
+  if (options.udp_address) settings.udp.address = *options.udp_address;
+  if (options.udp_port) settings.udp.port = *options.udp_port;
+  if (options.duration_s) {
+    if (!(std::isfinite(*options.duration_s) && *options.duration_s > 0.0 &&
+          *options.duration_s <= 86400.0))
+      throw InputError("--duration must be in (0, 86400] seconds, got " +
+                       fmt("%g", *options.duration_s));
+    settings.duration_s = *options.duration_s;
+  }
+  kind_ = settings.device;
+  clock_ =
+      options.clock.value_or(kind_ == DeviceKind::kScript ? ClockMode::kFake : ClockMode::kReal);
+  if (kind_ == DeviceKind::kUdp && clock_ == ClockMode::kFake)
+    throw InputError(
+        "--clock fake cannot be used with the udp device (a real device runs in real time)");
+  // A port of 0 (any free port) is allowed from the command line only.
+  const int port = settings.udp.port;
+  if (port == 0) settings.udp.port = 1;
+  if (std::string m = validate(settings); !m.empty())
+    throw InputError(source_.string() + ": haptics." + m);
+  settings.udp.port = port;
+
+  // The path the script and sim devices follow, and the default orientation.
+  const Motion* cut = find_followed_cut(sc, settings.cut);
+  if (!settings.cut.empty() && !cut)
+    throw InputError(source_.string() + ": haptics.cut: no cut named '" + settings.cut +
+                     "' in the scenario");
+  if (!cut && kind_ != DeviceKind::kUdp)
+    throw InputError(source_.string() + ": haptics.cut: the " + std::string(to_string(kind_)) +
+                     " device follows a cut, and the scenario has none");
+  cut_name_ = cut ? cut->name : "";
+  const Quat default_orientation = cut ? cut->keyframes.front().pose.orientation : Quat{};
+  const double path_s = cut ? cut->duration_s() : 0.0;
+  duration_s_ =
+      settings.duration_s.value_or(kind_ == DeviceKind::kUdp ? 30.0 : path_s + settings.settle_s);
+  if (!(duration_s_ > 0.0))
+    throw InputError(source_.string() +
+                     ": haptics.duration_s: the session would last 0 s (the cut has one keyframe "
+                     "and settle_s is 0); give duration_s or --duration");
+
+  // The device.
+  const Workspace workspace(settings.workspace);
+  switch (kind_) {
+    case DeviceKind::kScript:
+      device_ = std::make_unique<ScriptDevice>(DevicePath(*cut, workspace));
+      break;
+    case DeviceKind::kSim:
+      device_ = std::make_unique<SimHandDevice>(
+          SimHand(settings.hand, settings.forces.device.inherent_damping_n_s_per_m,
+                  DevicePath(*cut, workspace), settings.rate_hz));
+      break;
+    case DeviceKind::kUdp: {
+      auto udp = std::make_unique<UdpDevice>(settings.udp.address, settings.udp.port);
+      settings.udp.port = udp->port();  // the port bound (a free one when 0 was asked)
+      device_ = std::move(udp);
+      break;
+    }
+  }
+  if (settings.udp.port == 0) settings.udp.port = 1;  // not used by script and sim
+
+  // The loop.
+  LoopOptions lo;
+  lo.ticks = std::max<std::int64_t>(1, std::llround(duration_s_ * settings.rate_hz));
+  lo.record_capacity = std::min<std::size_t>(options.max_records, std::size_t(lo.ticks));
+  lo.realtime = options.realtime;
+  lo.snapshot = options.snapshot;
+  try {
+    loop_ = std::make_unique<HapticLoop>(settings, io::sim_params(sc),
+                                         io::build_initial_heights(sc), default_orientation,
+                                         *device_, lo);
+  } catch (const InputError& e) {
+    throw InputError(source_.string() + ": " + e.what());  // e.g. a refused force rendering
+  }
+
+  // What the device check changed, said once at start.
+  const RenderingCheck& rc = loop_->force_model().rendering();
+  const ForceModelParams& used = loop_->force_model().params();
+  if (rc.surface_stiffness_limited)
+    build_warnings_.push_back("forces.surface.stiffness_n_per_m lowered to " +
+                              fmt("%.6g", used.surface.stiffness_n_per_m) + " N/m (world; " +
+                              fmt("%.6g", rc.surface_stiffness_n_per_m) +
+                              " N/m on the device) to stay passive and within the device");
+  if (rc.surface_damping_limited)
+    build_warnings_.push_back("forces.surface.damping_n_s_per_m lowered to " +
+                              fmt("%.6g", used.surface.damping_n_s_per_m) + " N s/m (world; " +
+                              fmt("%.6g", rc.surface_damping_n_s_per_m) + " N s/m on the device)");
+  if (rc.cutting_damping_limited)
+    build_warnings_.push_back(
+        "forces.low_speed_damping_n_s_per_m lowered to " +
+        fmt("%.6g", used.low_speed_damping_n_s_per_m) + " N s/m (world; cutting damping " +
+        fmt("%.6g", rc.cutting_damping_n_s_per_m) + " N s/m on the device, its limit)");
+  if (options.log)
+    for (const std::string& w : build_warnings_)
+      *options.log << "terracut haptics: warning: " << w << "\n";
+}
+
+Session::~Session() = default;
+
+int Session::udp_port() const {
+  const auto* udp = dynamic_cast<const UdpDevice*>(device_.get());
+  return udp ? udp->port() : -1;
+}
+
+// ---------------------------------------------------------------------------
+// Running
+// ---------------------------------------------------------------------------
+
+void Session::run() {
+  const auto begin = std::chrono::steady_clock::now();
+  if (clock_ == ClockMode::kFake) {
+    loop_->run_deterministic();
+  } else {
+    loop_->start();
+    if (options_.log)
+      *options_.log << "terracut haptics: " << loop_->realtime_status().message << "\n";
+    while (loop_->running()) {
+      if (options_.interrupt && options_.interrupt->load(std::memory_order_relaxed)) {
+        interrupted_ = true;
+        loop_->request_stop();
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    loop_->join();
+  }
+  wall_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+}
+
+// ---------------------------------------------------------------------------
+// Outputs
+// ---------------------------------------------------------------------------
+
+std::vector<std::string> Session::warnings() const {
+  std::vector<std::string> w = build_warnings_;
+  const HapticLoop& l = *loop_;
+  const LoopCounters& c = l.counters();
+  const SafetyCounters& s = l.safety().counters();
+  if (clock_ == ClockMode::kReal && !l.realtime_status().fifo)
+    w.push_back(l.realtime_status().message);
+  if (c.bad_samples > 0)
+    w.push_back(std::to_string(c.bad_samples) +
+                " device samples were not finite (ignored, answered with zero force)");
+  if (s.nonfinite > 0)
+    w.push_back(std::to_string(s.nonfinite) + " non-finite forces were replaced by zero");
+  if (c.missed_deadlines > 0)
+    w.push_back(std::to_string(c.missed_deadlines) +
+                " ticks started late: the tick before ran past their deadline (see timing_us)");
+  if (s.watchdog_trips > 0)
+    w.push_back("the watchdog ramped the force to zero " + std::to_string(s.watchdog_trips) +
+                " times (no device sample for more than safety.watchdog_timeout_s, counting the "
+                "wait for the first sample)");
+  if (c.records_dropped > 0)
+    w.push_back(std::to_string(c.records_dropped) +
+                " oldest records were not kept (the session was longer than max_records)");
+  if (kind_ == DeviceKind::kUdp && c.samples == 0)
+    w.push_back("no device sample was received on udp " + l.settings().udp.address + ":" +
+                std::to_string(udp_port()) + " (is the bridge running?)");
+  if (const auto* udp = dynamic_cast<const UdpDevice*>(device_.get()))
+    if (udp->bridge_stats().rejected.total() > 0)
+      w.push_back(std::to_string(udp->bridge_stats().rejected.total()) +
+                  " bridge packets were rejected (see rejected_packets)");
+  if (interrupted_) w.push_back("interrupted before the end of the session");
+  return w;
+}
+
+std::string Session::summary_json() const {
+  const HapticLoop& l = *loop_;
+  const HapticSettings& st = l.settings();
+  const LoopCounters& c = l.counters();
+  const SafetyCounters& s = l.safety().counters();
+  const RenderingCheck& rc = l.force_model().rendering();
+  const ForceModelParams& fp = l.force_model().params();
+  const std::vector<LoopRecord> records = l.records();
+
+  double peak_contact = 0.0, max_world = 0.0, removed = 0.0;
+  std::int64_t in_contact = 0;
+  for (const LoopRecord& r : records) {
+    peak_contact = std::max(peak_contact, r.contact_length_m);
+    max_world = std::max(max_world, length(r.force_world_n));
+    if (r.contact_length_m > 0.0) ++in_contact;
+  }
+  removed = l.simulation().removed_volume_m3();
+
+  std::ostringstream j;
+  j << "{\n";
+  j << "  \"scenario\": " << json_string(name_) << ",\n";
+  j << "  \"source\": " << json_string(source_.string()) << ",\n";
+  j << "  \"device\": " << json_string(std::string(to_string(kind_))) << ",\n";
+  j << "  \"cut\": " << json_string(cut_name_) << ",\n";
+  j << "  \"clock\": " << json_string(clock_ == ClockMode::kFake ? "fake" : "real") << ",\n";
+  j << "  \"rate_hz\": " << json_number(st.rate_hz) << ",\n";
+  j << "  \"duration_s\": " << json_number(duration_s_) << ",\n";
+  j << "  \"ticks\": " << c.ticks << ",\n";
+  j << "  \"wall_s\": " << json_number(wall_s_) << ",\n";
+  j << "  \"realtime\": {\"fifo\": " << (l.realtime_status().fifo ? "true" : "false")
+    << ", \"priority\": " << l.realtime_status().priority
+    << ", \"memory_locked\": " << (l.realtime_status().memory_locked ? "true" : "false")
+    << ", \"message\": " << json_string(l.realtime_status().message) << "},\n";
+  // Timing: the pacer's histograms cover every tick; the period's
+  // percentiles come from the kept records.
+  const LoopStats& ps = l.pacer_stats();
+  j << "  \"timing_us\": {\n";
+  j << "    \"period_jitter\": " << json_percentiles(ps.period_jitter) << ",\n";
+  j << "    \"compute\": " << json_percentiles(ps.compute) << ",\n";
+  j << "    \"wake_latency\": " << json_percentiles(ps.wake_latency) << ",\n";
+  j << "    \"period\": " << json_percentiles(l.period()) << ",\n";
+  j << "    \"missed_deadlines\": " << ps.missed_deadlines << ",\n";
+  j << "    \"skipped_slots\": " << ps.skipped_slots << "\n  },\n";
+  j << "  \"loop\": {\"samples\": " << c.samples << ", \"silent_ticks\": " << c.silent_ticks
+    << ", \"bad_samples\": " << c.bad_samples << ", \"reconnects\": " << c.reconnects
+    << ", \"records_kept\": " << records.size() << ", \"records_dropped\": " << c.records_dropped
+    << "},\n";
+  j << "  \"safety\": {\"samples\": " << s.samples << ", \"clamped\": " << s.clamped
+    << ", \"rate_limited\": " << s.rate_limited << ", \"ramping\": " << s.ramping
+    << ", \"watchdog\": " << s.watchdog << ", \"watchdog_trips\": " << s.watchdog_trips
+    << ", \"nonfinite\": " << s.nonfinite << ", \"restarts\": " << s.restarts << "},\n";
+
+  // Rejected bridge packets by reason (all zero for script and sim).
+  RejectCounts rejected{};
+  const auto* udp = dynamic_cast<const UdpDevice*>(device_.get());
+  if (udp) rejected = udp->bridge_stats().rejected;
+  j << "  \"rejected_packets\": {";
+  for (std::size_t i = 1; i < kRejectReasonCount; ++i)
+    j << (i > 1 ? ", " : "") << json_string(std::string(to_string(static_cast<Reject>(i)))) << ": "
+      << rejected.by_reason[i];
+  j << ", \"total\": " << rejected.total() << "},\n";
+
+  j << "  \"device_stats\": {";
+  const std::vector<DeviceStat> ds = device_->stats();
+  for (std::size_t i = 0; i < ds.size(); ++i)
+    j << (i ? ", " : "") << json_string(ds[i].name) << ": " << json_number(ds[i].value);
+  if (udp) j << (ds.empty() ? "" : ", ") << "\"port\": " << udp->port();
+  j << "},\n";
+
+  j << "  \"forces\": {\"cutting\": " << json_string(std::string(to_string(fp.cutting)))
+    << ", \"surface\": " << (fp.surface_enabled ? "true" : "false")
+    << ", \"surface_reference\": " << json_string(std::string(to_string(st.surface_reference)))
+    << ", \"force_scale\": " << json_number(fp.force_scale)
+    << ", \"workspace_scale\": " << json_number(fp.workspace_scale)
+    << ", \"max_device_force_n\": " << json_number(l.max_device_force_n())
+    << ", \"max_world_force_n\": " << json_number(max_world) << ",\n";
+  j << "    \"rendering\": {\"surface_stiffness_n_per_m\": "
+    << json_number(rc.surface_stiffness_n_per_m)
+    << ", \"surface_damping_n_s_per_m\": " << json_number(rc.surface_damping_n_s_per_m)
+    << ", \"passive_stiffness_n_per_m\": " << json_number(rc.passive_stiffness_n_per_m)
+    << ", \"cutting_damping_n_s_per_m\": " << json_number(rc.cutting_damping_n_s_per_m)
+    << ", \"surface_stiffness_limited\": " << (rc.surface_stiffness_limited ? "true" : "false")
+    << ", \"surface_damping_limited\": " << (rc.surface_damping_limited ? "true" : "false")
+    << ", \"cutting_damping_limited\": " << (rc.cutting_damping_limited ? "true" : "false")
+    << "},\n";
+  j << "    \"safety_limits\": {\"max_force_n\": " << json_number(st.safety.max_force_n)
+    << ", \"max_force_rate_n_per_s\": " << json_number(st.safety.max_force_rate_n_per_s)
+    << ", \"rise_time_s\": " << json_number(st.safety.rise_time_s)
+    << ", \"watchdog_timeout_s\": " << json_number(st.safety.watchdog_timeout_s)
+    << ", \"watchdog_ramp_s\": " << json_number(st.safety.watchdog_ramp_s) << "}},\n";
+  j << "  \"cutting\": {\"removed_volume_m3\": " << json_number(removed)
+    << ", \"peak_contact_m\": " << json_number(peak_contact)
+    << ", \"ticks_in_contact\": " << in_contact << "},\n";
+  const std::vector<std::string> w = warnings();
+  j << "  \"warnings\": [";
+  for (std::size_t i = 0; i < w.size(); ++i) j << (i ? ", " : "") << json_string(w[i]);
+  j << "]\n}\n";
+  return j.str();
+}
+
+void parse_endpoint(std::string_view text, std::string_view option,
+                    std::optional<std::string>& address, std::optional<int>& port) {
+  const auto fail = [&](const std::string& what) -> void {
+    throw InputError(std::string(option) + ": '" + std::string(text) + "': " + what);
+  };
+  std::string_view port_text = text;
+  if (!text.empty() && text.front() == '[') {
+    const std::size_t close = text.find(']');
+    if (close == std::string_view::npos || close + 1 >= text.size() || text[close + 1] != ':')
+      fail("expected [IPV6]:PORT");
+    address = std::string(text.substr(1, close - 1));
+    port_text = text.substr(close + 2);
+  } else if (const std::size_t colon = text.rfind(':'); colon != std::string_view::npos) {
+    address = std::string(text.substr(0, colon));
+    port_text = text.substr(colon + 1);
+    if (address->empty()) fail("the address before ':' is empty");
+  }
+  if (port_text.empty() || port_text.size() > 5 ||
+      !std::all_of(port_text.begin(), port_text.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    fail("the port must be a number in [0, 65535]");
+  const int p = std::stoi(std::string(port_text));
+  if (p > 65535) fail("the port must be a number in [0, 65535]");
+  port = p;
+}
+
+DeviceOption parse_device_option(std::string_view text) {
+  DeviceOption d;
+  const std::string_view head = text.substr(0, text.find(':'));
+  const std::optional<DeviceKind> kind = parse_device_kind(head);
+  if (!kind)
+    throw InputError("--device: unknown device '" + std::string(text) +
+                     "'; allowed: script, sim, udp, udp:PORT, udp:ADDR:PORT");
+  d.kind = *kind;
+  if (head.size() == text.size()) return d;
+  if (d.kind != DeviceKind::kUdp)
+    throw InputError("--device: '" + std::string(text) + "': only udp takes an address");
+  parse_endpoint(text.substr(head.size() + 1), "--device", d.address, d.port);
+  return d;
+}
+
+void write_haptics_csv(std::ostream& out, const std::vector<LoopRecord>& records) {
+  out << kHapticsCsvColumns << "\n";
+  char line[1024];
+  for (const LoopRecord& r : records) {
+    const auto bit = [&](std::uint32_t b) { return (r.flags & b) ? 1 : 0; };
+    std::snprintf(
+        line, sizeof line,
+        "%.9g,%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
+        "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%d,%d,%d,%d,%.9g,%.9g\n",
+        r.t_s, static_cast<long long>(r.tick), r.device_position_m.x, r.device_position_m.y,
+        r.device_position_m.z, r.tool.position_m.x, r.tool.position_m.y, r.tool.position_m.z,
+        r.tool.orientation.w, r.tool.orientation.x, r.tool.orientation.y, r.tool.orientation.z,
+        r.contact_length_m, r.cut_depth_m, r.removed_volume_m3, r.velocity_m_per_s.x,
+        r.velocity_m_per_s.y, r.velocity_m_per_s.z, r.force_world_n.x, r.force_world_n.y,
+        r.force_world_n.z, r.force_device_n.x, r.force_device_n.y, r.force_device_n.z,
+        bit(kFlagClamped), bit(kFlagRateLimited), bit(kFlagWatchdog), bit(kFlagRamping),
+        bit(kFlagNonfinite), bit(kFlagBadSample), bit(kFlagSilent), bit(kFlagMissedDeadline),
+        r.period_s, r.compute_s);
+    out << line;
+  }
+}
+
+void Session::write_outputs(const fs::path& out_dir) const {
+  if (out_dir.empty()) throw InputError("--out: no output folder given");
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec || !fs::is_directory(out_dir))
+    throw InputError(out_dir.string() + ": cannot create the output folder" +
+                     (ec ? " (" + ec.message() + ")" : std::string()));
+  std::ostringstream csv;
+  write_haptics_csv(csv, loop_->records());
+  write_text_file(out_dir / "haptics.csv", csv.str());
+  write_text_file(out_dir / "summary.json", summary_json());
+}
+
+std::string Session::summary_line() const {
+  const HapticLoop& l = *loop_;
+  const LoopStats& ps = l.pacer_stats();
+  const TimeStats& j = ps.period_jitter;
+  const TimeStats& c = ps.compute;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "%s: %s device, %lld ticks at %g Hz (%s clock), period jitter p50 %.1f us p99 "
+                "%.1f us max %.1f us, compute p50 %.1f us p99 %.1f us, %lld missed deadlines, "
+                "max device force %.3g N, removed %.4g m^3",
+                name_.c_str(), std::string(to_string(kind_)).c_str(),
+                static_cast<long long>(l.counters().ticks), l.settings().rate_hz,
+                clock_ == ClockMode::kFake ? "fake" : "real", j.p50_s * 1e6, j.p99_s * 1e6,
+                j.max_s * 1e6, c.p50_s * 1e6, c.p99_s * 1e6,
+                static_cast<long long>(ps.missed_deadlines), l.max_device_force_n(),
+                l.simulation().removed_volume_m3());
+  return line;
+}
+
+}  // namespace terracut::haptics

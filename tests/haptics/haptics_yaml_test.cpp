@@ -1,0 +1,213 @@
+// The `haptics:` section reader: defaults, every block, units (degrees in the
+// file, radians in the structs) and errors that name the file, line and field.
+#include "terracut/io/haptics_yaml.hpp"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+#include "terracut/core/error.hpp"
+
+namespace terracut::io {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+HapticSettings parse(const std::string& text) {
+  const YAML::Node root = YAML::Load(text);
+  return parse_haptics(root["haptics"], "test.yaml");
+}
+
+// The message of the InputError that parsing text throws ("" if none).
+std::string error_of(const std::string& text) {
+  try {
+    parse(text);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(HapticsYaml, EmptySectionGivesTheDefaults) {
+  const HapticSettings s = parse("haptics:\n");
+  const HapticSettings d;
+  EXPECT_EQ(s.rate_hz, d.rate_hz);
+  EXPECT_EQ(s.device, DeviceKind::kSim);
+  EXPECT_EQ(s.safety.max_force_n, d.forces.device.max_force_n);
+  EXPECT_EQ(s.forces.cutting, d.forces.cutting);
+  EXPECT_EQ(s.udp.address, "127.0.0.1");
+  EXPECT_FALSE(s.duration_s.has_value());
+  EXPECT_FALSE(s.tool_rotation_deg.has_value());
+  EXPECT_EQ(validate(s), "");
+}
+
+TEST(HapticsYaml, ReadsEveryBlock) {
+  const HapticSettings s = parse(R"(
+haptics:
+  rate_hz: 500
+  device: udp
+  cut: pass2
+  duration_s: 12.5
+  settle_s: 0.25
+  workspace: {scale: 12, offset_m: [0.5, 0.1, -0.2], yaw_deg: -90}
+  tool: {rotation_deg: [0, 30, 0]}
+  velocity_cutoff_hz: 50
+  surface_reference: terrain
+  forces:
+    cutting: earthmoving
+    force_scale: 0.01
+    low_speed_damping_n_s_per_m: 80
+    project_width_on_motion: false
+    policy: refuse
+    contact_drag: {drag_n_per_m: 300, viscous_n_s_per_m2: 2}
+    earthmoving:
+      soil: {preset: clay, cohesion_pa: 5000, internal_friction_deg: 20}
+      rake_angle_deg: 60
+    surface: {enabled: false, stiffness_n_per_m: 9000, damping_n_s_per_m: 3}
+    device: {max_force_n: 6, max_stiffness_n_per_m: 2000, max_damping_n_s_per_m: 10,
+             inherent_damping_n_s_per_m: 2}
+  safety: {max_force_rate_n_per_s: 500, rise_time_s: 0, watchdog_timeout_s: 0.1,
+           watchdog_ramp_s: 0.2}
+  hand: {mass_kg: 0.3, stiffness_n_per_m: 250, damping_n_s_per_m: 4, substeps: 10,
+         start_offset_m: [0, 0.01, 0]}
+  udp: {address: "::1", port: 50001}
+)");
+  EXPECT_EQ(s.rate_hz, 500.0);
+  EXPECT_EQ(s.device, DeviceKind::kUdp);
+  EXPECT_EQ(s.cut, "pass2");
+  EXPECT_EQ(*s.duration_s, 12.5);
+  EXPECT_EQ(s.settle_s, 0.25);
+  EXPECT_EQ(s.workspace.scale, 12.0);
+  EXPECT_EQ(s.workspace.offset_m.z, -0.2);
+  EXPECT_EQ(s.workspace.yaw_deg, -90.0);
+  EXPECT_EQ(s.tool_rotation_deg->y, 30.0);
+  EXPECT_EQ(s.velocity_cutoff_hz, 50.0);
+  EXPECT_EQ(s.surface_reference, SurfaceReference::kTerrain);
+  EXPECT_EQ(s.forces.cutting, CuttingModel::kEarthmoving);
+  EXPECT_EQ(s.forces.force_scale, 0.01);
+  EXPECT_EQ(s.forces.low_speed_damping_n_s_per_m, 80.0);
+  EXPECT_FALSE(s.forces.project_width_on_motion);
+  EXPECT_EQ(s.forces.policy, LimitPolicy::kRefuse);
+  EXPECT_EQ(s.forces.contact_drag.drag_n_per_m, 300.0);
+  EXPECT_EQ(s.forces.contact_drag.viscous_n_s_per_m2, 2.0);
+  // The clay preset with two fields replaced; angles converted to radians.
+  const SoilParams clay = soil_preset(SoilPreset::kClay);
+  EXPECT_EQ(s.forces.earthmoving.soil.unit_weight_n_per_m3, clay.unit_weight_n_per_m3);
+  EXPECT_EQ(s.forces.earthmoving.soil.adhesion_pa, clay.adhesion_pa);
+  EXPECT_EQ(s.forces.earthmoving.soil.cohesion_pa, 5000.0);
+  EXPECT_NEAR(s.forces.earthmoving.soil.internal_friction_rad, 20 * kDeg, 1e-15);
+  EXPECT_NEAR(s.forces.earthmoving.rake_angle_rad, 60 * kDeg, 1e-15);
+  EXPECT_FALSE(s.forces.surface_enabled);
+  EXPECT_EQ(s.forces.surface.stiffness_n_per_m, 9000.0);
+  EXPECT_EQ(s.forces.device.max_force_n, 6.0);
+  EXPECT_EQ(s.forces.device.inherent_damping_n_s_per_m, 2.0);
+  // safety.max_force_n follows the device's maximum when not given.
+  EXPECT_EQ(s.safety.max_force_n, 6.0);
+  EXPECT_EQ(s.safety.rise_time_s, 0.0);
+  EXPECT_EQ(s.safety.watchdog_ramp_s, 0.2);
+  EXPECT_EQ(s.hand.mass_kg, 0.3);
+  EXPECT_EQ(s.hand.substeps, 10);
+  EXPECT_EQ(s.hand.start_offset_m.y, 0.01);
+  EXPECT_EQ(s.udp.address, "::1");
+  EXPECT_EQ(s.udp.port, 50001);
+}
+
+TEST(HapticsYaml, SoilPresetByName) {
+  const HapticSettings s = parse("haptics:\n  forces:\n    earthmoving:\n      soil: loose_sand\n");
+  const SoilParams loose = soil_preset(SoilPreset::kLooseSand);
+  EXPECT_EQ(s.forces.earthmoving.soil.cohesion_pa, loose.cohesion_pa);
+  EXPECT_EQ(s.forces.earthmoving.soil.internal_friction_rad, loose.internal_friction_rad);
+}
+
+TEST(HapticsYaml, ErrorsNameFileLineAndField) {
+  // Unknown key, at its own line.
+  EXPECT_EQ(error_of("haptics:\n  rate_hz: 1000\n  rat_hz: 3\n")
+                .rfind("test.yaml:3: haptics.rat_hz: unknown key 'rat_hz'", 0),
+            0u);
+  // Wrong type.
+  EXPECT_NE(error_of("haptics:\n  workspace:\n    scale: big\n")
+                .find("test.yaml:3: haptics.workspace.scale: expected a number, got 'big'"),
+            std::string::npos);
+  // A list of the wrong length.
+  EXPECT_NE(error_of("haptics:\n  workspace: {offset_m: [1, 2]}\n")
+                .find("haptics.workspace.offset_m: expected a list of 3 numbers"),
+            std::string::npos);
+  // Unknown enumerated values list the allowed ones.
+  EXPECT_NE(
+      error_of("haptics:\n  device: falcon\n")
+          .find("test.yaml:2: haptics.device: unknown value 'falcon'; allowed: script, sim, udp"),
+      std::string::npos);
+  EXPECT_NE(error_of("haptics:\n  forces: {earthmoving: {soil: peat}}\n")
+                .find("allowed: dry_sand, loose_sand, clay"),
+            std::string::npos);
+  // Out of range (found by validate), reported at the field's line.
+  EXPECT_NE(error_of("haptics:\n  hand:\n    mass_kg: 0.1\n    stiffness_n_per_m: -5\n")
+                .find("test.yaml:4: haptics.hand.stiffness_n_per_m: must be finite and > 0"),
+            std::string::npos);
+  EXPECT_NE(error_of("haptics:\n  rate_hz: 5\n").find("test.yaml:2: haptics.rate_hz: must be"),
+            std::string::npos);
+  // Nested force fields keep their path; radians are named as degrees.
+  EXPECT_NE(
+      error_of("haptics:\n  forces:\n    earthmoving:\n      soil:\n        "
+               "internal_friction_deg: 95\n")
+          .find("test.yaml:5: haptics.forces.earthmoving.soil.internal_friction_deg: must be"),
+      std::string::npos);
+  // safety.max_force_n above the device's maximum.
+  EXPECT_NE(error_of("haptics:\n  safety: {max_force_n: 9}\n")
+                .find("haptics.safety.max_force_n: must not exceed forces.device.max_force_n"),
+            std::string::npos);
+  // A repeated key.
+  EXPECT_NE(error_of("haptics:\n  rate_hz: 1000\n  rate_hz: 500\n").find("key given twice"),
+            std::string::npos);
+  // Not a mapping.
+  EXPECT_NE(error_of("haptics: [1, 2]\n").find("haptics: expected a mapping"), std::string::npos);
+  // A fraction where a whole number is needed.
+  EXPECT_NE(error_of("haptics:\n  hand: {substeps: 2.5}\n").find("expected a whole number"),
+            std::string::npos);
+  EXPECT_NE(error_of("haptics:\n  forces: {project_width_on_motion: maybe}\n")
+                .find("expected true or false"),
+            std::string::npos);
+}
+
+TEST(HapticsYaml, LoadHapticsReadsTheTrenchScenario) {
+  const HapticSettings s =
+      load_haptics(std::filesystem::path(TERRACUT_SOURCE_DIR) / "scenarios/trench_dry_sand.yaml");
+  EXPECT_EQ(s.device, DeviceKind::kSim);
+  EXPECT_EQ(s.cut, "trench");
+  EXPECT_EQ(s.forces.cutting, CuttingModel::kEarthmoving);
+  EXPECT_EQ(s.forces.policy, LimitPolicy::kRefuse);
+  EXPECT_EQ(s.workspace.scale, 15.0);
+  EXPECT_EQ(validate(s), "");
+}
+
+TEST(HapticsYaml, LoadHapticsErrors) {
+  const auto dir = std::filesystem::temp_directory_path() / "terracut_haptics_yaml_test";
+  std::filesystem::create_directories(dir);
+  // No haptics key: the defaults.
+  {
+    std::ofstream(dir / "none.yaml") << "name: x\n";
+    EXPECT_EQ(load_haptics(dir / "none.yaml").rate_hz, 1000.0);
+  }
+  // Malformed YAML: the file and line.
+  {
+    std::ofstream(dir / "bad.yaml") << "name: x\nhaptics: {rate_hz: [\n";
+    try {
+      load_haptics(dir / "bad.yaml");
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.yaml:"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("not valid YAML"), std::string::npos) << e.what();
+    }
+  }
+  // A missing file.
+  EXPECT_THROW(load_haptics(dir / "missing.yaml"), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace terracut::io

@@ -1,0 +1,456 @@
+// The haptic loop in deterministic mode (fake clock, no sleeping): the trench
+// scenario with the script and sim devices, bad and missing samples, the
+// closed loop's energy, unsafe stiffness, the loop's statistics and the
+// viewer feed.
+#include "terracut/haptics/loop.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+
+#include "haptics_fixture.hpp"
+#include "terracut/core/error.hpp"
+#include "terracut/haptics/script_device.hpp"
+#include "terracut/haptics/sim_hand.hpp"
+#include "terracut/io/run.hpp"
+
+namespace terracut::haptics {
+namespace {
+
+using test::trench;
+
+// A loop on the trench scenario with the given device and settings.
+std::unique_ptr<HapticLoop> trench_loop(const HapticSettings& settings, Device& device,
+                                        std::int64_t ticks, SnapshotExchange* snapshot = nullptr) {
+  const io::Scenario& sc = trench().scenario;
+  LoopOptions o;
+  o.ticks = ticks;
+  o.record_capacity = std::size_t(ticks);
+  o.realtime = false;
+  o.snapshot = snapshot;
+  return std::make_unique<HapticLoop>(settings, io::sim_params(sc), io::build_initial_heights(sc),
+                                      sc.cuts[0].keyframes[0].pose.orientation, device, o);
+}
+
+const Motion& trench_cut() { return trench().scenario.cuts[0]; }
+
+DevicePath trench_path(const HapticSettings& s) {
+  return DevicePath(trench_cut(), Workspace(s.workspace));
+}
+
+std::int64_t ticks_of(const HapticSettings& s) {
+  return std::llround((trench_cut().duration_s() + s.settle_s) * s.rate_hz);
+}
+
+TEST(HapticLoop, ScriptTrenchForcesFollowTheContact) {
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice device(trench_path(s));
+  auto loop = trench_loop(s, device, ticks_of(s));
+  loop->run_deterministic();
+  const std::vector<LoopRecord> rs = loop->records();
+  ASSERT_EQ(std::int64_t(rs.size()), ticks_of(s));
+
+  const SoilParams soil = s.forces.earthmoving.soil;
+  const double cell = 2.0 / 100;  // the scenario's cell size, metres
+  int cutting = 0, outside = 0;
+  for (const LoopRecord& r : rs) {
+    // Never more than the Falcon's maximum.
+    ASSERT_LE(length(r.force_device_n), s.safety.max_force_n * (1 + 1e-12)) << r.t_s;
+    if (r.contact_length_m == 0.0 && r.tool.position_m.y > 0.0) {
+      // Out of the soil and above the floor: exactly no force.
+      ++outside;
+      EXPECT_EQ(length(r.force_world_n), 0.0) << r.t_s;
+      EXPECT_EQ(length(r.force_device_n), 0.0) << r.t_s;
+    }
+    // Steady cutting along -Z at 1 m/s, 8 cm deep, after the soft start.
+    if (r.t_s > 1.8 && r.t_s < 2.6) {
+      ++cutting;
+      EXPECT_NEAR(r.contact_length_m, 0.4, 1e-9) << r.t_s;    // the whole blade is in the sand
+      EXPECT_NEAR(r.cut_depth_m, 0.08, 0.5 * cell) << r.t_s;  // sand at 0.3, edge at 0.22
+      EXPECT_NEAR(r.velocity_m_per_s.z, -1.0, 1e-6) << r.t_s;
+      // The soil resists the motion (+Z on the tool) and lifts the vertical
+      // plate (McKyes: V < 0 for alpha = 90 deg): the FEE at this width and depth.
+      EarthmovingParams ep;
+      ep.soil = soil;
+      ep.rake_angle_rad = s.forces.earthmoving.rake_angle_rad;
+      const EarthmovingResult fee = earthmoving_force(ep, 0.4, r.cut_depth_m);
+      EXPECT_GT(fee.horizontal_n, 0.0);
+      EXPECT_NEAR(r.force_world_n.z, fee.horizontal_n, 1e-6 * fee.horizontal_n) << r.t_s;
+      EXPECT_NEAR(r.force_world_n.y, -fee.vertical_n, 1e-6 * fee.horizontal_n) << r.t_s;
+      EXPECT_NEAR(r.force_world_n.x, 0.0, 1e-9);
+      // On the device: scaled by force_scale and turned into the device frame
+      // (world +Z is "toward the operator", device +x; world +Y is device +z).
+      if (r.flags == 0) {
+        EXPECT_NEAR(r.force_device_n.x, r.force_world_n.z * s.forces.force_scale, 1e-9);
+        EXPECT_NEAR(r.force_device_n.z, r.force_world_n.y * s.forces.force_scale, 1e-9);
+        EXPECT_NEAR(r.force_device_n.y, r.force_world_n.x * s.forces.force_scale, 1e-9);
+      }
+    }
+  }
+  EXPECT_GT(outside, 1000);
+  EXPECT_EQ(cutting, 799);
+
+  // The trench: the region below the sand that the edge swept, times the
+  // blade's width: a 1.2 m x 8 cm floor plus two triangles where the blade
+  // goes in and out (each 0.092 m x 8 cm / 2). A cell's worth at each end.
+  const double area = 1.2 * 0.08 + 2 * 0.5 * (0.15 * 0.08 / 0.13) * 0.08;
+  EXPECT_NEAR(loop->simulation().removed_volume_m3(), 0.4 * area, 0.4 * 2 * cell * 0.08);
+  EXPECT_EQ(loop->counters().bad_samples, 0);
+  EXPECT_EQ(loop->safety().counters().nonfinite, 0);
+}
+
+TEST(HapticLoop, DeterministicRunsAreIdentical) {
+  for (DeviceKind kind : {DeviceKind::kScript, DeviceKind::kSim}) {
+    std::vector<LoopRecord> runs[2];
+    for (auto& out : runs) {
+      const HapticSettings& s = trench().haptics;
+      std::unique_ptr<Device> device;
+      if (kind == DeviceKind::kScript)
+        device = std::make_unique<ScriptDevice>(trench_path(s));
+      else
+        device = std::make_unique<SimHandDevice>(
+            SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, trench_path(s), s.rate_hz));
+      auto loop = trench_loop(s, *device, 3000);
+      loop->run_deterministic();
+      out = loop->records();
+      for (LoopRecord& r : out) r.compute_s = 0.0;  // the one measured field
+    }
+    ASSERT_EQ(runs[0].size(), runs[1].size());
+    EXPECT_EQ(std::memcmp(runs[0].data(), runs[1].data(), runs[0].size() * sizeof(LoopRecord)), 0)
+        << to_string(kind);
+  }
+}
+
+TEST(HapticLoop, BadSampleIsCountedAndAnsweredWithZeroForce) {
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice script(trench_path(s));
+  // Five NaN positions in the middle of the cut (t = 2.0 s), where the force is up.
+  test::FaultyDevice device(
+      script, [](std::int64_t tick) { return tick >= 2000 && tick < 2005; }, nullptr);
+  const std::int64_t ticks = ticks_of(s);
+  auto loop = trench_loop(s, device, ticks);
+  loop->run_deterministic();
+  const std::vector<LoopRecord> rs = loop->records();
+  EXPECT_EQ(loop->counters().ticks, ticks);  // the loop went on
+  EXPECT_EQ(loop->counters().bad_samples, 5);
+  EXPECT_GT(length(rs[1999].force_device_n), 0.5);
+  for (int i = 2000; i < 2005; ++i) {
+    EXPECT_TRUE(rs[std::size_t(i)].flags & kFlagBadSample) << i;
+    EXPECT_EQ(length(rs[std::size_t(i)].force_device_n), 0.0) << i;
+    EXPECT_EQ(rs[std::size_t(i)].contact_length_m, 0.0) << i;
+  }
+  // The force comes back within the rate limit's build-up time.
+  const double rebuild_s = rs[1999].force_device_n.x / s.safety.max_force_rate_n_per_s;
+  const std::size_t back = 2005 + std::size_t(std::ceil(rebuild_s * s.rate_hz)) + 2;
+  EXPECT_NEAR(length(rs[back].force_device_n), length(rs[1999].force_device_n),
+              0.05 * length(rs[1999].force_device_n));
+  EXPECT_EQ(device.commands.size(), std::size_t(ticks));
+}
+
+TEST(HapticLoop, SilentDeviceTripsTheWatchdogAndSoftStartsOnReturn) {
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice script(trench_path(s));
+  // Silent for 300 ms from t = 2.0 s (mid-cut).
+  test::FaultyDevice device(script, nullptr,
+                            [](std::int64_t tick) { return tick >= 2000 && tick < 2300; });
+  auto loop = trench_loop(s, device, ticks_of(s));
+  loop->run_deterministic();
+  const std::vector<LoopRecord> rs = loop->records();
+  const double f0 = length(rs[1999].force_device_n);
+  ASSERT_GT(f0, 0.5);
+  const int timeout = int(std::lround(s.safety.watchdog_timeout_s * s.rate_hz));
+  const int ramp = int(std::lround(s.safety.watchdog_ramp_s * s.rate_hz));
+  // Before the timeout the last force is held; after it, ramped to zero.
+  EXPECT_FALSE(rs[std::size_t(1999 + timeout)].flags & kFlagWatchdog);
+  EXPECT_TRUE(rs[std::size_t(2001 + timeout)].flags & kFlagWatchdog);
+  EXPECT_EQ(length(rs[std::size_t(2002 + timeout + ramp)].force_device_n), 0.0);
+  for (int i = 2002 + timeout + ramp; i < 2300; ++i)
+    EXPECT_EQ(length(rs[std::size_t(i)].force_device_n), 0.0) << i;
+  EXPECT_EQ(loop->safety().counters().watchdog_trips, 1);
+  // The device is back: a new soft start.
+  EXPECT_TRUE(rs[2301].flags & kFlagRamping);
+  EXPECT_EQ(loop->counters().silent_ticks, 300);
+}
+
+// The closed loop with the simulated hand along the trench: it digs, the
+// force stays within the device, and the hand's motion about its target
+// stays within what the rendered force can explain (no instability).
+TEST(HapticLoop, SimHandTrenchStaysBoundedAndDigs) {
+  const HapticSettings& s = trench().haptics;
+  SimHandDevice device(
+      SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, trench_path(s), s.rate_hz));
+  auto loop = trench_loop(s, device, ticks_of(s));
+  loop->run_deterministic();
+  const std::vector<LoopRecord> rs = loop->records();
+
+  double max_force = 0.0;
+  int cutting_with_force = 0, cutting = 0;
+  for (const LoopRecord& r : rs) {
+    max_force = std::max(max_force, length(r.force_device_n));
+    if (r.contact_length_m > 0.2 && r.t_s > 1.8 && r.t_s < 2.6) {
+      ++cutting;
+      if (r.force_device_n.x > 0.1) ++cutting_with_force;  // resists the push along -x
+    }
+    if (r.contact_length_m == 0.0 && r.tool.position_m.y > 0.0) {
+      EXPECT_EQ(length(r.force_device_n), 0.0) << r.t_s;
+    }
+  }
+  EXPECT_LE(max_force, s.safety.max_force_n);
+  EXPECT_GT(cutting, 700);
+  EXPECT_EQ(cutting_with_force, cutting);
+  EXPECT_GT(loop->simulation().removed_volume_m3(), 0.02);
+
+  // Bound on |x - x_t|: e obeys m e'' + (c + b) e' + k e = F - b v_t - m a_t.
+  // The bounded input |F - b v_t| <= G moves e by at most G ||h||_1 with
+  // ||h||_1 = coth(zeta pi / (2 sqrt(1 - zeta^2))) / k (underdamped impulse
+  // response); each keyframe's velocity jump dv adds at most |dv| / omega_d.
+  const SimHandParams& h = s.hand;
+  const double b = s.forces.device.inherent_damping_n_s_per_m;
+  const double wn = std::sqrt(h.stiffness_n_per_m / h.mass_kg);
+  const double zeta =
+      (h.damping_n_s_per_m + b) / (2.0 * std::sqrt(h.stiffness_n_per_m * h.mass_kg));
+  ASSERT_LT(zeta, 1.0);
+  const double wd = wn * std::sqrt(1.0 - zeta * zeta);
+  const double l1 = 1.0 /
+                    std::tanh(zeta * std::numbers::pi / (2.0 * std::sqrt(1.0 - zeta * zeta))) /
+                    h.stiffness_n_per_m;
+  const DevicePath path = trench_path(s);
+  double jumps = 0.0;
+  const auto& k = trench_cut().keyframes;
+  for (std::size_t i = 0; i < k.size(); ++i) {
+    const Vec3 before = i > 0 ? path.velocity_m_per_s(k[i].t_s - 1e-9) : Vec3{};
+    const Vec3 after = path.velocity_m_per_s(k[i].t_s);
+    jumps += length(after - before);
+  }
+  const double g = max_force + b * path.max_speed_m_per_s();
+  const double bound = g * l1 + jumps / wd;
+  const SimHand& hand = device.hand();
+  EXPECT_LT(hand.max_tracking_error_m(), bound);
+  // The cutting force did slow the hand: it lags by at least the force / k.
+  EXPECT_GT(hand.max_tracking_error_m(), 0.5 / h.stiffness_n_per_m);
+  // After the path ends (out of the sand, no force) the hand settles onto
+  // its target: the error decays at least as exp(-sigma t).
+  const double sigma = zeta * wn;
+  EXPECT_LT(length(hand.position_m() - hand.target_m()), bound * std::exp(-sigma * s.settle_s));
+}
+
+// A hand held still, pulled 2 mm (device) below the rigid floor of an empty
+// terrain: total energy (hand kinetic + arm spring + floor spring) never
+// rises above its starting value, with the safety limiter in the chain.
+double holding_energy(const SimHand& hand, const HapticLoop& loop) {
+  const double k_floor = loop.force_model().rendering().surface_stiffness_n_per_m;
+  const double ws = loop.settings().workspace.scale;
+  const double ground = loop.simulation().grid().spec().origin_m.y;
+  const double y = loop.workspace().to_world(hand.position_m()).y;
+  const double pen_device = std::max(0.0, ground - y) / ws;
+  return hand.tracking_energy_j() + 0.5 * k_floor * pen_device * pen_device;
+}
+
+struct HoldResult {
+  double start_j = 0.0;
+  double max_j = 0.0;
+  double end_j = 0.0;
+  double max_force_n = 0.0;
+};
+
+HoldResult hold_against_floor(HapticSettings s, double floor_stiffness_world) {
+  s.forces.surface.stiffness_n_per_m = floor_stiffness_world;
+  s.safety.rise_time_s = 0.0;  // a fixed wall (a rising stiffness is not)
+  s.hand.start_offset_m = {0.0, 0.0, 0.012};
+  // An empty terrain: only the floor.
+  io::Scenario sc = trench().scenario;
+  sc.generator->plane.height_m = 0.0;
+  Motion hold;
+  hold.name = "hold";
+  hold.keyframes = {{0.0, {{0.0, -0.03, 0.0}, Quat{}}}};  // 2 mm below the floor, on the device
+  const DevicePath path(hold, Workspace(s.workspace));
+  SimHandDevice device(
+      SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, path, s.rate_hz));
+  LoopOptions o;
+  o.ticks = 2000;
+  o.realtime = false;
+  HapticLoop loop(s, io::sim_params(sc), io::build_initial_heights(sc), Quat{}, device, o);
+  HoldResult r;
+  for (std::int64_t i = 0; i < o.ticks; ++i) {
+    loop.step1(double(i) / s.rate_hz);
+    const double e = holding_energy(device.hand(), loop);
+    if (i == 0) r.start_j = e;
+    r.max_j = std::max(r.max_j, e);
+    r.end_j = e;
+    r.max_force_n = std::max(r.max_force_n, length(loop.step2(0.001, 0.0, false).force_device_n));
+  }
+  return r;
+}
+
+TEST(HapticLoop, HandHeldAgainstTheFloorNeverGainsEnergy) {
+  HapticSettings s = trench().haptics;
+  const HoldResult r = hold_against_floor(s, s.forces.surface.stiffness_n_per_m);
+  EXPECT_GT(r.max_force_n, 0.5);  // the floor pushed back
+  EXPECT_LE(r.max_j, r.start_j);
+  EXPECT_LT(r.end_j, 0.5 * r.start_j);
+}
+
+TEST(HapticLoop, UnsafeStiffnessIsRefusedOrLimited) {
+  HapticSettings s = trench().haptics;
+  // 2e6 N/m in the world is 75 000 N/m on the device: far above the
+  // Falcon's 3000 N/m and the passivity bound 2 (b - |B|) / T = 2400 N/m.
+  s.forces.policy = LimitPolicy::kRefuse;
+  s.forces.surface.stiffness_n_per_m = 2e6;
+  ScriptDevice device(trench_path(s));
+  try {
+    trench_loop(s, device, 10);
+    ADD_FAILURE() << "an unsafe stiffness was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("haptics.forces.surface.stiffness_n_per_m"),
+              std::string::npos)
+        << e.what();
+  }
+  // With clamp the stiffness is lowered to the bound, and the closed loop
+  // still never gains energy.
+  s.forces.policy = LimitPolicy::kClamp;
+  auto loop = trench_loop(s, device, 10);
+  const RenderingCheck& rc = loop->force_model().rendering();
+  EXPECT_TRUE(rc.surface_stiffness_limited);
+  EXPECT_LE(rc.surface_stiffness_n_per_m, rc.passive_stiffness_n_per_m);
+  const HoldResult r = hold_against_floor(s, 2e6);
+  EXPECT_LE(r.max_j, r.start_j);
+}
+
+TEST(HapticLoop, StatisticsFromTheTickTimes) {
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice device(trench_path(s));
+  auto loop = trench_loop(s, device, 1000);
+  // A fake clock: 989 periods exactly nominal, 10 late by 500 us; compute
+  // times 100 us, except one of 700 us; three missed deadlines.
+  const double T = 1.0 / s.rate_hz;
+  for (int i = 0; i < 1000; ++i) {
+    loop->step1(i * T);
+    const double period = i == 0 ? 0.0 : (i % 100 == 50 ? T + 500e-6 : T);
+    loop->step2(period, i == 400 ? 700e-6 : 100e-6, i == 10 || i == 20 || i == 30);
+  }
+  const TimePercentiles j = loop->jitter();
+  EXPECT_NEAR(j.p50_us, 0.0, 1e-6);
+  // 999 periods, 10 of them late: the 99th percentile (nearest rank 990) is late.
+  EXPECT_NEAR(j.p99_us, 500.0, 1e-6);
+  EXPECT_NEAR(j.max_us, 500.0, 1e-6);
+  EXPECT_NEAR(j.mean_us, 10 * 500.0 / 999, 1e-6);
+  const TimePercentiles p = loop->period();
+  EXPECT_NEAR(p.p50_us, 1000.0, 1e-6);
+  const TimePercentiles c = loop->compute();
+  EXPECT_NEAR(c.p50_us, 100.0, 1e-6);
+  EXPECT_NEAR(c.p99_us, 100.0, 1e-6);
+  EXPECT_NEAR(c.max_us, 700.0, 1e-6);
+  EXPECT_EQ(loop->counters().missed_deadlines, 3);
+  EXPECT_TRUE(loop->records()[20].flags & kFlagMissedDeadline);
+}
+
+// A fake clock for the threaded loop: time moves when the pacer sleeps or
+// spins, and when the device below "computes".
+class TestClock final : public PacerClock {
+ public:
+  double now_s() override { return now_s_; }
+  void sleep_until(double t_s) override { now_s_ = std::max(now_s_, t_s); }
+  void relax() override { now_s_ += 1e-6; }
+  void advance(double dt_s) { now_s_ += dt_s; }
+
+ private:
+  double now_s_ = 100.0;
+};
+
+// A device that takes 200 us of (fake) time per read, and 2.5 ms on tick 50.
+class SlowDevice final : public Device {
+ public:
+  SlowDevice(Device& inner, TestClock& clock) : inner_(inner), clock_(clock) {}
+  std::string_view kind() const override { return inner_.kind(); }
+  void start(double t_s) override { inner_.start(t_s); }
+  bool read(double t_s, DeviceSample& out) noexcept override {
+    clock_.advance(reads_++ == 50 ? 2.5e-3 : 200e-6);
+    return inner_.read(t_s, out);
+  }
+  void write(const DeviceCommand& command) noexcept override { inner_.write(command); }
+
+ private:
+  Device& inner_;
+  TestClock& clock_;
+  std::int64_t reads_ = 0;
+};
+
+// The threaded loop paced by the Pacer on a fake clock: the overrun of tick
+// 50 makes tick 51 start late, counted once, and the compute times are the
+// fake ones.
+TEST(HapticLoop, PacedLoopStatisticsWithAFakeClock) {
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice script(trench_path(s));
+  auto clock = std::make_shared<TestClock>();
+  SlowDevice device(script, *clock);
+  const io::Scenario& sc = trench().scenario;
+  LoopOptions o;
+  o.ticks = 300;
+  o.record_capacity = 300;
+  o.realtime = false;
+  o.clock = clock;
+  HapticLoop loop(s, io::sim_params(sc), io::build_initial_heights(sc), Quat{}, device, o);
+  loop.start();
+  loop.join();
+  EXPECT_FALSE(loop.running());
+  EXPECT_EQ(loop.counters().ticks, 300);
+  EXPECT_EQ(loop.counters().missed_deadlines, 1);
+  const std::vector<LoopRecord> rs = loop.records();
+  EXPECT_TRUE(rs[51].flags & kFlagMissedDeadline);
+  EXPECT_FALSE(rs[50].flags & kFlagMissedDeadline);
+  // Tick 51 started when tick 50's work ended, 2.5 ms after tick 50 began.
+  EXPECT_NEAR(rs[51].t_s - rs[50].t_s, 2.5e-3, 1e-9);
+  EXPECT_NEAR(rs[51].period_s, 2.5e-3, 1e-9);
+  EXPECT_NEAR(rs[40].period_s, 1e-3, 1e-9);
+  EXPECT_NEAR(rs[40].compute_s, 200e-6, 1e-9);
+  const LoopStats& ps = loop.pacer_stats();
+  EXPECT_EQ(ps.ticks, 299);  // ticks ended by a wait: all but the last
+  EXPECT_EQ(ps.missed_deadlines, 1);
+  // Histogram percentiles: never below the value, at most 1/64 above it.
+  EXPECT_GE(ps.compute.p50_s, 200e-6 - 1e-9);
+  EXPECT_LE(ps.compute.p50_s, 200e-6 * (1 + 1.0 / 64) + 1e-9);
+  EXPECT_NEAR(ps.compute.max_s, 2.5e-3, 1e-8);
+  EXPECT_NEAR(ps.period_jitter.max_s, 1.5e-3, 1e-8);
+  EXPECT_LT(ps.period_jitter.p50_s, 2e-6);
+}
+
+TEST(HapticLoop, RecordsKeepTheNewestWhenFull) {
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice device(trench_path(s));
+  const io::Scenario& sc = trench().scenario;
+  LoopOptions o;
+  o.ticks = 250;
+  o.record_capacity = 100;
+  o.realtime = false;
+  HapticLoop loop(s, io::sim_params(sc), io::build_initial_heights(sc), Quat{}, device, o);
+  loop.run_deterministic();
+  const std::vector<LoopRecord> rs = loop.records();
+  ASSERT_EQ(rs.size(), 100u);
+  EXPECT_EQ(rs.front().tick, 150);
+  EXPECT_EQ(rs.back().tick, 249);
+  EXPECT_EQ(loop.counters().records_dropped, 150);
+}
+
+TEST(HapticLoop, FeedsTheViewerSnapshot) {
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice device(trench_path(s));
+  const io::Scenario& sc = trench().scenario;
+  const Simulation probe(io::sim_params(sc), io::build_initial_heights(sc));
+  SnapshotExchange exchange(probe.grid());
+  auto loop = trench_loop(s, device, 2200, &exchange);
+  loop->run_deterministic();
+  const ViewFrame* f = exchange.acquire();
+  ASSERT_NE(f, nullptr);
+  EXPECT_EQ(f->sequence, 2200u);
+  EXPECT_EQ(f->step, loop->simulation().last().step);
+  EXPECT_EQ(f->pose.position_m.z, loop->last().tool.position_m.z);
+  EXPECT_EQ(f->force_device_n.x, loop->last().force_device_n.x);
+  const HeightGrid& g = loop->simulation().grid();
+  EXPECT_TRUE(std::equal(f->heights.begin(), f->heights.end(), g.heights()));
+}
+
+}  // namespace
+}  // namespace terracut::haptics

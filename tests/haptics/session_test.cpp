@@ -1,0 +1,173 @@
+// Sessions: scenario loading (with the haptics section hidden from the
+// scenario loader, line numbers kept), --device parsing, outputs.
+#include "terracut/haptics/session.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "haptics_fixture.hpp"
+#include "terracut/core/error.hpp"
+
+namespace terracut::haptics {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("terracut_session_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(Session, LoadsTheTrenchScenario) {
+  const HapticScenario& s = test::trench();
+  EXPECT_EQ(s.scenario.name, "trench_dry_sand");
+  ASSERT_EQ(s.scenario.cuts.size(), 1u);
+  EXPECT_EQ(s.scenario.cuts[0].name, "trench");
+  EXPECT_EQ(s.haptics.device, DeviceKind::kSim);
+  EXPECT_EQ(s.haptics.forces.cutting, CuttingModel::kEarthmoving);
+}
+
+TEST(Session, ScenarioErrorsAfterTheHapticsSectionKeepTheirLine) {
+  const fs::path dir = scratch("lines");
+  // An unknown top-level key after the haptics section (the file's last block).
+  std::string text = read(test::trench_path()) + "blade_extra: 1\n";
+  std::ofstream(dir / "broken.yaml") << text;
+  const int line = int(std::count(text.begin(), text.end(), '\n'));
+  const std::string e = error_of([&] { load_haptic_scenario(dir / "broken.yaml"); });
+  EXPECT_NE(e.find("broken.yaml:" + std::to_string(line) + ":"), std::string::npos) << e;
+  EXPECT_NE(e.find("blade_extra"), std::string::npos) << e;
+  // An error inside the haptics section names it, at its line.
+  std::string bad = read(test::trench_path());
+  const std::size_t at = bad.find("    scale: 15");
+  bad.replace(at, 13, "    scale: -1");
+  std::ofstream(dir / "bad_scale.yaml") << bad;
+  const int scale_line = int(std::count(bad.begin(), bad.begin() + std::ptrdiff_t(at), '\n')) + 1;
+  const std::string e2 = error_of([&] { load_haptic_scenario(dir / "bad_scale.yaml"); });
+  EXPECT_NE(e2.find("bad_scale.yaml:" + std::to_string(scale_line) + ": haptics.workspace.scale"),
+            std::string::npos)
+      << e2;
+  fs::remove_all(dir);
+}
+
+TEST(Session, DeviceOption) {
+  EXPECT_EQ(parse_device_option("script").kind, DeviceKind::kScript);
+  EXPECT_EQ(parse_device_option("sim").kind, DeviceKind::kSim);
+  const DeviceOption u = parse_device_option("udp");
+  EXPECT_EQ(u.kind, DeviceKind::kUdp);
+  EXPECT_FALSE(u.address && u.port);
+  const DeviceOption a = parse_device_option("udp:127.0.0.1:47001");
+  EXPECT_EQ(*a.address, "127.0.0.1");
+  EXPECT_EQ(*a.port, 47001);
+  const DeviceOption p = parse_device_option("udp:47002");
+  EXPECT_FALSE(p.address);
+  EXPECT_EQ(*p.port, 47002);
+  const DeviceOption v6 = parse_device_option("udp:[::1]:9");
+  EXPECT_EQ(*v6.address, "::1");
+  EXPECT_EQ(*v6.port, 9);
+  for (const char* bad : {"falcon", "sim:1", "udp:", "udp:1.2.3.4:", "udp:1.2.3.4:70000",
+                          "udp:[::1]", "udp::5", "udp:host:x1"})
+    EXPECT_NE(error_of([&] { parse_device_option(bad); }).find("--device"), std::string::npos)
+        << bad;
+}
+
+TEST(Session, RefusesWhatCannotRun) {
+  const HapticScenario& in = test::trench();
+  SessionOptions o;
+  o.device = DeviceKind::kUdp;
+  o.clock = ClockMode::kFake;
+  EXPECT_NE(error_of([&] { Session s(in, o); }).find("--clock fake"), std::string::npos);
+  HapticScenario other = in;
+  other.haptics.cut = "no_such_cut";
+  EXPECT_NE(error_of([&] { Session s(other, SessionOptions{}); }).find("haptics.cut: no cut named"),
+            std::string::npos);
+  SessionOptions d;
+  d.duration_s = -1.0;
+  EXPECT_NE(error_of([&] { Session s(in, d); }).find("--duration"), std::string::npos);
+}
+
+TEST(Session, ScriptSessionWritesConsistentOutputs) {
+  SessionOptions o;
+  o.device = DeviceKind::kScript;
+  Session session(test::trench(), o);
+  EXPECT_EQ(session.clock(), ClockMode::kFake);
+  session.run();
+  const fs::path dir = scratch("outputs");
+  session.write_outputs(dir);
+
+  // haptics.csv: the documented header and one row per tick.
+  std::ifstream csv(dir / "haptics.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header, kHapticsCsvColumns);
+  const int columns = int(std::count(header.begin(), header.end(), ',')) + 1;
+  int rows = 0, clamped = 0, rate_limited = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    ASSERT_EQ(int(std::count(line.begin(), line.end(), ',')) + 1, columns) << line;
+    // Columns 25 and 26 are clamped and rate_limited.
+    std::stringstream ss(line);
+    std::string cell;
+    for (int c = 0; std::getline(ss, cell, ','); ++c) {
+      if (c == 24) clamped += cell == "1";
+      if (c == 25) rate_limited += cell == "1";
+    }
+  }
+  const double duration =
+      test::trench().scenario.cuts[0].duration_s() + test::trench().haptics.settle_s;
+  EXPECT_EQ(rows, std::lround(duration * 1000.0));
+
+  // summary.json agrees with the log and the loop.
+  const nlohmann::json j = nlohmann::json::parse(read(dir / "summary.json"));
+  EXPECT_EQ(j["device"], "script");
+  EXPECT_EQ(j["clock"], "fake");
+  EXPECT_EQ(j["ticks"].get<int>(), rows);
+  EXPECT_EQ(j["safety"]["clamped"].get<int>(), clamped);
+  EXPECT_EQ(j["safety"]["rate_limited"].get<int>(), rate_limited);
+  EXPECT_EQ(j["rejected_packets"]["total"].get<int>(), 0);
+  EXPECT_EQ(j["timing_us"]["missed_deadlines"].get<int>(), 0);
+  EXPECT_NEAR(j["timing_us"]["period"]["p50"].get<double>(), 1000.0, 1e-9);
+  EXPECT_GT(j["cutting"]["removed_volume_m3"].get<double>(), 0.0);
+  EXPECT_LE(j["forces"]["max_device_force_n"].get<double>(), 8.0);
+  EXPECT_GT(j["forces"]["max_device_force_n"].get<double>(), 0.5);
+  EXPECT_TRUE(j["warnings"].is_array());
+  fs::remove_all(dir);
+}
+
+TEST(Session, SimSessionReportsTheHand) {
+  SessionOptions o;
+  o.clock = ClockMode::kFake;
+  Session session(test::trench(), o);
+  session.run();
+  const nlohmann::json j = nlohmann::json::parse(session.summary_json());
+  EXPECT_EQ(j["device"], "sim");
+  EXPECT_LT(j["device_stats"]["hand_rendered_work_j"].get<double>(), 0.0);  // the soil took energy
+  EXPECT_GT(j["device_stats"]["hand_max_tracking_error_m"].get<double>(), 0.0);
+}
+
+}  // namespace
+}  // namespace terracut::haptics
