@@ -1,0 +1,127 @@
+#include "loop_driver.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "terracut/core/error.hpp"
+#include "terracut/io/run.hpp"
+
+namespace terracut::viewer {
+
+HapticSettings viewer_settings(HapticSettings settings) {
+  settings.tool_rotation_deg.reset();
+  return settings;
+}
+
+LoopDriver::LoopDriver(const io::Scenario& scenario, const HapticSettings& settings,
+                       const DriverOptions& options, LoopTiming* timing)
+    : scenario_(scenario),
+      settings_(with_derived_fields(settings, scenario.blade.length_m)),
+      options_(options),
+      spec_(io::grid_spec(scenario)),
+      representation_(scenario.representation),
+      blade_length_m_(scenario.blade.length_m),
+      initial_(io::build_initial_heights(scenario)) {
+  // Transits between cuts rise above everything the blade could touch.
+  float max_h = 0.0f;
+  for (float h : initial_) max_h = std::max(max_h, h);
+  const double extent = std::max(spec_.size_x_m, spec_.size_z_m);
+  const double clearance = spec_.origin_m.y + double(max_h) + 0.5 * blade_length_m_ + 0.05 * extent;
+  const double transit_speed = std::max(0.5 * extent, 0.2);
+  if (options.plough) {
+    tour_ = plough_tour(spec_, double(max_h), blade_length_m_, std::max(0.3 * extent, 0.1), 1000);
+  } else {
+    tour_ = Tour(scenario_, clearance, transit_speed);
+  }
+  script_ticks_ = tour_.empty() ? 0 : std::llround(tour_.duration_s() * settings_.rate_hz) + 1;
+
+  // The tool starts at the script's first pose, or above the middle.
+  BladePose start;
+  if (!tour_.empty()) {
+    start = tour_.sample(0.0);
+  } else {
+    start.position_m = {spec_.origin_m.x + 0.5 * spec_.size_x_m,
+                        spec_.origin_m.y + double(max_h) + 0.1 * extent,
+                        spec_.origin_m.z + 0.5 * spec_.size_z_m};
+  }
+
+  {
+    HeightGrid grid(spec_, initial_);
+    exchange_ = std::make_unique<haptics::SnapshotExchange>(grid);
+  }
+  if (std::string m = validate(settings_); !m.empty()) throw InputError("haptics." + m);
+  device_ = std::make_unique<ViewerDevice>(haptics::Workspace(settings_.workspace), tour_, start,
+                                           settings_.rate_hz, clearance, transit_speed,
+                                           options.paced ? timing : nullptr);
+  device_->set_playing(options.playing);
+  device_->set_speed(options.speed);
+  device_->set_source(options.source);
+  device_->set_pause_at_end(options.pause_at_end);
+
+  haptics::LoopOptions lo;
+  lo.ticks = std::numeric_limits<std::int64_t>::max() / 2;  // until stop()
+  lo.record_capacity = options.record_capacity;
+  lo.realtime = options.realtime;
+  lo.lock_memory = false;  // the viewer's GL driver allocates; locking all memory is not ours to do
+  lo.snapshot = exchange_.get();
+  loop_ = std::make_unique<haptics::HapticLoop>(settings_, io::sim_params(scenario_), initial_,
+                                                start.orientation, *device_, lo);
+
+  // The first frame shows the tool where it starts (the loop is not running
+  // yet, so this thread may write).
+  haptics::ViewFrame& f = exchange_->back();
+  f.pose = start;
+  f.edge = blade_segment(scenario_.blade, start);
+  f.device_position_m = start.position_m;
+  f.proxy_position_m = start.position_m;
+  HeightGrid grid(spec_, initial_);
+  exchange_->publish(grid);
+}
+
+LoopDriver::~LoopDriver() { stop(); }
+
+void LoopDriver::start() {
+  if (started_) return;
+  started_ = true;
+  if (options_.paced) {
+    loop_->start();
+  } else {
+    lockstep_running_.store(true);
+    lockstep_thread_ = std::thread([this] { lockstep_main(); });
+  }
+}
+
+void LoopDriver::stop() {
+  if (!started_) return;
+  if (options_.paced) {
+    loop_->request_stop();
+    loop_->join();
+  } else {
+    lockstep_running_.store(false);
+    if (lockstep_thread_.joinable()) lockstep_thread_.join();
+  }
+  started_ = false;
+}
+
+void LoopDriver::lockstep_main() {
+  using Clock = std::chrono::steady_clock;
+  const double period = 1.0 / settings_.rate_hz;
+  std::int64_t i = 0;
+  while (lockstep_running_.load(std::memory_order_relaxed)) {
+    if (i >= target_ticks_.load()) {
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+      continue;
+    }
+    // Tick i at t = i / rate exactly, as HapticLoop::run_deterministic does.
+    const Clock::time_point begin = Clock::now();
+    loop_->step1(double(i) * period);
+    const double compute = std::chrono::duration<double>(Clock::now() - begin).count();
+    loop_->step2(i == 0 ? 0.0 : period, compute, false);
+    ++i;
+    ticks_done_.store(i);  // after step2 published the tick's frame
+  }
+}
+
+}  // namespace terracut::viewer

@@ -1,0 +1,117 @@
+// The viewer's session with the haptic loop: builds a haptics::HapticLoop
+// over the scenario with the viewer's virtual device (viewer_device.hpp) and
+// a haptics::SnapshotExchange, and runs it on the loop's thread. The drawing
+// thread only acquires frames from the exchange (wait-free) and posts
+// controls and targets to the device (atomics, a wait-free mailbox): it never
+// blocks the loop.
+//
+// Two ways to run:
+//  - paced (the window, the benchmark): HapticLoop::start(), its own thread
+//    at the loop rate with absolute deadlines (and SCHED_FIFO / locked memory
+//    where the system permits);
+//  - lock-step (headless screenshots): a thread of this class ticks the loop
+//    (step1 at t = i / rate, step2), as fast as it can, up to the tick the
+//    drawing thread asks for, then waits; frame k shows exactly the state
+//    after the ticks it asked for, the same on every run.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "terracut/core/haptic_settings.hpp"
+#include "terracut/haptics/loop.hpp"
+#include "terracut/haptics/snapshot.hpp"
+#include "terracut/io/scenario.hpp"
+#include "viewer_device.hpp"
+
+namespace terracut::viewer {
+
+/// How the session runs.
+struct DriverOptions {
+  bool paced = true;                       ///< real time (true) or lock-step (false)
+  ToolSource source = ToolSource::kScript;
+  bool playing = true;                     ///< the device's clock starts running
+  double speed = 1.0;                      ///< device clock per loop second, [0, 16]
+  bool pause_at_end = true;                ///< stop playing when the script ends
+  /// Loop records kept (the newest), for the loop's own percentiles after
+  /// stop(); 0 keeps none.
+  std::size_t record_capacity = 0;
+  bool realtime = true;                    ///< paced: ask for SCHED_FIFO and locked memory
+  /// The script is the benchmark's plough (plough_tour) instead of the
+  /// scenario's cut sequence.
+  bool plough = false;
+};
+
+class LoopDriver {
+ public:
+  /// Throws InputError naming the field when the scenario or settings are
+  /// invalid (the haptic loop's checks, including a refused force rendering).
+  /// timing: where the device records the loop's period and compute time
+  /// (paced mode; may be shared by successive sessions), or nullptr.
+  LoopDriver(const io::Scenario& scenario, const HapticSettings& settings,
+             const DriverOptions& options, LoopTiming* timing);
+  ~LoopDriver();
+  LoopDriver(const LoopDriver&) = delete;
+  LoopDriver& operator=(const LoopDriver&) = delete;
+
+  void start();
+  /// Stops and joins the loop's thread (idempotent); the loop's results
+  /// (loop().period() etc.) may be read afterwards.
+  void stop();
+
+  // --- fixed after construction ---
+  const GridSpec& spec() const { return spec_; }
+  Representation representation() const { return representation_; }
+  double rate_hz() const { return settings_.rate_hz; }
+  double blade_length_m() const { return blade_length_m_; }
+  /// Initial heights, rows x cols, row-major, metres.
+  const std::vector<float>& initial_heights() const { return initial_; }
+  /// The loop's force model (const after construction).
+  const ForceModel& force_model() const { return loop_->force_model(); }
+  const HapticSettings& settings() const { return settings_; }
+  const Tour& tour() const { return tour_; }
+  /// Ticks that play the whole script once: round(duration * rate) + 1.
+  std::int64_t script_ticks() const { return script_ticks_; }
+
+  haptics::SnapshotExchange& exchange() { return *exchange_; }
+  ViewerDevice& device() { return *device_; }
+  /// The loop; its results only after stop().
+  const haptics::HapticLoop& loop() const { return *loop_; }
+
+  /// Lock-step: run until `ticks` ticks are done in all.
+  void run_until_tick(std::int64_t ticks) { target_ticks_.store(ticks); }
+  /// Lock-step: ticks done, counted once the tick's frame is published.
+  std::int64_t ticks_done() const { return ticks_done_.load(); }
+
+ private:
+  void lockstep_main();
+
+  io::Scenario scenario_;  // the Tour points into its cuts
+  HapticSettings settings_;
+  DriverOptions options_;
+  GridSpec spec_;
+  Representation representation_;
+  double blade_length_m_;
+  std::vector<float> initial_;
+  Tour tour_;
+  std::int64_t script_ticks_ = 0;
+  std::unique_ptr<haptics::SnapshotExchange> exchange_;
+  std::unique_ptr<ViewerDevice> device_;
+  std::unique_ptr<haptics::HapticLoop> loop_;
+
+  std::thread lockstep_thread_;
+  std::atomic<bool> lockstep_running_{false};
+  std::atomic<std::int64_t> target_ticks_{0};
+  std::atomic<std::int64_t> ticks_done_{0};
+  bool started_ = false;
+};
+
+/// The haptic settings the viewer uses: the scenario's `haptics:` section (or
+/// the defaults), with a fixed tool rotation dropped (the viewer's device
+/// gives the orientation, so the keys can turn the tool).
+HapticSettings viewer_settings(HapticSettings settings);
+
+}  // namespace terracut::viewer

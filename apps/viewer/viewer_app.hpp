@@ -1,0 +1,146 @@
+// The viewer application: one session (a LoopDriver stepping the simulation
+// on its own thread) drawn by the terrain and shape renderers, with the
+// ImGui panel, either in a GLFW window driven by mouse and keyboard or
+// headless (EGL) for screenshots and benchmarks.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "camera.hpp"
+#include "loop_driver.hpp"
+#include "shape_renderer.hpp"
+#include "terrain_renderer.hpp"
+#include "terracut/haptics/session.hpp"
+#include "terracut/io/scenario.hpp"
+
+struct GLFWwindow;
+
+namespace terracut::viewer {
+
+/// Command-line options of terracut-viewer (see docs/viewer.md).
+struct ViewerOptions {
+  std::filesystem::path input;  ///< a scenario (.yaml/.yml) or a heightmap (.png)
+  std::filesystem::path screenshot;  ///< headless: write the last frame here (PNG)
+  bool headless = false;             ///< render with EGL, no window
+  /// Headless frames to simulate and draw; -1: enough for the whole scripted sequence.
+  int frames = -1;
+  double frame_time_s = 1.0 / 60.0;  ///< headless: simulated seconds per frame, > 0
+  int width = 1280;                  ///< image or window width, pixels
+  int height = 800;                  ///< image or window height, pixels
+  CameraMode camera = CameraMode::kOrbit;
+  /// Orbit camera override: yaw and pitch in degrees, zoom factor on the framing distance.
+  std::optional<std::array<float, 3>> orbit;
+  /// Orbit camera override: the point it turns about, world metres.
+  std::optional<Vec3> look_at;
+  ColorMode color = ColorMode::kHeight;
+  bool contours = true;   ///< height contour lines
+  bool panel = true;      ///< draw the ImGui panel
+  std::optional<Representation> representation;
+  std::optional<io::Resolution> resolution;
+  int benchmark_frames = 0;  ///< > 0: headless benchmark of this many frames
+  bool benchmark_no_draw = false;  ///< benchmark: consume frames at 60/s without drawing (reference)
+  int mesh_max = kDefaultMeshMax;
+  int msaa = 4;              ///< headless multisampling (0: none)
+  int max_fps = 60;          ///< window mode frame cap (0: none)
+  double heightmap_size_m = 1.0;        ///< heightmap input: extent along X and Z, metres
+  double heightmap_full_scale_m = 0.2;  ///< heightmap input: height of white, metres
+  std::filesystem::path font;           ///< TTF for the panel; empty: DejaVu Sans if present
+  bool tool_from_script = false;        ///< window mode: start playing the script (else mouse)
+  bool realtime = true;                 ///< ask for SCHED_FIFO for the loop thread
+};
+
+/// Loads the scenario (and its `haptics:` section) or the heightmap named by
+/// options.input, with the resolution/representation overrides applied.
+/// Throws InputError.
+haptics::HapticScenario load_input(const ViewerOptions& options);
+
+class ViewerApp {
+ public:
+  /// haptic_settings: the scenario's `haptics:` section (viewer_settings() is applied).
+  ViewerApp(ViewerOptions options, io::Scenario scenario, const HapticSettings& haptic_settings);
+  ~ViewerApp();
+  ViewerApp(const ViewerApp&) = delete;
+  ViewerApp& operator=(const ViewerApp&) = delete;
+
+  /// Headless: screenshot and/or benchmark. Returns the exit status
+  /// (kExitNoContext when EGL gives no context).
+  int run_headless();
+  /// A GLFW window (needs a display). Returns the exit status.
+  int run_window();
+
+ private:
+  struct Live;  // the latest frame's scalar fields and the plot histories
+
+  void init_gl_objects();
+  void init_imgui(bool with_glfw, GLFWwindow* window);
+  void shutdown_imgui(bool with_glfw);
+  void open_session(const DriverOptions& driver_options);
+  void close_session();
+  /// Takes the newest published frame (if any), uploads its dirty rectangle
+  /// and records its values; returns whether one was taken.
+  bool consume_frame();
+  void push_history();
+  void render(int fb_width, int fb_height, bool draw_imgui);
+  void draw_scene(int x, int y, int w, int h);
+  void draw_panel(int fb_width, int fb_height);
+  void draw_labels(int x, int y, int w, int h);
+  void apply_model_changes();
+  void reset_session();
+  /// Stops the loop and prints its timing (benchmark).
+  void print_loop_summary();
+  void handle_window_input(GLFWwindow* window, double dt_s);
+  void begin_mouse_drive();
+  float ground_height_at(double x, double z) const;
+
+  ViewerOptions options_;
+  io::Scenario base_scenario_;  // as loaded (overrides applied)
+  io::Scenario scenario_;       // the running session's
+  HapticSettings haptics_;
+  DriverOptions driver_options_;
+  LoopTiming timing_;  // the loop's period and compute time, shared by sessions
+  std::unique_ptr<LoopDriver> driver_;
+  std::unique_ptr<TerrainRenderer> terrain_;
+  std::unique_ptr<ShapeRenderer> shapes_;
+  unsigned background_program_ = 0, background_vao_ = 0;
+  Camera camera_;
+  bool camera_framed_ = false;
+  double framed_size_[2] = {0.0, 0.0};  // extent the camera was framed on, metres
+  TerrainStyle style_;
+  float max_initial_height_m_ = 1.0f;
+  int panel_width_ = 0;
+  bool imgui_ready_ = false;
+  bool reset_requested_ = false;
+
+  std::unique_ptr<Live> live_;
+
+  // Panel edits that apply on "Apply (reset)".
+  Representation pending_representation_ = Representation::kSurface;
+  int pending_resolution_[2] = {0, 0};
+  HapticSettings pending_haptics_;
+  int pending_soil_ = 0;  // index of SoilPreset
+  std::string panel_error_;
+
+  // Display toggles.
+  bool show_force_ = true;
+  bool show_labels_ = true;
+  float arrow_length_m_ = 0.3f;  // arrow length of the largest force in the plot window, metres
+
+  // Virtual device (window mode).
+  BladePose device_target_{};
+  bool dragging_tool_ = false;
+  Vec3f grab_offset_{};
+  bool orbiting_ = false, panning_ = false;
+  double last_mx_ = 0.0, last_my_ = 0.0;
+  double scroll_accum_ = 0.0;
+  bool key_down_[512] = {};
+  int scene_x_ = 0, scene_y_ = 0, scene_w_ = 1, scene_h_ = 1;  // window pixels, y down
+
+  friend void scroll_callback(GLFWwindow*, double, double);
+};
+
+}  // namespace terracut::viewer
