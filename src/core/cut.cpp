@@ -1,9 +1,30 @@
-// Swept cutting, visiting only the samples under the swept triangles: each
-// triangle is rasterised row by row (sample rows for the surface
-// representation, cell rows for columns), so the cost follows the swept area.
+// Swept cutting, visiting only the samples under the swept region: the two
+// triangles of a sweep are rasterised row by row together (sample rows for
+// the surface representation, cell rows for columns), so the cost follows
+// the swept area.
+//
+// - Each triangle is walked by its edges with its vertices sorted by z (the
+//   classic scanline set-up: a long edge A-C and a short chain A-B-C), so a
+//   row costs a few multiply-adds and no polygon clipping.
+// - Surface: along a row the height is linear; with the plane's slope when
+//   the triangle is well inclined (no division per row).
+// - Columns: a cell's height is the lowest point of the row's polygon over
+//   it, found from the polygon's vertices and its crossings with the cells'
+//   side lines, each crossing computed once for the two cells it bounds.
+// - A row's samples are lowered as one span (SSE2, four at a time), with the
+//   same values HeightGrid::lower would write.
+// - Spans are prefetched on big terrains, and so is the strip the blade will
+//   sweep next if it keeps its motion.
 #include "terracut/core/cut.hpp"
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
+#include <limits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "geometry.hpp"
 
@@ -13,96 +34,653 @@ namespace {
 
 using detail::GridFrame;
 
-/// Lowers sample (c, r) to world height y and books the change.
-inline void lower_to(HeightGrid& grid, const GridFrame& f, int c, int r, double y, CutResult& out) {
-  float removed = grid.lower(grid.index(c, r), float(y - f.ground_y));
-  if (removed > 0.0f) {
-    out.removed_volume_m3 += double(removed) * f.cx * f.cz;
-    out.changed.include(c, r);
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// What lowering one row (or part of it) changed: the removed heights summed
+/// (metres), the first and last sample changed (-1 when none), the samples
+/// examined.
+struct RowChange {
+  double removed_m = 0.0;
+  int first = -1;
+  int last = -1;
+  int visited = 0;
+};
+
+/// What a cut has changed so far: height removed (sum over samples, metres),
+/// the rectangle of changed samples (as plain inclusive bounds), samples
+/// examined. Kept as a local of each rasteriser so that it stays in registers.
+struct CutBook {
+  double removed_m = 0.0;
+  int c0 = INT_MAX, r0 = INT_MAX, c1 = INT_MIN, r1 = INT_MIN;
+  std::int64_t visited = 0;
+
+  void add(int r, const RowChange& change) {
+    visited += change.visited;
+    if (change.last < 0) return;
+    removed_m += change.removed_m;
+    c0 = std::min(c0, change.first);
+    c1 = std::max(c1, change.last);
+    r0 = std::min(r0, r);
+    r1 = std::max(r1, r);
+  }
+  void add(const CutBook& other) {
+    visited += other.visited;
+    removed_m += other.removed_m;
+    c0 = std::min(c0, other.c0);
+    c1 = std::max(c1, other.c1);
+    r0 = std::min(r0, other.r0);
+    r1 = std::max(r1, other.r1);
+  }
+  Rect changed() const { return c1 < c0 ? Rect{} : Rect{c0, r0, c1 + 1, r1 + 1}; }
+};
+
+/// A vertex of a swept triangle, its height relative to the ground level.
+struct Point {
+  double x, y, z;
+};
+
+/// Sorts three points by z (ascending).
+inline void sort_by_z(Point& a, Point& b, Point& c) {
+  if (b.z < a.z) std::swap(a, b);
+  if (c.z < b.z) std::swap(b, c);
+  if (b.z < a.z) std::swap(a, b);
+}
+
+/// What lowering a span of samples did: the removed heights summed (metres)
+/// and the first and last sample changed (-1 when none), from the span's start.
+struct SpanResult {
+  double removed_m = 0.0;
+  int first = -1;
+  int last = -1;
+};
+
+/// HeightGrid::lower applied to the n samples from height[0] with targets
+/// t[0..n): each sample goes down to max(t, 0) when that is lower, and its
+/// removed layer to initial - height. Same values, bit for bit, as calling
+/// HeightGrid::lower per sample (only the order of the removed-height sum
+/// differs), four samples at a time with SSE2 where available.
+SpanResult lower_span(float* height, float* removed, const float* initial, const float* t, int n) {
+  SpanResult out;
+  int k = 0;
+#if defined(__SSE2__) && defined(__GNUC__)
+  const __m128 zero = _mm_setzero_ps();
+  __m128d sum_lo = _mm_setzero_pd(), sum_hi = _mm_setzero_pd();
+  for (; k + 4 <= n; k += 4) {
+    __m128 target = _mm_max_ps(_mm_loadu_ps(t + k), zero);  // NaN -> 0, as lower()
+    __m128 old = _mm_loadu_ps(height + k);
+    __m128 lowered = _mm_min_ps(target, old);                 // target < old ? target : old
+    __m128 changed = _mm_cmplt_ps(lowered, old);
+    int mask = _mm_movemask_ps(changed);
+    if (mask == 0) continue;
+    _mm_storeu_ps(height + k, lowered);
+    // removed = initial - height where the height changed, else as it was.
+    __m128 fresh = _mm_sub_ps(_mm_loadu_ps(initial + k), lowered);
+    __m128 kept = _mm_loadu_ps(removed + k);
+    _mm_storeu_ps(removed + k, _mm_or_ps(_mm_and_ps(changed, fresh), _mm_andnot_ps(changed, kept)));
+    __m128 drop = _mm_sub_ps(old, lowered);  // 0 where unchanged
+    sum_lo = _mm_add_pd(sum_lo, _mm_cvtps_pd(drop));
+    sum_hi = _mm_add_pd(sum_hi, _mm_cvtps_pd(_mm_movehl_ps(drop, drop)));
+    if (out.first < 0) out.first = k + __builtin_ctz(unsigned(mask));
+    out.last = k + 31 - __builtin_clz(unsigned(mask));
+  }
+  __m128d sum = _mm_add_pd(sum_lo, sum_hi);
+  out.removed_m = _mm_cvtsd_f64(sum) + _mm_cvtsd_f64(_mm_unpackhi_pd(sum, sum));
+#endif
+  for (; k < n; ++k) {
+    float h = t[k] > 0.0f ? t[k] : 0.0f;
+    float old = height[k];
+    if (!(h < old)) continue;
+    height[k] = h;
+    removed[k] = initial[k] - h;
+    out.removed_m += double(old - h);
+    if (out.first < 0) out.first = k;
+    out.last = k;
+  }
+  return out;
+}
+
+/// Samples per batch of targets.
+constexpr int kBatch = 256;
+/// Samples of a row whose cache lines are requested before it is lowered.
+constexpr int kPrimeSamples = 1024;
+/// Spans up to this many samples are lowered by a plain inline loop.
+constexpr int kSmallSpan = 8;
+
+/// A hint to fetch the cache line at p (no effect on results; prefetches
+/// never fault).
+inline void prefetch(const float* p) {
+#if defined(__GNUC__)
+  __builtin_prefetch(p, 0, 2);
+#else
+  (void)p;
+#endif
+}
+
+/// Lowers samples c in [c_lo, c_hi] of row r to the targets that
+/// fill(c, n, t) writes for samples c .. c + n - 1 (metres above the ground,
+/// float; +inf leaves a sample as it is), kBatch at a time, and returns the
+/// change. The layers are written in place through the grid's stable arrays
+/// (see grid.hpp), exactly as HeightGrid::lower would write them.
+template <class Fill>
+inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& fill) {
+  const std::int64_t row = grid.index(0, r);
+  float* height = const_cast<float*>(grid.heights()) + row;
+  float* removed = const_cast<float*>(grid.removed()) + row;
+  const float* initial = grid.initial() + row;
+  RowChange change;
+  change.visited = c_hi - c_lo + 1;
+  if (change.visited <= kSmallSpan) {
+    // A few samples (a thin sliver crossing the row, as when the blade
+    // moves obliquely): inline, without the batch machinery.
+    float t[kSmallSpan];
+    fill(c_lo, change.visited, t);
+    for (int k = 0; k < change.visited; ++k) {
+      int c = c_lo + k;
+      float h = t[k] > 0.0f ? t[k] : 0.0f;
+      float old = height[c];
+      if (!(h < old)) continue;
+      height[c] = h;
+      removed[c] = initial[c] - h;
+      change.removed_m += double(old - h);
+      if (change.first < 0) change.first = c;
+      change.last = c;
+    }
+    return change;
+  }
+  // Ask for the row's first cache lines in the three layers at once, so that
+  // on a terrain larger than the caches their misses overlap instead of
+  // queueing one after the other (the hardware prefetcher takes long rows
+  // from there).
+  for (int c = c_lo; c <= std::min(c_hi, c_lo + kPrimeSamples - 1); c += 16) {
+    prefetch(height + c);
+    prefetch(initial + c);
+    prefetch(removed + c);
+  }
+  float t[kBatch];
+  for (int c = c_lo; c <= c_hi; c += kBatch) {
+    int n = std::min(kBatch, c_hi - c + 1);
+    fill(c, n, t);
+    SpanResult span = lower_span(height + c, removed + c, initial + c, t, n);
+    if (span.last >= 0) {
+      change.removed_m += span.removed_m;
+      if (change.first < 0) change.first = c + span.first;
+      change.last = c + span.last;
+    }
+  }
+  return change;
+}
+
+/// lower_row with the targets already computed: targets[k] for sample c_lo + k.
+inline RowChange lower_row_targets(HeightGrid& grid, int r, int c_lo, int c_hi, const float* targets) {
+  const std::int64_t row = grid.index(0, r) + c_lo;
+  float* height = const_cast<float*>(grid.heights()) + row;
+  float* removed = const_cast<float*>(grid.removed()) + row;
+  const float* initial = grid.initial() + row;
+  int n = c_hi - c_lo + 1;
+  for (int k = 0; k < std::min(n, kPrimeSamples); k += 16) {
+    prefetch(height + k);
+    prefetch(initial + k);
+    prefetch(removed + k);
+  }
+  SpanResult span = lower_span(height, removed, initial, targets, n);
+  RowChange change;
+  change.visited = n;
+  if (span.last >= 0) {
+    change.removed_m = span.removed_m;
+    change.first = c_lo + span.first;
+    change.last = c_lo + span.last;
+  }
+  return change;
+}
+
+/// Targets of a row along which y is linear: y(c) = base + c * step.
+inline auto linear_targets(double base, double step) {
+  return [base, step](int c0, int n, float* t) {
+    for (int k = 0; k < n; ++k) t[k] = float(base + double(c0 + k) * step);
+  };
+}
+
+/// floor and ceil of x clamped to [lo, hi] (grid index ranges; also keeps
+/// far-away coordinates inside int range).
+inline int floor_clamped(double x, int lo, int hi) {
+  if (!(x > lo)) return lo;
+  if (!(x < hi)) return hi;
+  int i = int(x);  // truncation, then the fix for negatives
+  return i - (double(i) > x);
+}
+inline int ceil_clamped(double x, int lo, int hi) {
+  if (!(x > lo)) return lo;
+  if (!(x < hi)) return hi;
+  int i = int(x);
+  return i + (double(i) < x);
+}
+
+/// The triangle's edges, walked by z: the long edge A-C and the short chain
+/// A-B-C (vertices sorted by z, heights relative to the ground). Meaningful
+/// when c.z > a.z.
+struct Scanline {
+  Point a, b, c;
+  double ac_kx, ac_ky, ab_kx, ab_ky, bc_kx, bc_ky;  // dx/dz and dy/dz per edge
+
+  Scanline(const Point& p0, const Point& p1, const Point& p2) : a(p0), b(p1), c(p2) {
+    sort_by_z(a, b, c);
+    double inv_ac = c.z > a.z ? 1.0 / (c.z - a.z) : 0.0;
+    ac_kx = (c.x - a.x) * inv_ac;
+    ac_ky = (c.y - a.y) * inv_ac;
+    double inv_ab = b.z > a.z ? 1.0 / (b.z - a.z) : 0.0;
+    ab_kx = (b.x - a.x) * inv_ab;
+    ab_ky = (b.y - a.y) * inv_ab;
+    double inv_bc = c.z > b.z ? 1.0 / (c.z - b.z) : 0.0;
+    bc_kx = (c.x - b.x) * inv_bc;
+    bc_ky = (c.y - b.y) * inv_bc;
+  }
+
+  /// The point of the long edge at z (a.z <= z <= c.z).
+  Point long_at(double z) const { return {a.x + (z - a.z) * ac_kx, a.y + (z - a.z) * ac_ky, z}; }
+  /// The point of the short chain at z (a.z <= z <= c.z).
+  Point short_at(double z) const {
+    if (z < b.z) return {a.x + (z - a.z) * ab_kx, a.y + (z - a.z) * ab_ky, z};
+    if (c.z > b.z) return {b.x + (z - b.z) * bc_kx, b.y + (z - b.z) * bc_ky, z};
+    return b;
+  }
+};
+
+/// One sample row's part of a triangle (surface representation): samples
+/// [c_lo, c_hi] go down to base + c * step (metres above the ground).
+struct Section {
+  int c_lo, c_hi;
+  double base, step;
+};
+
+/// A swept triangle set up for the surface rasteriser. Each sample row's
+/// section of the triangle (its intersection with the plane z = row's z) runs
+/// from the long edge to the short chain, and y is linear along it: with the
+/// slope of the triangle's plane along x when the triangle is well inclined
+/// (no division per row), else from the section's two ends. A section that
+/// is a point or vertical (a triangle standing on edge) counts with its
+/// lowest point. Triangles with all three vertices at one z ("flat") are
+/// handled apart (cut_flat_points).
+struct SurfaceTriangle {
+  Point q[3];
+  Scanline tri;
+  bool flat = false;
+  bool planar = false;
+  double slope_x = 0.0;
+  bool long_on_left = false;
+  int r_lo = 0, r_hi = -1;  // sample rows the triangle spans
+
+  SurfaceTriangle(const Vec3 (&p)[3], const GridFrame& f)
+      : q{{p[0].x, p[0].y - f.ground_y, p[0].z},
+          {p[1].x, p[1].y - f.ground_y, p[1].z},
+          {p[2].x, p[2].y - f.ground_y, p[2].z}},
+        tri(q[0], q[1], q[2]) {
+    double zmin = tri.a.z, zmax = tri.c.z;
+    r_lo = ceil_clamped((zmin - f.z0) * f.inv_cz - 0.5, 0, f.rows);
+    r_hi = floor_clamped((zmax - f.z0) * f.inv_cz - 0.5, -1, f.rows - 1);
+    flat = !(zmax > zmin);
+    if (flat) return;
+    // The plane's slope along x, when the footprint is far from degenerate
+    // (its area not lost to cancellation).
+    double ex1 = tri.b.x - tri.a.x, ez1 = tri.b.z - tri.a.z, ey1 = tri.b.y - tri.a.y;
+    double ex2 = tri.c.x - tri.a.x, ez2 = tri.c.z - tri.a.z, ey2 = tri.c.y - tri.a.y;
+    double det = ex1 * ez2 - ex2 * ez1;
+    planar = std::abs(det) > 1e-6 * (std::abs(ex1 * ez2) + std::abs(ex2 * ez1));
+    slope_x = planar ? (ey1 * ez2 - ey2 * ez1) / det : 0.0;
+    // The long edge lies on one side of the short chain for the whole
+    // height: B's side of the line A-C.
+    long_on_left = ex1 > ex2 * (ez1 / ez2);
+  }
+
+  /// The section in row r (rd = r); false when the row misses the triangle.
+  bool section(const GridFrame& f, double rd, Section& s) const {
+    double zr = f.z0 + (rd + 0.5) * f.cz;
+    if (zr < tri.a.z || zr > tri.c.z) return false;  // rounding at the first and last row
+    Point e_long = tri.long_at(zr), e_short = tri.short_at(zr);
+    const Point& e1 = long_on_left ? e_long : e_short;
+    const Point& e2 = long_on_left ? e_short : e_long;
+    s.c_lo = ceil_clamped((std::min(e1.x, e2.x) - f.x0) * f.inv_cx - 0.5, 0, f.cols);
+    s.c_hi = floor_clamped((std::max(e1.x, e2.x) - f.x0) * f.inv_cx - 0.5, -1, f.cols - 1);
+    if (s.c_lo > s.c_hi) return false;
+    double span = e2.x - e1.x;
+    double slope;
+    if (planar) {
+      slope = slope_x;
+    } else if (span > 1e-12 * f.cx || span < -1e-12 * f.cx) {
+      slope = (e2.y - e1.y) / span;
+    } else {
+      s.base = std::min(e1.y, e2.y);
+      s.step = 0.0;
+      return true;
+    }
+    // y at sample c's centre, x0 + (c + 0.5) cx, as base + c * step.
+    s.base = e1.y + (f.x0 + 0.5 * f.cx - e1.x) * slope;
+    s.step = f.cx * slope;
+    return true;
+  }
+};
+
+/// A flat triangle (all three vertices on the plane z = zmax): it cuts only
+/// when that plane is a sample row's, along the triangle's extent in x, from
+/// its lowest point at the smallest x to its lowest point at the largest x.
+void cut_flat_points(HeightGrid& grid, const GridFrame& f, const SurfaceTriangle& t, CutBook& book) {
+  const Point* q = t.q;
+  int lo = 0, hi = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (q[k].x < q[lo].x || (q[k].x == q[lo].x && q[k].y < q[lo].y)) lo = k;
+    if (q[k].x > q[hi].x || (q[k].x == q[hi].x && q[k].y < q[hi].y)) hi = k;
+  }
+  for (int r = t.r_lo; r <= t.r_hi; ++r) {
+    if (f.z0 + (r + 0.5) * f.cz != q[0].z) continue;
+    int c_lo = ceil_clamped((q[lo].x - f.x0) * f.inv_cx - 0.5, 0, f.cols);
+    int c_hi = floor_clamped((q[hi].x - f.x0) * f.inv_cx - 0.5, -1, f.cols - 1);
+    if (c_lo > c_hi) continue;
+    double span = q[hi].x - q[lo].x;
+    if (!(span > 1e-12 * f.cx)) {
+      double y = std::min({q[0].y, q[1].y, q[2].y});
+      book.add(r, lower_row(grid, r, c_lo, c_hi, linear_targets(y, 0.0)));
+    } else {
+      double slope = (q[hi].y - q[lo].y) / span;
+      double base = q[lo].y + (f.x0 + 0.5 * f.cx - q[lo].x) * slope, step = f.cx * slope;
+      book.add(r, lower_row(grid, r, c_lo, c_hi, linear_targets(base, step)));
+    }
   }
 }
 
-/// Surface representation: lowers every sample point under the triangle to
-/// the triangle's height there. For each sample row, the triangle's section
-/// with the plane z = row's z is a segment along which y is linear.
-void cut_triangle_points(HeightGrid& grid, const GridFrame& f, const Vec3 (&p)[3],
-                         CutResult& out) {
-  double zmin = std::min({p[0].z, p[1].z, p[2].z});
-  double zmax = std::max({p[0].z, p[1].z, p[2].z});
-  int r_lo = std::max(0, int(std::ceil((zmin - f.z0) * f.inv_cz - 0.5)));
-  int r_hi = std::min(f.rows - 1, int(std::floor((zmax - f.z0) * f.inv_cz - 0.5)));
-  for (int r = r_lo; r <= r_hi; ++r) {
-    double zr = f.z0 + (r + 0.5) * f.cz;
-    // Points where the triangle's edges meet the plane z = zr.
-    double xs[6], ys[6];
+/// Sections further apart than this many samples are lowered separately
+/// rather than as one span.
+constexpr int kMaxGap = 64;
+
+/// Surface representation: lowers every sample point under the swept region
+/// (both triangles) to the region's height there. The two triangles are
+/// walked row by row together: in a row their sections usually meet at the
+/// shared edge, and are lowered as one span (one pass over the row's memory,
+/// one set-up); where they overlap (on the shared edge) the lower counts.
+void cut_sweep_points(HeightGrid& grid, const GridFrame& f, const Vec3 (&tris)[2][3], CutBook& book) {
+  const SurfaceTriangle t0(tris[0], f), t1(tris[1], f);
+  const SurfaceTriangle* walk[2];
+  int n_walk = 0;
+  for (const SurfaceTriangle* t : {&t0, &t1}) {
+    if (t->r_lo > t->r_hi) continue;
+    if (t->flat) {
+      cut_flat_points(grid, f, *t, book);
+    } else {
+      walk[n_walk++] = t;
+    }
+  }
+  if (n_walk == 0) return;
+  CutBook rows;  // a local, so that its fields stay in registers
+  int r_lo = walk[0]->r_lo, r_hi = walk[0]->r_hi;
+  for (int k = 1; k < n_walk; ++k) {
+    r_lo = std::min(r_lo, walk[k]->r_lo);
+    r_hi = std::max(r_hi, walk[k]->r_hi);
+  }
+  double rd = r_lo;
+  for (int r = r_lo; r <= r_hi; ++r, rd += 1.0) {
+    Section s[2];
     int n = 0;
-    for (int k = 0; k < 3; ++k) {
-      const Vec3& a = p[k];
-      const Vec3& b = p[(k + 1) % 3];
-      if (a.z == b.z) {
-        if (a.z == zr) {
-          xs[n] = a.x, ys[n++] = a.y;
-          xs[n] = b.x, ys[n++] = b.y;
-        }
-      } else if ((a.z <= zr && zr <= b.z) || (b.z <= zr && zr <= a.z)) {
-        double t = (zr - a.z) / (b.z - a.z);
-        xs[n] = a.x + t * (b.x - a.x);
-        ys[n++] = a.y + t * (b.y - a.y);
-      }
+    for (int k = 0; k < n_walk; ++k) {
+      if (r >= walk[k]->r_lo && r <= walk[k]->r_hi && walk[k]->section(f, rd, s[n])) ++n;
     }
     if (n == 0) continue;
-    // The section's ends; where several points share an end, the lowest counts.
-    int lo = 0, hi = 0;
-    for (int k = 1; k < n; ++k) {
-      if (xs[k] < xs[lo] || (xs[k] == xs[lo] && ys[k] < ys[lo])) lo = k;
-      if (xs[k] > xs[hi] || (xs[k] == xs[hi] && ys[k] < ys[hi])) hi = k;
-    }
-    double x_lo = xs[lo], x_hi = xs[hi];
-    int c_lo = std::max(0, int(std::ceil((x_lo - f.x0) * f.inv_cx - 0.5)));
-    int c_hi = std::min(f.cols - 1, int(std::floor((x_hi - f.x0) * f.inv_cx - 0.5)));
-    if (c_lo > c_hi) continue;
-    double span = x_hi - x_lo;
-    if (!(span > 1e-12 * f.cx)) {
-      // A section that is a point or vertical: its lowest point counts.
-      double y = ys[0];
-      for (int k = 1; k < n; ++k) y = std::min(y, ys[k]);
-      for (int c = c_lo; c <= c_hi; ++c) lower_to(grid, f, c, r, y, out);
-      out.cells_visited += c_hi - c_lo + 1;
+    if (n == 2 && s[1].c_lo < s[0].c_lo) std::swap(s[0], s[1]);
+    if (n == 1 || s[1].c_lo - s[0].c_hi - 1 > kMaxGap) {
+      for (int k = 0; k < n; ++k) {
+        rows.add(r, lower_row(grid, r, s[k].c_lo, s[k].c_hi, linear_targets(s[k].base, s[k].step)));
+      }
       continue;
     }
-    double slope = (ys[hi] - ys[lo]) / span;
-    for (int c = c_lo; c <= c_hi; ++c) {
-      double xc = f.x0 + (c + 0.5) * f.cx;
-      lower_to(grid, f, c, r, ys[lo] + slope * (xc - x_lo), out);
-    }
-    out.cells_visited += c_hi - c_lo + 1;
+    const Section a = s[0], b = s[1];
+    rows.add(r, lower_row(grid, r, a.c_lo, std::max(a.c_hi, b.c_hi), [a, b](int c0, int count, float* t) {
+      // Each section's part of the batch [c0, c0 + count), then the lower of
+      // the two where they overlap (rounding to float keeps the order).
+      for (int k = 0; k < count; ++k) t[k] = float(kInf);
+      for (const Section& sec : {a, b}) {
+        int k0 = std::max(sec.c_lo - c0, 0), k1 = std::min(sec.c_hi - c0, count - 1);
+        for (int k = k0; k <= k1; ++k) t[k] = std::min(t[k], float(sec.base + double(c0 + k) * sec.step));
+      }
+    }));
   }
+  book.add(rows);
 }
 
-/// Columns representation: lowers every column whose (closed) cell the
-/// triangle touches to the triangle's lowest point inside the cell.
-void cut_triangle_columns(HeightGrid& grid, const GridFrame& f, const Vec3 (&p)[3],
-                          CutResult& out) {
-  double zmin = std::min({p[0].z, p[1].z, p[2].z});
-  double zmax = std::max({p[0].z, p[1].z, p[2].z});
-  int r_lo = std::max(0, int(std::ceil((zmin - f.z0) * f.inv_cz)) - 1);
-  int r_hi = std::min(f.rows - 1, int(std::floor((zmax - f.z0) * f.inv_cz)));
-  for (int r = r_lo; r <= r_hi; ++r) {
-    detail::Polygon strip;
-    detail::clip_to_strip_z(p[0], p[1], p[2], f.z0 + r * f.cz, f.z0 + (r + 1) * f.cz, strip);
-    if (strip.n == 0) continue;
-    double xmin = strip.v[0].x, xmax = strip.v[0].x;
-    for (int k = 1; k < strip.n; ++k) {
-      xmin = std::min(xmin, strip.v[k].x);
-      xmax = std::max(xmax, strip.v[k].x);
+/// Columns: candidate heights of one cell row, kChunk cells at a time.
+constexpr int kChunk = 128;
+
+/// A segment of a row polygon's boundary with its slope dy/dx (unused when
+/// the segment is vertical seen from above).
+struct Side {
+  Point p, q;
+  double slope;
+};
+
+/// A convex polygon in one cell row, as its sides in order (side k runs from
+/// vertex k to vertex k + 1).
+struct RowPolygon {
+  Side sides[5];
+  int n = 0;
+  int c_lo = 0, c_hi = -1;  // cells it touches (closed cells)
+};
+
+/// Sets the polygon's cell range from its vertices.
+inline void set_cells(RowPolygon& poly, const GridFrame& f) {
+  double xmin = poly.sides[0].p.x, xmax = poly.sides[0].p.x;
+  for (int k = 1; k < poly.n; ++k) {
+    xmin = std::min(xmin, poly.sides[k].p.x);
+    xmax = std::max(xmax, poly.sides[k].p.x);
+  }
+  poly.c_lo = std::max(0, ceil_clamped((xmin - f.x0) * f.inv_cx, 0, f.cols + 1) - 1);
+  poly.c_hi = floor_clamped((xmax - f.x0) * f.inv_cx, -1, f.cols - 1);
+}
+
+/// Lowers every cell [c_lo, c_hi] of row r to the lowest point over the cell
+/// of the convex polygons (closed cells). The lowest point of a polygon over
+/// a cell is a vertex of the polygon's part there: a polygon vertex inside
+/// the cell, or where the polygon's boundary crosses one of the cell's two
+/// side lines. The side-line crossings are shared by neighbouring cells, so
+/// each is computed once: boundary[k] holds the lowest crossing on line x =
+/// x0 + (cb + k) cx over all the polygons (a crossing on a side line belongs
+/// to both cells it bounds); the vertices then lower their cells' targets.
+RowChange cut_row_polygons(HeightGrid& grid, const GridFrame& f, int r, const RowPolygon* polys,
+                           int n_polys, int c_lo, int c_hi) {
+  RowChange change;
+  double boundary[kChunk + 1];
+  for (int cb = c_lo; cb <= c_hi; cb += kChunk) {
+    int ce = std::min(c_hi, cb + kChunk - 1);
+    int cells = ce - cb + 1;
+    double xb = f.x0 + cb * f.cx;  // the chunk's first side line
+    // Sides spanning the whole chunk (the long sides of a sliver, most of the
+    // work) are evaluated together in one pass that also initialises
+    // boundary[]; up to kFused of them, padded with sides at +inf.
+    constexpr int kFused = 4;
+    double fused_base[kFused] = {kInf, kInf, kInf, kInf}, fused_step[kFused] = {0.0, 0.0, 0.0, 0.0};
+    int n_fused = 0;
+    struct Partial {
+      int k0, k1;
+      double base, step;
+    } partial[2 * 5];
+    int n_partial = 0;
+    for (int p = 0; p < n_polys; ++p) {
+      const RowPolygon& poly = polys[p];
+      for (int s = 0; s < poly.n; ++s) {
+        const Side& side = poly.sides[s];
+        double lo_x = std::min(side.p.x, side.q.x), hi_x = std::max(side.p.x, side.q.x);
+        if (!(hi_x > lo_x)) continue;  // seen from above a point: its ends are vertices
+        int k0 = std::max(0, ceil_clamped((lo_x - xb) * f.inv_cx, -1, cells + 1));
+        int k1 = std::min(cells, floor_clamped((hi_x - xb) * f.inv_cx, -1, cells + 1));
+        if (k0 > k1) continue;
+        // y at x0 + (cb + k) cx, as base + k * step.
+        double base = side.p.y + (xb - side.p.x) * side.slope, step = f.cx * side.slope;
+        if (k0 == 0 && k1 == cells && n_fused < kFused) {
+          fused_base[n_fused] = base;
+          fused_step[n_fused++] = step;
+        } else {
+          partial[n_partial++] = {k0, k1, base, step};
+        }
+      }
     }
-    int c_lo = std::max(0, int(std::ceil((xmin - f.x0) * f.inv_cx)) - 1);
-    int c_hi = std::min(f.cols - 1, int(std::floor((xmax - f.x0) * f.inv_cx)));
-    for (int c = c_lo; c <= c_hi; ++c) {
-      double y = detail::min_y_in_strip_x(strip, f.x0 + c * f.cx, f.x0 + (c + 1) * f.cx);
-      if (y < INFINITY) lower_to(grid, f, c, r, y, out);
+    for (int k = 0; k <= cells; ++k) {
+      double kd = double(k);
+      double a = std::min(fused_base[0] + kd * fused_step[0], fused_base[1] + kd * fused_step[1]);
+      double b = std::min(fused_base[2] + kd * fused_step[2], fused_base[3] + kd * fused_step[3]);
+      boundary[k] = std::min(a, b);
     }
-    out.cells_visited += std::max(0, c_hi - c_lo + 1);
+    for (int j = 0; j < n_partial; ++j) {
+      const Partial& side = partial[j];
+      for (int k = side.k0; k <= side.k1; ++k) {
+        boundary[k] = std::min(boundary[k], side.base + double(k) * side.step);
+      }
+    }
+    // The cells' targets: the lower of their two side lines, then the
+    // polygon vertices inside them (rounding to float keeps the order).
+    float target[kChunk];
+    for (int k = 0; k < cells; ++k) {
+      target[k] = float(boundary[k] < boundary[k + 1] ? boundary[k] : boundary[k + 1]);
+    }
+    for (int p = 0; p < n_polys; ++p) {
+      const RowPolygon& poly = polys[p];
+      // Each vertex counts in every closed cell that holds it (two on a side line).
+      for (int s = 0; s < poly.n; ++s) {
+        const Point& v = poly.sides[s].p;
+        float y = float(v.y);
+        int c = floor_clamped((v.x - f.x0) * f.inv_cx, cb - 1, ce + 1);
+        if (c > cb - 1 && f.x0 + c * f.cx > v.x) --c;
+        if (c < ce + 1 && f.x0 + (c + 1) * f.cx <= v.x) ++c;
+        if (c >= cb && c <= ce) target[c - cb] = std::min(target[c - cb], y);
+        if (c - 1 >= cb && c - 1 <= ce && f.x0 + c * f.cx == v.x) {
+          target[c - 1 - cb] = std::min(target[c - 1 - cb], y);
+        }
+      }
+    }
+    RowChange part = lower_row_targets(grid, r, cb, ce, target);
+    change.visited += part.visited;
+    if (part.last >= 0) {
+      change.removed_m += part.removed_m;
+      if (change.first < 0) change.first = part.first;
+      change.last = part.last;
+    }
+  }
+  return change;
+}
+
+/// The side p -> q with its slope computed.
+inline Side side_of(const Point& p, const Point& q) {
+  double dx = q.x - p.x;
+  return {p, q, dx != 0.0 ? (q.y - p.y) / dx : 0.0};
+}
+
+/// A swept triangle set up for the columns rasteriser: in each cell row it
+/// is a convex polygon, the triangle clipped by the row's two lines, built
+/// from the scanline's long edge and short chain. A triangle with all three
+/// vertices at one z ("flat") is its own polygon, in the one or two rows
+/// whose closed strip holds that plane.
+struct ColumnTriangle {
+  Point q[3];
+  Scanline tri;
+  bool flat = false;
+  double ac_slope = 0.0, ab_slope = 0.0, bc_slope = 0.0;  // dy/dx along the edges
+  int r_lo = 0, r_hi = -1;  // cell rows the triangle touches (closed)
+
+  ColumnTriangle(const Vec3 (&p)[3], const GridFrame& f)
+      : q{{p[0].x, p[0].y - f.ground_y, p[0].z},
+          {p[1].x, p[1].y - f.ground_y, p[1].z},
+          {p[2].x, p[2].y - f.ground_y, p[2].z}},
+        tri(q[0], q[1], q[2]) {
+    double zmin = tri.a.z, zmax = tri.c.z;
+    r_lo = std::max(0, ceil_clamped((zmin - f.z0) * f.inv_cz, 0, f.rows + 1) - 1);
+    r_hi = floor_clamped((zmax - f.z0) * f.inv_cz, -1, f.rows - 1);
+    flat = !(zmax > zmin);
+    auto slope = [](const Point& a, const Point& b) { return b.x != a.x ? (b.y - a.y) / (b.x - a.x) : 0.0; };
+    ac_slope = slope(tri.a, tri.c);
+    ab_slope = slope(tri.a, tri.b);
+    bc_slope = slope(tri.b, tri.c);
+  }
+
+  /// The polygon in row r (rd = r); false when the row misses the triangle.
+  bool polygon(const GridFrame& f, double rd, RowPolygon& poly) const {
+    poly.n = 0;
+    if (flat) {
+      poly.sides[0] = side_of(q[0], q[1]);
+      poly.sides[1] = side_of(q[1], q[2]);
+      poly.sides[2] = side_of(q[2], q[0]);
+      poly.n = 3;
+      set_cells(poly, f);
+      return true;
+    }
+    double z_bottom = f.z0 + rd * f.cz, z_top = f.z0 + (rd + 1.0) * f.cz;
+    if (z_top < tri.a.z || z_bottom > tri.c.z) return false;
+    double za = std::max(z_bottom, tri.a.z), zb = std::min(z_top, tri.c.z);
+    // In order: bottom section (long -> short), the short chain up (through
+    // B when B is strictly inside the row), top section (short -> long), and
+    // the long edge back down.
+    Point long_a = tri.long_at(za), short_a = tri.short_at(za);
+    Point long_b = tri.long_at(zb), short_b = tri.short_at(zb);
+    Side* sides = poly.sides;
+    int n = 0;
+    sides[n++] = side_of(long_a, short_a);
+    if (tri.b.z > za && tri.b.z < zb) {
+      sides[n++] = {short_a, tri.b, ab_slope};
+      sides[n++] = {tri.b, short_b, bc_slope};
+    } else {
+      sides[n++] = {short_a, short_b, zb <= tri.b.z ? ab_slope : bc_slope};
+    }
+    sides[n++] = side_of(short_b, long_b);
+    sides[n++] = {long_b, long_a, ac_slope};
+    poly.n = n;
+    set_cells(poly, f);
+    return true;
+  }
+};
+
+/// Columns representation: lowers every column whose (closed) cell the swept
+/// region touches to the region's lowest point inside the cell. The two
+/// triangles are walked row by row together; where their polygons touch
+/// the same cells (in a row they usually cover the same span), the cells are
+/// lowered once, to the lower of the two.
+void cut_sweep_columns(HeightGrid& grid, const GridFrame& f, const Vec3 (&tris)[2][3], CutBook& book) {
+  const ColumnTriangle t0(tris[0], f), t1(tris[1], f);
+  int r_lo = std::min(t0.r_lo, t1.r_lo), r_hi = std::max(t0.r_hi, t1.r_hi);
+  CutBook rows;  // a local, so that its fields stay in registers
+  double rd = r_lo;
+  for (int r = r_lo; r <= r_hi; ++r, rd += 1.0) {
+    RowPolygon polys[2];
+    int n = 0;
+    for (const ColumnTriangle* t : {&t0, &t1}) {
+      if (r >= t->r_lo && r <= t->r_hi && t->polygon(f, rd, polys[n]) && polys[n].c_lo <= polys[n].c_hi) ++n;
+    }
+    if (n == 0) continue;
+    if (n == 2 && polys[1].c_lo < polys[0].c_lo) std::swap(polys[0], polys[1]);
+    if (n == 1 || polys[1].c_lo - polys[0].c_hi - 1 > kMaxGap) {
+      for (int k = 0; k < n; ++k) rows.add(r, cut_row_polygons(grid, f, r, &polys[k], 1, polys[k].c_lo, polys[k].c_hi));
+    } else {
+      rows.add(r, cut_row_polygons(grid, f, r, polys, 2, polys[0].c_lo, std::max(polys[0].c_hi, polys[1].c_hi)));
+    }
+  }
+  book.add(rows);
+}
+
+/// Prefetch hints for the samples along the edge where the blade would be
+/// a step from now if it kept its motion (to + (to - from)): on a terrain
+/// larger than the caches the next step's cut and contact then find their
+/// rows on chip instead of waiting for memory. One hint per cache line along
+/// a row and per row crossed, at most kMaxAhead points; no effect on results.
+void prefetch_next_sweep(const HeightGrid& grid, const GridFrame& f, const Segment& from, const Segment& to) {
+  constexpr int kMaxAhead = 256;
+  Vec3 a = to.a + (to.a - from.a), b = to.b + (to.b - from.b);
+  double ua = (a.x - f.x0) * f.inv_cx, va = (a.z - f.z0) * f.inv_cz;
+  double ub = (b.x - f.x0) * f.inv_cx, vb = (b.z - f.z0) * f.inv_cz;
+  int points = std::min(kMaxAhead, int(std::max(std::abs(ub - ua) / 8.0, std::abs(vb - va))) + 1);
+  if (!(points >= 1)) return;  // NaN from a far-away edge
+  const float* height = grid.heights();
+  const float* removed = grid.removed();
+  const float* initial = grid.initial();
+  for (int k = 0; k <= points; ++k) {
+    double t = double(k) / points;
+    int c = floor_clamped(ua + t * (ub - ua), 0, f.cols - 1);
+    int r = floor_clamped(va + t * (vb - va), 0, f.rows - 1);
+    std::int64_t i = grid.index(c, r);
+    prefetch(height + i);
+    prefetch(removed + i);
+    prefetch(initial + i);
   }
 }
 
@@ -115,13 +693,16 @@ CutResult cut_sweep(HeightGrid& grid, Representation representation, const Segme
   GridFrame f(grid);
   Vec3 tri[2][3];
   detail::sweep_triangles(from, to, tri);
-  for (const auto& t : tri) {
-    if (representation == Representation::kColumns) {
-      cut_triangle_columns(grid, f, t, out);
-    } else {
-      cut_triangle_points(grid, f, t, out);
-    }
+  CutBook book;
+  if (representation == Representation::kColumns) {
+    cut_sweep_columns(grid, f, tri, book);
+  } else {
+    cut_sweep_points(grid, f, tri, book);
   }
+  prefetch_next_sweep(grid, f, from, to);
+  out.removed_volume_m3 = book.removed_m * f.cx * f.cz;
+  out.changed = book.changed();
+  out.cells_visited = book.visited;
   return out;
 }
 
