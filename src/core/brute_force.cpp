@@ -31,7 +31,7 @@ ContactResult measure_contact_brute_force(const HeightGrid& grid, Representation
         if (!detail::clip_axis(edge.a.z, d.z, f.z0 + r * f.cz, f.z0 + (r + 1) * f.cz, s0, s1)) continue;
         double top = f.ground_y + h[std::int64_t(r) * f.cols + c];
         detail::accumulate_piece(s0, s1, top, top, edge.a.y + s0 * d.y, edge.a.y + s1 * d.y, f,
-                                 seg_len, out);
+                                 f.min_contact_depth_m(representation), seg_len, out);
       }
     }
     return out;
@@ -65,7 +65,7 @@ ContactResult measure_contact_brute_force(const HeightGrid& grid, Representation
         double top1 = f.ground_y + detail::surface_in_square(h00, h10, h01, h11, u0 + s1 * du - i,
                                                             v0 + s1 * dv - j, lower);
         detail::accumulate_piece(s0, s1, top0, top1, edge.a.y + s0 * d.y, edge.a.y + s1 * d.y, f,
-                                 seg_len, out);
+                                 f.min_contact_depth_m(representation), seg_len, out);
       }
     }
   }

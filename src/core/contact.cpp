@@ -353,7 +353,7 @@ ContactResult contact_columns(const HeightGrid& grid, const Segment& edge) {
     s1 = 1.0 - t;
   }
   const float* h = grid.heights();
-  const double eps = f.depth_epsilon_m;
+  const double eps = f.min_contact_depth_m(Representation::kColumns);
   ContactSums sums;
   std::int64_t visited = 0;
   // Full columns take the fast walk, the partial first and last the general one.
@@ -624,7 +624,7 @@ ContactResult contact_surface(const HeightGrid& grid, const Segment& edge) {
     s1 = 1.0 - t;
   }
   const float* h = grid.heights();
-  const double eps = f.depth_epsilon_m;
+  const double eps = f.min_contact_depth_m(Representation::kSurface);
   ContactSums sums;
   std::int64_t visited = 0;
   // The interior part, where every node of the squares crossed exists: p in

@@ -20,9 +20,17 @@ struct GridFrame {
   double x0, z0, ground_y;
   double cx, cz, inv_cx, inv_cz;
   int cols, rows;
-  /// Depths below this are treated as no material: a blade resting on a
-  /// surface it has just cut is not in contact (float rounding of heights).
+  /// Float rounding of heights: 2^-20 of the full scale. The surface
+  /// representation counts material only deeper than this above the blade,
+  /// so a blade resting on a surface it has just cut is not in contact; the
+  /// columns representation counts depths down to minus this, so a blade
+  /// resting on a column's top touches it (closed boxes, as the slab method).
   double depth_epsilon_m;
+
+  /// The smallest depth of material above the edge that counts as contact.
+  double min_contact_depth_m(Representation representation) const {
+    return representation == Representation::kColumns ? -depth_epsilon_m : depth_epsilon_m;
+  }
 
   explicit GridFrame(const HeightGrid& grid)
       : x0(grid.spec().origin_m.x),
@@ -57,15 +65,15 @@ inline bool clip_linear(double fa, double fb, bool strict, double& t0, double& t
 
 /// Adds the contact of one piece of the edge, [sa, sb] in edge parameter,
 /// over which both the material top and the edge height are linear: inside
-/// material where ground <= y < top (depth above epsilon). seg_length_m is the
-/// edge's 3-D length.
+/// material where ground <= y and top - y > min_depth_m (see
+/// GridFrame::min_contact_depth_m). seg_length_m is the edge's 3-D length.
 inline void accumulate_piece(double sa, double sb, double top_a, double top_b, double y_a,
-                             double y_b, const GridFrame& frame, double seg_length_m,
-                             ContactResult& out) {
+                             double y_b, const GridFrame& frame, double min_depth_m,
+                             double seg_length_m, ContactResult& out) {
   if (!(sb > sa)) return;
   double t0 = 0.0, t1 = 1.0;
   double da = top_a - y_a, db = top_b - y_b;
-  if (!clip_linear(da - frame.depth_epsilon_m, db - frame.depth_epsilon_m, true, t0, t1)) return;
+  if (!clip_linear(da - min_depth_m, db - min_depth_m, true, t0, t1)) return;
   if (!clip_linear(y_a - frame.ground_y, y_b - frame.ground_y, false, t0, t1)) return;
   double d0 = da + (db - da) * t0;
   double d1 = da + (db - da) * t1;
