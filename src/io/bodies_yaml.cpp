@@ -10,24 +10,13 @@
 #include <string_view>
 
 #include "terracut/core/error.hpp"
+#include "yaml_util.hpp"
 
 namespace terracut::io {
 namespace {
 
-std::string describe(const YAML::Node& node) {
-  switch (node.Type()) {
-    case YAML::NodeType::Null:
-      return "nothing";
-    case YAML::NodeType::Scalar:
-      return "'" + node.Scalar() + "'";
-    case YAML::NodeType::Sequence:
-      return "a list";
-    case YAML::NodeType::Map:
-      return "a mapping";
-    default:
-      return "an undefined value";
-  }
-}
+using detail::describe;
+using detail::mark_or;
 
 // Reports errors as "FILE:LINE: PATH: what", the line taken from the value's
 // own mark or, when it has none, the nearest enclosing one.
@@ -45,11 +34,6 @@ class Reporter {
  private:
   std::string file_;
 };
-
-YAML::Mark mark_or(const YAML::Node& node, const YAML::Mark& fallback) {
-  YAML::Mark m = node.Mark();
-  return m.is_null() ? fallback : m;
-}
 
 // One body mapping: its keys (each checked against the allowed set, no
 // repeats), with typed getters that name the field on error.

@@ -14,31 +14,15 @@
 #include <vector>
 
 #include "terracut/core/error.hpp"
+#include "yaml_util.hpp"
 
 namespace terracut::io {
 namespace {
 
+using detail::describe;
+using detail::mark_or;
+
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-std::string describe(const YAML::Node& node) {
-  switch (node.Type()) {
-    case YAML::NodeType::Null:
-      return "nothing";
-    case YAML::NodeType::Scalar:
-      return "'" + node.Scalar() + "'";
-    case YAML::NodeType::Sequence:
-      return "a list";
-    case YAML::NodeType::Map:
-      return "a mapping";
-    default:
-      return "an undefined value";
-  }
-}
-
-YAML::Mark mark_or(const YAML::Node& node, const YAML::Mark& fallback) {
-  YAML::Mark m = node.Mark();
-  return m.is_null() ? fallback : m;
-}
 
 // Error reporting plus the line of every field read, so that a range error
 // found after parsing (by validate) still names the line of its field.

@@ -15,9 +15,12 @@
 #include "terracut/core/error.hpp"
 #include "terracut/io/bodies_yaml.hpp"
 #include "terracut/io/haptics_yaml.hpp"
+#include "yaml_util.hpp"
 
 namespace terracut::io {
 namespace {
+
+using detail::describe;
 
 // Largest scenario file read (a scenario is a few kilobytes; this only stops a
 // wrong path to a huge file from being read into memory).
@@ -61,21 +64,6 @@ std::string child_path(const std::string& parent, std::string_view key) {
   return parent.empty() ? std::string(key) : parent + "." + std::string(key);
 }
 
-std::string describe_kind(const YAML::Node& node) {
-  switch (node.Type()) {
-    case YAML::NodeType::Null:
-      return "nothing";
-    case YAML::NodeType::Scalar:
-      return "'" + node.Scalar() + "'";
-    case YAML::NodeType::Sequence:
-      return "a list";
-    case YAML::NodeType::Map:
-      return "a mapping";
-    default:
-      return "an undefined value";
-  }
-}
-
 // One value in the document with its field path and a line to report (its own
 // mark, or the mark of its key when the value has none).
 class Field {
@@ -101,19 +89,19 @@ class Field {
   bool is_scalar() const { return node_.IsScalar(); }
 
   std::string string() const {
-    if (!node_.IsScalar()) fail("expected a text value, got " + describe_kind(node_));
+    if (!node_.IsScalar()) fail("expected a text value, got " + describe(node_));
     return node_.Scalar();
   }
 
   double number() const {
-    if (!node_.IsScalar()) fail("expected a number, got " + describe_kind(node_));
+    if (!node_.IsScalar()) fail("expected a number, got " + describe(node_));
     double v = 0.0;
     try {
       v = node_.as<double>();
     } catch (const YAML::Exception&) {
-      fail("expected a number, got " + describe_kind(node_));
+      fail("expected a number, got " + describe(node_));
     }
-    if (!std::isfinite(v)) fail("must be a finite number, got " + describe_kind(node_));
+    if (!std::isfinite(v)) fail("must be a finite number, got " + describe(node_));
     return v;
   }
 
@@ -130,22 +118,22 @@ class Field {
   }
 
   long long integer() const {
-    if (!node_.IsScalar()) fail("expected a whole number, got " + describe_kind(node_));
+    if (!node_.IsScalar()) fail("expected a whole number, got " + describe(node_));
     const std::string& s = node_.Scalar();
     long long v = 0;
     const char* first = s.data();
     const char* last = s.data() + s.size();
     if (first != last && *first == '+') ++first;
     const auto [ptr, ec] = std::from_chars(first, last, v);
-    if (ec == std::errc::result_out_of_range) fail("whole number " + describe_kind(node_) + " is out of range");
+    if (ec == std::errc::result_out_of_range) fail("whole number " + describe(node_) + " is out of range");
     if (ec != std::errc() || ptr != last || first == last)
-      fail("expected a whole number, got " + describe_kind(node_));
+      fail("expected a whole number, got " + describe(node_));
     return v;
   }
 
   // Elements of a list, each with its path "path[i]".
   std::vector<Field> elements() const {
-    if (!node_.IsSequence()) fail("expected a list, got " + describe_kind(node_));
+    if (!node_.IsSequence()) fail("expected a list, got " + describe(node_));
     std::vector<Field> out;
     std::size_t i = 0;
     for (const auto& element : node_) {
@@ -159,7 +147,7 @@ class Field {
   // A list of exactly n finite numbers.
   std::vector<double> numbers(std::size_t n) const {
     if (!node_.IsSequence())
-      fail("expected a list of " + std::to_string(n) + " numbers, got " + describe_kind(node_));
+      fail("expected a list of " + std::to_string(n) + " numbers, got " + describe(node_));
     const std::vector<Field> items = elements();
     if (items.size() != n)
       fail("expected a list of " + std::to_string(n) + " numbers, got " +
@@ -186,13 +174,13 @@ class Map {
     const YAML::Node& node = field.node();
     if (!node.IsMap())
       field.fail("expected a mapping with keys " + allowed_list() + ", got " +
-                 describe_kind(node));
+                 describe(node));
     for (const auto& kv : node) {
       const YAML::Node& key = kv.first;
       YAML::Mark key_mark = key.Mark().is_null() ? field.mark() : key.Mark();
       if (!key.IsScalar())
         field.ctx().fail(key_mark, field.path(), "keys must be plain names, got " +
-                                                     describe_kind(key));
+                                                     describe(key));
       const std::string name = key.Scalar();
       const std::string path = child_path(field.path(), name);
       if (std::find(allowed_.begin(), allowed_.end(), name) == allowed_.end())
