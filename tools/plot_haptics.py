@@ -19,48 +19,14 @@ import json
 import os
 import sys
 
+from plot_common import import_plotting, make_fail, parse_dir_args
 
-def fail(message, code=2):
-    print(f"plot_haptics.py: error: {message}", file=sys.stderr)
-    sys.exit(code)
-
-
-try:
-    import numpy as np
-except ImportError:
-    fail("missing Python module 'numpy' (Debian: apt-get install python3-numpy)", 3)
-try:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-except ImportError:
-    fail("missing Python module 'matplotlib' (Debian: apt-get install python3-matplotlib)", 3)
+fail = make_fail("plot_haptics.py")
+np, plt = import_plotting(fail)
 
 
 def parse_args(argv):
-    run_dir, out, quiet = None, None, False
-    i = 1
-    while i < len(argv):
-        a = argv[i]
-        if a in ("-h", "--help"):
-            print(__doc__)
-            sys.exit(0)
-        elif a == "--quiet":
-            quiet = True
-        elif a == "--out":
-            if i + 1 >= len(argv):
-                fail("--out needs a file name")
-            out = argv[i + 1]
-            i += 1
-        elif run_dir is None:
-            run_dir = a
-        else:
-            fail(f"unexpected argument '{a}' (see --help)")
-        i += 1
-    if run_dir is None:
-        fail("no output folder given (usage: plot_haptics.py DIR [--out FILE.png])")
-    return run_dir, out or os.path.join(run_dir, "haptics.png"), quiet
+    return parse_dir_args(argv, __doc__, "haptics.png", fail, "plot_haptics.py")
 
 
 def need(path):
