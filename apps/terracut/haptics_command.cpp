@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "bodies_engine.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/haptics/session.hpp"
 
@@ -123,7 +124,9 @@ Command add_haptics_command(CLI::App& app) {
       "                  contact_length, cut_depth blade length in soil, depth cut (m)\n"
       "                  removed_volume            volume cut this tick (m^3)\n"
       "                  vel_x,vel_y,vel_z         estimated tool velocity, world m/s\n"
-      "                  fw_x,fw_y,fw_z            force models' world force on the tool (N)\n"
+      "                  fw_x,fw_y,fw_z            world force on the tool: force models +\n"
+      "                                            rigid bodies (N)\n"
+      "                  fb_x,fb_y,fb_z            the rigid bodies' part of it (N; 0 without)\n"
       "                  fd_x,fd_y,fd_z            force sent to the device, device frame (N)\n"
       "                  clamped,rate_limited,watchdog,ramping,nonfinite  safety flags (0/1)\n"
       "                  bad_sample,silent,missed_deadline                loop flags (0/1)\n"
@@ -132,6 +135,11 @@ Command add_haptics_command(CLI::App& app) {
       "                us), missed deadlines, loop and safety counters, rejected packets by\n"
       "                reason (udp), device figures, forces, cutting totals, warnings\n"
       "  haptics.png   force and contact over time (tools/plot_haptics.py)\n"
+      "  bodies.csv    only when the scenario has bodies: one row per body per tick,\n"
+      "                t,body,name,x,y,z,qw,qx,qy,qz,vx,vy,vz (SI; Bullet rigid bodies on\n"
+      "                the same terrain, pushed by the blade's plate: the force they put on\n"
+      "                it joins the force felt, scaled by forces.force_scale; summary.json\n"
+      "                \"bodies\" gives the peak)\n"
       "\n"
       "Exit codes: 0 done; 1 bad input or failed output; 2 bad command line; 3 outputs\n"
       "written but the plot could not be made. Ctrl-C ends the session early and still\n"
@@ -142,7 +150,9 @@ Command add_haptics_command(CLI::App& app) {
       "  terracut haptics scenarios/trench_dry_sand.yaml --device script --out out/trench_script\n"
       "  terracut haptics scenarios/trench_dry_sand.yaml --device udp:127.0.0.1:47000 \\\n"
       "      --duration 10 --out out/trench_udp    # then run terracut-device in another shell\n"
-      "Docs: docs/haptics.md (what you feel and why), docs/bridge-protocol.md (the bridge).");
+      "  terracut haptics scenarios/rock_push.yaml --out out/rock   # the blade hits a rock\n"
+      "Docs: docs/haptics.md (what you feel and why), docs/bridge-protocol.md (the bridge),\n"
+      "docs/bullet.md (rigid bodies).");
 
   return [opt]() {
     haptics::SessionOptions so;
@@ -163,6 +173,25 @@ Command add_haptics_command(CLI::App& app) {
     };
 
     const haptics::HapticScenario input = haptics::load_haptic_scenario(opt->scenario);
+    // Rigid bodies: the Bullet world is stepped by the loop (the force on the
+    // blade's plate is felt) and writes bodies.csv into the output folder,
+    // which must exist before the loop is built. Declared before the session,
+    // which must be destroyed first.
+    std::unique_ptr<haptics::LoopEngine> bodies;
+    if (!input.scenario.bodies.empty()) {
+      if (!apps::bodies_engine_available())
+        throw InputError(opt->scenario + ": " + apps::bodies_engine_unavailable_message());
+      std::error_code ec;
+      fs::create_directories(opt->out, ec);
+      if (ec || !fs::is_directory(opt->out))
+        throw InputError(opt->out + ": cannot create the output folder" +
+                         (ec ? " (" + ec.message() + ")" : std::string()));
+      bodies = apps::make_bodies_engine(input.scenario.bodies,
+                                        {fs::path(opt->out) / "bodies.csv"});
+      so.engine = bodies.get();
+      say(std::to_string(input.scenario.bodies.size()) +
+          " rigid bodies (Bullet) on the terrain: their force on the blade is felt");
+    }
     haptics::Session session(input, so);
     if (session.device_kind() == DeviceKind::kUdp)
       say("waiting for a device on udp " + session.loop().settings().udp.address + ":" +
@@ -190,6 +219,13 @@ Command add_haptics_command(CLI::App& app) {
     for (const std::string& w : session.warnings())
       if (w.rfind("real-time:", 0) != 0) std::cerr << "terracut haptics: warning: " << w << "\n";
     if (!opt->quiet) std::cout << session.summary_line() << " -> " << opt->out << "\n";
+    if (bodies) {
+      char line[160];
+      std::snprintf(line, sizeof line,
+                    "bodies: peak force of the bodies on the blade %.4g N (world); bodies.csv",
+                    session.loop().max_body_force_n());
+      say(line);
+    }
     if (opt->no_plot) return kExitOk;
 
     // The plot, by the plot script; a failure leaves the outputs in place.

@@ -8,6 +8,10 @@
 #include "terracut/core/error.hpp"
 #include "terracut/io/run.hpp"
 
+#ifdef TERRACUT_VIEWER_BODIES
+#include "bodies_engine.hpp"
+#endif
+
 namespace terracut::viewer {
 
 HapticSettings viewer_settings(HapticSettings settings) {
@@ -60,12 +64,24 @@ LoopDriver::LoopDriver(const io::Scenario& scenario, const HapticSettings& setti
   device_->set_source(options.source);
   device_->set_pause_at_end(options.pause_at_end);
 
+  // Rigid bodies: the Bullet engine, stepped by the loop with the terrain.
+  if (!scenario_.bodies.empty()) {
+#ifdef TERRACUT_VIEWER_BODIES
+    engine_ = apps::make_bodies_engine(scenario_.bodies);
+#else
+    throw InputError(
+        "bodies: this terracut-viewer was built without the rigid-body engine, so the "
+        "scenario's bodies cannot be simulated");
+#endif
+  }
+
   haptics::LoopOptions lo;
   lo.ticks = std::numeric_limits<std::int64_t>::max() / 2;  // until stop()
   lo.record_capacity = options.record_capacity;
   lo.realtime = options.realtime;
   lo.lock_memory = false;  // the viewer's GL driver allocates; locking all memory is not ours to do
   lo.snapshot = exchange_.get();
+  lo.engine = engine_.get();
   loop_ = std::make_unique<haptics::HapticLoop>(settings_, io::sim_params(scenario_), initial_,
                                                 start.orientation, *device_, lo);
 
@@ -76,6 +92,7 @@ LoopDriver::LoopDriver(const io::Scenario& scenario, const HapticSettings& setti
   f.edge = blade_segment(scenario_.blade, start);
   f.device_position_m = start.position_m;
   f.proxy_position_m = start.position_m;
+  if (engine_) engine_->fill_frame(f);  // the bodies where they start
   HeightGrid grid(spec_, initial_);
   exchange_->publish(grid);
 }

@@ -13,6 +13,11 @@
 //    (step1 at t = i / rate, step2), as fast as it can, up to the tick the
 //    drawing thread asks for, then waits; frame k shows exactly the state
 //    after the ticks it asked for, the same on every run.
+//
+// A scenario with rigid bodies (`bodies:`) gets the Bullet engine of the
+// haptic loop (apps/terracut/bodies_engine.hpp, the one `terracut haptics`
+// uses): the bodies are stepped with the terrain, their force on the blade
+// joins the force, and every frame carries their poses.
 #pragma once
 
 #include <atomic>
@@ -80,6 +85,8 @@ class LoopDriver {
   ViewerDevice& device() { return *device_; }
   /// The loop; its results only after stop().
   const haptics::HapticLoop& loop() const { return *loop_; }
+  /// Rigid bodies of the scenario (simulated by the loop's engine).
+  int body_count() const { return int(scenario_.bodies.size()); }
 
   /// Lock-step: run until `ticks` ticks are done in all.
   void run_until_tick(std::int64_t ticks) { target_ticks_.store(ticks); }
@@ -100,6 +107,8 @@ class LoopDriver {
   std::int64_t script_ticks_ = 0;
   std::unique_ptr<haptics::SnapshotExchange> exchange_;
   std::unique_ptr<ViewerDevice> device_;
+  // The bodies engine outlives the loop (the loop detaches it when it goes).
+  std::unique_ptr<haptics::LoopEngine> engine_;
   std::unique_ptr<haptics::HapticLoop> loop_;
 
   std::thread lockstep_thread_;

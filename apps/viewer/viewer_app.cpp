@@ -70,8 +70,11 @@ struct ViewerApp::Live {
   BladePose pose{};
   Segment edge{};
   ContactResult contact{};
-  Vec3 device_m{}, proxy_m{}, force_world_n{}, force_device_n{};
+  Vec3 device_m{}, proxy_m{}, force_world_n{}, force_device_n{}, body_force_n{};
   double step_time_s = 0.0, period_s = 0.0;
+  // Rigid bodies of the frame (the first body_count are valid).
+  int body_count = 0, body_total = 0;
+  std::array<haptics::ViewBody, haptics::kMaxViewBodies> bodies{};
   std::int64_t uploaded_last = 0;
 
   std::vector<float> contact_hist = std::vector<float>(kHistory, 0.0f);
@@ -251,6 +254,10 @@ bool ViewerApp::consume_frame() {
   l.proxy_m = f->proxy_position_m;
   l.force_world_n = f->force_world_n;
   l.force_device_n = f->force_device_n;
+  l.body_force_n = f->body_force_world_n;
+  l.body_count = f->body_count;
+  l.body_total = f->body_total;
+  std::copy_n(f->bodies.begin(), f->body_count, l.bodies.begin());
   l.step_time_s = f->step_time_s;
   l.period_s = f->period_s;
   return true;
@@ -404,6 +411,35 @@ void ViewerApp::draw_scene(int x, int y, int w, int h) {
                translation({0.0f, 0.5f * plate_h + rod, 0.0f}) *
                scaling({blade_len, plate_h, 0.6f * rod});
 
+  // Rigid bodies (the Bullet world's), lit, in cool stone colours that stand
+  // apart from the soil's browns.
+  static const Color kBodyColors[4] = {{0.52f, 0.60f, 0.72f, 1.0f},
+                                       {0.60f, 0.64f, 0.70f, 1.0f},
+                                       {0.46f, 0.56f, 0.62f, 1.0f},
+                                       {0.62f, 0.58f, 0.72f, 1.0f}};
+  for (int i = 0; i < l.body_count; ++i) {
+    const haptics::ViewBody& body = l.bodies[std::size_t(i)];
+    const Color color = kBodyColors[i % 4];
+    const Vec3f centre = to_f(body.position_m);
+    switch (body.shape) {
+      case BodyShape::kBox:
+        shapes_->box(translation(centre) * rotation(body.orientation) *
+                         scaling(to_f(body.half_extents_m) * 2.0f),
+                     color);
+        break;
+      case BodyShape::kSphere:
+        shapes_->sphere(centre, float(body.half_extents_m.x), color);
+        break;
+      case BodyShape::kCylinder: {
+        // The axis is the body's local Y.
+        const Vec3 half_axis = rotate(body.orientation, Vec3{0.0, body.half_extents_m.y, 0.0});
+        shapes_->cylinder(to_f(body.position_m - half_axis), to_f(body.position_m + half_axis),
+                          float(body.half_extents_m.x), color);
+        break;
+      }
+    }
+  }
+
   // Device point, proxy and the spring between them; a drop line to the ground.
   float r = 0.012f * extent;
   Vec3f device = to_f(l.device_m), proxy = to_f(l.proxy_m);
@@ -541,6 +577,9 @@ void ViewerApp::draw_panel(int fb_width, int fb_height) {
   ImGui::Text("contact %.3f m   depth %.3f m", l.contact.length_m, l.contact.max_depth_m);
   ImGui::Text("|F| %.1f N world   %.2f N device", double(magnitude(l.force_world_n)),
               double(magnitude(l.force_device_n)));
+  if (l.body_total > 0)
+    ImGui::Text("bodies %d (Bullet)   on the blade %.1f N", l.body_total,
+                double(magnitude(l.body_force_n)));
   char overlay[64];
   const float plot_w = float(panel_width_) - 20.0f;
   std::snprintf(overlay, sizeof overlay, "contact length %.3f m", l.contact.length_m);

@@ -62,11 +62,15 @@ HapticLoop::HapticLoop(const HapticSettings& settings, const SimParams& sim,
   }
   // Everything a tick touches is allocated here, never during the run.
   records_.resize(options_.record_capacity);
+  // The engine builds itself over the simulation (it may throw InputError).
+  if (options_.engine) options_.engine->attach(sim_);
 }
 
 HapticLoop::~HapticLoop() {
   request_stop();
   if (thread_.joinable()) thread_.join();
+  // The engine outlives the loop: it must let go of the simulation first.
+  if (options_.engine) options_.engine->detach();
 }
 
 // ---------------------------------------------------------------------------
@@ -120,7 +124,10 @@ void HapticLoop::step1(double t_s) noexcept {
     has_previous_tool_ = false;  // start the estimate afresh
     return;
   }
-  if (tick_flags_ & kFlagReconnected) sim_.lift();  // the handle may be anywhere: no sweep
+  if (tick_flags_ & kFlagReconnected) {
+    sim_.lift();  // the handle may be anywhere: no sweep
+    if (options_.engine) options_.engine->lifted();
+  }
   BladePose pose;
   {
     pose.position_m = workspace_.to_world(sample_.position_m);
@@ -171,6 +178,15 @@ const LoopRecord& HapticLoop::step2(double period_s, double compute_s,
     force = model_.compute(in);
   }
 
+  // The engine's step (e.g. rigid bodies pushing the blade's plate): its
+  // world force joins the models' and is scaled to the device the same way.
+  Vec3 body_force{};
+  if (usable && options_.engine) {
+    body_force = options_.engine->after_cut(out);
+    force.world_n = force.world_n + body_force;
+    force.device_n = force.world_n * model_.params().force_scale;
+  }
+
   // Safety: a bad sample or no sample yet asks for zero force (shrinking to
   // zero is immediate); the watchdog looks at the last good sample's time.
   const Vec3 request = usable ? force.device_n : Vec3{};
@@ -198,11 +214,13 @@ const LoopRecord& HapticLoop::step2(double period_s, double compute_s,
   r.removed_volume_m3 = out.cut.removed_volume_m3;
   r.velocity_m_per_s = velocity_m_per_s_;
   r.force_world_n = force.world_n;
+  r.body_force_world_n = body_force;
   r.force_device_n = command.force_n;
   r.flags = flags;
   r.period_s = period_s;
   r.compute_s = compute_s;
   max_device_force_n_ = std::max(max_device_force_n_, length(command.force_n));
+  max_body_force_n_ = std::max(max_body_force_n_, length(body_force));
   ++counters_.ticks;
   record(r);
 
@@ -220,8 +238,15 @@ const LoopRecord& HapticLoop::step2(double period_s, double compute_s,
     f.proxy_position_m = force.surface.in_contact ? force.surface.proxy_m : out.pose.position_m;
     f.force_world_n = force.world_n;
     f.force_device_n = command.force_n;
+    f.body_force_world_n = body_force;
     f.step_time_s = compute_s;
     f.period_s = period_s;
+    if (options_.engine) {
+      options_.engine->fill_frame(f);
+    } else {
+      f.body_count = 0;
+      f.body_total = 0;
+    }
     x.publish(sim_.grid());
   }
   return last_;

@@ -171,6 +171,7 @@ Session::Session(const HapticScenario& input, const SessionOptions& options)
   lo.record_capacity = std::min<std::size_t>(options.max_records, std::size_t(lo.ticks));
   lo.realtime = options.realtime;
   lo.snapshot = options.snapshot;
+  lo.engine = options.engine;
   try {
     loop_ = std::make_unique<HapticLoop>(settings, io::sim_params(sc),
                                          io::build_initial_heights(sc), default_orientation,
@@ -362,6 +363,12 @@ std::string Session::summary_json() const {
   j << "  \"cutting\": {\"removed_volume_m3\": " << json_number(removed)
     << ", \"peak_contact_m\": " << json_number(peak_contact)
     << ", \"ticks_in_contact\": " << in_contact << "},\n";
+  // The engine's entry (e.g. "bodies": the rigid bodies and the peak force
+  // they put on the tool).
+  if (const LoopEngine* engine = l.engine()) {
+    const std::string key = engine->summary_key();
+    if (!key.empty()) j << "  " << json_string(key) << ": " << engine->summary_json() << ",\n";
+  }
   const std::vector<std::string> w = warnings();
   j << "  \"warnings\": [";
   for (std::size_t i = 0; i < w.size(); ++i) j << (i ? ", " : "") << json_string(w[i]);
@@ -417,13 +424,14 @@ void write_haptics_csv(std::ostream& out, const std::vector<LoopRecord>& records
     std::snprintf(
         line, sizeof line,
         "%.9g,%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
-        "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%d,%d,%d,%d,%.9g,%.9g\n",
+        "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%d,%d,%d,%d,%.9g,%.9g\n",
         r.t_s, static_cast<long long>(r.tick), r.device_position_m.x, r.device_position_m.y,
         r.device_position_m.z, r.tool.position_m.x, r.tool.position_m.y, r.tool.position_m.z,
         r.tool.orientation.w, r.tool.orientation.x, r.tool.orientation.y, r.tool.orientation.z,
         r.contact_length_m, r.cut_depth_m, r.removed_volume_m3, r.velocity_m_per_s.x,
         r.velocity_m_per_s.y, r.velocity_m_per_s.z, r.force_world_n.x, r.force_world_n.y,
-        r.force_world_n.z, r.force_device_n.x, r.force_device_n.y, r.force_device_n.z,
+        r.force_world_n.z, r.body_force_world_n.x, r.body_force_world_n.y, r.body_force_world_n.z,
+        r.force_device_n.x, r.force_device_n.y, r.force_device_n.z,
         bit(kFlagClamped), bit(kFlagRateLimited), bit(kFlagWatchdog), bit(kFlagRamping),
         bit(kFlagNonfinite), bit(kFlagBadSample), bit(kFlagSilent), bit(kFlagMissedDeadline),
         r.period_s, r.compute_s);
@@ -438,6 +446,7 @@ void Session::write_outputs(const fs::path& out_dir) const {
   if (ec || !fs::is_directory(out_dir))
     throw InputError(out_dir.string() + ": cannot create the output folder" +
                      (ec ? " (" + ec.message() + ")" : std::string()));
+  if (options_.engine) options_.engine->finish();
   std::ostringstream csv;
   write_haptics_csv(csv, loop_->records());
   write_text_file(out_dir / "haptics.csv", csv.str());

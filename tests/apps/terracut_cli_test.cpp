@@ -6,7 +6,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <fcntl.h>
 #include <filesystem>
@@ -188,6 +190,57 @@ cuts:
   EXPECT_NEAR(last_y[1], first_y[1], 0.002);
   EXPECT_NEAR(last_x[1], 0.85, 0.002);
   EXPECT_NE(slurp(out / "summary.json").find("\"bodies\""), std::string::npos);
+}
+
+// `terracut haptics` on a scenario with bodies: the Bullet world is stepped
+// by the haptic loop, bodies.csv is written beside haptics.csv (whose bodies'
+// force columns are filled while the plate pushes the rock) and summary.json
+// has a "bodies" entry. A build without Bullet refuses the scenario, naming
+// it, with exit code 1 and nothing written. (The forces themselves are
+// checked in bodies_engine_test.cpp.)
+TEST_F(CliTest, HapticsWithBodiesFeelsThemAndWritesTheirPoses) {
+  const fs::path out = dir_ / "rock";
+  const Result r = terracut({"haptics", scenario("rock_push.yaml"), "--device", "script",
+                             "--no-plot", "--quiet", "--out", out.string()});
+  if (r.err.find("built without Bullet") != std::string::npos) {
+    expect_clean_failure(r, {"rock_push.yaml", "bodies", "libbullet-dev"});
+    EXPECT_FALSE(fs::exists(out / "haptics.csv"));
+    GTEST_SKIP() << "built without Bullet: " << r.err;
+  }
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* name : {"haptics.csv", "summary.json", "bodies.csv"})
+    EXPECT_TRUE(fs::exists(out / name)) << name;
+  const std::string bodies = slurp(out / "bodies.csv");
+  EXPECT_EQ(bodies.rfind("t,body,name,x,y,z,qw,qx,qy,qz,vx,vy,vz\n0,0,rock,", 0), 0u);
+  // One row for the start, then one per tick (4.5 s at 1 kHz).
+  EXPECT_EQ(std::count(bodies.begin(), bodies.end(), '\n'), 1 + 1 + 4500);
+  const std::string summary = slurp(out / "summary.json");
+  EXPECT_NE(summary.find("\"bodies\": {"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"peak_tool_force_n\""), std::string::npos) << summary;
+  // haptics.csv: some ticks have a force from the rock along +Z (fb_z > 0).
+  std::ifstream csv(out / "haptics.csv");
+  std::string line;
+  std::getline(csv, line);
+  std::vector<std::string> names;
+  for (std::size_t a = 0, b; a <= line.size(); a = b + 1) {
+    b = line.find(',', a);
+    if (b == std::string::npos) b = line.size();
+    names.push_back(line.substr(a, b - a));
+  }
+  const auto fb_z = std::find(names.begin(), names.end(), "fb_z");
+  ASSERT_NE(fb_z, names.end()) << line;
+  const std::size_t col = std::size_t(fb_z - names.begin());
+  int pushed = 0;
+  while (std::getline(csv, line)) {
+    std::size_t at = 0;
+    for (std::size_t k = 0; k < col; ++k) at = line.find(',', at) + 1;
+    if (std::strtod(line.c_str() + at, nullptr) > 0.0) ++pushed;
+  }
+  EXPECT_GT(pushed, 800);
+
+  const Result help = terracut({"haptics", "--help"});
+  for (const char* word : {"bodies.csv", "fb_x", "rock_push.yaml"})
+    EXPECT_NE(help.out.find(word), std::string::npos) << word;
 }
 
 // --realtime paces the steps to the wall clock and reports the loop's timing.

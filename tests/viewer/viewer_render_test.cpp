@@ -342,6 +342,88 @@ TEST_F(ViewerRenderTest, HeightmapPngIsDrawnWithItsSlope) {
   EXPECT_LT(third[1] + 10.0, third[2]);
 }
 
+// A big box resting on a flat 0.1 m layer (0.5 x 0.2 x 0.3 m, turned 30
+// degrees about Y, so that its footprint shows the orientation), the tool
+// far away. From the top, every pixel of the box's footprint differs from the
+// same scenario without the box and is drawn in the bodies' cool colour
+// (blue above red, where the soil is red above blue); every pixel away from
+// it is unchanged.
+const char* kBoxScenario = R"(
+name: viewer_box
+terrain:
+  generator: plane
+  resolution: 64
+  size_m: [1.0, 1.0]
+  full_scale_m: 0.2
+  plane: {height_m: 0.1}
+blade: {length_m: 0.3}
+bodies:
+  - {name: block, shape: box, size_m: [0.5, 0.2, 0.3], mass_kg: 60,
+     position_m: [0.5, 0.2, 0.5], rotation_deg: [0, 30, 0]}
+cuts:
+  - name: away
+    keyframes:
+      - {t_s: 0.0, position_m: [20.0, 1.0, 20.0]}
+      - {t_s: 0.2, position_m: [21.0, 1.0, 20.0]}
+)";
+
+TEST_F(ViewerRenderTest, RigidBodyIsDrawnWhereItRests) {
+  const int w = 320, h = 320;
+  const std::string with_text = kBoxScenario;
+  const std::string without_text = with_text.substr(0, with_text.find("bodies:")) +
+                                   with_text.substr(with_text.find("cuts:"));
+  const fs::path with_sc = write("box.yaml", with_text);
+  const fs::path without_sc = write("nobox.yaml", without_text);
+  const std::vector<std::string> common = {"--camera", "top", "--no-panel", "--no-contours",
+                                           "--size", "320x320"};
+  // The box as the viewer gets it from the loop (the whole 0.2 s script).
+  const fs::path png = dir_ / "box.png";
+  std::vector<std::string> argv = {with_sc.string(), "--screenshot", png.string(), "--msaa", "0"};
+  argv.insert(argv.end(), common.begin(), common.end());
+  const Result r = run(argv);
+  if (r.exited && r.code == kExitNoContext) GTEST_SKIP() << "no OpenGL context: " << r.err;
+  if (r.err.find("built without") != std::string::npos) {
+    EXPECT_EQ(r.code, 2) << r.err;  // refused as bad input, with the reason
+    GTEST_SKIP() << r.err;
+  }
+  ASSERT_TRUE(r.exited && r.code == 0) << "terracut-viewer failed (" << r.code << "): " << r.err;
+  const RgbImage with = terracut::viewer::read_png_rgb(png);
+  RENDER_OR_SKIP(without, without_sc, "nobox.png", common);
+  ASSERT_EQ(with.cols, w);
+
+  const TopMapping map(w, h, 0.0, 0.0, 1.0, 1.0);
+  const double c = std::cos(30.0 * M_PI / 180.0), s = std::sin(30.0 * M_PI / 180.0);
+  const double hx = 0.25, hz = 0.15, px = 1.0 / map.px_per_m;
+  int inside = 0, inside_changed = 0, inside_cool = 0, far = 0, far_changed = 0;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const double dx = map.x(u) - 0.5, dz = map.z(v) - 0.5;
+      if (std::abs(dx) > 0.48 || std::abs(dz) > 0.48) continue;  // the terrain only
+      // Body-frame coordinates: world = R_y(30 deg) body, body = R_y(-30 deg) world.
+      const double bx = c * dx - s * dz, bz = s * dx + c * dz;
+      const std::uint8_t* p = pixel(with, u, v);
+      const int d = max_diff(p, pixel(without, u, v));
+      if (std::abs(bx) < hx - 2 * px && std::abs(bz) < hz - 2 * px) {
+        ++inside;
+        inside_changed += d > 25 ? 1 : 0;
+        inside_cool += p[2] > p[0] ? 1 : 0;
+      } else if (std::abs(bx) > hx + 3 * px || std::abs(bz) > hz + 3 * px) {
+        ++far;
+        far_changed += d > 3 ? 1 : 0;
+      }
+    }
+  }
+  // The footprint: 0.5 x 0.3 m at about 256 px per metre.
+  EXPECT_GT(inside, 8000);
+  EXPECT_GT(far, 40000);
+  EXPECT_EQ(inside_changed, inside) << "pixels of the box drawn in the terrain's colour";
+  EXPECT_EQ(inside_cool, inside) << "pixels of the box not in the bodies' colour";
+  EXPECT_EQ(far_changed, 0) << "pixels away from the box that changed";
+  // The soil itself is warm (red above blue).
+  const std::uint8_t* soil = pixel(without, w / 2, h / 2);
+  EXPECT_GT(soil[0], soil[2]);
+}
+
 TEST_F(ViewerRenderTest, MissingScenarioIsReportedByName) {
   Result r = run({(dir_ / "no_such.yaml").string(), "--screenshot", (dir_ / "x.png").string()});
   ASSERT_TRUE(r.exited) << "the viewer crashed";

@@ -2,9 +2,11 @@
 //
 //   step1: read the device -> map its workspace to the world -> set the tool
 //          pose -> Simulation::begin_step (contact before the cut)
-//   step2: Simulation::finish_step (swept cut) -> ForceModel::compute ->
-//          SafetyLimiter::update -> map the force to the device -> write ->
-//          record -> feed the snapshot exchange (optional)
+//   step2: Simulation::finish_step (swept cut) -> LoopEngine::after_cut
+//          (optional: e.g. rigid bodies; an extra world force) ->
+//          ForceModel::compute (+ the engine's force) -> SafetyLimiter::update
+//          -> map the force to the device -> write -> record -> feed the
+//          snapshot exchange (optional)
 //
 // the split where the outside world comes in, as MuJoCo's mj_step1/mj_step2.
 // Parameters (settings, force model, workspace) are read-only during a run;
@@ -67,7 +69,12 @@ struct LoopRecord {
   double cut_depth_m = 0.0;  ///< depth given to the earthmoving model, metres (0 without contact)
   double removed_volume_m3 = 0.0;  ///< volume cut this tick, m^3
   Vec3 velocity_m_per_s{};         ///< estimated tool velocity, world m/s
-  Vec3 force_world_n{};            ///< force models' world force on the tool, world N
+  /// World force on the tool, world N: the force models' (cutting + surface)
+  /// plus the engine's (body_force_world_n).
+  Vec3 force_world_n{};
+  /// The engine's part of force_world_n (e.g. rigid bodies pushing the
+  /// blade's plate), world N; zero without an engine.
+  Vec3 body_force_world_n{};
   Vec3 force_device_n{};           ///< force sent, device frame, device N (after safety)
   std::uint32_t flags = 0;         ///< kFlag* bits
   double period_s = 0.0;           ///< time since the previous tick's start, seconds
@@ -93,6 +100,56 @@ struct TimePercentiles {
   double mean_us = 0.0;
 };
 
+/// An optional engine stepped by the loop with the simulation (the haptics
+/// layer knows none: e.g. the Bullet rigid-body world of the apps, which
+/// makes an operator feel the blade hitting a rock). The loop calls, on its
+/// own thread:
+///
+///   attach(sim)      once, from the HapticLoop constructor, before any tick
+///   after_cut(out)   each tick the simulation is stepped, right after
+///                    Simulation::finish_step and before the force goes to
+///                    the safety limiter; the returned world force is added
+///                    to the force models' world force and scaled to the
+///                    device with the same force_scale
+///   lifted()         when the loop lifts the tool (Simulation::lift: the
+///                    next pose is a jump, not a sweep)
+///   fill_frame(f)    each tick a snapshot exchange is fed, before publish
+///   detach()         once, from the HapticLoop destructor after its thread
+///                    has ended: drop every reference to the simulation
+///
+/// On ticks where the simulation is not stepped (no device sample yet, or a
+/// non-finite one) after_cut is not called: the engine stands still, as the
+/// terrain does. after_cut, lifted and fill_frame run inside a tick: they
+/// must not allocate, block or throw. The engine must outlive the loop.
+class LoopEngine {
+ public:
+  virtual ~LoopEngine() = default;
+  /// Builds the engine over the loop's simulation (its grid, rate and blade);
+  /// may allocate and throw InputError naming the bad field.
+  virtual void attach(Simulation& sim) = 0;
+  /// One step after the simulation's: returns the extra world force on the
+  /// tool, world N (finite; a non-finite value is caught by the safety
+  /// limiter like any other).
+  virtual Vec3 after_cut(const StepOutput& out) noexcept = 0;
+  /// The tool was lifted: the next pose is a jump.
+  virtual void lifted() noexcept {}
+  /// Writes the engine's part of a viewer frame (body poses); the default
+  /// writes no bodies.
+  virtual void fill_frame(ViewFrame& frame) const noexcept {
+    frame.body_count = 0;
+    frame.body_total = 0;
+  }
+  /// The loop is being destroyed: release whatever refers to its simulation.
+  virtual void detach() noexcept {}
+  /// After the run: flush and close the engine's files (idempotent). Throws
+  /// InputError naming a file that could not be written.
+  virtual void finish() {}
+  /// After the run: the key and the JSON object text of the engine's entry in
+  /// a session's summary.json; an empty key adds none.
+  virtual std::string summary_key() const { return {}; }
+  virtual std::string summary_json() const { return {}; }
+};
+
 /// How to run a loop.
 struct LoopOptions {
   /// Ticks to run, >= 1 (the session: round(duration * rate)).
@@ -109,6 +166,9 @@ struct LoopOptions {
   /// Optional viewer feed, fed every tick from the loop thread (one writer);
   /// must outlive the loop and be built on the same grid size.
   SnapshotExchange* snapshot = nullptr;
+  /// Optional engine stepped with the simulation (LoopEngine); must outlive
+  /// the loop. Attached by the constructor.
+  LoopEngine* engine = nullptr;
 };
 
 class HapticLoop {
@@ -161,6 +221,8 @@ class HapticLoop {
   const Simulation& simulation() const { return sim_; }
   const Workspace& workspace() const { return workspace_; }
   const LoopCounters& counters() const { return counters_; }
+  /// The attached engine, or nullptr.
+  LoopEngine* engine() const { return options_.engine; }
   const LoopRecord& last() const { return last_; }
   /// The kept records, oldest first.
   std::vector<LoopRecord> records() const;
@@ -176,6 +238,8 @@ class HapticLoop {
   const RealtimeStatus& realtime_status() const { return realtime_; }
   /// Largest |force sent| over the run, device N.
   double max_device_force_n() const { return max_device_force_n_; }
+  /// Largest |engine force| over the run (every tick, kept or not), world N.
+  double max_body_force_n() const { return max_body_force_n_; }
 
  private:
   void thread_main(std::promise<void>& ready);
@@ -216,6 +280,7 @@ class HapticLoop {
   LoopCounters counters_{};
   LoopRecord last_{};
   double max_device_force_n_ = 0.0;
+  double max_body_force_n_ = 0.0;
 
   std::vector<LoopRecord> records_;  // ring of options_.record_capacity
   std::size_t next_record_ = 0;

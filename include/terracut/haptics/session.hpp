@@ -4,7 +4,8 @@
 //   haptics.csv   one row per tick (columns in kHapticsCsvColumns; docs/haptics.md)
 //   summary.json  settings used, loop timing percentiles, missed deadlines,
 //                 counters (loop, safety, rejected packets by reason), forces,
-//                 cutting totals and warnings
+//                 cutting totals and warnings, and the engine's entry (e.g.
+//                 "bodies") when SessionOptions::engine has one
 #pragma once
 
 #include <atomic>
@@ -25,8 +26,8 @@ namespace terracut::haptics {
 /// The columns of haptics.csv, in order.
 inline constexpr const char* kHapticsCsvColumns =
     "t,tick,dev_x,dev_y,dev_z,tool_x,tool_y,tool_z,qw,qx,qy,qz,contact_length,cut_depth,"
-    "removed_volume,vel_x,vel_y,vel_z,fw_x,fw_y,fw_z,fd_x,fd_y,fd_z,clamped,rate_limited,"
-    "watchdog,ramping,nonfinite,bad_sample,silent,missed_deadline,period,compute";
+    "removed_volume,vel_x,vel_y,vel_z,fw_x,fw_y,fw_z,fb_x,fb_y,fb_z,fd_x,fd_y,fd_z,clamped,"
+    "rate_limited,watchdog,ramping,nonfinite,bad_sample,silent,missed_deadline,period,compute";
 
 /// A scenario and its haptics settings.
 struct HapticScenario {
@@ -57,6 +58,10 @@ struct SessionOptions {
   std::size_t max_records = 600000;
   std::ostream* log = nullptr;           ///< one-line messages (e.g. &std::cerr), or nullptr
   SnapshotExchange* snapshot = nullptr;  ///< optional viewer feed
+  /// Optional engine stepped with the simulation (LoopEngine, e.g. rigid
+  /// bodies); must outlive the session. write_outputs() calls its finish()
+  /// and summary.json holds its entry.
+  LoopEngine* engine = nullptr;
   /// Polled every 10 ms while a real-time loop runs; true stops it (e.g. set by SIGINT).
   const std::atomic<bool>* interrupt = nullptr;
 };
@@ -72,8 +77,9 @@ class Session {
   /// Runs the loop to its end (or an interrupt). Call once.
   void run();
 
-  /// Writes haptics.csv and summary.json into out_dir (created if missing).
-  /// Throws InputError naming the file when it cannot be written.
+  /// Writes haptics.csv and summary.json into out_dir (created if missing),
+  /// after finishing the engine (its own files, e.g. bodies.csv, are the
+  /// engine's). Throws InputError naming the file when it cannot be written.
   void write_outputs(const std::filesystem::path& out_dir) const;
 
   /// One line: device, ticks, jitter and compute p99, max force, warnings.

@@ -11,13 +11,30 @@
 // a renderer uploads just that region.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <vector>
 
+#include "terracut/core/bodies.hpp"
 #include "terracut/core/simulation.hpp"
 
 namespace terracut::haptics {
+
+/// Most rigid bodies a ViewFrame carries (a fixed array: publishing never allocates).
+inline constexpr int kMaxViewBodies = 64;
+
+/// A rigid body's shape and pose in a ViewFrame.
+struct ViewBody {
+  BodyShape shape = BodyShape::kBox;  ///< box, sphere or cylinder (axis = local Y)
+  /// Half of the body's extent along its local axes, metres, each > 0: a
+  /// box's half sizes, (r, r, r) for a sphere, (r, h/2, r) for a cylinder
+  /// (half_extents_m() of its BodySpec).
+  Vec3 half_extents_m{};
+  Vec3 position_m{};    ///< centre, world metres
+  Quat orientation{};   ///< body frame -> world, unit quaternion
+  bool active = true;   ///< false while the physics engine has it asleep
+};
 
 /// One consistent picture of the simulation.
 struct ViewFrame {
@@ -35,8 +52,16 @@ struct ViewFrame {
   Vec3 proxy_position_m{};     ///< surface proxy, world metres
   Vec3 force_world_n{};        ///< force on the tool in the world, newtons
   Vec3 force_device_n{};       ///< force sent to the device, newtons
+  Vec3 body_force_world_n{};   ///< the engine's (rigid bodies') part of force_world_n, newtons
   double step_time_s = 0.0;    ///< compute time of the step, seconds
   double period_s = 0.0;       ///< measured loop period before the step, seconds
+  /// Rigid bodies (filled by the loop's engine, LoopEngine::fill_frame): the
+  /// first body_count entries of bodies are valid, body_count in
+  /// [0, kMaxViewBodies]; body_total counts all the engine's bodies (more
+  /// than body_count when it has more than kMaxViewBodies).
+  int body_count = 0;
+  int body_total = 0;
+  std::array<ViewBody, kMaxViewBodies> bodies{};
 };
 
 class SnapshotExchange {

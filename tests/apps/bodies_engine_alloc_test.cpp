@@ -1,0 +1,110 @@
+// The haptic loop with the rigid-body engine (Bullet world, bodies.csv and
+// the viewer feed) allocates nothing per tick once Bullet is warm: every
+// global operator new and every Bullet allocation (btAlignedAlloc,
+// redirected here) of this program is counted over the rock session's ticks
+// after the plate's first touch (Bullet's contact arrays grow to their
+// working size on the first contacts of each kind).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <LinearMath/btAlignedAllocator.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <filesystem>
+#include <new>
+
+#include "bodies_engine.hpp"
+#include "terracut/haptics/script_device.hpp"
+#include "terracut/haptics/session.hpp"
+#include "terracut/io/run.hpp"
+
+// GCC pairs the replaced operator new (malloc) with free() through inlining
+// and warns about a mismatch that is not one.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+
+namespace {
+std::atomic<long> g_allocations{0};
+
+void* counted_bullet_alloc(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return std::malloc(size);
+}
+void bullet_free(void* p) { std::free(p); }
+
+// Installed before main, so every Bullet object of the program uses it.
+const bool g_installed = [] {
+  btAlignedAllocSetCustom(counted_bullet_alloc, bullet_free);
+  return true;
+}();
+}  // namespace
+
+void* operator new(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace terracut::apps {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(BodiesEngineAllocation, TicksAllocateNothingOnceBulletIsWarm) {
+  ASSERT_TRUE(g_installed);
+  const haptics::HapticScenario in = haptics::load_haptic_scenario(
+      fs::path(TERRACUT_SOURCE_DIR) / "scenarios/rock_push.yaml");
+  const fs::path dir = fs::temp_directory_path() / ("terracut_bodies_alloc_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  const io::Scenario& sc = in.scenario;
+  const Motion& cut = sc.cuts.at(0);
+  const double rate = in.haptics.rate_hz;
+  const std::int64_t ticks = std::llround((cut.duration_s() + in.haptics.settle_s) * rate);
+  // The plate's first touch: its front face (edge + half the plate's 2 cm)
+  // reaches the rock's back face at t = 2.58 s (scenarios/rock_push.yaml).
+  const std::int64_t warm = std::llround(2.7 * rate);
+
+  std::unique_ptr<haptics::LoopEngine> engine = make_bodies_engine(sc.bodies, {dir / "bodies.csv"});
+  haptics::ScriptDevice device(haptics::DevicePath(cut, haptics::Workspace(in.haptics.workspace)));
+  HeightGrid grid(io::grid_spec(sc), io::build_initial_heights(sc));
+  haptics::SnapshotExchange exchange(grid);
+  haptics::LoopOptions o;
+  o.ticks = ticks;
+  o.record_capacity = std::size_t(ticks);
+  o.realtime = false;
+  o.snapshot = &exchange;
+  o.engine = engine.get();
+  long during = -1;
+  double peak = 0.0;
+  const long at_start = g_allocations.load();
+  {
+    haptics::HapticLoop loop(in.haptics, io::sim_params(sc), io::build_initial_heights(sc),
+                             cut.keyframes[0].pose.orientation, device, o);
+    for (std::int64_t i = 0; i < warm; ++i) {
+      loop.step1(double(i) / rate);
+      loop.step2(i == 0 ? 0.0 : 1.0 / rate, 0.0, false);
+    }
+    ASSERT_GT(loop.max_body_force_n(), 0.0) << "the plate has not touched the rock yet";
+    const long before = g_allocations.load();
+    // Building the world and Bullet's first contacts did allocate: the
+    // counter sees them.
+    EXPECT_GT(before - at_start, 10);
+    for (std::int64_t i = warm; i < ticks; ++i) {
+      loop.step1(double(i) / rate);
+      loop.step2(1.0 / rate, 0.0, false);
+      exchange.acquire();  // a reader taking frames, as the viewer does
+    }
+    during = g_allocations.load() - before;
+    peak = loop.max_body_force_n();
+  }
+  engine->finish();
+  EXPECT_EQ(during, 0) << "allocations in " << (ticks - warm)
+                       << " ticks of pushing the rock and leaving it";
+  EXPECT_GT(peak, 0.0);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace terracut::apps
