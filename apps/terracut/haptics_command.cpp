@@ -1,8 +1,6 @@
 // `terracut haptics`: one haptic session, outputs into a folder.
 #include "haptics_command.hpp"
 
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
@@ -16,6 +14,7 @@
 #include <vector>
 
 #include "bodies_engine.hpp"
+#include "subprocess.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/haptics/session.hpp"
 
@@ -28,25 +27,6 @@ namespace fs = std::filesystem;
 // outputs of what ran are written.
 std::atomic<bool> g_interrupt{false};
 extern "C" void on_interrupt(int) { g_interrupt.store(true); }
-
-// Runs a program (no shell); its exit code, or -1 when it could not be run.
-int run_program(const std::vector<std::string>& argv) {
-  std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  std::cout.flush();
-  std::cerr.flush();
-  const pid_t pid = fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    execv(args[0], args.data());
-    _exit(127);
-  }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 }  // namespace
 

@@ -2,8 +2,6 @@
 // files, with an error analysis against exact geometry, a report and figures.
 // The experiment definitions are in scenarios/paper_experiment{1,2}.yaml and
 // docs/experiments.md.
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -19,6 +17,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "subprocess.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/core/generators.hpp"
 #include "terracut/io/image.hpp"
@@ -155,27 +154,6 @@ Exp1Row exp1_errors(const io::Scenario& sc, const io::RunResult& run,
   row.p50_step_us = run.step_timing.p50_us;
   row.p99_step_us = run.step_timing.p99_us;
   return row;
-}
-
-// Runs a program (no shell) and returns its exit code, or -1 when it could not
-// be started or did not exit normally.
-int run_program(const std::vector<std::string>& argv) {
-  std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  std::cout.flush();
-  std::cerr.flush();
-  const pid_t pid = fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    execv(args[0], args.data());
-    _exit(127);
-  }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return -1;
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 std::string rep_name(Representation r) { return std::string(to_string(r)); }

@@ -1,9 +1,9 @@
-// Runs a scenario with rigid bodies end to end, the way `terracut run` will
-// once it drives the Bullet world: load_scenario reads `bodies:` into
-// Scenario::bodies; then a TerrainWorld over the Simulation,
-// world.lift_tool() next to sim.lift(), world.step(out) after each sim.step,
-// and a BodiesCsvWriter for DIR/bodies.csv. Shared by the rescue test and the
-// bullet_rescue_run program.
+// Runs a scenario with rigid bodies end to end, in memory, the way `terracut
+// run` drives the Bullet world (apps/terracut/bodies_observer.cpp):
+// load_scenario reads `bodies:` into Scenario::bodies; then a TerrainWorld
+// over the Simulation, world.lift_tool() next to sim.lift(), world.step(out)
+// after each sim.step, and a BodiesCsvWriter for DIR/bodies.csv. Used by the
+// rescue test, which checks every step's body states.
 #pragma once
 
 #include <cmath>
