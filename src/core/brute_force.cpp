@@ -77,13 +77,15 @@ CutResult cut_sweep_brute_force(HeightGrid& grid, Representation representation,
   CutResult out;
   if (!is_finite(from.a) || !is_finite(from.b) || !is_finite(to.a) || !is_finite(to.b)) return out;
   GridFrame f(grid);
-  Vec3 tri[2][3];
-  detail::sweep_triangles(from, to, tri);
+  // The part of the sweep inside the rigid floor cuts nothing.
+  Vec3 tri[4][3];
+  const int n_tri = detail::sweep_triangles_above_floor(from, to, f.ground_y, tri);
   for (int r = 0; r < f.rows; ++r) {
     for (int c = 0; c < f.cols; ++c) {
       ++out.cells_visited;
       double lowest = INFINITY;
-      for (const auto& t : tri) {
+      for (int k = 0; k < n_tri; ++k) {
+        const auto& t = tri[k];
         if (representation == Representation::kColumns) {
           // Each column box against the swept region (the paper's per-column test).
           detail::Polygon strip;

@@ -255,6 +255,47 @@ inline int ceil_clamped(double x, int lo, int hi) {
   return i + (double(i) < x);
 }
 
+/// Prefetch hints for the rows ahead of an oblique walk: while row r is
+/// lowered, the three layers' cache lines around the sweep's edge in row
+/// r + kRowsAhead are requested, so that a sliver crossing many rows with a
+/// sample or two each (a yawed blade) overlaps those rows' misses instead of
+/// waiting for each row in turn. The column is where the line x = x_at_0 +
+/// (row centre) * x_per_row crosses that row (one of the sweep's long edges);
+/// no effect on results.
+struct RowPrefetcher {
+  static constexpr int kRowsAhead = 12;
+  const float* height;
+  const float* removed;
+  const float* initial;
+  double u0, du;  // column coordinate of the edge at row 0's centre, per row
+  int cols, rows;
+  bool active = false;
+
+  RowPrefetcher(const HeightGrid& grid, const GridFrame& f, const Point& a, const Point& c)
+      : height(grid.heights()), removed(grid.removed()), initial(grid.initial()), u0(0.0), du(0.0),
+        cols(f.cols), rows(f.rows) {
+    // Worth it only when the walk crosses rows quickly (few samples a row)
+    // on a terrain larger than the caches.
+    double dz = c.z - a.z;
+    if (!(dz > 4.0 * f.cz) || std::int64_t(f.cols) * f.rows < (std::int64_t(1) << 20)) return;
+    double kx = (c.x - a.x) / dz;
+    du = kx * f.cz * f.inv_cx;
+    u0 = (a.x + (f.z0 + 0.5 * f.cz - a.z) * kx - f.x0) * f.inv_cx;
+    active = std::abs(du) < 64.0 && std::isfinite(u0);
+  }
+
+  void ahead_of(int r) const {
+    if (!active) return;
+    int ra = r + kRowsAhead;
+    if (ra >= rows) return;
+    int c = floor_clamped(u0 + double(ra) * du, 0, cols - 1);
+    std::int64_t i = std::int64_t(ra) * cols + c;
+    prefetch(height + i);
+    prefetch(removed + i);
+    prefetch(initial + i);
+  }
+};
+
 /// The triangle's edges, walked by z: the long edge A-C and the short chain
 /// A-B-C (vertices sorted by z, heights relative to the ground). Meaningful
 /// when c.z > a.z.
@@ -390,6 +431,51 @@ void cut_flat_points(HeightGrid& grid, const GridFrame& f, const SurfaceTriangle
 /// rather than as one span.
 constexpr int kMaxGap = 64;
 
+/// Samples of the fixed-width window that lower_window handles.
+constexpr int kWindow = 4;
+
+/// Lowers a row's samples [c_lo, c_lo + n) (n <= kWindow, c_lo + kWindow <=
+/// cols) to the lower of the sections' heights that cover each sample, with
+/// the values, the removed-height sum (same order) and the first/last sample
+/// that lower_row gives for the same span, but without loops whose trip
+/// count changes from row to row: the window is always kWindow samples, the
+/// samples outside the span or the sections get +inf (so they keep their
+/// values), and every sample of the window is written back, changed or not.
+/// This is the case of a sliver crossing the rows obliquely, where a row has
+/// a sample or two and mispredicted loop exits would cost more than the
+/// samples themselves.
+inline RowChange lower_window(HeightGrid& grid, int r, int c_lo, int n, const Section* sec, int n_sec) {
+  const std::int64_t row = grid.index(c_lo, r);
+  float* height = const_cast<float*>(grid.heights()) + row;
+  float* removed = const_cast<float*>(grid.removed()) + row;
+  const float* initial = grid.initial() + row;
+  const float inf = std::numeric_limits<float>::infinity();
+  float t[kWindow];
+  for (int k = 0; k < kWindow; ++k) t[k] = inf;
+  for (int j = 0; j < n_sec; ++j) {
+    const Section& q = sec[j];
+    for (int k = 0; k < kWindow; ++k) {
+      int c = c_lo + k;
+      float y = float(q.base + double(c) * q.step);
+      bool in = c >= q.c_lo && c <= q.c_hi && k < n;
+      t[k] = in && y < t[k] ? y : t[k];
+    }
+  }
+  RowChange change;
+  change.visited = n;
+  for (int k = 0; k < n; ++k) {
+    float h = t[k] > 0.0f ? t[k] : 0.0f;
+    float old = height[k];
+    if (!(h < old)) continue;
+    height[k] = h;
+    removed[k] = initial[k] - h;
+    change.removed_m += double(old - h);
+    if (change.first < 0) change.first = c_lo + k;
+    change.last = c_lo + k;
+  }
+  return change;
+}
+
 /// Surface representation: lowers every sample point under the swept region
 /// (both triangles) to the region's height there. The two triangles are
 /// walked row by row together: in a row their sections usually meet at the
@@ -414,14 +500,23 @@ void cut_sweep_points(HeightGrid& grid, const GridFrame& f, const Vec3 (&tris)[2
     r_lo = std::min(r_lo, walk[k]->r_lo);
     r_hi = std::max(r_hi, walk[k]->r_hi);
   }
+  const RowPrefetcher ahead(grid, f, walk[0]->tri.a, walk[0]->tri.c);
   double rd = r_lo;
   for (int r = r_lo; r <= r_hi; ++r, rd += 1.0) {
+    ahead.ahead_of(r);
     Section s[2];
     int n = 0;
     for (int k = 0; k < n_walk; ++k) {
       if (r >= walk[k]->r_lo && r <= walk[k]->r_hi && walk[k]->section(f, rd, s[n])) ++n;
     }
     if (n == 0) continue;
+    // A sample or few (an oblique sliver): the fixed window.
+    int u_lo = n == 2 ? std::min(s[0].c_lo, s[1].c_lo) : s[0].c_lo;
+    int u_hi = n == 2 ? std::max(s[0].c_hi, s[1].c_hi) : s[0].c_hi;
+    if (u_hi - u_lo < kWindow && u_lo <= f.cols - kWindow) {
+      rows.add(r, lower_window(grid, r, u_lo, u_hi - u_lo + 1, s, n));
+      continue;
+    }
     if (n == 2 && s[1].c_lo < s[0].c_lo) std::swap(s[0], s[1]);
     if (n == 1 || s[1].c_lo - s[0].c_hi - 1 > kMaxGap) {
       for (int k = 0; k < n; ++k) {
@@ -640,8 +735,10 @@ void cut_sweep_columns(HeightGrid& grid, const GridFrame& f, const Vec3 (&tris)[
   const ColumnTriangle t0(tris[0], f), t1(tris[1], f);
   int r_lo = std::min(t0.r_lo, t1.r_lo), r_hi = std::max(t0.r_hi, t1.r_hi);
   CutBook rows;  // a local, so that its fields stay in registers
+  const RowPrefetcher ahead(grid, f, t0.tri.a, t0.tri.c);
   double rd = r_lo;
   for (int r = r_lo; r <= r_hi; ++r, rd += 1.0) {
+    ahead.ahead_of(r);
     RowPolygon polys[2];
     int n = 0;
     for (const ColumnTriangle* t : {&t0, &t1}) {
@@ -691,13 +788,32 @@ CutResult cut_sweep(HeightGrid& grid, Representation representation, const Segme
   CutResult out;
   if (!is_finite(from.a) || !is_finite(from.b) || !is_finite(to.a) || !is_finite(to.b)) return out;
   GridFrame f(grid);
-  Vec3 tri[2][3];
-  detail::sweep_triangles(from, to, tri);
   CutBook book;
-  if (representation == Representation::kColumns) {
-    cut_sweep_columns(grid, f, tri, book);
+  auto cut_pair = [&](const Vec3 (&pair)[2][3]) {
+    if (representation == Representation::kColumns) {
+      cut_sweep_columns(grid, f, pair, book);
+    } else {
+      cut_sweep_points(grid, f, pair, book);
+    }
+  };
+  if (detail::sweep_above_floor(from, to, f.ground_y)) {
+    Vec3 tri[2][3];
+    detail::sweep_triangles(from, to, tri);
+    cut_pair(tri);
   } else {
-    cut_sweep_points(grid, f, tri, book);
+    // Part of the sweep is inside the rigid floor: only the part above it
+    // cuts. The triangles go in pairs (a lone one paired with itself: lowering
+    // twice to the same height changes nothing).
+    Vec3 clipped[4][3];
+    int n = detail::sweep_triangles_above_floor(from, to, f.ground_y, clipped);
+    for (int k = 0; k < n; k += 2) {
+      Vec3 pair[2][3];
+      for (int v = 0; v < 3; ++v) {
+        pair[0][v] = clipped[k][v];
+        pair[1][v] = clipped[k + 1 < n ? k + 1 : k][v];
+      }
+      cut_pair(pair);
+    }
   }
   prefetch_next_sweep(grid, f, from, to);
   out.removed_volume_m3 = book.removed_m * f.cx * f.cz;

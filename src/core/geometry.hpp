@@ -159,7 +159,7 @@ inline double min_y_in_strip_x(const Polygon& poly, double x0, double x1) {
   return lowest;
 }
 
-/// The number of sweep sub-steps and the swept triangles of one sub-step.
+/// The swept triangles of one sub-step.
 inline void sweep_triangles(const Segment& from, const Segment& to, Vec3 tri[2][3]) {
   tri[0][0] = from.a;
   tri[0][1] = from.b;
@@ -167,6 +167,45 @@ inline void sweep_triangles(const Segment& from, const Segment& to, Vec3 tri[2][
   tri[1][0] = from.a;
   tri[1][1] = to.b;
   tri[1][2] = to.a;
+}
+
+/// True when the whole sweep lies at or above the ground (the usual case).
+inline bool sweep_above_floor(const Segment& from, const Segment& to, double ground_y) {
+  return from.a.y >= ground_y && from.b.y >= ground_y && to.a.y >= ground_y && to.b.y >= ground_y;
+}
+
+/// The swept triangles with their parts below the ground removed: the blade
+/// inside the rigid floor touches no material and cuts nothing. Writes 0 to 4
+/// triangles (each clipped triangle is a triangle or a quad split in two)
+/// and returns how many.
+inline int sweep_triangles_above_floor(const Segment& from, const Segment& to, double ground_y,
+                                       Vec3 out[4][3]) {
+  Vec3 tri[2][3];
+  sweep_triangles(from, to, tri);
+  int n = 0;
+  for (const auto& t : tri) {
+    // Sutherland-Hodgman against y >= ground_y.
+    Vec3 poly[4];
+    int m = 0;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& p = t[k];
+      const Vec3& q = t[(k + 1) % 3];
+      double dp = p.y - ground_y, dq = q.y - ground_y;
+      if (dp >= 0.0) poly[m++] = p;
+      if ((dp >= 0.0) != (dq >= 0.0)) {
+        Vec3 c = lerp(p, q, dp / (dp - dq));
+        c.y = ground_y;  // exactly on the floor despite rounding
+        poly[m++] = c;
+      }
+    }
+    for (int k = 1; k + 1 < m; ++k) {
+      out[n][0] = poly[0];
+      out[n][1] = poly[k];
+      out[n][2] = poly[k + 1];
+      ++n;
+    }
+  }
+  return n;
 }
 
 }  // namespace terracut::detail

@@ -114,14 +114,48 @@ TEST(Cut, SweepAboveMaterialChangesNothing) {
   }
 }
 
-// A cut below the ground stops at the rigid floor (height 0), never below.
-TEST(Cut, NeverBelowTheFloor) {
+// Below the ground is a rigid floor: a blade inside it touches no material
+// and cuts nothing (its contact is 0 too), and heights never go below 0.
+TEST(Cut, BladeInsideTheFloorCutsNothing) {
   GridSpec s = test::square_spec(20, 20);
   for (Representation rep : kBoth) {
     HeightGrid grid(s, std::vector<float>(400, 0.3f));
-    cut_sweep(grid, rep, horizontal_edge(0, 1, -0.5, 0.1), horizontal_edge(0, 1, -0.5, 0.9));
-    for (int i = 0; i < 400; ++i) EXPECT_GE(grid.heights()[i], 0.0f);
-    EXPECT_EQ(grid.height(10, 10), 0.0f);
+    CutResult r = cut_sweep(grid, rep, horizontal_edge(0, 1, -0.5, 0.1), horizontal_edge(0, 1, -0.5, 0.9));
+    EXPECT_EQ(r.removed_volume_m3, 0.0) << to_string(rep);
+    for (int i = 0; i < 400; ++i) ASSERT_EQ(grid.heights()[i], 0.3f) << to_string(rep);
+    EXPECT_EQ(measure_contact(grid, rep, horizontal_edge(0, 1, -0.5, 0.5)).length_m, 0.0);
+  }
+}
+
+// A tilted blade half inside the floor: y = 0.2 at x = 0 down to -0.2 at
+// x = 1, swept along Z. Where it is above the floor (x < 0.5) the soil is cut
+// to the blade; where it is inside the floor nothing is cut; nothing goes
+// below 0. Equal to the brute force.
+TEST(Cut, SweepCrossingTheFloorCutsOnlyAboveIt) {
+  GridSpec s = test::square_spec(40, 40);
+  for (Representation rep : kBoth) {
+    HeightGrid grid(s, std::vector<float>(1600, 0.3f)), oracle(s, std::vector<float>(1600, 0.3f));
+    Segment from{{0.0, 0.2, 0.1}, {1.0, -0.2, 0.1}}, to{{0.0, 0.2, 0.9}, {1.0, -0.2, 0.9}};
+    CutResult fast = cut_sweep(grid, rep, from, to);
+    CutResult slow = cut_sweep_brute_force(oracle, rep, from, to);
+    EXPECT_NEAR(fast.removed_volume_m3, slow.removed_volume_m3, 1e-9) << to_string(rep);
+    for (int r = 0; r < 40; ++r) {
+      for (int c = 0; c < 40; ++c) {
+        const double zc = grid.sample_z(r);
+        const float h = grid.height(c, r);
+        ASSERT_GE(h, 0.0f);
+        ASSERT_NEAR(h, oracle.height(c, r), 1e-6) << to_string(rep);
+        if (zc < 0.15 || zc > 0.85) continue;  // away from the sweep's z edges
+        // Blade height at the sample (surface) or the cell's lowest point (columns).
+        double x = rep == Representation::kSurface ? grid.sample_x(c) : (c + 1) * s.cell_x_m();
+        double y = 0.2 - 0.4 * x;
+        if (x < 0.5 - s.cell_x_m()) {
+          EXPECT_NEAR(h, y, 1e-6) << to_string(rep) << " c=" << c;
+        } else if (rep == Representation::kSurface ? x > 0.5 : c * s.cell_x_m() > 0.5) {
+          EXPECT_EQ(h, 0.3f) << to_string(rep) << " c=" << c;
+        }
+      }
+    }
   }
 }
 
