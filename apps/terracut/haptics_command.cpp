@@ -174,8 +174,10 @@ Command add_haptics_command(CLI::App& app) {
     }
     haptics::Session session(input, so);
     if (session.device_kind() == DeviceKind::kUdp)
-      say("waiting for a device on udp " + session.loop().settings().udp.address + ":" +
-          std::to_string(session.udp_port()));
+      say("listening for a device on udp " + session.loop().settings().udp.address + ":" +
+          std::to_string(session.udp_port()) +
+          " (the session clock runs from now; until poses arrive the force is zero and the "
+          "watchdog counts the silence)");
     char what[160];
     std::snprintf(what, sizeof what, "running the %s device for %g s (%s clock)",
                   std::string(to_string(session.device_kind())).c_str(), session.duration_s(),

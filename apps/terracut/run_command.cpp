@@ -36,7 +36,7 @@ Command add_run_command(CLI::App& app) {
       ->type_name("SCENARIO.yaml");
   sub->add_option("--out,-o", opt->out,
                   "Output folder; created if missing. Output files of the same names are\n"
-                  "replaced; if the run fails, none of them is left behind")
+                  "replaced; if the run stops with an error, none of them is left behind")
       ->required()
       ->type_name("DIR");
   sub->add_option("--resolution", opt->resolution,

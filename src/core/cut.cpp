@@ -255,47 +255,6 @@ inline int ceil_clamped(double x, int lo, int hi) {
   return i + (double(i) < x);
 }
 
-/// Prefetch hints for the rows ahead of an oblique walk: while row r is
-/// lowered, the three layers' cache lines around the sweep's edge in row
-/// r + kRowsAhead are requested, so that a sliver crossing many rows with a
-/// sample or two each (a yawed blade) overlaps those rows' misses instead of
-/// waiting for each row in turn. The column is where the line x = x_at_0 +
-/// (row centre) * x_per_row crosses that row (one of the sweep's long edges);
-/// no effect on results.
-struct RowPrefetcher {
-  static constexpr int kRowsAhead = 12;
-  const float* height;
-  const float* removed;
-  const float* initial;
-  double u0, du;  // column coordinate of the edge at row 0's centre, per row
-  int cols, rows;
-  bool active = false;
-
-  RowPrefetcher(const HeightGrid& grid, const GridFrame& f, const Point& a, const Point& c)
-      : height(grid.heights()), removed(grid.removed()), initial(grid.initial()), u0(0.0), du(0.0),
-        cols(f.cols), rows(f.rows) {
-    // Worth it only when the walk crosses rows quickly (few samples a row)
-    // on a terrain larger than the caches.
-    double dz = c.z - a.z;
-    if (!(dz > 4.0 * f.cz) || std::int64_t(f.cols) * f.rows < (std::int64_t(1) << 20)) return;
-    double kx = (c.x - a.x) / dz;
-    du = kx * f.cz * f.inv_cx;
-    u0 = (a.x + (f.z0 + 0.5 * f.cz - a.z) * kx - f.x0) * f.inv_cx;
-    active = std::abs(du) < 64.0 && std::isfinite(u0);
-  }
-
-  void ahead_of(int r) const {
-    if (!active) return;
-    int ra = r + kRowsAhead;
-    if (ra >= rows) return;
-    int c = floor_clamped(u0 + double(ra) * du, 0, cols - 1);
-    std::int64_t i = std::int64_t(ra) * cols + c;
-    prefetch(height + i);
-    prefetch(removed + i);
-    prefetch(initial + i);
-  }
-};
-
 /// The triangle's edges, walked by z: the long edge A-C and the short chain
 /// A-B-C (vertices sorted by z, heights relative to the ground). Meaningful
 /// when c.z > a.z.
@@ -431,51 +390,6 @@ void cut_flat_points(HeightGrid& grid, const GridFrame& f, const SurfaceTriangle
 /// rather than as one span.
 constexpr int kMaxGap = 64;
 
-/// Samples of the fixed-width window that lower_window handles.
-constexpr int kWindow = 4;
-
-/// Lowers a row's samples [c_lo, c_lo + n) (n <= kWindow, c_lo + kWindow <=
-/// cols) to the lower of the sections' heights that cover each sample, with
-/// the values, the removed-height sum (same order) and the first/last sample
-/// that lower_row gives for the same span, but without loops whose trip
-/// count changes from row to row: the window is always kWindow samples, the
-/// samples outside the span or the sections get +inf (so they keep their
-/// values), and every sample of the window is written back, changed or not.
-/// This is the case of a sliver crossing the rows obliquely, where a row has
-/// a sample or two and mispredicted loop exits would cost more than the
-/// samples themselves.
-inline RowChange lower_window(HeightGrid& grid, int r, int c_lo, int n, const Section* sec, int n_sec) {
-  const std::int64_t row = grid.index(c_lo, r);
-  float* height = const_cast<float*>(grid.heights()) + row;
-  float* removed = const_cast<float*>(grid.removed()) + row;
-  const float* initial = grid.initial() + row;
-  const float inf = std::numeric_limits<float>::infinity();
-  float t[kWindow];
-  for (int k = 0; k < kWindow; ++k) t[k] = inf;
-  for (int j = 0; j < n_sec; ++j) {
-    const Section& q = sec[j];
-    for (int k = 0; k < kWindow; ++k) {
-      int c = c_lo + k;
-      float y = float(q.base + double(c) * q.step);
-      bool in = c >= q.c_lo && c <= q.c_hi && k < n;
-      t[k] = in && y < t[k] ? y : t[k];
-    }
-  }
-  RowChange change;
-  change.visited = n;
-  for (int k = 0; k < n; ++k) {
-    float h = t[k] > 0.0f ? t[k] : 0.0f;
-    float old = height[k];
-    if (!(h < old)) continue;
-    height[k] = h;
-    removed[k] = initial[k] - h;
-    change.removed_m += double(old - h);
-    if (change.first < 0) change.first = c_lo + k;
-    change.last = c_lo + k;
-  }
-  return change;
-}
-
 /// Surface representation: lowers every sample point under the swept region
 /// (both triangles) to the region's height there. The two triangles are
 /// walked row by row together: in a row their sections usually meet at the
@@ -500,23 +414,14 @@ void cut_sweep_points(HeightGrid& grid, const GridFrame& f, const Vec3 (&tris)[2
     r_lo = std::min(r_lo, walk[k]->r_lo);
     r_hi = std::max(r_hi, walk[k]->r_hi);
   }
-  const RowPrefetcher ahead(grid, f, walk[0]->tri.a, walk[0]->tri.c);
   double rd = r_lo;
   for (int r = r_lo; r <= r_hi; ++r, rd += 1.0) {
-    ahead.ahead_of(r);
     Section s[2];
     int n = 0;
     for (int k = 0; k < n_walk; ++k) {
       if (r >= walk[k]->r_lo && r <= walk[k]->r_hi && walk[k]->section(f, rd, s[n])) ++n;
     }
     if (n == 0) continue;
-    // A sample or few (an oblique sliver): the fixed window.
-    int u_lo = n == 2 ? std::min(s[0].c_lo, s[1].c_lo) : s[0].c_lo;
-    int u_hi = n == 2 ? std::max(s[0].c_hi, s[1].c_hi) : s[0].c_hi;
-    if (u_hi - u_lo < kWindow && u_lo <= f.cols - kWindow) {
-      rows.add(r, lower_window(grid, r, u_lo, u_hi - u_lo + 1, s, n));
-      continue;
-    }
     if (n == 2 && s[1].c_lo < s[0].c_lo) std::swap(s[0], s[1]);
     if (n == 1 || s[1].c_lo - s[0].c_hi - 1 > kMaxGap) {
       for (int k = 0; k < n; ++k) {
@@ -534,6 +439,136 @@ void cut_sweep_points(HeightGrid& grid, const GridFrame& f, const Vec3 (&tris)[2
         for (int k = k0; k <= k1; ++k) t[k] = std::min(t[k], float(sec.base + double(c0 + k) * sec.step));
       }
     }));
+  }
+  book.add(rows);
+}
+
+/// A sweep that is a translation (the edge's vector the same at both ends,
+/// to rounding) sweeps a parallelogram, one plane, the union of its two
+/// triangles. When it crosses many sample rows (an edge oblique to the rows)
+/// most rows hold a sample or two, and the per-row set-up of the two
+/// triangles' sections, not the samples, is the cost. This walks the
+/// parallelogram itself instead: each side not parallel to the rows bounds a
+/// row's section on one side, as a linear function of the row index set up
+/// once, so a row costs a few multiply-adds (no division, no branch on the
+/// geometry), and the height is the plane's, linear in the row and column.
+/// The samples are those whose centres lie in the closed parallelogram, as
+/// for the two triangles; heights agree with theirs to rounding.
+struct ObliqueSweep {
+  /// Bounds of a row's section in column units (sample c's centre at u = c):
+  /// u(rd) = u_p + (rd - rd_p) * u_k, measured from the side's first vertex
+  /// so that rounding stays at the scale of the side's own extent.
+  static constexpr int kBounds = 3;
+  double lo_u[kBounds], lo_r[kBounds], lo_k[kBounds];
+  double hi_u[kBounds], hi_r[kBounds], hi_k[kBounds];
+  double base0 = 0.0, base_k = 0.0, step = 0.0;  // y = base0 + rd * base_k + c * step
+  int r_lo = 0, r_hi = -1;
+};
+
+/// Rows crossed from which a translation takes the parallelogram walk.
+constexpr double kObliqueMinRows = 8.0;
+
+/// Sets up the parallelogram walk; false when the sweep is not a translation
+/// crossing at least kObliqueMinRows rows with a well-shaped footprint (then
+/// the triangles' walk takes it).
+bool setup_oblique(const GridFrame& f, const Segment& from, const Segment& to, ObliqueSweep& w) {
+  Vec3 e = from.b - from.a, e_to = to.b - to.a, sh = to.a - from.a;
+  double e_len = std::abs(e.x) + std::abs(e.y) + std::abs(e.z);
+  Vec3 de = e_to - e;
+  if (!(std::abs(de.x) + std::abs(de.y) + std::abs(de.z) <= 1e-9 * e_len)) return false;
+  // The footprint (x-z) far from degenerate: the plane's slopes are well defined.
+  double det = e.x * sh.z - e.z * sh.x;
+  if (!(std::abs(det) > 1e-6 * (std::abs(e.x * sh.z) + std::abs(e.z * sh.x)))) return false;
+  const Vec3 v[4] = {from.a, from.b, to.b, to.a};
+  double zmin = v[0].z, zmax = v[0].z;
+  for (const Vec3& p : v) {
+    zmin = std::min(zmin, p.z);
+    zmax = std::max(zmax, p.z);
+  }
+  if (!((zmax - zmin) * f.inv_cz >= kObliqueMinRows)) return false;
+  // Sides going up in z bound the section from one side, sides going down
+  // from the other (which is which depends on the winding); sides along a
+  // row lie at the footprint's lowest or highest z and bound only the rows.
+  bool ccw = det > 0.0;
+  int n_lo = 0, n_hi = 0;
+  for (int k = 0; k < 4; ++k) {
+    const Vec3& p = v[k];
+    const Vec3& q = v[(k + 1) % 4];
+    double dz = q.z - p.z;
+    if (dz == 0.0) continue;
+    if (std::abs(dz) < 1e-9 * f.cz) return false;  // nearly along a row: left to the triangles
+    double u_p = (p.x - f.x0) * f.inv_cx - 0.5;
+    double rd_p = (p.z - f.z0) * f.inv_cz - 0.5;
+    double u_k = (q.x - p.x) / dz * f.cz * f.inv_cx;
+    // Counter-clockwise seen with x right and z up, the inside is left of
+    // each side: a side going up bounds x from above.
+    if ((dz > 0.0) == ccw) {
+      if (n_hi == ObliqueSweep::kBounds) return false;
+      w.hi_u[n_hi] = u_p, w.hi_r[n_hi] = rd_p, w.hi_k[n_hi++] = u_k;
+    } else {
+      if (n_lo == ObliqueSweep::kBounds) return false;
+      w.lo_u[n_lo] = u_p, w.lo_r[n_lo] = rd_p, w.lo_k[n_lo++] = u_k;
+    }
+  }
+  if (n_lo == 0 || n_hi == 0) return false;
+  for (; n_lo < ObliqueSweep::kBounds; ++n_lo) w.lo_u[n_lo] = -kInf, w.lo_r[n_lo] = 0.0, w.lo_k[n_lo] = 0.0;
+  for (; n_hi < ObliqueSweep::kBounds; ++n_hi) w.hi_u[n_hi] = kInf, w.hi_r[n_hi] = 0.0, w.hi_k[n_hi] = 0.0;
+  // The plane through from.a spanned by the edge and the shift: y = y_a +
+  // slope_x (x - x_a) + slope_z (z - z_a), heights relative to the ground.
+  double slope_x = (e.y * sh.z - e.z * sh.y) / det;
+  double slope_z = (e.x * sh.y - e.y * sh.x) / det;
+  double y_origin = (from.a.y - f.ground_y) + slope_x * (f.x0 + 0.5 * f.cx - from.a.x) +
+                    slope_z * (f.z0 + 0.5 * f.cz - from.a.z);
+  w.base0 = y_origin;
+  w.base_k = slope_z * f.cz;
+  w.step = slope_x * f.cx;
+  w.r_lo = ceil_clamped((zmin - f.z0) * f.inv_cz - 0.5, 0, f.rows);
+  w.r_hi = floor_clamped((zmax - f.z0) * f.inv_cz - 0.5, -1, f.rows - 1);
+  return std::isfinite(w.base0) && std::isfinite(w.base_k) && std::isfinite(w.step);
+}
+
+/// Surface representation, a translation across many rows: lowers the
+/// samples under the parallelogram, row by row from the bounds set up once.
+void cut_oblique_points(HeightGrid& grid, const GridFrame& f, const ObliqueSweep& w, CutBook& book) {
+  CutBook rows;  // a local, so that its fields stay in registers
+  float* height = const_cast<float*>(grid.heights());
+  float* removed = const_cast<float*>(grid.removed());
+  const float* initial = grid.initial();
+  const double step = w.step;
+  for (int r = w.r_lo; r <= w.r_hi; ++r) {
+    double rd = r;
+    double lo = w.lo_u[0] + (rd - w.lo_r[0]) * w.lo_k[0];
+    double hi = w.hi_u[0] + (rd - w.hi_r[0]) * w.hi_k[0];
+    for (int k = 1; k < ObliqueSweep::kBounds; ++k) {
+      double l = w.lo_u[k] + (rd - w.lo_r[k]) * w.lo_k[k];
+      double h = w.hi_u[k] + (rd - w.hi_r[k]) * w.hi_k[k];
+      lo = l > lo ? l : lo;
+      hi = h < hi ? h : hi;
+    }
+    int c_lo = ceil_clamped(lo, 0, f.cols);
+    int c_hi = floor_clamped(hi, -1, f.cols - 1);
+    if (c_lo > c_hi) continue;
+    double base = w.base0 + rd * w.base_k;
+    if (c_hi - c_lo >= kSmallSpan) {
+      rows.add(r, lower_row(grid, r, c_lo, c_hi, linear_targets(base, step)));
+      continue;
+    }
+    // A sample or few: inline, as lower_row's small path.
+    const std::int64_t row = grid.index(0, r);
+    RowChange change;
+    change.visited = c_hi - c_lo + 1;
+    for (int c = c_lo; c <= c_hi; ++c) {
+      float t = float(base + double(c) * step);
+      float h = t > 0.0f ? t : 0.0f;
+      float old = height[row + c];
+      if (!(h < old)) continue;
+      height[row + c] = h;
+      removed[row + c] = initial[row + c] - h;
+      change.removed_m += double(old - h);
+      if (change.first < 0) change.first = c;
+      change.last = c;
+    }
+    rows.add(r, change);
   }
   book.add(rows);
 }
@@ -735,10 +770,8 @@ void cut_sweep_columns(HeightGrid& grid, const GridFrame& f, const Vec3 (&tris)[
   const ColumnTriangle t0(tris[0], f), t1(tris[1], f);
   int r_lo = std::min(t0.r_lo, t1.r_lo), r_hi = std::max(t0.r_hi, t1.r_hi);
   CutBook rows;  // a local, so that its fields stay in registers
-  const RowPrefetcher ahead(grid, f, t0.tri.a, t0.tri.c);
   double rd = r_lo;
   for (int r = r_lo; r <= r_hi; ++r, rd += 1.0) {
-    ahead.ahead_of(r);
     RowPolygon polys[2];
     int n = 0;
     for (const ColumnTriangle* t : {&t0, &t1}) {
@@ -796,10 +829,15 @@ CutResult cut_sweep(HeightGrid& grid, Representation representation, const Segme
       cut_sweep_points(grid, f, pair, book);
     }
   };
+  ObliqueSweep oblique;
   if (detail::sweep_above_floor(from, to, f.ground_y)) {
-    Vec3 tri[2][3];
-    detail::sweep_triangles(from, to, tri);
-    cut_pair(tri);
+    if (representation == Representation::kSurface && setup_oblique(f, from, to, oblique)) {
+      cut_oblique_points(grid, f, oblique, book);
+    } else {
+      Vec3 tri[2][3];
+      detail::sweep_triangles(from, to, tri);
+      cut_pair(tri);
+    }
   } else {
     // Part of the sweep is inside the rigid floor: only the part above it
     // cuts. The triangles go in pairs (a lone one paired with itself: lowering

@@ -28,6 +28,19 @@ constexpr std::uintmax_t kMaxScenarioFileBytes = 64u << 20;
 // Largest number of steps one cut may take (duration * rate); a longer cut
 // would write a contact.csv of more than ~10 GB.
 constexpr double kMaxStepsPerCut = 1e8;
+/// Largest number of steps of a whole run (the sequence); each step is a row
+/// of contact.csv (about 200 bytes), so 1e8 steps is about 20 GB.
+constexpr double kMaxStepsPerRun = 1e8;
+/// Largest magnitude of any number in a scenario file.
+constexpr double kMaxMagnitude = 1e9;
+
+// Steps of the whole sequence: each cut runs round(duration * rate) + 1 steps.
+double sequence_steps(const Scenario& sc) {
+  double total = 0.0;
+  for (int index : sc.sequence)
+    total += std::round(sc.cuts[std::size_t(index)].duration_s() * sc.rate_hz) + 1.0;
+  return total;
+}
 constexpr double kMaxRateHz = 1e6;
 
 std::string join(const std::vector<std::string>& items, std::string_view sep = ", ") {
@@ -102,6 +115,10 @@ class Field {
       fail("expected a number, got " + describe(node_));
     }
     if (!std::isfinite(v)) fail("must be a finite number, got " + describe(node_));
+    // No length, height, time or rate in a scenario comes near 1e9 in SI
+    // units; larger values would overflow float heights or volumes.
+    if (std::abs(v) > kMaxMagnitude)
+      fail("must be within +-1e9 (SI units), got " + describe(node_));
     return v;
   }
 
@@ -501,6 +518,12 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
   } else {
     for (std::size_t i = 0; i < sc.cuts.size(); ++i) sc.sequence.push_back(int(i));
   }
+  if (const double total = sequence_steps(sc); total > kMaxStepsPerRun) {
+    const std::string what = "the sequence runs " + format_number(total) +
+                             " steps at rate_hz in total; more than 1e8 steps is absurd";
+    if (const auto f = top.get("sequence")) f->fail(what);
+    top_field.fail(what);
+  }
 
   // Rigid bodies (format in bodies_yaml.hpp); an empty list is allowed.
   if (const auto f = top.get("bodies")) sc.bodies = parse_bodies(f->node(), ctx.file);
@@ -643,6 +666,9 @@ void apply_overrides(Scenario& scenario, std::optional<Resolution> resolution,
       indices.push_back(index);
     }
     scenario.sequence = std::move(indices);
+    if (const double total = sequence_steps(scenario); total > kMaxStepsPerRun)
+      fail_option("--sequence", "the sequence runs " + format_number(total) +
+                                    " steps in total; more than 1e8 steps is absurd");
   }
 }
 

@@ -433,6 +433,31 @@ TEST(ScenarioErrors, AbsurdlyLongCutIsRefused) {
   expect_error(text, line_of(text, "1e9"), "cuts[0].keyframes[1].t_s", "absurd");
 }
 
+// A whole sequence is capped too: cut A lasts 3e5 s (7.5e7 steps at 250 Hz,
+// under the per-cut cap), and the sequence runs it twice (1.5e8 steps).
+TEST(ScenarioErrors, AbsurdlyLongSequenceIsRefused) {
+  std::string text = replace(kGood, "t_s: 1.5", "t_s: 3e5");
+  EXPECT_NO_THROW(parse_scenario(replace(text, "sequence: [B_2, A, B_2]", "sequence: [A]"), "x.yaml"));
+  text = replace(text, "sequence: [B_2, A, B_2]", "sequence: [A, A]");
+  expect_error(text, line_of(text, "sequence:"), "sequence", "1e8 steps");
+  Scenario sc = parse_scenario(replace(kGood, "t_s: 1.5", "t_s: 3e5"), "x.yaml");
+  try {
+    apply_overrides(sc, std::nullopt, std::nullopt, std::vector<std::string>{"A", "A"});
+    FAIL() << "accepted";
+  } catch (const terracut::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--sequence"), std::string::npos) << e.what();
+  }
+}
+
+// Finite but absurd numbers (beyond 1e9 in SI units) are refused where they
+// are written, before they can overflow heights or volumes.
+TEST(ScenarioErrors, AbsurdMagnitudesAreRefused) {
+  const std::string size = replace(kGood, "size_m: [2.0, 1.0]", "size_m: [1e300, 1.0]");
+  expect_error(size, line_of(size, "1e300"), "terrain.size_m[0]", "1e9");
+  const std::string scale = replace(kGood, "full_scale_m: 0.3", "full_scale_m: 2e9");
+  expect_error(scale, line_of(scale, "2e9"), "terrain.full_scale_m", "1e9");
+}
+
 TEST_F(ScenarioTest, MissingScenarioFileIsNamed) {
   const fs::path path = dir_ / "nope.yaml";
   try {

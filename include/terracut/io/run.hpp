@@ -57,7 +57,8 @@ class RunObserver {
 /// How to run.
 struct RunOptions {
   /// Output folder; created (with parents) when missing. Output files of the
-  /// same names are replaced; on failure none of them is left behind.
+  /// same names are replaced; when the run stops with an error (an exception),
+  /// none of them is left behind. summary.json is written last.
   std::filesystem::path out_dir;
   /// Where progress lines go (e.g. &std::cerr), or nullptr for none. A line is
   /// written about once a second once the run has taken progress_after_s.
