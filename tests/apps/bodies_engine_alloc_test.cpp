@@ -19,33 +19,7 @@
 #include "terracut/haptics/session.hpp"
 #include "terracut/io/run.hpp"
 
-// GCC pairs the replaced operator new (malloc) with free() through inlining
-// and warns about a mismatch that is not one.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-
-namespace {
-std::atomic<long> g_allocations{0};
-
-void* counted_bullet_alloc(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size);
-}
-void bullet_free(void* p) { std::free(p); }
-
-// Installed before main, so every Bullet object of the program uses it.
-const bool g_installed = [] {
-  btAlignedAllocSetCustom(counted_bullet_alloc, bullet_free);
-  return true;
-}();
-}  // namespace
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#include "../support/counting_bullet_alloc.hpp"
 
 namespace terracut::apps {
 namespace {

@@ -16,23 +16,7 @@
 
 #include "terracut/core/error.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}
-
-// Every global operator new in this test program is counted. (GCC 11+ warns
-// that the replaced operator delete frees what operator new returned, once
-// it inlines both; that is the replacement's very purpose.)
-#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 11
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#include "../support/counting_new.hpp"
 
 namespace terracut::haptics {
 namespace {
