@@ -29,6 +29,40 @@ std::uint64_t loop_time_ns(double t_s) {
   return t_s > 0.0 && std::isfinite(t_s) ? static_cast<std::uint64_t>(std::llround(t_s * 1e9)) : 0;
 }
 
+// Reads the datagrams waiting on the socket (at most kMaxDatagramsPerPoll),
+// decodes each with decode(data, size, header, payload), checks it with the
+// sequence filter and books it in stats; calls accept(header, payload) for
+// each packet that passes. Both ends of the bridge read this way.
+template <class Payload, class Impl, class Decode, class Accept>
+void drain_datagrams(Impl& impl, BridgeStats& stats, SequenceFilter& filter, Decode&& decode,
+                     Accept&& accept) noexcept {
+  for (int i = 0; i < kMaxDatagramsPerPoll; ++i) {
+    asio::error_code ec;
+    const std::size_t n = impl.socket.receive_from(asio::buffer(impl.rx), impl.sender, 0, ec);
+    if (ec == asio::error::would_block || ec == asio::error::try_again) break;
+    if (ec) {
+      // ICMP "port unreachable" from an earlier send shows up here on Linux;
+      // nothing was received, go on.
+      ++stats.receive_errors;
+      if (ec == asio::error::connection_refused) continue;
+      break;
+    }
+    ++stats.datagrams_received;
+    PacketHeader header;
+    Payload payload;
+    Reject r = decode(impl.rx.data(), n, header, payload);
+    if (r == Reject::kNone) r = filter.check(header);
+    if (r != Reject::kNone) {
+      stats.rejected.add(r);
+      continue;
+    }
+    ++stats.accepted;
+    accept(header, payload);
+  }
+  stats.lost = filter.lost();
+  stats.sessions = filter.sessions();
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -74,36 +108,19 @@ bool UdpDevice::read(double t_s, DeviceSample& out) noexcept {
   (void)t_s;
   bool got = false;
   reconnected_ = false;
-  for (int i = 0; i < kMaxDatagramsPerPoll; ++i) {
-    asio::error_code ec;
-    const std::size_t n = impl_->socket.receive_from(asio::buffer(impl_->rx), impl_->sender, 0, ec);
-    if (ec == asio::error::would_block || ec == asio::error::try_again) break;
-    if (ec) {
-      // ICMP "port unreachable" from an earlier send shows up here on Linux;
-      // nothing was received, go on.
-      ++stats_.receive_errors;
-      if (ec == asio::error::connection_refused) continue;
-      break;
-    }
-    ++stats_.datagrams_received;
-    PacketHeader header;
-    PosePayload pose;
-    Reject r = decode_pose(impl_->rx.data(), n, header, pose);
-    if (r == Reject::kNone) r = filter_.check(header);
-    if (r != Reject::kNone) {
-      stats_.rejected.add(r);
-      continue;
-    }
-    ++stats_.accepted;
-    if (filter_.new_session() && filter_.sessions() > 1) reconnected_ = true;
-    impl_->newest = pose;
-    impl_->newest_sequence = header.sequence;
-    impl_->peer = impl_->sender;
-    impl_->has_peer = true;
-    got = true;
-  }
-  stats_.lost = filter_.lost();
-  stats_.sessions = filter_.sessions();
+  drain_datagrams<PosePayload>(
+      *impl_, stats_, filter_,
+      [](const std::uint8_t* data, std::size_t n, PacketHeader& h, PosePayload& p) {
+        return decode_pose(data, n, h, p);
+      },
+      [&](const PacketHeader& header, const PosePayload& pose) {
+        if (filter_.new_session() && filter_.sessions() > 1) reconnected_ = true;
+        impl_->newest = pose;
+        impl_->newest_sequence = header.sequence;
+        impl_->peer = impl_->sender;
+        impl_->has_peer = true;
+        got = true;
+      });
   if (!got) return false;
   const PosePayload& p = impl_->newest;
   out.position_m = p.position_m;
@@ -198,31 +215,16 @@ void BridgeClient::send_raw(const std::uint8_t* data, std::size_t size) noexcept
 
 bool BridgeClient::poll_force(ForcePayload& out, PacketHeader& header) noexcept {
   bool got = false;
-  for (int i = 0; i < kMaxDatagramsPerPoll; ++i) {
-    asio::error_code ec;
-    const std::size_t n = impl_->socket.receive_from(asio::buffer(impl_->rx), impl_->sender, 0, ec);
-    if (ec == asio::error::would_block || ec == asio::error::try_again) break;
-    if (ec) {
-      ++stats_.receive_errors;
-      if (ec == asio::error::connection_refused) continue;
-      break;
-    }
-    ++stats_.datagrams_received;
-    PacketHeader h;
-    ForcePayload f;
-    Reject r = decode_force(impl_->rx.data(), n, h, f);
-    if (r == Reject::kNone) r = filter_.check(h);
-    if (r != Reject::kNone) {
-      stats_.rejected.add(r);
-      continue;
-    }
-    ++stats_.accepted;
-    out = f;
-    header = h;
-    got = true;
-  }
-  stats_.lost = filter_.lost();
-  stats_.sessions = filter_.sessions();
+  drain_datagrams<ForcePayload>(
+      *impl_, stats_, filter_,
+      [](const std::uint8_t* data, std::size_t n, PacketHeader& h, ForcePayload& f) {
+        return decode_force(data, n, h, f);
+      },
+      [&](const PacketHeader& h, const ForcePayload& f) {
+        out = f;
+        header = h;
+        got = true;
+      });
   return got;
 }
 
