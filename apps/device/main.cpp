@@ -19,7 +19,8 @@
 #include "terracut/core/error.hpp"
 #include "terracut/haptics/device_player.hpp"
 #include "terracut/haptics/pacer.hpp"
-#include "terracut/haptics/session.hpp"
+#include "terracut/haptics/device_option.hpp"
+#include "terracut/session/scenario.hpp"
 
 namespace {
 
@@ -45,9 +46,9 @@ struct Options {
 };
 
 int run(const Options& opt) {
-  const HapticScenario input = load_haptic_scenario(opt.scenario);
+  const session::Scenario input = session::load_scenario(opt.scenario);
   const HapticSettings& s = input.haptics;
-  const io::Scenario& sc = input.scenario;
+  const io::Scenario& sc = input.base;
 
   // The cut to follow (as the loop's script and sim devices do).
   int cut = -1;

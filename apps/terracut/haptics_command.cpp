@@ -13,10 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "bodies_engine.hpp"
 #include "subprocess.hpp"
 #include "terracut/core/error.hpp"
-#include "terracut/haptics/session.hpp"
+#include "terracut/haptics/device_option.hpp"
+#include "terracut/io/files.hpp"
+#include "terracut/session/haptic.hpp"
 
 namespace terracut::cli {
 namespace {
@@ -135,7 +136,7 @@ Command add_haptics_command(CLI::App& app) {
       "docs/bullet.md (rigid bodies).");
 
   return [opt]() {
-    haptics::SessionOptions so;
+    session::SessionOptions so;
     if (!opt->device.empty()) {
       const haptics::DeviceOption d = haptics::parse_device_option(opt->device);
       so.device = d.kind;
@@ -144,7 +145,7 @@ Command add_haptics_command(CLI::App& app) {
     }
     if (opt->duration_s > 0.0) so.duration_s = opt->duration_s;
     if (!opt->clock.empty())
-      so.clock = opt->clock == "fake" ? haptics::ClockMode::kFake : haptics::ClockMode::kReal;
+      so.clock = opt->clock == "fake" ? session::ClockMode::kFake : session::ClockMode::kReal;
     so.realtime = !opt->no_realtime;
     so.log = &std::cerr;
     so.interrupt = &g_interrupt;
@@ -152,27 +153,18 @@ Command add_haptics_command(CLI::App& app) {
       if (!opt->quiet) std::cerr << "terracut haptics: " << line << "\n";
     };
 
-    const haptics::HapticScenario input = haptics::load_haptic_scenario(opt->scenario);
-    // Rigid bodies: the Bullet world is stepped by the loop (the force on the
-    // blade's plate is felt) and writes bodies.csv into the output folder,
-    // which must exist before the loop is built. Declared before the session,
-    // which must be destroyed first.
-    std::unique_ptr<haptics::LoopEngine> bodies;
-    if (!input.scenario.bodies.empty()) {
-      if (!apps::bodies_engine_available())
-        throw InputError(opt->scenario + ": " + apps::bodies_engine_unavailable_message());
-      std::error_code ec;
-      fs::create_directories(opt->out, ec);
-      if (ec || !fs::is_directory(opt->out))
-        throw InputError(opt->out + ": cannot create the output folder" +
-                         (ec ? " (" + ec.message() + ")" : std::string()));
-      bodies = apps::make_bodies_engine(input.scenario.bodies,
-                                        {fs::path(opt->out) / "bodies.csv"});
-      so.engine = bodies.get();
-      say(std::to_string(input.scenario.bodies.size()) +
-          " rigid bodies (Bullet) on the terrain: their force on the blade is felt");
+    const session::Scenario input = session::load_scenario(opt->scenario);
+    // Rigid bodies: the Bullet world is stepped with the terrain (the force
+    // on the blade's plate is felt) and writes bodies.csv into the output
+    // folder, which must exist before the world is built.
+    if (!input.bodies.empty()) {
+      io::make_output_folder(opt->out);
+      so.bodies_csv = fs::path(opt->out) / "bodies.csv";
     }
-    haptics::Session session(input, so);
+    session::HapticSession session(input, so);
+    if (session.world().bodies())
+      say(std::to_string(input.bodies.size()) +
+          " rigid bodies (Bullet) on the terrain: their force on the blade is felt");
     if (session.device_kind() == DeviceKind::kUdp)
       say("listening for a device on udp " + session.loop().settings().udp.address + ":" +
           std::to_string(session.udp_port()) +
@@ -181,7 +173,7 @@ Command add_haptics_command(CLI::App& app) {
     char what[160];
     std::snprintf(what, sizeof what, "running the %s device for %g s (%s clock)",
                   std::string(to_string(session.device_kind())).c_str(), session.duration_s(),
-                  session.clock() == haptics::ClockMode::kFake ? "fake" : "real");
+                  session.clock() == session::ClockMode::kFake ? "fake" : "real");
     say(what);
 
     g_interrupt.store(false);
@@ -201,7 +193,7 @@ Command add_haptics_command(CLI::App& app) {
     for (const std::string& w : session.warnings())
       if (w.rfind("real-time:", 0) != 0) std::cerr << "terracut haptics: warning: " << w << "\n";
     if (!opt->quiet) std::cout << session.summary_line() << " -> " << opt->out << "\n";
-    if (bodies) {
+    if (session.world().bodies()) {
       char line[160];
       std::snprintf(line, sizeof line,
                     "bodies: peak force of the bodies on the blade %.4g N (world); bodies.csv",

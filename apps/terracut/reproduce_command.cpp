@@ -21,7 +21,7 @@
 #include "terracut/core/error.hpp"
 #include "terracut/core/generators.hpp"
 #include "terracut/io/image.hpp"
-#include "terracut/io/run.hpp"
+#include "terracut/session/batch.hpp"
 #include "terracut/io/scenario.hpp"
 
 namespace terracut::cli {
@@ -88,7 +88,7 @@ struct Exp1Row {
 struct Exp2Run {
   Representation representation{};
   std::vector<std::string> sequence;
-  io::RunResult result;
+  session::RunResult result;
 };
 
 struct OrderMatch {
@@ -107,7 +107,7 @@ std::vector<double> exact_contact(const io::Scenario& sc, const std::vector<io::
   return exact;
 }
 
-Exp1Row exp1_errors(const io::Scenario& sc, const io::RunResult& run,
+Exp1Row exp1_errors(const io::Scenario& sc, const session::RunResult& run,
                     const std::vector<double>& exact) {
   Exp1Row row;
   row.representation = sc.representation;
@@ -273,7 +273,7 @@ std::string report_markdown(const ReportInput& in) {
        << "|---|---|---|---|---|---|\n";
     for (const Exp2Run& run : in.exp2_runs) {
       if (run.representation != rep) continue;
-      for (const io::CutStats& c : run.result.cuts)
+      for (const session::CutStats& c : run.result.cuts)
         md << "| (" << concat(run.sequence, ",") << ") | " << c.name << " | "
            << fmt("%.3f", c.start_t_s) << " | " << fmt("%.4f", c.peak_contact_m) << " | "
            << fmt("%.4f", c.mean_contact_m) << " | " << fmt("%.5f", c.removed_volume_m3)
@@ -402,8 +402,12 @@ Command add_reproduce_command(CLI::App& app) {
       if (!opt->quiet) std::cerr << "reproduce: " << line << "\n" << std::flush;
     };
 
-    const io::Scenario exp1 = io::load_scenario(fs::path(opt->scenarios) / "paper_experiment1.yaml");
-    const io::Scenario exp2 = io::load_scenario(fs::path(opt->scenarios) / "paper_experiment2.yaml");
+    const session::Scenario exp1_file =
+        session::load_scenario(fs::path(opt->scenarios) / "paper_experiment1.yaml");
+    const session::Scenario exp2_file =
+        session::load_scenario(fs::path(opt->scenarios) / "paper_experiment2.yaml");
+    const io::Scenario& exp1 = exp1_file.base;
+    const io::Scenario& exp2 = exp2_file.base;
     if (!exp1.reference_mound)
       throw InputError(exp1.source_path.string() +
                        ": reference: experiment 1 needs a 'reference: mound:' block for the "
@@ -419,14 +423,15 @@ Command add_reproduce_command(CLI::App& app) {
     std::vector<io::StepRecord> exact_records;
     for (Representation rep : kRepresentations)
       for (int n : kExp1Resolutions) {
-        io::Scenario sc = exp1;
-        io::apply_overrides(sc, io::Resolution{n, n}, rep, std::nullopt);
-        io::RunOptions ro;
+        session::Scenario run_sc = exp1_file;
+        io::apply_overrides(run_sc.base, io::Resolution{n, n}, rep, std::nullopt);
+        const io::Scenario& sc = run_sc.base;
+        session::RunOptions ro;
         ro.out_dir = out / "exp1" / rep_name(rep) / std::to_string(n);
         ro.keep_records = true;
         ro.progress = opt->quiet ? nullptr : &std::cerr;
         ro.progress_label = "reproduce: exp1 " + rep_name(rep) + " " + std::to_string(n);
-        io::RunResult run = io::run_scenario(sc, ro);
+        session::RunResult run = session::run_scenario(run_sc, ro);
         const std::vector<double> run_exact = exact_contact(sc, run.records);
         if (exact.empty()) {
           // Every run steps the same motion; its first run's poses give exact.csv.
@@ -465,13 +470,13 @@ Command add_reproduce_command(CLI::App& app) {
     // Experiment 2: every representation and order.
     for (Representation rep : kRepresentations) {
       for (const std::vector<std::string>& seq : kExp2Sequences) {
-        io::Scenario sc = exp2;
-        io::apply_overrides(sc, std::nullopt, rep, seq);
-        io::RunOptions ro;
+        session::Scenario sc = exp2_file;
+        io::apply_overrides(sc.base, std::nullopt, rep, seq);
+        session::RunOptions ro;
         ro.out_dir = out / "exp2" / rep_name(rep) / concat(seq);
         ro.progress = opt->quiet ? nullptr : &std::cerr;
         ro.progress_label = "reproduce: exp2 " + rep_name(rep) + " " + concat(seq);
-        Exp2Run run{rep, seq, io::run_scenario(sc, ro)};
+        Exp2Run run{rep, seq, session::run_scenario(sc, ro)};
         say("exp2 " + rep_name(rep) + " (" + concat(seq, ",") + "): " +
             std::to_string(run.result.steps) + " steps, removed " +
             fmt("%.5f", run.result.removed_volume_m3) + " m^3, " + fmt("%.2f", run.result.wall_s) +

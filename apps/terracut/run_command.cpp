@@ -5,12 +5,10 @@
 #include <optional>
 #include <string>
 
-#include "bodies_observer.hpp"
 #include "commands.hpp"
-#include "realtime_observer.hpp"
 #include "terracut/core/error.hpp"
-#include "terracut/io/run.hpp"
 #include "terracut/io/scenario.hpp"
+#include "terracut/session/batch.hpp"
 
 namespace terracut::cli {
 
@@ -105,7 +103,7 @@ Command add_run_command(CLI::App& app) {
       "      --representation columns");
 
   return [opt]() {
-    io::Scenario scenario = io::load_scenario(opt->scenario);
+    session::Scenario scenario = session::load_scenario(opt->scenario);
     std::optional<io::Resolution> resolution;
     if (!opt->resolution.empty()) resolution = io::parse_resolution(opt->resolution);
     std::optional<Representation> representation;
@@ -113,36 +111,27 @@ Command add_run_command(CLI::App& app) {
       representation = parse_representation(opt->representation);
     std::optional<std::vector<std::string>> sequence;
     if (!opt->sequence.empty()) sequence = io::parse_name_list(opt->sequence);
-    io::apply_overrides(scenario, resolution, representation, sequence);
+    io::apply_overrides(scenario.base, resolution, representation, sequence);
 
-    io::RunOptions run_options;
+    session::RunOptions run_options;
     run_options.out_dir = opt->out;
     run_options.progress = opt->quiet ? nullptr : &std::cerr;
-    run_options.progress_label = "terracut run " + scenario.name;
-    // Rigid bodies: a Bullet world shares the terrain and writes bodies.csv.
-    std::unique_ptr<io::RunObserver> bodies;
-    if (!scenario.bodies.empty()) {
-      bodies = make_bodies_observer(scenario.bodies);
-      run_options.observers.push_back(bodies.get());
-    }
-    std::unique_ptr<io::RunObserver> pacing;
-    if (opt->realtime) {
-      pacing = make_realtime_observer(scenario.rate_hz);
-      run_options.observers.push_back(pacing.get());
-    }
-    const io::RunResult result = io::run_scenario(scenario, run_options);
+    run_options.progress_label = "terracut run " + scenario.base.name;
+    run_options.realtime = opt->realtime;
+    const session::RunResult result = session::run_scenario(scenario, run_options);
 
     if (!opt->quiet) {
       char line[512];
       std::snprintf(line, sizeof line,
                     "%s: %lld steps, removed %.6g m^3 of %.6g m^3, conservation error %.3g m "
                     "(per sample), %.3g m^3 (volume), p99 step %.1f us -> %s\n",
-                    scenario.name.c_str(), static_cast<long long>(result.steps),
+                    scenario.base.name.c_str(), static_cast<long long>(result.steps),
                     result.removed_volume_m3, result.initial_volume_m3,
                     result.max_sample_error_m, result.volume_error_m3,
                     result.step_timing.p99_us, opt->out.c_str());
       std::cout << line;
-      if (pacing) std::cout << "realtime: " << pacing->summary_json() << "\n";
+      if (result.realtime)
+        std::cout << "realtime: " << session::realtime_json(*result.realtime) << "\n";
     }
     return kExitOk;
   };

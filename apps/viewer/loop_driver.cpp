@@ -6,11 +6,6 @@
 #include <limits>
 
 #include "terracut/core/error.hpp"
-#include "terracut/io/run.hpp"
-
-#ifdef TERRACUT_VIEWER_BODIES
-#include "bodies_engine.hpp"
-#endif
 
 namespace terracut::viewer {
 
@@ -19,15 +14,15 @@ HapticSettings viewer_settings(HapticSettings settings) {
   return settings;
 }
 
-LoopDriver::LoopDriver(const io::Scenario& scenario, const HapticSettings& settings,
+LoopDriver::LoopDriver(const session::Scenario& scenario, const HapticSettings& settings,
                        const DriverOptions& options, LoopTiming* timing)
     : scenario_(scenario),
-      settings_(with_derived_fields(settings, scenario.blade.length_m)),
+      params_(settings, scenario.base.blade),
       options_(options),
-      spec_(io::grid_spec(scenario)),
-      representation_(scenario.representation),
-      blade_length_m_(scenario.blade.length_m),
-      initial_(io::build_initial_heights(scenario)) {
+      spec_(io::grid_spec(scenario.base)),
+      representation_(scenario.base.representation),
+      blade_length_m_(scenario.base.blade.length_m),
+      initial_(io::build_initial_heights(scenario.base)) {
   // Transits between cuts rise above everything the blade could touch.
   float max_h = 0.0f;
   for (float h : initial_) max_h = std::max(max_h, h);
@@ -37,9 +32,9 @@ LoopDriver::LoopDriver(const io::Scenario& scenario, const HapticSettings& setti
   if (options.plough) {
     tour_ = plough_tour(spec_, double(max_h), blade_length_m_, std::max(0.3 * extent, 0.1), 1000);
   } else {
-    tour_ = Tour(scenario_, clearance, transit_speed);
+    tour_ = Tour(scenario_.base, clearance, transit_speed);
   }
-  script_ticks_ = tour_.empty() ? 0 : std::llround(tour_.duration_s() * settings_.rate_hz) + 1;
+  script_ticks_ = tour_.empty() ? 0 : std::llround(tour_.duration_s() * params_.rate_hz()) + 1;
 
   // The tool starts at the script's first pose, or above the middle.
   BladePose start;
@@ -55,44 +50,32 @@ LoopDriver::LoopDriver(const io::Scenario& scenario, const HapticSettings& setti
     HeightGrid grid(spec_, initial_);
     exchange_ = std::make_unique<haptics::SnapshotExchange>(grid);
   }
-  if (std::string m = validate(settings_); !m.empty()) throw InputError("haptics." + m);
-  device_ = std::make_unique<ViewerDevice>(haptics::Workspace(settings_.workspace), tour_, start,
-                                           settings_.rate_hz, clearance, transit_speed,
+  device_ = std::make_unique<ViewerDevice>(haptics::Workspace(params_.settings().workspace), tour_, start,
+                                           rate_hz(), clearance, transit_speed,
                                            options.paced ? timing : nullptr);
   device_->set_playing(options.playing);
   device_->set_speed(options.speed);
   device_->set_source(options.source);
   device_->set_pause_at_end(options.pause_at_end);
 
-  // Rigid bodies: the Bullet engine, stepped by the loop with the terrain.
-  if (!scenario_.bodies.empty()) {
-#ifdef TERRACUT_VIEWER_BODIES
-    engine_ = apps::make_bodies_engine(scenario_.bodies);
-#else
-    throw InputError(
-        "bodies: this terracut-viewer was built without the rigid-body engine, so the "
-        "scenario's bodies cannot be simulated");
-#endif
-  }
-
-  haptics::LoopOptions lo;
-  lo.ticks = std::numeric_limits<std::int64_t>::max() / 2;  // until stop()
-  lo.record_capacity = options.record_capacity;
-  lo.realtime = options.realtime;
-  lo.lock_memory = false;  // the viewer's GL driver allocates; locking all memory is not ours to do
-  lo.snapshot = exchange_.get();
-  lo.engine = engine_.get();
-  loop_ = std::make_unique<haptics::HapticLoop>(settings_, io::sim_params(scenario_), initial_,
-                                                start.orientation, *device_, lo);
+  // The world (with the rigid bodies' listener, when the scenario has
+  // bodies) and the loop over it.
+  session::RigOptions ro;
+  ro.loop.ticks = std::numeric_limits<std::int64_t>::max() / 2;  // until stop()
+  ro.loop.record_capacity = options.record_capacity;
+  ro.loop.realtime = options.realtime;
+  ro.loop.lock_memory = false;  // the viewer's GL driver allocates; locking all memory is not ours
+  ro.loop.snapshot = exchange_.get();
+  rig_ = std::make_unique<session::HapticRig>(scenario_, params_, start.orientation, *device_, ro);
 
   // The first frame shows the tool where it starts (the loop is not running
   // yet, so this thread may write).
   haptics::ViewFrame& f = exchange_->back();
   f.pose = start;
-  f.edge = blade_segment(scenario_.blade, start);
+  f.edge = blade_segment(scenario_.base.blade, start);
   f.device_position_m = start.position_m;
   f.proxy_position_m = start.position_m;
-  if (engine_) engine_->fill_frame(f);  // the bodies where they start
+  haptics::fill_bodies(f, rig_->world().bodies());  // the bodies where they start
   HeightGrid grid(spec_, initial_);
   exchange_->publish(grid);
 }
@@ -103,7 +86,7 @@ void LoopDriver::start() {
   if (started_) return;
   started_ = true;
   if (options_.paced) {
-    loop_->start();
+    rig_->loop().start();
   } else {
     lockstep_running_.store(true);
     lockstep_thread_ = std::thread([this] { lockstep_main(); });
@@ -113,8 +96,8 @@ void LoopDriver::start() {
 void LoopDriver::stop() {
   if (!started_) return;
   if (options_.paced) {
-    loop_->request_stop();
-    loop_->join();
+    rig_->loop().request_stop();
+    rig_->loop().join();
   } else {
     lockstep_running_.store(false);
     if (lockstep_thread_.joinable()) lockstep_thread_.join();
@@ -124,7 +107,7 @@ void LoopDriver::stop() {
 
 void LoopDriver::lockstep_main() {
   using Clock = std::chrono::steady_clock;
-  const double period = 1.0 / settings_.rate_hz;
+  const double period = 1.0 / rate_hz();
   std::int64_t i = 0;
   while (lockstep_running_.load(std::memory_order_relaxed)) {
     if (i >= target_ticks_.load()) {
@@ -133,9 +116,9 @@ void LoopDriver::lockstep_main() {
     }
     // Tick i at t = i / rate exactly, as HapticLoop::run_deterministic does.
     const Clock::time_point begin = Clock::now();
-    loop_->step1(double(i) * period);
+    rig_->loop().step1(double(i) * period);
     const double compute = std::chrono::duration<double>(Clock::now() - begin).count();
-    loop_->step2(i == 0 ? 0.0 : period, compute, false);
+    rig_->loop().step2(i == 0 ? 0.0 : period, compute, false);
     ++i;
     ticks_done_.store(i);  // after step2 published the tick's frame
   }

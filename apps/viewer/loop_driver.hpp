@@ -1,6 +1,8 @@
-// The viewer's session with the haptic loop: builds a haptics::HapticLoop
-// over the scenario with the viewer's virtual device (viewer_device.hpp) and
-// a haptics::SnapshotExchange, and runs it on the loop's thread. The drawing
+// The viewer's session with the haptic loop: builds the scenario's haptic rig
+// (session::HapticRig: the world with its step listeners, and the loop, as
+// `terracut haptics` builds them) with the viewer's virtual device
+// (viewer_device.hpp) and a haptics::SnapshotExchange, and runs it on the
+// loop's thread. The drawing
 // thread only acquires frames from the exchange (wait-free) and posts
 // controls and targets to the device (atomics, a wait-free mailbox): it never
 // blocks the loop.
@@ -14,10 +16,10 @@
 //    drawing thread asks for, then waits; frame k shows exactly the state
 //    after the ticks it asked for, the same on every run.
 //
-// A scenario with rigid bodies (`bodies:`) gets the Bullet engine of the
-// haptic loop (apps/terracut/bodies_engine.hpp, the one `terracut haptics`
-// uses): the bodies are stepped with the terrain, their force on the blade
-// joins the force, and every frame carries their poses.
+// A scenario with rigid bodies (`bodies:`) gets the world's Bullet listener
+// (the one `terracut run` and `terracut haptics` use): the bodies are stepped
+// with the terrain, their force on the blade joins the force, and every
+// frame carries their poses.
 #pragma once
 
 #include <atomic>
@@ -30,6 +32,7 @@
 #include "terracut/haptics/loop.hpp"
 #include "terracut/haptics/snapshot.hpp"
 #include "terracut/io/scenario.hpp"
+#include "terracut/session/haptic.hpp"
 #include "viewer_device.hpp"
 
 namespace terracut::viewer {
@@ -56,7 +59,9 @@ class LoopDriver {
   /// invalid (the haptic loop's checks, including a refused force rendering).
   /// timing: where the device records the loop's period and compute time
   /// (paced mode; may be shared by successive sessions), or nullptr.
-  LoopDriver(const io::Scenario& scenario, const HapticSettings& settings,
+  /// settings: the haptic settings to run with (the viewer's, which may
+  /// differ from scenario.haptics after the panel's edits).
+  LoopDriver(const session::Scenario& scenario, const HapticSettings& settings,
              const DriverOptions& options, LoopTiming* timing);
   ~LoopDriver();
   LoopDriver(const LoopDriver&) = delete;
@@ -70,13 +75,14 @@ class LoopDriver {
   // --- fixed after construction ---
   const GridSpec& spec() const { return spec_; }
   Representation representation() const { return representation_; }
-  double rate_hz() const { return settings_.rate_hz; }
+  double rate_hz() const { return params_.rate_hz(); }
   double blade_length_m() const { return blade_length_m_; }
   /// Initial heights, rows x cols, row-major, metres.
   const std::vector<float>& initial_heights() const { return initial_; }
   /// The loop's force model (const after construction).
-  const ForceModel& force_model() const { return loop_->force_model(); }
-  const HapticSettings& settings() const { return settings_; }
+  const ForceModel& force_model() const { return params_.force_model(); }
+  /// The settings in use (validated, derived fields filled in).
+  const HapticSettings& settings() const { return params_.settings(); }
   const Tour& tour() const { return tour_; }
   /// Ticks that play the whole script once: round(duration * rate) + 1.
   std::int64_t script_ticks() const { return script_ticks_; }
@@ -84,8 +90,8 @@ class LoopDriver {
   haptics::SnapshotExchange& exchange() { return *exchange_; }
   ViewerDevice& device() { return *device_; }
   /// The loop; its results only after stop().
-  const haptics::HapticLoop& loop() const { return *loop_; }
-  /// Rigid bodies of the scenario (simulated by the loop's engine).
+  const haptics::HapticLoop& loop() const { return rig_->loop(); }
+  /// Rigid bodies of the scenario (simulated by the world's listener).
   int body_count() const { return int(scenario_.bodies.size()); }
 
   /// Lock-step: run until `ticks` ticks are done in all.
@@ -96,8 +102,8 @@ class LoopDriver {
  private:
   void lockstep_main();
 
-  io::Scenario scenario_;  // the Tour points into its cuts
-  HapticSettings settings_;
+  session::Scenario scenario_;  // the Tour points into its cuts
+  haptics::LoopParams params_;
   DriverOptions options_;
   GridSpec spec_;
   Representation representation_;
@@ -107,9 +113,7 @@ class LoopDriver {
   std::int64_t script_ticks_ = 0;
   std::unique_ptr<haptics::SnapshotExchange> exchange_;
   std::unique_ptr<ViewerDevice> device_;
-  // The bodies engine outlives the loop (the loop detaches it when it goes).
-  std::unique_ptr<haptics::LoopEngine> engine_;
-  std::unique_ptr<haptics::HapticLoop> loop_;
+  std::unique_ptr<session::HapticRig> rig_;  // after the device, which it uses
 
   std::thread lockstep_thread_;
   std::atomic<bool> lockstep_running_{false};

@@ -117,8 +117,7 @@ int main(int argc, char** argv) {
     if (!resolution.empty()) opt.resolution = terracut::io::parse_resolution(resolution);
     if (!opt.screenshot.empty() || opt.benchmark_frames > 0) opt.headless = true;
 
-    terracut::haptics::HapticScenario input = terracut::viewer::load_input(opt);
-    terracut::viewer::ViewerApp viewer(opt, std::move(input.scenario), input.haptics);
+    terracut::viewer::ViewerApp viewer(opt, terracut::viewer::load_input(opt));
     return opt.headless ? viewer.run_headless() : viewer.run_window();
   } catch (const terracut::InputError& e) {
     std::cerr << "terracut-viewer: " << e.what() << "\n";

@@ -10,7 +10,7 @@
 //    vertices whose interior vertices run from the first to the last sample
 //    centre (so a 4096^2 terrain is drawn with a 1024^2 mesh sampling the
 //    texture bilinearly), plus a ring on the terrain's outer edge (the
-//    half-cell border is flat, as in core/forces.hpp's surface_height_m) and a
+//    half-cell border is flat, as in core/surface.hpp's surface_height_m) and a
 //    skirt down to the ground, so the terrain reads as a solid slab. Normals
 //    and colours are computed per fragment from the texture (central
 //    differences over one cell), so lighting keeps the texture's detail even

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -15,7 +16,7 @@
 #include "loop_driver.hpp"
 #include "shape_renderer.hpp"
 #include "terrain_renderer.hpp"
-#include "terracut/haptics/session.hpp"
+#include "terracut/session/scenario.hpp"
 #include "terracut/io/scenario.hpp"
 
 struct GLFWwindow;
@@ -57,12 +58,12 @@ struct ViewerOptions {
 /// Loads the scenario (and its `haptics:` section) or the heightmap named by
 /// options.input, with the resolution/representation overrides applied.
 /// Throws InputError.
-haptics::HapticScenario load_input(const ViewerOptions& options);
+session::Scenario load_input(const ViewerOptions& options);
 
 class ViewerApp {
  public:
   /// haptic_settings: the scenario's `haptics:` section (viewer_settings() is applied).
-  ViewerApp(ViewerOptions options, io::Scenario scenario, const HapticSettings& haptic_settings);
+  ViewerApp(ViewerOptions options, session::Scenario scenario);
   ~ViewerApp();
   ViewerApp(const ViewerApp&) = delete;
   ViewerApp& operator=(const ViewerApp&) = delete;
@@ -75,6 +76,8 @@ class ViewerApp {
 
  private:
   struct Live;  // the latest frame's scalar fields and the plot histories
+  struct ToolMarks;  // where and how large the tool's marks are drawn (viewer_scene.cpp)
+  struct Pointer;    // this frame's cursor, framebuffer pixels (viewer_input.cpp)
 
   void init_gl_objects();
   void init_imgui(bool with_glfw, GLFWwindow* window);
@@ -97,9 +100,54 @@ class ViewerApp {
   void begin_mouse_drive();
   float ground_height_at(double x, double z) const;
 
+  // Window loop (viewer_app.cpp). open_window: nullptr (and a message) when
+  // no window can be made.
+  GLFWwindow* open_window();
+  void window_frame(GLFWwindow* window, double dt_s);
+
+  // Headless runs (viewer_headless.cpp).
+  void headless_frame(int w, int h, bool with_panel_time);
+  void run_benchmark(int w, int h);
+  void print_benchmark(int w, int h, double wall_s, std::int64_t uploaded,
+                       std::int64_t frames_with_upload);
+  void run_lockstep(int w, int h);
+
+  // The 3D scene's parts, in drawing order (viewer_scene.cpp).
+  void draw_background(int fb_width, int fb_height);
+  void draw_terrain(const Mat4& vp, Vec3f eye);
+  ToolMarks tool_marks() const;
+  void draw_blade_edge(const ToolMarks& m);
+  void draw_bodies();
+  void draw_device(const ToolMarks& m);
+  void draw_force_arrow(const ToolMarks& m);
+  void draw_see_through(const ToolMarks& m);
+
+  // The panel's sections, top to bottom (viewer_panel.cpp).
+  void update_frame_timing();
+  void draw_panel_header();
+  void draw_run_section();
+  void draw_script_progress();
+  void draw_contact_section();
+  void draw_plots();
+  void draw_timing_section();
+  void draw_display_section();
+  void draw_model_section();
+  void draw_force_model_params();
+  void draw_help_section();
+
+  // Mouse and keyboard, in the order handle_window_input applies them (viewer_input.cpp).
+  Pointer read_pointer(GLFWwindow* window);
+  bool plane_hit(const Pointer& p, float plane_y, Vec3f& hit) const;
+  bool drag_tool(GLFWwindow* window, const Pointer& p);
+  void drag_camera(GLFWwindow* window, const Pointer& p);
+  bool handle_wheel(GLFWwindow* window);
+  bool turn_tool(GLFWwindow* window, double dt_s);
+  void key_commands(GLFWwindow* window);
+  bool key_pressed(GLFWwindow* window, int key);
+
   ViewerOptions options_;
-  io::Scenario base_scenario_;  // as loaded (overrides applied)
-  io::Scenario scenario_;       // the running session's
+  session::Scenario base_scenario_;  // as loaded (overrides applied)
+  session::Scenario scenario_;       // the running session's
   HapticSettings haptics_;
   DriverOptions driver_options_;
   LoopTiming timing_;  // the loop's period and compute time, shared by sessions

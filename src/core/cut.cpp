@@ -159,14 +159,15 @@ inline void prefetch(const float* p) {
 /// Lowers samples c in [c_lo, c_hi] of row r to the targets that
 /// fill(c, n, t) writes for samples c .. c + n - 1 (metres above the ground,
 /// float; +inf leaves a sample as it is), kBatch at a time, and returns the
-/// change. The layers are written in place through the grid's stable arrays
-/// (see grid.hpp), exactly as HeightGrid::lower would write them.
+/// change. The layers are written in place through HeightGrid::edit_layers
+/// (grid.hpp), exactly as HeightGrid::lower would write them.
 template <class Fill>
 inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& fill) {
   const std::int64_t row = grid.index(0, r);
-  float* height = const_cast<float*>(grid.heights()) + row;
-  float* removed = const_cast<float*>(grid.removed()) + row;
-  const float* initial = grid.initial() + row;
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  float* height = layers.height_m + row;
+  float* removed = layers.removed_m + row;
+  const float* initial = layers.initial_m + row;
   RowChange change;
   change.visited = c_hi - c_lo + 1;
   if (change.visited <= kSmallSpan) {
@@ -213,9 +214,10 @@ inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& f
 /// lower_row with the targets already computed: targets[k] for sample c_lo + k.
 inline RowChange lower_row_targets(HeightGrid& grid, int r, int c_lo, int c_hi, const float* targets) {
   const std::int64_t row = grid.index(0, r) + c_lo;
-  float* height = const_cast<float*>(grid.heights()) + row;
-  float* removed = const_cast<float*>(grid.removed()) + row;
-  const float* initial = grid.initial() + row;
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  float* height = layers.height_m + row;
+  float* removed = layers.removed_m + row;
+  const float* initial = layers.initial_m + row;
   int n = c_hi - c_lo + 1;
   for (int k = 0; k < std::min(n, kPrimeSamples); k += 16) {
     prefetch(height + k);
@@ -531,9 +533,10 @@ bool setup_oblique(const GridFrame& f, const Segment& from, const Segment& to, O
 /// samples under the parallelogram, row by row from the bounds set up once.
 void cut_oblique_points(HeightGrid& grid, const GridFrame& f, const ObliqueSweep& w, CutBook& book) {
   CutBook rows;  // a local, so that its fields stay in registers
-  float* height = const_cast<float*>(grid.heights());
-  float* removed = const_cast<float*>(grid.removed());
-  const float* initial = grid.initial();
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  float* height = layers.height_m;
+  float* removed = layers.removed_m;
+  const float* initial = layers.initial_m;
   const double step = w.step;
   for (int r = w.r_lo; r <= w.r_hi; ++r) {
     double rd = r;

@@ -306,35 +306,6 @@ Vec3 earthmoving_world_force(const EarthmovingResult& result, Vec3 velocity_m_pe
 // Surface
 // ---------------------------------------------------------------------------
 
-double surface_height_m(const HeightGrid& grid, Representation representation, double x,
-                        double z) noexcept {
-  const int cols = grid.cols(), rows = grid.rows();
-  double u = grid.cell_u(x), v = grid.cell_v(z);
-  if (!(u >= 0.0 && u <= cols && v >= 0.0 && v <= rows)) return 0.0;
-  const float* h = grid.heights();
-  if (representation == Representation::kColumns) {
-    int c = std::min(int(u), cols - 1), r = std::min(int(v), rows - 1);
-    return h[grid.index(c, r)];
-  }
-  // Node coordinates (sample (c, r) at integer (c, r)), clamped to the outer
-  // samples: the half-cell border is flat.
-  double us = std::clamp(u - 0.5, 0.0, double(cols - 1));
-  double vs = std::clamp(v - 0.5, 0.0, double(rows - 1));
-  int i = std::clamp(int(us), 0, std::max(cols - 2, 0));
-  int j = std::clamp(int(vs), 0, std::max(rows - 2, 0));
-  double a = us - i, b = vs - j;
-  double h00 = detail::clamped_height(h, cols, rows, i, j);
-  double h10 = detail::clamped_height(h, cols, rows, i + 1, j);
-  double h01 = detail::clamped_height(h, cols, rows, i, j + 1);
-  double h11 = detail::clamped_height(h, cols, rows, i + 1, j + 1);
-  return detail::surface_in_square(h00, h10, h01, h11, a, b, a + b <= 1.0);
-}
-
-double surface_y_m(const HeightGrid& grid, Representation representation, double x,
-                   double z) noexcept {
-  return grid.spec().origin_m.y + surface_height_m(grid, representation, x, z);
-}
-
 std::string validate(const SurfaceParams& params) {
   if (auto m = check_positive("stiffness_n_per_m", params.stiffness_n_per_m); !m.empty()) return m;
   return check_nonnegative("damping_n_s_per_m", params.damping_n_s_per_m);

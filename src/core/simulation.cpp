@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <stdexcept>
 
 #include "terracut/core/error.hpp"
 
@@ -61,6 +62,7 @@ const StepOutput& Simulation::begin_step(const BladePose& pose) {
   out_.contact = valid ? measure_contact(grid_, params_.representation, out_.edge) : ContactResult{};
   out_.cut = {};
   out_.substeps = 0;
+  out_.listener_force_world_n = {};
   out_.timers = {};
   out_.timers.contact_s = now_s() - begin_clock_s_;
   if (!valid) has_previous_ = false;
@@ -100,12 +102,37 @@ const StepOutput& Simulation::finish_step() {
   removed_volume_m3_ += out_.cut.removed_volume_m3;
   previous_pose_ = out_.pose;
   has_previous_ = true;
-  in_step_ = false;
   ++step_count_;
-  double end = now_s();
-  out_.timers.cut_s = end - cut_start;
+  const double cut_end = now_s();
+  out_.timers.cut_s = cut_end - cut_start;
+
+  // The listeners see the finished step (its cut and changed rectangle) and
+  // may push on the tool.
+  Vec3 listener_force{};
+  for (StepListener* listener : listeners_) listener_force = listener_force + listener->on_step(out_);
+  out_.listener_force_world_n = listener_force;
+  in_step_ = false;
+  const double end = now_s();
+  out_.timers.listeners_s = end - cut_end;
   out_.timers.total_s = end - begin_clock_s_;
   return out_;
+}
+
+void Simulation::lift() {
+  has_previous_ = false;
+  for (StepListener* listener : listeners_) listener->on_lift();
+}
+
+void Simulation::add_listener(StepListener& listener) {
+  if (in_step_) throw std::logic_error("Simulation::add_listener: not during a step");
+  if (std::find(listeners_.begin(), listeners_.end(), &listener) != listeners_.end())
+    throw std::logic_error("Simulation::add_listener: this listener was already added");
+  listeners_.push_back(&listener);
+}
+
+void Simulation::remove_listener(StepListener& listener) {
+  if (in_step_) throw std::logic_error("Simulation::remove_listener: not during a step");
+  listeners_.erase(std::remove(listeners_.begin(), listeners_.end(), &listener), listeners_.end());
 }
 
 void Simulation::reset() {

@@ -15,46 +15,46 @@
 namespace terracut::haptics {
 namespace {
 
-const HapticSettings& checked(const HapticSettings& settings) {
+HapticSettings validated(HapticSettings settings, const BladeSpec& blade) {
   if (std::string m = validate(settings); !m.empty()) throw InputError("haptics." + m);
-  return settings;
+  return with_derived_fields(std::move(settings), blade.length_m);
 }
 
-SimParams at_rate(SimParams sim, double rate_hz) {
-  sim.rate_hz = rate_hz;
-  return sim;
-}
-
-ForceModelParams model_params(const HapticSettings& s) {
+ForceModel built_model(const ForceModelParams& params) {
   try {
-    ForceModel probe(s.forces);  // validates and applies the device check
+    return ForceModel(params);  // validates and makes the device check
   } catch (const InputError& e) {
     throw InputError(std::string("haptics.forces.") + e.what());
   }
-  return s.forces;
 }
 
 }  // namespace
 
-HapticLoop::HapticLoop(const HapticSettings& settings, const SimParams& sim,
-                       std::vector<float> heights, Quat default_orientation, Device& device,
-                       const LoopOptions& options)
-    : settings_(with_derived_fields(checked(settings), sim.blade.length_m)),
+LoopParams::LoopParams(const HapticSettings& settings, const BladeSpec& blade)
+    : settings_(validated(settings, blade)), model_(built_model(settings_.forces)) {}
+
+HapticLoop::HapticLoop(const LoopParams& params, Simulation& sim, Quat default_orientation,
+                       Device& device, const LoopOptions& options)
+    : params_(params),
       device_(device),
       options_(options),
-      workspace_(settings_.workspace),
-      model_(model_params(settings_)),
-      safety_(settings_.safety),
-      sim_(at_rate(sim, settings_.rate_hz), std::move(heights)),
+      workspace_(params_.settings().workspace),
+      safety_(params_.settings().safety),
+      sim_(sim),
       default_orientation_(normalized(default_orientation)) {
+  const HapticSettings& settings = params_.settings();
   if (options_.ticks < 1) throw InputError("haptics: the loop needs at least one tick");
-  if (settings_.tool_rotation_deg) {
-    fixed_orientation_ = quat_from_euler_deg(*settings_.tool_rotation_deg);
+  if (sim_.params().rate_hz != params_.rate_hz())
+    throw InputError("haptics: the simulation steps at " + std::to_string(sim_.params().rate_hz) +
+                     " Hz, the loop runs at haptics.rate_hz " + std::to_string(params_.rate_hz()) +
+                     " Hz: build the simulation at the loop's rate");
+  if (settings.tool_rotation_deg) {
+    fixed_orientation_ = quat_from_euler_deg(*settings.tool_rotation_deg);
     has_fixed_orientation_ = true;
   }
   lookahead_m_ = depth_lookahead_m(sim_.grid().spec());
-  if (settings_.velocity_cutoff_hz > 0.0)
-    filter_rc_s_ = 1.0 / (2.0 * std::numbers::pi * settings_.velocity_cutoff_hz);
+  if (settings.velocity_cutoff_hz > 0.0)
+    filter_rc_s_ = 1.0 / (2.0 * std::numbers::pi * settings.velocity_cutoff_hz);
   if (options_.snapshot) {
     const ViewFrame& f = options_.snapshot->front();
     if (f.cols != sim_.grid().cols() || f.rows != sim_.grid().rows())
@@ -62,15 +62,11 @@ HapticLoop::HapticLoop(const HapticSettings& settings, const SimParams& sim,
   }
   // Everything a tick touches is allocated here, never during the run.
   records_.resize(options_.record_capacity);
-  // The engine builds itself over the simulation (it may throw InputError).
-  if (options_.engine) options_.engine->attach(sim_);
 }
 
 HapticLoop::~HapticLoop() {
   request_stop();
   if (thread_.joinable()) thread_.join();
-  // The engine outlives the loop: it must let go of the simulation first.
-  if (options_.engine) options_.engine->detach();
 }
 
 // ---------------------------------------------------------------------------
@@ -85,112 +81,95 @@ void HapticLoop::step1(double t_s) noexcept {
     device_.start(t_s);
     safety_.restart(t_s);
   }
+  const bool bad = !read_device(t_s);
 
-  // Read the device; count a non-finite sample and keep the last good one.
-  DeviceSample fresh = sample_;
-  fresh.reconnected = false;
-  bool bad = false;
-  if (device_.read(t_s, fresh)) {
-    ++counters_.samples;
-    const bool finite =
-        is_finite(fresh.position_m) && (!fresh.has_orientation || is_finite(fresh.orientation));
-    if (finite) {
-      sample_ = fresh;
-      device_position_m_ = fresh.position_m;
-      has_sample_ = true;
-      last_sample_t_s_ = t_s;
-      if (fresh.reconnected) {
-        ++counters_.reconnects;
-        tick_flags_ |= kFlagReconnected;
-        safety_.restart(t_s);
-        has_previous_tool_ = false;  // the handle may be anywhere now
-      }
-    } else {
-      bad = true;
-      ++counters_.bad_samples;
-      tick_flags_ |= kFlagBadSample;
-    }
-  } else {
-    ++counters_.silent_ticks;
-    tick_flags_ |= kFlagSilent;
-  }
-
-  // The tool pose: position from the device, orientation fixed, from the
-  // device, or the default. Without a usable sample (none yet, or a bad one)
-  // the simulation is not stepped: nothing is measured or cut.
+  // Without a usable sample (none yet, or a bad one) the simulation is not
+  // stepped: nothing is measured or cut.
   stepped_ = has_sample_ && !bad;
   if (!stepped_) {
     velocity_m_per_s_ = {};
     has_previous_tool_ = false;  // start the estimate afresh
     return;
   }
-  if (tick_flags_ & kFlagReconnected) {
-    sim_.lift();  // the handle may be anywhere: no sweep
-    if (options_.engine) options_.engine->lifted();
-  }
-  BladePose pose;
-  {
-    pose.position_m = workspace_.to_world(sample_.position_m);
-    if (has_fixed_orientation_)
-      pose.orientation = fixed_orientation_;
-    else if (sample_.has_orientation)
-      pose.orientation = workspace_.orientation_to_world(sample_.orientation);
-    else
-      pose.orientation = default_orientation_;
-  }
-
-  // Velocity: filtered backward difference, updated only on new good samples
-  // (a device slower than the loop does not read as stop-and-go).
-  if (!(tick_flags_ & kFlagSilent)) {
-    if (has_previous_tool_ && t_s > previous_tool_t_s_) {
-      const double dt = t_s - previous_tool_t_s_;
-      const Vec3 raw = (pose.position_m - previous_tool_m_) * (1.0 / dt);
-      const double alpha = filter_rc_s_ > 0.0 ? 1.0 - std::exp(-dt / filter_rc_s_) : 1.0;
-      velocity_m_per_s_ = velocity_m_per_s_ + (raw - velocity_m_per_s_) * alpha;
-    } else {
-      velocity_m_per_s_ = {};
-    }
-    previous_tool_m_ = pose.position_m;
-    previous_tool_t_s_ = t_s;
-    has_previous_tool_ = true;
-  }
+  if (tick_flags_ & kFlagReconnected) sim_.lift();  // the handle may be anywhere: no sweep
+  const BladePose pose = tool_pose();
+  estimate_velocity(pose, t_s);
   sim_.begin_step(pose);
+}
+
+// Reads the device: counts a non-finite sample (returns false) and keeps the
+// last good one; a reconnection restarts the soft start.
+bool HapticLoop::read_device(double t_s) noexcept {
+  DeviceSample fresh = sample_;
+  fresh.reconnected = false;
+  if (!device_.read(t_s, fresh)) {
+    ++counters_.silent_ticks;
+    tick_flags_ |= kFlagSilent;
+    return true;
+  }
+  ++counters_.samples;
+  const bool finite =
+      is_finite(fresh.position_m) && (!fresh.has_orientation || is_finite(fresh.orientation));
+  if (!finite) {
+    ++counters_.bad_samples;
+    tick_flags_ |= kFlagBadSample;
+    return false;
+  }
+  sample_ = fresh;
+  device_position_m_ = fresh.position_m;
+  has_sample_ = true;
+  last_sample_t_s_ = t_s;
+  if (fresh.reconnected) {
+    ++counters_.reconnects;
+    tick_flags_ |= kFlagReconnected;
+    safety_.restart(t_s);
+    has_previous_tool_ = false;  // the handle may be anywhere now
+  }
+  return true;
+}
+
+// The tool pose: position from the device, orientation fixed, from the
+// device, or the default.
+BladePose HapticLoop::tool_pose() const noexcept {
+  BladePose pose;
+  pose.position_m = workspace_.to_world(sample_.position_m);
+  if (has_fixed_orientation_)
+    pose.orientation = fixed_orientation_;
+  else if (sample_.has_orientation)
+    pose.orientation = workspace_.orientation_to_world(sample_.orientation);
+  else
+    pose.orientation = default_orientation_;
+  return pose;
+}
+
+// Velocity: filtered backward difference, updated only on new good samples
+// (a device slower than the loop does not read as stop-and-go).
+void HapticLoop::estimate_velocity(const BladePose& pose, double t_s) noexcept {
+  if (tick_flags_ & kFlagSilent) return;
+  if (has_previous_tool_ && t_s > previous_tool_t_s_) {
+    const double dt = t_s - previous_tool_t_s_;
+    const Vec3 raw = (pose.position_m - previous_tool_m_) * (1.0 / dt);
+    const double alpha = filter_rc_s_ > 0.0 ? 1.0 - std::exp(-dt / filter_rc_s_) : 1.0;
+    velocity_m_per_s_ = velocity_m_per_s_ + (raw - velocity_m_per_s_) * alpha;
+  } else {
+    velocity_m_per_s_ = {};
+  }
+  previous_tool_m_ = pose.position_m;
+  previous_tool_t_s_ = t_s;
+  has_previous_tool_ = true;
 }
 
 const LoopRecord& HapticLoop::step2(double period_s, double compute_s,
                                     bool missed_deadline) noexcept {
+  // Cut (and the simulation's listeners: e.g. the rigid bodies), then the
+  // force in the world from the contact, the motion and the listeners.
   const StepOutput& out = stepped_ ? sim_.finish_step() : not_stepped_;
-  const bool usable = stepped_;
-
-  // Force in the world from the contact and the motion.
-  ForceOutput force{};
-  if (usable) {
-    ForceInput in;
-    in.velocity_m_per_s = velocity_m_per_s_;
-    in.contact_length_m = out.contact.length_m;
-    in.cut_depth_m = cut_depth(out);
-    in.edge_direction = out.edge.b - out.edge.a;
-    in.device_point_m = out.pose.position_m;
-    in.surface_y_m = settings_.surface_reference == SurfaceReference::kGround
-                         ? sim_.grid().spec().origin_m.y
-                         : surface_y_m(sim_.grid(), sim_.params().representation,
-                                       out.pose.position_m.x, out.pose.position_m.z);
-    force = model_.compute(in);
-  }
-
-  // The engine's step (e.g. rigid bodies pushing the blade's plate): its
-  // world force joins the models' and is scaled to the device the same way.
-  Vec3 body_force{};
-  if (usable && options_.engine) {
-    body_force = options_.engine->after_cut(out);
-    force.world_n = force.world_n + body_force;
-    force.device_n = force.world_n * model_.params().force_scale;
-  }
+  const double depth_m = stepped_ ? cut_depth(out) : 0.0;
+  const ForceOutput force = stepped_ ? world_force(out, depth_m) : ForceOutput{};
 
   // Safety: a bad sample or no sample yet asks for zero force (shrinking to
   // zero is immediate); the watchdog looks at the last good sample's time.
-  const Vec3 request = usable ? force.device_n : Vec3{};
-  const SafetyOutput safe = safety_.update(t_s_, request, last_sample_t_s_);
+  const SafetyOutput safe = safety_.update(t_s_, force.device_n, last_sample_t_s_);
   std::uint32_t flags = tick_flags_ | safe.flags.bits();
   if (missed_deadline) {
     flags |= kFlagMissedDeadline;
@@ -204,57 +183,86 @@ const LoopRecord& HapticLoop::step2(double period_s, double compute_s,
   command.t_s = t_s_;
   device_.write(command);
 
+  LoopRecord& r = write_record(out, force, depth_m, command, period_s, compute_s);
+  if (options_.snapshot) publish_frame(out, force, command, period_s, compute_s);
+  return r;
+}
+
+// The force models' world force plus the listeners' (e.g. rigid bodies
+// pushing the blade's plate), both scaled to the device the same way.
+ForceOutput HapticLoop::world_force(const StepOutput& out, double cut_depth_m) const noexcept {
+  const HapticSettings& settings = params_.settings();
+  ForceInput in;
+  in.velocity_m_per_s = velocity_m_per_s_;
+  in.contact_length_m = out.contact.length_m;
+  in.cut_depth_m = cut_depth_m;
+  in.edge_direction = out.edge.b - out.edge.a;
+  in.device_point_m = out.pose.position_m;
+  in.surface_y_m = settings.surface_reference == SurfaceReference::kGround
+                       ? sim_.grid().spec().origin_m.y
+                       : surface_y_m(sim_.grid(), sim_.params().representation,
+                                     out.pose.position_m.x, out.pose.position_m.z);
+  ForceOutput force = params_.force_model().compute(in);
+  if (!sim_.listeners().empty()) {
+    force.world_n = force.world_n + out.listener_force_world_n;
+    force.device_n = force.world_n * params_.force_model().params().force_scale;
+  }
+  return force;
+}
+
+// The tick's record (last_, and the ring of kept records).
+LoopRecord& HapticLoop::write_record(const StepOutput& out, const ForceOutput& force,
+                                     double cut_depth_m, const DeviceCommand& command,
+                                     double period_s, double compute_s) noexcept {
+  const Vec3 body_force = stepped_ ? out.listener_force_world_n : Vec3{};
   LoopRecord& r = last_;
   r.tick = counters_.ticks;
   r.t_s = t_s_;
   r.device_position_m = device_position_m_;
   r.tool = stepped_ ? out.pose : sim_.last().pose;
   r.contact_length_m = out.contact.length_m;
-  r.cut_depth_m = usable ? cut_depth(out) : 0.0;
+  r.cut_depth_m = cut_depth_m;
   r.removed_volume_m3 = out.cut.removed_volume_m3;
   r.velocity_m_per_s = velocity_m_per_s_;
   r.force_world_n = force.world_n;
   r.body_force_world_n = body_force;
   r.force_device_n = command.force_n;
-  r.flags = flags;
+  r.flags = command.flags;
   r.period_s = period_s;
   r.compute_s = compute_s;
   max_device_force_n_ = std::max(max_device_force_n_, length(command.force_n));
   max_body_force_n_ = std::max(max_body_force_n_, length(body_force));
   ++counters_.ticks;
   record(r);
+  return r;
+}
 
-  // The viewer's picture of this tick.
-  if (options_.snapshot) {
-    SnapshotExchange& x = *options_.snapshot;
-    x.note_changed(out.cut.changed);
-    ViewFrame& f = x.back();
-    f.t_s = t_s_;
-    f.step = out.step;
-    f.pose = out.pose;
-    f.edge = out.edge;
-    f.contact = out.contact;
-    f.device_position_m = out.pose.position_m;
-    f.proxy_position_m = force.surface.in_contact ? force.surface.proxy_m : out.pose.position_m;
-    f.force_world_n = force.world_n;
-    f.force_device_n = command.force_n;
-    f.body_force_world_n = body_force;
-    f.step_time_s = compute_s;
-    f.period_s = period_s;
-    if (options_.engine) {
-      options_.engine->fill_frame(f);
-    } else {
-      f.body_count = 0;
-      f.body_total = 0;
-    }
-    x.publish(sim_.grid());
-  }
-  return last_;
+// The viewer's picture of this tick.
+void HapticLoop::publish_frame(const StepOutput& out, const ForceOutput& force,
+                               const DeviceCommand& command, double period_s,
+                               double compute_s) noexcept {
+  SnapshotExchange& x = *options_.snapshot;
+  x.note_changed(out.cut.changed);
+  ViewFrame& f = x.back();
+  f.t_s = t_s_;
+  f.step = out.step;
+  f.pose = out.pose;
+  f.edge = out.edge;
+  f.contact = out.contact;
+  f.device_position_m = out.pose.position_m;
+  f.proxy_position_m = force.surface.in_contact ? force.surface.proxy_m : out.pose.position_m;
+  f.force_world_n = force.world_n;
+  f.force_device_n = command.force_n;
+  f.body_force_world_n = last_.body_force_world_n;
+  f.step_time_s = compute_s;
+  f.period_s = period_s;
+  fill_bodies(f, options_.bodies);
+  x.publish(sim_.grid());
 }
 
 double HapticLoop::cut_depth(const StepOutput& out) const noexcept {
   if (out.contact.length_m <= 0.0) return 0.0;
-  if (settings_.cut_depth == CutDepthMeasure::kSection)
+  if (params_.settings().cut_depth == CutDepthMeasure::kSection)
     return out.contact.section_area_m2 / out.contact.length_m;
   return depth_ahead_m(sim_.grid(), sim_.params().representation, out.edge, velocity_m_per_s_,
                        lookahead_m_);
@@ -306,7 +314,7 @@ void HapticLoop::paced_tick(Pacer& pacer, PacerClock& measure, const Tick& tick,
   const double t = (fake ? tick.deadline_s : tick.start_s) - origin_s;
   step1(t);
   // The fake clock's periods are nominal (its deadlines differ from it by rounding only).
-  const double period = tick.index == 0 ? 0.0 : fake ? 1.0 / settings_.rate_hz : tick.period_s;
+  const double period = tick.index == 0 ? 0.0 : fake ? 1.0 / params_.rate_hz() : tick.period_s;
   step2(period, measure.now_s() - begin, tick.after_overrun);
   // step2's own cost belongs to the tick too.
   const double compute = measure.now_s() - begin;
@@ -318,7 +326,7 @@ void HapticLoop::run_deterministic() {
   realtime_ = {};
   realtime_.message = "real-time: not used (fake clock)";
   PacerSettings ps;
-  ps.rate_hz = settings_.rate_hz;
+  ps.rate_hz = params_.rate_hz();
   ps.spin_s = 0.0;
   Pacer pacer(ps, std::make_shared<FakeClock>());
   const std::shared_ptr<PacerClock> measure = steady_pacer_clock();
@@ -361,7 +369,7 @@ void HapticLoop::thread_main(std::promise<void>& ready) {
   ready.set_value();  // `ready` lives in start(), which returns after this
   {
     PacerSettings ps;
-    ps.rate_hz = settings_.rate_hz;
+    ps.rate_hz = params_.rate_hz();
     const std::shared_ptr<PacerClock> clock =
         options_.clock ? options_.clock : steady_pacer_clock();
     Pacer pacer(ps, clock);
@@ -395,27 +403,14 @@ TimePercentiles HapticLoop::percentiles(double LoopRecord::*field, bool deviatio
   const std::vector<LoopRecord> rs = records();
   std::vector<double> v;
   v.reserve(rs.size());
-  const double nominal = 1.0 / settings_.rate_hz;
+  const double nominal = 1.0 / params_.rate_hz();
   // The first tick has no period.
   for (const LoopRecord& r : rs) {
     if (field == &LoopRecord::period_s && r.tick == 0) continue;
     const double x = r.*field;
-    v.push_back((deviation ? std::abs(x - nominal) : x) * 1e6);
+    v.push_back(deviation ? std::abs(x - nominal) : x);
   }
-  TimePercentiles p;
-  if (v.empty()) return p;
-  std::sort(v.begin(), v.end());
-  const auto at = [&](double q) {
-    const std::size_t i = std::min(v.size() - 1, std::size_t(std::ceil(q * double(v.size()))) - 1);
-    return v[i];
-  };
-  p.p50_us = at(0.50);
-  p.p99_us = at(0.99);
-  p.max_us = v.back();
-  double sum = 0.0;
-  for (double x : v) sum += x;
-  p.mean_us = sum / double(v.size());
-  return p;
+  return timing_stats(v);
 }
 
 TimePercentiles HapticLoop::jitter() const { return percentiles(&LoopRecord::period_s, true); }

@@ -53,4 +53,14 @@ const ViewFrame* SnapshotExchange::acquire() {
   return &frames_[front_];
 }
 
+void fill_bodies(ViewFrame& frame, const BodySource* source) noexcept {
+  if (!source) {
+    frame.body_count = 0;
+    frame.body_total = 0;
+    return;
+  }
+  frame.body_count = source->write_bodies(frame.bodies);
+  frame.body_total = source->body_total();
+}
+
 }  // namespace terracut::haptics

@@ -672,6 +672,15 @@ void apply_overrides(Scenario& scenario, std::optional<Resolution> resolution,
   }
 }
 
+SimParams sim_params(const Scenario& scenario, std::optional<double> rate_hz) {
+  SimParams params;
+  params.grid = grid_spec(scenario);
+  params.representation = scenario.representation;
+  params.rate_hz = rate_hz.value_or(scenario.rate_hz);
+  params.blade = scenario.blade;
+  return params;
+}
+
 GridSpec grid_spec(const Scenario& scenario) {
   GridSpec spec;
   spec.cols = scenario.resolution.cols;

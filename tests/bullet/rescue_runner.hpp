@@ -1,9 +1,9 @@
 // Runs a scenario with rigid bodies end to end, in memory, the way `terracut
-// run` drives the Bullet world (apps/terracut/bodies_observer.cpp):
-// load_scenario reads `bodies:` into Scenario::bodies; then a TerrainWorld
-// over the Simulation, world.lift_tool() next to sim.lift(), world.step(out)
-// after each sim.step, and a BodiesCsvWriter for DIR/bodies.csv. Used by the
-// rescue test, which checks every step's body states.
+// run` drives the Bullet world: load_scenario reads `bodies:` into
+// Scenario::bodies; then the bodies' listener (bullet/bodies_listener.hpp)
+// on the Simulation, which lifts its plate with sim.lift(), steps the world
+// at the end of each sim.step and writes DIR/bodies.csv. Used by the rescue
+// test, which checks every step's body states.
 #pragma once
 
 #include <cmath>
@@ -11,9 +11,7 @@
 #include <memory>
 #include <vector>
 
-#include "terracut/bullet/bodies_csv.hpp"
-#include "terracut/bullet/terrain_world.hpp"
-#include "terracut/io/run.hpp"
+#include "terracut/bullet/bodies_listener.hpp"
 #include "terracut/io/scenario.hpp"
 
 namespace terracut::test {
@@ -40,13 +38,15 @@ struct BodiesRun {
 inline BodiesRun run_with_bodies(const io::Scenario& sc, const std::filesystem::path& out_dir,
                                  const bullet::TerrainWorldParams& params = {}) {
   Simulation sim(io::sim_params(sc), io::build_initial_heights(sc));
-  bullet::TerrainWorld world(sim, sc.bodies, params);
-
-  std::unique_ptr<bullet::BodiesCsvWriter> csv;
+  bullet::BodiesListenerOptions options;
+  options.world = params;
   if (!out_dir.empty()) {
     std::filesystem::create_directories(out_dir);
-    csv = std::make_unique<bullet::BodiesCsvWriter>(out_dir / "bodies.csv");
+    options.csv_path = out_dir / "bodies.csv";
   }
+  bullet::BodiesListener listener(sim, sc.bodies, options);
+  const bullet::TerrainWorld& world = listener.world();
+
   BodiesRun run;
   run.bodies = sc.bodies;
   auto record = [&](int sequence_index) {
@@ -54,7 +54,6 @@ inline BodiesRun run_with_bodies(const io::Scenario& sc, const std::filesystem::
     run.sequence_index.push_back(sequence_index);
     for (int i = 0; i < world.body_count(); ++i) run.states.push_back(world.body_state(i));
     run.tool_force_n.push_back(world.last().tool_force_n);
-    if (csv) csv->write_step(world);
   };
   record(-1);
   for (std::size_t k = 0; k < sc.sequence.size(); ++k) {
@@ -62,20 +61,16 @@ inline BodiesRun run_with_bodies(const io::Scenario& sc, const std::filesystem::
     const std::int64_t n = std::llround(motion.duration_s() * sc.rate_hz) + 1;
     // Each cut is a separate stroke: the blade and its plate jump to its start.
     sim.lift();
-    world.lift_tool();
     for (std::int64_t i = 0; i < n; ++i) {
-      const StepOutput& out = sim.step(motion.sample(double(i) / sc.rate_hz));
-      world.step(out);
+      sim.step(motion.sample(double(i) / sc.rate_hz));
       run.physics_s.push_back(world.last().physics_s);
       record(int(k));
       ++run.steps;
     }
   }
   run.bounds = world.bounds();
-  if (csv) {
-    run.csv_rows = csv->rows_written();
-    csv->close();
-  }
+  run.csv_rows = listener.csv_rows();
+  listener.finish();
   return run;
 }
 

@@ -1,5 +1,5 @@
-// Shared set-ups of the haptics tests: the trench scenario, and a device
-// wrapper that injects bad or missing samples.
+// Shared set-ups of the haptics tests: the trench scenario, a loop over a
+// simulation of it, and a device wrapper that injects bad or missing samples.
 #pragma once
 
 #include <cmath>
@@ -8,8 +8,11 @@
 #include <memory>
 #include <vector>
 
+#include "terracut/core/step_listener.hpp"
 #include "terracut/haptics/device.hpp"
-#include "terracut/haptics/session.hpp"
+#include "terracut/haptics/loop.hpp"
+#include "terracut/io/haptics_yaml.hpp"
+#include "terracut/io/scenario.hpp"
 
 namespace terracut::haptics::test {
 
@@ -17,9 +20,39 @@ inline std::filesystem::path trench_path() {
   return std::filesystem::path(TERRACUT_SOURCE_DIR) / "scenarios/trench_dry_sand.yaml";
 }
 
+/// A scenario and its `haptics:` settings.
+struct HapticScenario {
+  io::Scenario scenario;
+  HapticSettings haptics;
+};
+
 inline const HapticScenario& trench() {
-  static const HapticScenario s = load_haptic_scenario(trench_path());
+  static const HapticScenario s{io::load_scenario(trench_path()), io::load_haptics(trench_path())};
   return s;
+}
+
+/// A haptic loop and the simulation it steps (which a loop does not own:
+/// in the programs, the session layer's world does). The loop goes first.
+struct LoopRig {
+  std::unique_ptr<Simulation> sim;
+  std::unique_ptr<HapticLoop> loop;
+  HapticLoop* operator->() const { return loop.get(); }
+  HapticLoop& operator*() const { return *loop; }
+};
+
+/// A loop over a fresh simulation of sc at the loop's rate, with the given
+/// step listeners added to the simulation first. Throws as LoopParams and
+/// HapticLoop do.
+inline LoopRig make_loop_rig(const HapticSettings& settings, const io::Scenario& sc,
+                             Quat default_orientation, Device& device, const LoopOptions& options,
+                             const std::vector<StepListener*>& listeners = {}) {
+  const LoopParams params(settings, sc.blade);
+  LoopRig rig;
+  rig.sim = std::make_unique<Simulation>(io::sim_params(sc, params.rate_hz()),
+                                         io::build_initial_heights(sc));
+  for (StepListener* l : listeners) rig.sim->add_listener(*l);
+  rig.loop = std::make_unique<HapticLoop>(params, *rig.sim, default_orientation, device, options);
+  return rig;
 }
 
 /// Wraps a device: ticks for which `bad(tick)` is true read a NaN position,

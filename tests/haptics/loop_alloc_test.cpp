@@ -13,7 +13,7 @@
 #include "terracut/haptics/script_device.hpp"
 #include "terracut/haptics/sim_hand.hpp"
 #include "terracut/haptics/udp_device.hpp"
-#include "terracut/io/run.hpp"
+#include "terracut/io/scenario.hpp"
 
 #include "../support/counting_new.hpp"
 
@@ -24,14 +24,14 @@ namespace {
 // all but the first (the first tick starts the device).
 long allocations_per_run(Device& device, std::int64_t ticks, SnapshotExchange* snapshot,
                          const std::function<void(std::int64_t)>& before_tick = nullptr) {
-  const HapticScenario& in = test::trench();
+  const test::HapticScenario& in = test::trench();
   LoopOptions o;
   o.ticks = ticks;
   o.record_capacity = std::size_t(ticks);
   o.realtime = false;
   o.snapshot = snapshot;
-  HapticLoop loop(in.haptics, io::sim_params(in.scenario), io::build_initial_heights(in.scenario),
-                  Quat{}, device, o);
+  const test::LoopRig rig = test::make_loop_rig(in.haptics, in.scenario, Quat{}, device, o);
+  HapticLoop& loop = *rig;
   loop.step1(0.0);
   loop.step2(0.0, 0.0, false);
   const long before = g_allocations.load();

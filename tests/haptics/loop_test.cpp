@@ -15,7 +15,7 @@
 #include "terracut/core/error.hpp"
 #include "terracut/haptics/script_device.hpp"
 #include "terracut/haptics/sim_hand.hpp"
-#include "terracut/io/run.hpp"
+#include "terracut/io/scenario.hpp"
 
 namespace terracut::haptics {
 namespace {
@@ -23,16 +23,15 @@ namespace {
 using test::trench;
 
 // A loop on the trench scenario with the given device and settings.
-std::unique_ptr<HapticLoop> trench_loop(const HapticSettings& settings, Device& device,
-                                        std::int64_t ticks, SnapshotExchange* snapshot = nullptr) {
+test::LoopRig trench_loop(const HapticSettings& settings, Device& device, std::int64_t ticks,
+                          SnapshotExchange* snapshot = nullptr) {
   const io::Scenario& sc = trench().scenario;
   LoopOptions o;
   o.ticks = ticks;
   o.record_capacity = std::size_t(ticks);
   o.realtime = false;
   o.snapshot = snapshot;
-  return std::make_unique<HapticLoop>(settings, io::sim_params(sc), io::build_initial_heights(sc),
-                                      sc.cuts[0].keyframes[0].pose.orientation, device, o);
+  return test::make_loop_rig(settings, sc, sc.cuts[0].keyframes[0].pose.orientation, device, o);
 }
 
 const Motion& trench_cut() { return trench().scenario.cuts[0]; }
@@ -272,7 +271,8 @@ HoldResult hold_against_floor(HapticSettings s, double floor_stiffness_world) {
   LoopOptions o;
   o.ticks = 2000;
   o.realtime = false;
-  HapticLoop loop(s, io::sim_params(sc), io::build_initial_heights(sc), Quat{}, device, o);
+  const test::LoopRig rig = test::make_loop_rig(s, sc, Quat{}, device, o);
+  HapticLoop& loop = *rig;
   HoldResult r;
   for (std::int64_t i = 0; i < o.ticks; ++i) {
     loop.step1(double(i) / s.rate_hz);
@@ -392,7 +392,8 @@ TEST(HapticLoop, PacedLoopStatisticsWithAFakeClock) {
   o.record_capacity = 300;
   o.realtime = false;
   o.clock = clock;
-  HapticLoop loop(s, io::sim_params(sc), io::build_initial_heights(sc), Quat{}, device, o);
+  const test::LoopRig rig = test::make_loop_rig(s, sc, Quat{}, device, o);
+  HapticLoop& loop = *rig;
   loop.start();
   loop.join();
   EXPECT_FALSE(loop.running());
@@ -425,7 +426,8 @@ TEST(HapticLoop, RecordsKeepTheNewestWhenFull) {
   o.ticks = 250;
   o.record_capacity = 100;
   o.realtime = false;
-  HapticLoop loop(s, io::sim_params(sc), io::build_initial_heights(sc), Quat{}, device, o);
+  const test::LoopRig rig = test::make_loop_rig(s, sc, Quat{}, device, o);
+  HapticLoop& loop = *rig;
   loop.run_deterministic();
   const std::vector<LoopRecord> rs = loop.records();
   ASSERT_EQ(rs.size(), 100u);

@@ -14,7 +14,7 @@
 #include "terracut/haptics/device_player.hpp"
 #include "terracut/haptics/loop.hpp"
 #include "terracut/haptics/udp_device.hpp"
-#include "terracut/io/run.hpp"
+#include "terracut/io/scenario.hpp"
 
 namespace terracut::haptics {
 namespace {
@@ -155,7 +155,7 @@ TEST(UdpBridge, BindErrorsNameTheSetting) {
 // The running loop (its own thread) and a device-player thread exchanging
 // poses and forces over loopback until the loop's ticks are done.
 TEST(UdpBridge, RoundTripBetweenAPlayerThreadAndTheLoop) {
-  const HapticScenario& in = test::trench();
+  const test::HapticScenario& in = test::trench();
   HapticSettings s = in.haptics;
   s.device = DeviceKind::kUdp;
   UdpDevice device("127.0.0.1", 0);
@@ -163,8 +163,9 @@ TEST(UdpBridge, RoundTripBetweenAPlayerThreadAndTheLoop) {
   o.ticks = 300;
   o.record_capacity = 300;
   o.realtime = false;
-  HapticLoop loop(s, io::sim_params(in.scenario), io::build_initial_heights(in.scenario),
-                  in.scenario.cuts[0].keyframes[0].pose.orientation, device, o);
+  const test::LoopRig rig = test::make_loop_rig(
+      s, in.scenario, in.scenario.cuts[0].keyframes[0].pose.orientation, device, o);
+  HapticLoop& loop = *rig;
 
   // The player follows the trench from its cutting part (t = 1.6 s on), so
   // the blade is in the sand and forces come back.

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -76,5 +77,31 @@ Quat initial_orientation(const BodySpec& spec);
 /// Half of the body's extent along its local axes, metres: the box's half
 /// sizes, (r, r, r) for a sphere, (r, h/2, r) for a cylinder.
 Vec3 half_extents_m(const BodySpec& spec);
+
+/// Where one rigid body is and what it looks like, as a viewer draws it.
+struct BodyView {
+  BodyShape shape = BodyShape::kBox;  ///< box, sphere or cylinder (axis = local Y)
+  /// Half of the body's extent along its local axes, metres, each > 0: a
+  /// box's half sizes, (r, r, r) for a sphere, (r, h/2, r) for a cylinder
+  /// (half_extents_m() of its BodySpec).
+  Vec3 half_extents_m{};
+  Vec3 position_m{};    ///< centre, world metres
+  Quat orientation{};   ///< body frame -> world, unit quaternion
+  bool active = true;   ///< false while the physics engine has it asleep
+};
+
+/// Something that simulates the scenario's rigid bodies and can say where
+/// they are (the Bullet listener, terracut/bullet/bodies_listener.hpp). The
+/// haptic loop reads it for the viewer's frames; the core knows no engine.
+class BodySource {
+ public:
+  virtual ~BodySource() = default;
+  /// Number of bodies simulated.
+  virtual int body_total() const noexcept = 0;
+  /// Writes the first min(body_total(), out.size()) bodies into out and
+  /// returns how many it wrote. Called on the stepping thread between steps;
+  /// must not allocate or throw.
+  virtual int write_bodies(std::span<BodyView> out) const noexcept = 0;
+};
 
 }  // namespace terracut

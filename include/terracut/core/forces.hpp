@@ -27,6 +27,7 @@
 #include "terracut/core/contact.hpp"
 #include "terracut/core/grid.hpp"
 #include "terracut/core/math.hpp"
+#include "terracut/core/surface.hpp"
 
 namespace terracut {
 
@@ -183,17 +184,8 @@ Vec3 earthmoving_world_force(const EarthmovingResult& result, Vec3 velocity_m_pe
 // Surface: proxy on the terrain and a spring-damper to the device point
 // ---------------------------------------------------------------------------
 
-/// Height of the terrain surface above the ground level (origin_m.y) at world
-/// (x, z), metres, as the representation reads the samples: kColumns, the
-/// height of the cell containing the point; kSurface, the triangulated surface
-/// through the cell centres (same split as contact.hpp), flat over the
-/// half-cell border. Outside the terrain rectangle: 0 (the rigid ground).
-double surface_height_m(const HeightGrid& grid, Representation representation, double x,
-                        double z) noexcept;
-
-/// World Y of the terrain surface at (x, z): origin_m.y + surface_height_m.
-double surface_y_m(const HeightGrid& grid, Representation representation, double x,
-                   double z) noexcept;
+// The surface query the proxy reads (surface_y_m) lives with the grid:
+// terracut/core/surface.hpp.
 
 /// Parameters of the surface model, world units; read-only during a run.
 struct SurfaceParams {

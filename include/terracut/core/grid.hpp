@@ -87,6 +87,20 @@ class HeightGrid {
 
   float height(int c, int r) const { return height_[index(c, r)]; }
 
+  /// The layers opened for an in-place edit by a core phase (the cut, later
+  /// soil flow): height and removed writable, initial read-only, each
+  /// rows x cols, row-major. The editor must keep height + removed = initial
+  /// per sample and report the rectangle it changed (StepOutput), which is
+  /// how everyone caching the heights (Bullet, the viewer) learns of it.
+  struct EditLayers {
+    float* height_m;         ///< rows x cols, metres
+    float* removed_m;        ///< rows x cols, metres
+    const float* initial_m;  ///< rows x cols, metres
+  };
+  /// Opens the layers for an edit (see EditLayers): the one way to write
+  /// samples besides lower() and set_heights().
+  EditLayers edit_layers() { return {height_.data(), removed_.data(), initial_.data()}; }
+
   /// Lowers sample i to new_height_m if that is lower than its height (and not
   /// below 0). Returns the height removed, metres (0 when nothing changed).
   float lower(std::int64_t i, float new_height_m) {

@@ -5,8 +5,11 @@
 //   1. begin_step(pose): the blade moves to `pose`; contact is measured against
 //      the terrain as it was before this step's cut, so a cut never hides the
 //      contact that caused it.
-//   2. finish_step(): the region the edge swept since the previous pose is cut.
-// step(pose) does both. A step allocates nothing.
+//   2. finish_step(): the region the edge swept since the previous pose is
+//      cut; then every StepListener added (step_listener.hpp: the rigid-body
+//      world, recorders, ...) sees the step's output and the rectangle it
+//      changed, and may put a force on the tool.
+// step(pose) does both. A step allocates nothing (nor may its listeners).
 #pragma once
 
 #include <cstdint>
@@ -14,6 +17,7 @@
 #include <vector>
 
 #include "terracut/core/cut.hpp"
+#include "terracut/core/step_listener.hpp"
 
 namespace terracut {
 
@@ -36,6 +40,7 @@ std::string validate(const SimParams& params);
 struct StepTimers {
   double contact_s = 0.0;
   double cut_s = 0.0;
+  double listeners_s = 0.0;  ///< all step listeners together (e.g. the Bullet world)
   double total_s = 0.0;
 };
 
@@ -48,6 +53,9 @@ struct StepOutput {
   ContactResult contact{};   ///< measured before the cut
   CutResult cut{};           ///< what the sweep since the previous pose removed
   int substeps = 0;          ///< sweep sub-steps used (0 when the blade was lifted)
+  /// Sum of the step listeners' forces on the tool (StepListener::on_step),
+  /// world N; zero without listeners.
+  Vec3 listener_force_world_n{};
   StepTimers timers{};
 };
 
@@ -62,11 +70,22 @@ class Simulation {
 
   /// Lifts the blade out of the soil: the next step starts a new stroke and
   /// sweeps nothing from the previous pose (used between separate cuts).
-  void lift() { has_previous_ = false; }
+  /// Tells every listener (StepListener::on_lift).
+  void lift();
+
+  /// Adds a listener, run at the end of every finish_step after those added
+  /// before it. Not owned: it must outlive the simulation or be removed
+  /// first. Adding one twice is refused (std::logic_error). Not during a step.
+  void add_listener(StepListener& listener);
+  /// Removes a listener (nothing when it was not added). Not during a step.
+  void remove_listener(StepListener& listener);
+  /// The listeners, in the order they run.
+  const std::vector<StepListener*>& listeners() const { return listeners_; }
 
   /// Phase 1: move the blade and measure contact before any cut.
   const StepOutput& begin_step(const BladePose& pose);
-  /// Phase 2: cut what the edge swept since the previous pose; advance time.
+  /// Phase 2: cut what the edge swept since the previous pose, run the
+  /// listeners; advance time.
   const StepOutput& finish_step();
   /// Both phases.
   const StepOutput& step(const BladePose& pose) {
@@ -93,6 +112,7 @@ class Simulation {
   double removed_volume_m3_ = 0.0;
   StepOutput out_{};
   double begin_clock_s_ = 0.0;
+  std::vector<StepListener*> listeners_;
 };
 
 }  // namespace terracut

@@ -2,15 +2,17 @@
 //
 //   step1: read the device -> map its workspace to the world -> set the tool
 //          pose -> Simulation::begin_step (contact before the cut)
-//   step2: Simulation::finish_step (swept cut) -> LoopEngine::after_cut
-//          (optional: e.g. rigid bodies; an extra world force) ->
-//          ForceModel::compute (+ the engine's force) -> SafetyLimiter::update
-//          -> map the force to the device -> write -> record -> feed the
-//          snapshot exchange (optional)
+//   step2: Simulation::finish_step (swept cut, then the simulation's step
+//          listeners: e.g. rigid bodies, whose force on the tool joins the
+//          force) -> ForceModel::compute (+ the listeners' force) ->
+//          SafetyLimiter::update -> map the force to the device -> write ->
+//          record -> feed the snapshot exchange (optional)
 //
 // the split where the outside world comes in, as MuJoCo's mj_step1/mj_step2.
-// Parameters (settings, force model, workspace) are read-only during a run;
-// the state (simulation, limiter, estimator, records, counters) lives here.
+// Parameters (LoopParams: settings, force model; the workspace) are
+// read-only during a run; the state (limiter, estimator, records, counters)
+// lives here, and the simulation it steps (with its listeners) belongs to
+// whoever built the loop (the session layer's world).
 // A tick allocates nothing and never throws: a bad device sample (non-finite
 // position or orientation) is counted and answered with zero force, and the
 // loop goes on.
@@ -36,6 +38,7 @@
 #include "terracut/core/haptic_settings.hpp"
 #include "terracut/core/safety.hpp"
 #include "terracut/core/simulation.hpp"
+#include "terracut/core/stats.hpp"
 #include "terracut/haptics/device.hpp"
 #include "terracut/haptics/pacer.hpp"
 #include "terracut/haptics/realtime.hpp"
@@ -70,10 +73,11 @@ struct LoopRecord {
   double removed_volume_m3 = 0.0;  ///< volume cut this tick, m^3
   Vec3 velocity_m_per_s{};         ///< estimated tool velocity, world m/s
   /// World force on the tool, world N: the force models' (cutting + surface)
-  /// plus the engine's (body_force_world_n).
+  /// plus the step listeners' (body_force_world_n).
   Vec3 force_world_n{};
-  /// The engine's part of force_world_n (e.g. rigid bodies pushing the
-  /// blade's plate), world N; zero without an engine.
+  /// The step listeners' part of force_world_n (e.g. rigid bodies pushing
+  /// the blade's plate: StepOutput::listener_force_world_n), world N; zero
+  /// without listeners.
   Vec3 body_force_world_n{};
   Vec3 force_device_n{};           ///< force sent, device frame, device N (after safety)
   std::uint32_t flags = 0;         ///< kFlag* bits
@@ -92,62 +96,32 @@ struct LoopCounters {
   std::int64_t records_dropped = 0;   ///< oldest records overwritten (capacity reached)
 };
 
-/// Percentiles of a per-tick time, microseconds.
-struct TimePercentiles {
-  double p50_us = 0.0;
-  double p99_us = 0.0;
-  double max_us = 0.0;
-  double mean_us = 0.0;
-};
+/// Percentiles of a per-tick time, microseconds (core/stats.hpp).
+using TimePercentiles = TimingStats;
 
-/// An optional engine stepped by the loop with the simulation (the haptics
-/// layer knows none: e.g. the Bullet rigid-body world of the apps, which
-/// makes an operator feel the blade hitting a rock). The loop calls, on its
-/// own thread:
-///
-///   attach(sim)      once, from the HapticLoop constructor, before any tick
-///   after_cut(out)   each tick the simulation is stepped, right after
-///                    Simulation::finish_step and before the force goes to
-///                    the safety limiter; the returned world force is added
-///                    to the force models' world force and scaled to the
-///                    device with the same force_scale
-///   lifted()         when the loop lifts the tool (Simulation::lift: the
-///                    next pose is a jump, not a sweep)
-///   fill_frame(f)    each tick a snapshot exchange is fed, before publish
-///   detach()         once, from the HapticLoop destructor after its thread
-///                    has ended: drop every reference to the simulation
-///
-/// On ticks where the simulation is not stepped (no device sample yet, or a
-/// non-finite one) after_cut is not called: the engine stands still, as the
-/// terrain does. after_cut, lifted and fill_frame run inside a tick: they
-/// must not allocate, block or throw. The engine must outlive the loop.
-class LoopEngine {
+/// The loop's parameters: the haptic settings, validated once, with their
+/// derived values computed once (the force model's workspace scale, loop
+/// rate and largest contact length) and the force model built once (its
+/// device check made). Read-only during a run.
+class LoopParams {
  public:
-  virtual ~LoopEngine() = default;
-  /// Builds the engine over the loop's simulation (its grid, rate and blade);
-  /// may allocate and throw InputError naming the bad field.
-  virtual void attach(Simulation& sim) = 0;
-  /// One step after the simulation's: returns the extra world force on the
-  /// tool, world N (finite; a non-finite value is caught by the safety
-  /// limiter like any other).
-  virtual Vec3 after_cut(const StepOutput& out) noexcept = 0;
-  /// The tool was lifted: the next pose is a jump.
-  virtual void lifted() noexcept {}
-  /// Writes the engine's part of a viewer frame (body poses); the default
-  /// writes no bodies.
-  virtual void fill_frame(ViewFrame& frame) const noexcept {
-    frame.body_count = 0;
-    frame.body_total = 0;
-  }
-  /// The loop is being destroyed: release whatever refers to its simulation.
-  virtual void detach() noexcept {}
-  /// After the run: flush and close the engine's files (idempotent). Throws
-  /// InputError naming a file that could not be written.
-  virtual void finish() {}
-  /// After the run: the key and the JSON object text of the engine's entry in
-  /// a session's summary.json; an empty key adds none.
-  virtual std::string summary_key() const { return {}; }
-  virtual std::string summary_json() const { return {}; }
+  /// settings: as parsed (any derived force fields are replaced); blade: the
+  /// scenario's blade (its length bounds the contact). Throws InputError
+  /// "haptics.FIELD ..." naming the bad field, including a ForceModel refusal
+  /// ("haptics.forces. ...").
+  LoopParams(const HapticSettings& settings, const BladeSpec& blade);
+
+  /// The settings with the derived force fields filled in.
+  const HapticSettings& settings() const { return settings_; }
+  /// The loop rate, Hz (settings().rate_hz): the simulation the loop steps
+  /// must run at this rate.
+  double rate_hz() const { return settings_.rate_hz; }
+  /// The force model (after the device check).
+  const ForceModel& force_model() const { return model_; }
+
+ private:
+  HapticSettings settings_;
+  ForceModel model_;
 };
 
 /// How to run a loop.
@@ -166,22 +140,22 @@ struct LoopOptions {
   /// Optional viewer feed, fed every tick from the loop thread (one writer);
   /// must outlive the loop and be built on the same grid size.
   SnapshotExchange* snapshot = nullptr;
-  /// Optional engine stepped with the simulation (LoopEngine); must outlive
-  /// the loop. Attached by the constructor.
-  LoopEngine* engine = nullptr;
+  /// Optional: the rigid bodies simulated with the terrain (a step listener
+  /// of the simulation that also says where the bodies are), for the
+  /// snapshot's frames; must outlive the loop. Null: frames carry no bodies.
+  const BodySource* bodies = nullptr;
 };
 
 class HapticLoop {
  public:
-  /// settings: as parsed (derived force fields are filled in here from the
-  /// blade length); sim: the scenario's simulation parameters (rate_hz is
-  /// replaced by settings.rate_hz); heights: rows x cols initial heights;
-  /// default_orientation: the tool orientation when neither
-  /// settings.tool_rotation_deg nor the device gives one. The device must
-  /// outlive the loop. Throws InputError naming the field on bad settings
-  /// (including a ForceModel refusal).
-  HapticLoop(const HapticSettings& settings, const SimParams& sim, std::vector<float> heights,
-             Quat default_orientation, Device& device, const LoopOptions& options);
+  /// params: the loop's validated parameters; sim: the simulation it steps
+  /// (with its listeners), at params.rate_hz(); default_orientation: the tool
+  /// orientation when neither settings.tool_rotation_deg nor the device gives
+  /// one. The simulation and the device must outlive the loop. Throws
+  /// InputError when the simulation's rate is not the loop's, or on bad
+  /// options.
+  HapticLoop(const LoopParams& params, Simulation& sim, Quat default_orientation, Device& device,
+             const LoopOptions& options);
   ~HapticLoop();
   HapticLoop(const HapticLoop&) = delete;
   HapticLoop& operator=(const HapticLoop&) = delete;
@@ -215,14 +189,13 @@ class HapticLoop {
 
   // --- results (read after the run) -------------------------------------
 
-  const HapticSettings& settings() const { return settings_; }
-  const ForceModel& force_model() const { return model_; }
+  const HapticSettings& settings() const { return params_.settings(); }
+  const LoopParams& params() const { return params_; }
+  const ForceModel& force_model() const { return params_.force_model(); }
   const SafetyLimiter& safety() const { return safety_; }
   const Simulation& simulation() const { return sim_; }
   const Workspace& workspace() const { return workspace_; }
   const LoopCounters& counters() const { return counters_; }
-  /// The attached engine, or nullptr.
-  LoopEngine* engine() const { return options_.engine; }
   const LoopRecord& last() const { return last_; }
   /// The kept records, oldest first.
   std::vector<LoopRecord> records() const;
@@ -238,7 +211,7 @@ class HapticLoop {
   const RealtimeStatus& realtime_status() const { return realtime_; }
   /// Largest |force sent| over the run, device N.
   double max_device_force_n() const { return max_device_force_n_; }
-  /// Largest |engine force| over the run (every tick, kept or not), world N.
+  /// Largest |listeners' force| over the run (every tick, kept or not), world N.
   double max_body_force_n() const { return max_body_force_n_; }
 
  private:
@@ -247,16 +220,27 @@ class HapticLoop {
                   bool fake) noexcept;
   void patch_compute(double compute_s) noexcept;
   void record(const LoopRecord& r) noexcept;
+  // step1's phases.
+  bool read_device(double t_s) noexcept;
+  BladePose tool_pose() const noexcept;
+  void estimate_velocity(const BladePose& pose, double t_s) noexcept;
+  // step2's phases.
+  ForceOutput world_force(const StepOutput& out, double cut_depth_m) const noexcept;
+  LoopRecord& write_record(const StepOutput& out, const ForceOutput& force, double cut_depth_m,
+                           const DeviceCommand& command, double period_s,
+                           double compute_s) noexcept;
+  void publish_frame(const StepOutput& out, const ForceOutput& force,
+                     const DeviceCommand& command, double period_s,
+                     double compute_s) noexcept;
   double cut_depth(const StepOutput& out) const noexcept;
   TimePercentiles percentiles(double LoopRecord::*field, bool deviation) const;
 
-  HapticSettings settings_;
+  LoopParams params_;
   Device& device_;
   LoopOptions options_;
   Workspace workspace_;
-  ForceModel model_;
   SafetyLimiter safety_;
-  Simulation sim_;
+  Simulation& sim_;
   Quat default_orientation_{};
   Quat fixed_orientation_{};
   bool has_fixed_orientation_ = false;

@@ -25,16 +25,7 @@ namespace terracut::haptics {
 inline constexpr int kMaxViewBodies = 64;
 
 /// A rigid body's shape and pose in a ViewFrame.
-struct ViewBody {
-  BodyShape shape = BodyShape::kBox;  ///< box, sphere or cylinder (axis = local Y)
-  /// Half of the body's extent along its local axes, metres, each > 0: a
-  /// box's half sizes, (r, r, r) for a sphere, (r, h/2, r) for a cylinder
-  /// (half_extents_m() of its BodySpec).
-  Vec3 half_extents_m{};
-  Vec3 position_m{};    ///< centre, world metres
-  Quat orientation{};   ///< body frame -> world, unit quaternion
-  bool active = true;   ///< false while the physics engine has it asleep
-};
+using ViewBody = BodyView;  // terracut/core/bodies.hpp
 
 /// One consistent picture of the simulation.
 struct ViewFrame {
@@ -52,17 +43,21 @@ struct ViewFrame {
   Vec3 proxy_position_m{};     ///< surface proxy, world metres
   Vec3 force_world_n{};        ///< force on the tool in the world, newtons
   Vec3 force_device_n{};       ///< force sent to the device, newtons
-  Vec3 body_force_world_n{};   ///< the engine's (rigid bodies') part of force_world_n, newtons
+  Vec3 body_force_world_n{};   ///< the step listeners' (rigid bodies') part of force_world_n, newtons
   double step_time_s = 0.0;    ///< compute time of the step, seconds
   double period_s = 0.0;       ///< measured loop period before the step, seconds
-  /// Rigid bodies (filled by the loop's engine, LoopEngine::fill_frame): the
+  /// Rigid bodies (filled by fill_bodies from the loop's BodySource): the
   /// first body_count entries of bodies are valid, body_count in
-  /// [0, kMaxViewBodies]; body_total counts all the engine's bodies (more
-  /// than body_count when it has more than kMaxViewBodies).
+  /// [0, kMaxViewBodies]; body_total counts all the simulated bodies (more
+  /// than body_count when there are more than kMaxViewBodies).
   int body_count = 0;
   int body_total = 0;
   std::array<ViewBody, kMaxViewBodies> bodies{};
 };
+
+/// Writes the bodies of `source` into the frame (body_count, body_total and
+/// bodies[]); none when source is null. Allocation-free.
+void fill_bodies(ViewFrame& frame, const BodySource* source) noexcept;
 
 class SnapshotExchange {
  public:

@@ -18,6 +18,7 @@
 #include "terracut/core/generators.hpp"
 #include "terracut/core/haptic_settings.hpp"
 #include "terracut/core/grid.hpp"
+#include "terracut/core/simulation.hpp"
 #include "terracut/io/image.hpp"
 
 namespace terracut::io {
@@ -118,6 +119,11 @@ std::vector<std::string> parse_name_list(std::string_view text,
 
 /// The grid parameters of the scenario (resolution, extent, origin, full scale).
 GridSpec grid_spec(const Scenario& scenario);
+
+/// The simulation parameters of the scenario (grid, representation, blade)
+/// at its rate_hz, or at rate_hz when given (a haptic loop steps the
+/// simulation at its own rate, haptics.rate_hz).
+SimParams sim_params(const Scenario& scenario, std::optional<double> rate_hz = std::nullopt);
 
 /// The initial heights, rows x cols, row-major, metres: the generator sampled
 /// at cell centres, or the image resampled to the resolution (area average when

@@ -1,7 +1,7 @@
-// Running a scenario: determinism of every output file, conservation in the
-// outputs, the CSV layout, progress lines, and failures that leave nothing
-// behind.
-#include "terracut/io/run.hpp"
+// A batch run of a scenario: determinism of every output file, conservation
+// in the outputs, the CSV layout, progress lines, and failures that leave
+// nothing behind.
+#include "terracut/session/batch.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -17,8 +17,14 @@
 #include "terracut/io/image.hpp"
 #include "terracut/io/scenario.hpp"
 
-namespace terracut::io {
+namespace terracut::session {
 namespace {
+
+using io::apply_overrides;
+using io::Image;
+using io::parse_scenario;
+using io::read_npy;
+using io::read_png;
 
 namespace fs = std::filesystem;
 
@@ -59,8 +65,9 @@ class RunTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   Scenario scenario(Representation rep = Representation::kSurface) {
-    Scenario sc = parse_scenario(kScenario, dir_ / "small.yaml");
-    apply_overrides(sc, std::nullopt, rep, std::nullopt);
+    Scenario sc;
+    sc.base = parse_scenario(kScenario, dir_ / "small.yaml");
+    apply_overrides(sc.base, std::nullopt, rep, std::nullopt);
     return sc;
   }
 
@@ -121,7 +128,7 @@ TEST_F(RunTest, SameScenarioTwiceGivesBitwiseIdenticalOutputs) {
 TEST_F(RunTest, OutputsConserveMaterial) {
   const Scenario sc = scenario();
   const RunResult result = run(sc, dir_ / "out");
-  const std::vector<float> initial = build_initial_heights(sc);
+  const std::vector<float> initial = io::build_initial_heights(sc.base);
   int rows = 0;
   int cols = 0;
   const std::vector<float> height = read_npy(dir_ / "out" / "height.npy", &rows, &cols);
@@ -277,4 +284,4 @@ TEST_F(RunTest, MissingFoldersAreCreated) {
 }
 
 }  // namespace
-}  // namespace terracut::io
+}  // namespace terracut::session

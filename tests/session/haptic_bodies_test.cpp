@@ -1,4 +1,4 @@
-// The rigid-body engine of the haptic loop (apps/terracut/bodies_engine.*)
+// The rigid bodies in a haptic session (the world's Bullet listener)
 // on scenarios/rock_push.yaml, with the script device on the fake clock
 // (deterministic): the blade cuts a 4 cm trench along -Z and its plate runs
 // into a 40 kg block resting on the sand. Checked against the same session
@@ -19,23 +19,22 @@
 #include <string>
 #include <vector>
 
-#include "bodies_engine.hpp"
-#include "terracut/haptics/session.hpp"
-#include "terracut/io/run.hpp"
+#include "terracut/haptics/haptics_csv.hpp"
+#include "terracut/session/haptic.hpp"
 
 #ifdef TERRACUT_HAVE_BULLET
 #include "terracut/bullet/terrain_world.hpp"
 #endif
 
-namespace terracut::apps {
+namespace terracut::session {
 namespace {
 
 namespace fs = std::filesystem;
 
 #ifdef TERRACUT_HAVE_BULLET
 
-const haptics::HapticScenario& rock_scenario() {
-  static const haptics::HapticScenario s = haptics::load_haptic_scenario(
+const Scenario& rock_scenario() {
+  static const Scenario s = load_scenario(
       fs::path(TERRACUT_SOURCE_DIR) / "scenarios/rock_push.yaml");
   return s;
 }
@@ -56,25 +55,21 @@ struct RockRun {
 };
 
 RockRun run_rock(bool with_bodies, const fs::path& dir) {
-  haptics::HapticScenario input = rock_scenario();
-  if (!with_bodies) input.scenario.bodies.clear();
+  Scenario input = rock_scenario();
+  if (!with_bodies) input.bodies.clear();
   fs::create_directories(dir);
-  haptics::SessionOptions so;
+  SessionOptions so;
   so.device = DeviceKind::kScript;
-  so.clock = haptics::ClockMode::kFake;
+  so.clock = ClockMode::kFake;
   so.realtime = false;
-  const io::Scenario& sc = input.scenario;
+  const io::Scenario& sc = input.base;
   HeightGrid grid(io::grid_spec(sc), io::build_initial_heights(sc));
   haptics::SnapshotExchange exchange(grid);
   so.snapshot = &exchange;
-  std::unique_ptr<haptics::LoopEngine> engine;
-  if (with_bodies) {
-    engine = make_bodies_engine(sc.bodies, {dir / "bodies.csv"});
-    so.engine = engine.get();
-  }
+  if (with_bodies) so.bodies_csv = dir / "bodies.csv";
   RockRun out;
   {
-    haptics::Session session(input, so);
+    HapticSession session(input, so);
     session.run();
     session.write_outputs(dir);
     out.records = session.loop().records();
@@ -117,7 +112,7 @@ struct Geometry {
   double push_end_z;  // edge z where the push ends
   double mu_m_g;      // the rock's sliding friction force on the sand, N
   Geometry() {
-    const io::Scenario& sc = rock_scenario().scenario;
+    const io::Scenario& sc = rock_scenario().base;
     rock = sc.bodies.at(0);
     const bullet::TerrainWorldParams world{};
     touch_z = rock.position_m.z + 0.5 * rock.size_m.z + 0.5 * world.tool.thickness_m;
@@ -172,7 +167,7 @@ TEST_F(RockPush, TheRockIsFeltAgainstTheMotionOnlyWhileThePlatePushesIt) {
       sum_fb_x += r.body_force_world_n.x;
       if (dot(r.body_force_world_n, r.velocity_m_per_s) < 0.0) ++against;
       sum_fd_gain += length(r.force_device_n) - length(q.force_device_n);
-    } else if (r.t_s > rock_scenario().scenario.cuts[0].duration_s() - 0.4) {
+    } else if (r.t_s > rock_scenario().base.cuts[0].duration_s() - 0.4) {
       // Backed off and rising, then holding: the plate has left the rock.
       ++after;
       EXPECT_EQ(length(r.body_force_world_n), 0.0) << "t = " << r.t_s;
@@ -299,17 +294,17 @@ TEST_F(RockPush, TheSameSessionTwiceIsIdentical) {
   EXPECT_EQ(slurp(dir_ / "again" / "bodies.csv"), slurp(dir_ / "with" / "bodies.csv"));
 }
 
-TEST(BodiesEngine, IsAvailableWithBullet) { EXPECT_TRUE(bodies_engine_available()); }
+TEST(BodiesEngine, IsAvailableWithBullet) { EXPECT_TRUE(bodies_available()); }
 
 #else
 
 TEST(BodiesEngine, NeedsBullet) {
-  EXPECT_FALSE(bodies_engine_available());
+  EXPECT_FALSE(bodies_available());
   GTEST_SKIP() << "built without Bullet: the rock-push session is not run ("
-               << bodies_engine_unavailable_message() << ")";
+               << bodies_unavailable_message() << ")";
 }
 
 #endif
 
 }  // namespace
-}  // namespace terracut::apps
+}  // namespace terracut::session

@@ -1,58 +1,42 @@
-// Running a scenario: builds the simulation, performs the cuts of the
-// scenario's sequence at the fixed rate, and writes the outputs of
-// `terracut run` into a folder:
+// A batch run (`terracut run`): builds the scenario's world (the simulation
+// and its step listeners, e.g. the rigid bodies), performs the cuts of the
+// scenario's sequence at the fixed rate, and writes the outputs into a folder:
 //
-//   contact.csv   one row per step:
+//   contact.csv   one row per step (io/recording.hpp):
 //                 t,cut,x,y,z,qw,qx,qy,qz,contact_length,removed_volume,
 //                 section_area,max_depth,cells_visited
 //   height.npy    float32 (rows, cols) final heights, metres
 //   removed.npy   float32 (rows, cols) removed material, metres
 //   height.png    16-bit grey, pixel = height / full_scale_m
 //   removed.png   16-bit grey, pixel = removed / full_scale_m
+//   bodies.csv    only when the scenario has bodies (bullet/bodies_csv.hpp)
 //   summary.json  inputs, step count, volumes, conservation error, per-cut
-//                 results and per-step timing percentiles
+//                 results, per-step timing percentiles, the bodies' entry
+//                 and, when paced, the "realtime" entry
 //
-// Everything except the "timing" object of summary.json is bitwise identical
-// between two runs of the same scenario on the same build.
+// Everything except the "timing" and "realtime" objects of summary.json is
+// bitwise identical between two runs of the same scenario on the same build.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include "terracut/core/simulation.hpp"
-#include "terracut/io/scenario.hpp"
+#include "terracut/core/stats.hpp"
+#include "terracut/haptics/pacer.hpp"
+#include "terracut/io/recording.hpp"
+#include "terracut/session/scenario.hpp"
 
-namespace terracut::io {
+namespace terracut::session {
 
-/// The file names written into the output folder, in writing order
-/// (summary.json last, so its presence means the run completed).
+/// The file names every run writes into the output folder, in writing order
+/// (summary.json last, so its presence means the run completed). A run with
+/// bodies also writes bodies.csv.
 inline constexpr const char* kRunOutputFiles[] = {"contact.csv", "height.npy", "removed.npy",
                                                   "height.png",  "removed.png", "summary.json"};
-
-/// An engine that follows the run step by step (the Bullet world, a
-/// real-time pacer). Its hooks are called on the run's thread, in order:
-/// start once, then per cut lifted and per step before_step / stepped, then
-/// finish, which writes its own files into the output folder.
-class RunObserver {
- public:
-  virtual ~RunObserver() = default;
-  /// Before the first step; the simulation lives until finish() returns.
-  virtual void start(Simulation& sim, const std::filesystem::path& out_dir) = 0;
-  /// The blade was lifted: the next step starts a new cut.
-  virtual void lifted() {}
-  /// Just before a step.
-  virtual void before_step() {}
-  /// Just after a step.
-  virtual void stepped(const StepOutput& out) = 0;
-  /// After the last step: write files; throw terracut::InputError naming a file on failure.
-  virtual void finish() {}
-  /// Key and JSON object text added to summary.json (empty key: nothing added).
-  virtual std::string summary_key() const { return {}; }
-  virtual std::string summary_json() const { return "{}"; }
-};
 
 /// How to run.
 struct RunOptions {
@@ -69,18 +53,10 @@ struct RunOptions {
   std::string progress_label = "terracut run";
   /// Keep every step's record in RunResult::records (memory ~ 150 bytes/step).
   bool keep_records = false;
-  /// Engines that follow the run (not owned; may be empty).
-  std::vector<RunObserver*> observers;
-};
-
-/// One step: one row of contact.csv.
-struct StepRecord {
-  double t_s = 0.0;        ///< global simulation time, seconds
-  int cut = 0;             ///< index into Scenario::cuts
-  int sequence_index = 0;  ///< index into Scenario::sequence
-  BladePose pose{};        ///< blade pose during the step
-  ContactResult contact{};  ///< contact measured before the step's cut
-  double removed_volume_m3 = 0.0;  ///< volume cut in this step, m^3
+  /// Pace the steps to the wall clock at the scenario's rate (absolute
+  /// deadlines, sleep then a short spin), as a haptic loop would; the
+  /// pacer's figures go to RunResult::realtime and summary.json's "realtime".
+  bool realtime = false;
 };
 
 /// Results of one cut of the sequence.
@@ -95,15 +71,6 @@ struct CutStats {
   double removed_volume_m3 = 0.0;  ///< volume it cut, m^3
 };
 
-/// Percentiles of one per-step timer, microseconds.
-struct TimingStats {
-  double p50_us = 0.0;
-  double p90_us = 0.0;
-  double p99_us = 0.0;
-  double max_us = 0.0;
-  double mean_us = 0.0;
-};
-
 /// What a run did.
 struct RunResult {
   std::int64_t steps = 0;            ///< steps simulated in total
@@ -116,16 +83,20 @@ struct RunResult {
   TimingStats contact_timing{};      ///< StepTimers::contact_s
   TimingStats cut_timing{};          ///< StepTimers::cut_s
   TimingStats step_timing{};         ///< StepTimers::total_s
-  std::vector<StepRecord> records;   ///< every step, when RunOptions::keep_records
+  /// The pacer's figures, with RunOptions::realtime.
+  std::optional<haptics::LoopStats> realtime;
+  std::vector<io::StepRecord> records;  ///< every step, when RunOptions::keep_records
   double wall_s = 0.0;               ///< wall-clock time of the simulation loop, seconds
 };
-
-/// The simulation parameters of a scenario (grid, representation, rate, blade).
-SimParams sim_params(const Scenario& scenario);
 
 /// Runs the scenario's sequence and writes the outputs into options.out_dir.
 /// Throws terracut::InputError naming the file or folder when an output cannot
 /// be written, or the field when the scenario cannot be simulated.
 RunResult run_scenario(const Scenario& scenario, const RunOptions& options);
 
-}  // namespace terracut::io
+/// The "realtime" entry of summary.json (JSON text, one line): the pacer's
+/// rate, period, ticks, missed deadlines, skipped slots, and step time,
+/// period jitter and wake latency percentiles in microseconds.
+std::string realtime_json(const haptics::LoopStats& stats);
+
+}  // namespace terracut::session

@@ -1,4 +1,4 @@
-// The haptic loop with the rigid-body engine (Bullet world, bodies.csv and
+// The haptic loop with the rigid bodies' listener (Bullet world, bodies.csv and
 // the viewer feed) allocates nothing per tick once Bullet is warm: every
 // global operator new and every Bullet allocation (btAlignedAlloc,
 // redirected here) of this program is counted over the rock session's ticks
@@ -14,25 +14,22 @@
 #include <filesystem>
 #include <new>
 
-#include "bodies_engine.hpp"
 #include "terracut/haptics/script_device.hpp"
-#include "terracut/haptics/session.hpp"
-#include "terracut/io/run.hpp"
+#include "terracut/session/haptic.hpp"
 
 #include "../support/counting_bullet_alloc.hpp"
 
-namespace terracut::apps {
+namespace terracut::session {
 namespace {
 
 namespace fs = std::filesystem;
 
 TEST(BodiesEngineAllocation, TicksAllocateNothingOnceBulletIsWarm) {
   ASSERT_TRUE(g_installed);
-  const haptics::HapticScenario in = haptics::load_haptic_scenario(
-      fs::path(TERRACUT_SOURCE_DIR) / "scenarios/rock_push.yaml");
+  const Scenario in = load_scenario(fs::path(TERRACUT_SOURCE_DIR) / "scenarios/rock_push.yaml");
   const fs::path dir = fs::temp_directory_path() / ("terracut_bodies_alloc_" + std::to_string(getpid()));
   fs::create_directories(dir);
-  const io::Scenario& sc = in.scenario;
+  const io::Scenario& sc = in.base;
   const Motion& cut = sc.cuts.at(0);
   const double rate = in.haptics.rate_hz;
   const std::int64_t ticks = std::llround((cut.duration_s() + in.haptics.settle_s) * rate);
@@ -40,7 +37,6 @@ TEST(BodiesEngineAllocation, TicksAllocateNothingOnceBulletIsWarm) {
   // reaches the rock's back face at t = 2.58 s (scenarios/rock_push.yaml).
   const std::int64_t warm = std::llround(2.7 * rate);
 
-  std::unique_ptr<haptics::LoopEngine> engine = make_bodies_engine(sc.bodies, {dir / "bodies.csv"});
   haptics::ScriptDevice device(haptics::DevicePath(cut, haptics::Workspace(in.haptics.workspace)));
   HeightGrid grid(io::grid_spec(sc), io::build_initial_heights(sc));
   haptics::SnapshotExchange exchange(grid);
@@ -49,13 +45,16 @@ TEST(BodiesEngineAllocation, TicksAllocateNothingOnceBulletIsWarm) {
   o.record_capacity = std::size_t(ticks);
   o.realtime = false;
   o.snapshot = &exchange;
-  o.engine = engine.get();
+  RigOptions ro;
+  ro.loop = o;
+  ro.bodies_csv = dir / "bodies.csv";
   long during = -1;
   double peak = 0.0;
   const long at_start = g_allocations.load();
   {
-    haptics::HapticLoop loop(in.haptics, io::sim_params(sc), io::build_initial_heights(sc),
-                             cut.keyframes[0].pose.orientation, device, o);
+    const haptics::LoopParams params(in.haptics, sc.blade);
+    HapticRig rig(in, params, cut.keyframes[0].pose.orientation, device, ro);
+    haptics::HapticLoop& loop = rig.loop();
     for (std::int64_t i = 0; i < warm; ++i) {
       loop.step1(double(i) / rate);
       loop.step2(i == 0 ? 0.0 : 1.0 / rate, 0.0, false);
@@ -72,8 +71,8 @@ TEST(BodiesEngineAllocation, TicksAllocateNothingOnceBulletIsWarm) {
     }
     during = g_allocations.load() - before;
     peak = loop.max_body_force_n();
+    rig.world().finish();
   }
-  engine->finish();
   EXPECT_EQ(during, 0) << "allocations in " << (ticks - warm)
                        << " ticks of pushing the rock and leaving it";
   EXPECT_GT(peak, 0.0);
@@ -81,4 +80,4 @@ TEST(BodiesEngineAllocation, TicksAllocateNothingOnceBulletIsWarm) {
 }
 
 }  // namespace
-}  // namespace terracut::apps
+}  // namespace terracut::session

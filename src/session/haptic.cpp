@@ -1,5 +1,6 @@
-// A haptic session: scenario + settings -> device + loop -> run -> outputs.
-#include "terracut/haptics/session.hpp"
+// Haptic runs: the rig (world + loop) and the session of `terracut haptics`.
+// See haptic.hpp.
+#include "terracut/session/haptic.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -9,14 +10,16 @@
 #include <sstream>
 #include <thread>
 
+#include "bodies_json.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/haptics/haptics_csv.hpp"
 #include "terracut/haptics/script_device.hpp"
 #include "terracut/haptics/sim_hand.hpp"
 #include "terracut/haptics/udp_device.hpp"
-#include "terracut/io/haptics_yaml.hpp"
-#include "terracut/io/run.hpp"
+#include "terracut/io/files.hpp"
 
-namespace terracut::haptics {
+namespace terracut::session {
+using namespace terracut::haptics;
 namespace fs = std::filesystem;
 
 namespace {
@@ -75,34 +78,52 @@ std::string json_percentiles(const TimePercentiles& s) {
          ", \"max\": " + json_number(s.max_us) + ", \"mean\": " + json_number(s.mean_us) + "}";
 }
 
-void write_text_file(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw InputError(path.string() + ": cannot write the file");
-  out << text;
-  out.flush();
-  if (!out) throw InputError(path.string() + ": cannot write the file (disk full?)");
-}
-
 }  // namespace
-
-// ---------------------------------------------------------------------------
-// Loading
-// ---------------------------------------------------------------------------
-
-HapticScenario load_haptic_scenario(const fs::path& path) {
-  HapticScenario out;
-  out.scenario = io::load_scenario(path);
-  out.haptics = out.scenario.haptics.value_or(HapticSettings{});
-  return out;
-}
 
 // ---------------------------------------------------------------------------
 // Building
 // ---------------------------------------------------------------------------
 
-Session::Session(const HapticScenario& input, const SessionOptions& options)
-    : source_(input.scenario.source_path), name_(input.scenario.name), options_(options) {
-  const io::Scenario& sc = input.scenario;
+HapticRig::HapticRig(const Scenario& scenario, const LoopParams& params, Quat default_orientation,
+                     Device& device, const RigOptions& options) {
+  WorldOptions wo;
+  wo.rate_hz = params.rate_hz();
+  wo.bodies_csv = options.bodies_csv;
+  world_ = std::make_unique<World>(scenario, wo);
+  LoopOptions lo = options.loop;
+  lo.bodies = world_->bodies();
+  loop_ = std::make_unique<HapticLoop>(params, world_->simulation(), default_orientation, device,
+                                       lo);
+}
+
+HapticRig::~HapticRig() {
+  loop_.reset();  // the loop steps the world's simulation: it goes first
+}
+
+std::vector<std::string> HapticRig::rendering_changes() const {
+  std::vector<std::string> out;
+  const RenderingCheck& rc = loop_->force_model().rendering();
+  const ForceModelParams& used = loop_->force_model().params();
+  if (rc.surface_stiffness_limited)
+    out.push_back("forces.surface.stiffness_n_per_m lowered to " +
+                  fmt("%.6g", used.surface.stiffness_n_per_m) + " N/m (world; " +
+                  fmt("%.6g", rc.surface_stiffness_n_per_m) +
+                  " N/m on the device) to stay passive and within the device");
+  if (rc.surface_damping_limited)
+    out.push_back("forces.surface.damping_n_s_per_m lowered to " +
+                  fmt("%.6g", used.surface.damping_n_s_per_m) + " N s/m (world; " +
+                  fmt("%.6g", rc.surface_damping_n_s_per_m) + " N s/m on the device)");
+  if (rc.cutting_damping_limited)
+    out.push_back("forces.low_speed_damping_n_s_per_m lowered to " +
+                  fmt("%.6g", used.low_speed_damping_n_s_per_m) +
+                  " N s/m (world; cutting damping " + fmt("%.6g", rc.cutting_damping_n_s_per_m) +
+                  " N s/m on the device, its limit)");
+  return out;
+}
+
+HapticSession::HapticSession(const Scenario& input, const SessionOptions& options)
+    : source_(input.base.source_path), name_(input.base.name), options_(options) {
+  const io::Scenario& sc = input.base;
   HapticSettings settings = input.haptics;
   if (options.device) settings.device = *options.device;
   if (options.udp_address) settings.udp.address = *options.udp_address;
@@ -120,17 +141,24 @@ Session::Session(const HapticScenario& input, const SessionOptions& options)
   if (kind_ == DeviceKind::kUdp && clock_ == ClockMode::kFake)
     throw InputError(
         "--clock fake cannot be used with the udp device (a real device runs in real time)");
-  // A port of 0 (any free port) is allowed from the command line only.
+
+  // The settings, validated once, and what derives from them. A port of 0
+  // (any free port) is allowed from the command line only: the device binds
+  // the port asked for, and the loop never reads it.
   const int port = settings.udp.port;
   if (port == 0) settings.udp.port = 1;
-  if (std::string m = validate(settings); !m.empty())
-    throw InputError(source_.string() + ": haptics." + m);
-  settings.udp.port = port;
+  std::optional<LoopParams> params;
+  try {
+    params.emplace(settings, sc.blade);
+  } catch (const InputError& e) {
+    throw InputError(source_.string() + ": " + e.what());
+  }
+  const HapticSettings& valid = params->settings();
 
   // The path the script and sim devices follow, and the default orientation.
-  const Motion* cut = find_followed_cut(sc, settings.cut);
-  if (!settings.cut.empty() && !cut)
-    throw InputError(source_.string() + ": haptics.cut: no cut named '" + settings.cut +
+  const Motion* cut = find_followed_cut(sc, valid.cut);
+  if (!valid.cut.empty() && !cut)
+    throw InputError(source_.string() + ": haptics.cut: no cut named '" + valid.cut +
                      "' in the scenario");
   if (!cut && kind_ != DeviceKind::kUdp)
     throw InputError(source_.string() + ": haptics.cut: the " + std::string(to_string(kind_)) +
@@ -139,72 +167,51 @@ Session::Session(const HapticScenario& input, const SessionOptions& options)
   const Quat default_orientation = cut ? cut->keyframes.front().pose.orientation : Quat{};
   const double path_s = cut ? cut->duration_s() : 0.0;
   duration_s_ =
-      settings.duration_s.value_or(kind_ == DeviceKind::kUdp ? 30.0 : path_s + settings.settle_s);
+      valid.duration_s.value_or(kind_ == DeviceKind::kUdp ? 30.0 : path_s + valid.settle_s);
   if (!(duration_s_ > 0.0))
     throw InputError(source_.string() +
                      ": haptics.duration_s: the session would last 0 s (the cut has one keyframe "
                      "and settle_s is 0); give duration_s or --duration");
 
   // The device.
-  const Workspace workspace(settings.workspace);
+  const Workspace workspace(valid.workspace);
   switch (kind_) {
     case DeviceKind::kScript:
       device_ = std::make_unique<ScriptDevice>(DevicePath(*cut, workspace));
       break;
     case DeviceKind::kSim:
       device_ = std::make_unique<SimHandDevice>(
-          SimHand(settings.hand, settings.forces.device.inherent_damping_n_s_per_m,
-                  DevicePath(*cut, workspace), settings.rate_hz));
+          SimHand(valid.hand, valid.forces.device.inherent_damping_n_s_per_m,
+                  DevicePath(*cut, workspace), valid.rate_hz));
       break;
-    case DeviceKind::kUdp: {
-      auto udp = std::make_unique<UdpDevice>(settings.udp.address, settings.udp.port);
-      settings.udp.port = udp->port();  // the port bound (a free one when 0 was asked)
-      device_ = std::move(udp);
+    case DeviceKind::kUdp:
+      device_ = std::make_unique<UdpDevice>(valid.udp.address, port);
       break;
-    }
   }
-  if (settings.udp.port == 0) settings.udp.port = 1;  // not used by script and sim
 
-  // The loop.
-  LoopOptions lo;
-  lo.ticks = std::max<std::int64_t>(1, std::llround(duration_s_ * settings.rate_hz));
-  lo.record_capacity = std::min<std::size_t>(options.max_records, std::size_t(lo.ticks));
-  lo.realtime = options.realtime;
-  lo.snapshot = options.snapshot;
-  lo.engine = options.engine;
+  // The world and the loop.
+  RigOptions ro;
+  ro.loop.ticks = std::max<std::int64_t>(1, std::llround(duration_s_ * valid.rate_hz));
+  ro.loop.record_capacity = std::min<std::size_t>(options.max_records, std::size_t(ro.loop.ticks));
+  ro.loop.realtime = options.realtime;
+  ro.loop.snapshot = options.snapshot;
+  ro.bodies_csv = options.bodies_csv;
   try {
-    loop_ = std::make_unique<HapticLoop>(settings, io::sim_params(sc),
-                                         io::build_initial_heights(sc), default_orientation,
-                                         *device_, lo);
+    rig_ = std::make_unique<HapticRig>(input, *params, default_orientation, *device_, ro);
   } catch (const InputError& e) {
-    throw InputError(source_.string() + ": " + e.what());  // e.g. a refused force rendering
+    throw InputError(source_.string() + ": " + e.what());
   }
 
   // What the device check changed, said once at start.
-  const RenderingCheck& rc = loop_->force_model().rendering();
-  const ForceModelParams& used = loop_->force_model().params();
-  if (rc.surface_stiffness_limited)
-    build_warnings_.push_back("forces.surface.stiffness_n_per_m lowered to " +
-                              fmt("%.6g", used.surface.stiffness_n_per_m) + " N/m (world; " +
-                              fmt("%.6g", rc.surface_stiffness_n_per_m) +
-                              " N/m on the device) to stay passive and within the device");
-  if (rc.surface_damping_limited)
-    build_warnings_.push_back("forces.surface.damping_n_s_per_m lowered to " +
-                              fmt("%.6g", used.surface.damping_n_s_per_m) + " N s/m (world; " +
-                              fmt("%.6g", rc.surface_damping_n_s_per_m) + " N s/m on the device)");
-  if (rc.cutting_damping_limited)
-    build_warnings_.push_back(
-        "forces.low_speed_damping_n_s_per_m lowered to " +
-        fmt("%.6g", used.low_speed_damping_n_s_per_m) + " N s/m (world; cutting damping " +
-        fmt("%.6g", rc.cutting_damping_n_s_per_m) + " N s/m on the device, its limit)");
+  build_warnings_ = rig_->rendering_changes();
   if (options.log)
     for (const std::string& w : build_warnings_)
       *options.log << "terracut haptics: warning: " << w << "\n";
 }
 
-Session::~Session() = default;
+HapticSession::~HapticSession() = default;
 
-int Session::udp_port() const {
+int HapticSession::udp_port() const {
   const auto* udp = dynamic_cast<const UdpDevice*>(device_.get());
   return udp ? udp->port() : -1;
 }
@@ -213,22 +220,22 @@ int Session::udp_port() const {
 // Running
 // ---------------------------------------------------------------------------
 
-void Session::run() {
+void HapticSession::run() {
   const auto begin = std::chrono::steady_clock::now();
   if (clock_ == ClockMode::kFake) {
-    loop_->run_deterministic();
+    rig_->loop().run_deterministic();
   } else {
-    loop_->start();
+    rig_->loop().start();
     if (options_.log)
-      *options_.log << "terracut haptics: " << loop_->realtime_status().message << "\n";
-    while (loop_->running()) {
+      *options_.log << "terracut haptics: " << rig_->loop().realtime_status().message << "\n";
+    while (rig_->loop().running()) {
       if (options_.interrupt && options_.interrupt->load(std::memory_order_relaxed)) {
         interrupted_ = true;
-        loop_->request_stop();
+        rig_->loop().request_stop();
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
-    loop_->join();
+    rig_->loop().join();
   }
   wall_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
 }
@@ -237,9 +244,9 @@ void Session::run() {
 // Outputs
 // ---------------------------------------------------------------------------
 
-std::vector<std::string> Session::warnings() const {
+std::vector<std::string> HapticSession::warnings() const {
   std::vector<std::string> w = build_warnings_;
-  const HapticLoop& l = *loop_;
+  const HapticLoop& l = rig_->loop();
   const LoopCounters& c = l.counters();
   const SafetyCounters& s = l.safety().counters();
   if (clock_ == ClockMode::kReal && !l.realtime_status().fifo)
@@ -270,8 +277,8 @@ std::vector<std::string> Session::warnings() const {
   return w;
 }
 
-std::string Session::summary_json() const {
-  const HapticLoop& l = *loop_;
+std::string HapticSession::summary_json() const {
+  const HapticLoop& l = rig_->loop();
   const HapticSettings& st = l.settings();
   const LoopCounters& c = l.counters();
   const SafetyCounters& s = l.safety().counters();
@@ -363,12 +370,10 @@ std::string Session::summary_json() const {
   j << "  \"cutting\": {\"removed_volume_m3\": " << json_number(removed)
     << ", \"peak_contact_m\": " << json_number(peak_contact)
     << ", \"ticks_in_contact\": " << in_contact << "},\n";
-  // The engine's entry (e.g. "bodies": the rigid bodies and the peak force
-  // they put on the tool).
-  if (const LoopEngine* engine = l.engine()) {
-    const std::string key = engine->summary_key();
-    if (!key.empty()) j << "  " << json_string(key) << ": " << engine->summary_json() << ",\n";
-  }
+  // The rigid bodies and the peak force they put on the tool.
+  if (rig_->world().bodies())
+    j << "  \"bodies\": "
+      << detail::bodies_json(rig_->world(), detail::BodiesEntry::kLoop).dump() << ",\n";
   const std::vector<std::string> w = warnings();
   j << "  \"warnings\": [";
   for (std::size_t i = 0; i < w.size(); ++i) j << (i ? ", " : "") << json_string(w[i]);
@@ -376,85 +381,17 @@ std::string Session::summary_json() const {
   return j.str();
 }
 
-void parse_endpoint(std::string_view text, std::string_view option,
-                    std::optional<std::string>& address, std::optional<int>& port) {
-  const auto fail = [&](const std::string& what) -> void {
-    throw InputError(std::string(option) + ": '" + std::string(text) + "': " + what);
-  };
-  std::string_view port_text = text;
-  if (!text.empty() && text.front() == '[') {
-    const std::size_t close = text.find(']');
-    if (close == std::string_view::npos || close + 1 >= text.size() || text[close + 1] != ':')
-      fail("expected [IPV6]:PORT");
-    address = std::string(text.substr(1, close - 1));
-    port_text = text.substr(close + 2);
-  } else if (const std::size_t colon = text.rfind(':'); colon != std::string_view::npos) {
-    address = std::string(text.substr(0, colon));
-    port_text = text.substr(colon + 1);
-    if (address->empty()) fail("the address before ':' is empty");
-  }
-  if (port_text.empty() || port_text.size() > 5 ||
-      !std::all_of(port_text.begin(), port_text.end(), [](char c) { return c >= '0' && c <= '9'; }))
-    fail("the port must be a number in [0, 65535]");
-  const int p = std::stoi(std::string(port_text));
-  if (p > 65535) fail("the port must be a number in [0, 65535]");
-  port = p;
-}
-
-DeviceOption parse_device_option(std::string_view text) {
-  DeviceOption d;
-  const std::string_view head = text.substr(0, text.find(':'));
-  const std::optional<DeviceKind> kind = parse_device_kind(head);
-  if (!kind)
-    throw InputError("--device: unknown device '" + std::string(text) +
-                     "'; allowed: script, sim, udp, udp:PORT, udp:ADDR:PORT");
-  d.kind = *kind;
-  if (head.size() == text.size()) return d;
-  if (d.kind != DeviceKind::kUdp)
-    throw InputError("--device: '" + std::string(text) + "': only udp takes an address");
-  parse_endpoint(text.substr(head.size() + 1), "--device", d.address, d.port);
-  return d;
-}
-
-void write_haptics_csv(std::ostream& out, const std::vector<LoopRecord>& records) {
-  out << kHapticsCsvColumns << "\n";
-  char line[1024];
-  for (const LoopRecord& r : records) {
-    const auto bit = [&](std::uint32_t b) { return (r.flags & b) ? 1 : 0; };
-    std::snprintf(
-        line, sizeof line,
-        "%.9g,%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
-        "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%d,%d,%d,%d,%.9g,%.9g\n",
-        r.t_s, static_cast<long long>(r.tick), r.device_position_m.x, r.device_position_m.y,
-        r.device_position_m.z, r.tool.position_m.x, r.tool.position_m.y, r.tool.position_m.z,
-        r.tool.orientation.w, r.tool.orientation.x, r.tool.orientation.y, r.tool.orientation.z,
-        r.contact_length_m, r.cut_depth_m, r.removed_volume_m3, r.velocity_m_per_s.x,
-        r.velocity_m_per_s.y, r.velocity_m_per_s.z, r.force_world_n.x, r.force_world_n.y,
-        r.force_world_n.z, r.body_force_world_n.x, r.body_force_world_n.y, r.body_force_world_n.z,
-        r.force_device_n.x, r.force_device_n.y, r.force_device_n.z,
-        bit(kFlagClamped), bit(kFlagRateLimited), bit(kFlagWatchdog), bit(kFlagRamping),
-        bit(kFlagNonfinite), bit(kFlagBadSample), bit(kFlagSilent), bit(kFlagMissedDeadline),
-        r.period_s, r.compute_s);
-    out << line;
-  }
-}
-
-void Session::write_outputs(const fs::path& out_dir) const {
-  if (out_dir.empty()) throw InputError("--out: no output folder given");
-  std::error_code ec;
-  fs::create_directories(out_dir, ec);
-  if (ec || !fs::is_directory(out_dir))
-    throw InputError(out_dir.string() + ": cannot create the output folder" +
-                     (ec ? " (" + ec.message() + ")" : std::string()));
-  if (options_.engine) options_.engine->finish();
+void HapticSession::write_outputs(const fs::path& out_dir) {
+  io::make_output_folder(out_dir);
+  rig_->world().finish();
   std::ostringstream csv;
-  write_haptics_csv(csv, loop_->records());
-  write_text_file(out_dir / "haptics.csv", csv.str());
-  write_text_file(out_dir / "summary.json", summary_json());
+  write_haptics_csv(csv, rig_->loop().records());
+  io::write_text_file(out_dir / "haptics.csv", csv.str());
+  io::write_text_file(out_dir / "summary.json", summary_json());
 }
 
-std::string Session::summary_line() const {
-  const HapticLoop& l = *loop_;
+std::string HapticSession::summary_line() const {
+  const HapticLoop& l = rig_->loop();
   const LoopStats& ps = l.pacer_stats();
   const TimeStats& j = ps.period_jitter;
   const TimeStats& c = ps.compute;
@@ -472,4 +409,4 @@ std::string Session::summary_line() const {
   return line;
 }
 
-}  // namespace terracut::haptics
+}  // namespace terracut::session

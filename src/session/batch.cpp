@@ -1,5 +1,5 @@
-// Running a scenario and writing its outputs. See run.hpp.
-#include "terracut/io/run.hpp"
+// A batch run of a scenario and its outputs. See batch.hpp.
+#include "terracut/session/batch.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -12,62 +12,17 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
+#include "bodies_json.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/io/files.hpp"
+#include "terracut/io/image.hpp"
+#include "terracut/session/world.hpp"
 
-namespace terracut::io {
+namespace terracut::session {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 using Json = nlohmann::ordered_json;
-
-[[noreturn]] void fail_file(const std::filesystem::path& path, const std::string& what) {
-  throw InputError(path.string() + ": " + what);
-}
-
-// contact.csv, written row by row through a large stdio buffer with fixed
-// printf formats (so the text is the same on every run).
-class CsvWriter {
- public:
-  explicit CsvWriter(std::filesystem::path path) : path_(std::move(path)) {
-    file_ = std::fopen(path_.c_str(), "wb");
-    if (!file_) fail_file(path_, std::string("cannot create: ") + std::strerror(errno));
-    std::setvbuf(file_, nullptr, _IOFBF, 1 << 20);
-    put("t,cut,x,y,z,qw,qx,qy,qz,contact_length,removed_volume,section_area,max_depth,"
-        "cells_visited\n");
-  }
-  ~CsvWriter() {
-    if (file_) std::fclose(file_);
-  }
-  CsvWriter(const CsvWriter&) = delete;
-  CsvWriter& operator=(const CsvWriter&) = delete;
-
-  void row(const StepRecord& r, const std::string& cut_name, std::int64_t cells_visited) {
-    const Vec3& p = r.pose.position_m;
-    const Quat& q = r.pose.orientation;
-    const int n = std::fprintf(
-        file_, "%.9g,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%lld\n", r.t_s,
-        cut_name.c_str(), p.x, p.y, p.z, q.w, q.x, q.y, q.z, r.contact.length_m,
-        r.removed_volume_m3, r.contact.section_area_m2, r.contact.max_depth_m,
-        static_cast<long long>(cells_visited));
-    if (n < 0) fail_file(path_, std::string("write failed: ") + std::strerror(errno));
-  }
-
-  void close() {
-    const bool bad = std::ferror(file_) != 0;
-    const int rc = std::fclose(file_);
-    file_ = nullptr;
-    if (bad || rc != 0) fail_file(path_, std::string("write failed: ") + std::strerror(errno));
-  }
-
- private:
-  void put(const char* text) {
-    if (std::fputs(text, file_) < 0)
-      fail_file(path_, std::string("write failed: ") + std::strerror(errno));
-  }
-
-  std::filesystem::path path_;
-  std::FILE* file_ = nullptr;
-};
 
 // Removes the named outputs from the folder (ignoring ones that do not exist).
 void remove_outputs(const std::filesystem::path& dir) {
@@ -78,33 +33,12 @@ void remove_outputs(const std::filesystem::path& dir) {
   }
 }
 
-TimingStats timing_stats(std::vector<double>& seconds) {
-  TimingStats s;
-  if (seconds.empty()) return s;
-  std::sort(seconds.begin(), seconds.end());
-  // Nearest-rank percentile.
-  auto pct = [&](double p) {
-    const std::size_t n = seconds.size();
-    std::size_t rank = static_cast<std::size_t>(std::ceil(p / 100.0 * double(n)));
-    rank = std::clamp<std::size_t>(rank, 1, n);
-    return seconds[rank - 1] * 1e6;
-  };
-  s.p50_us = pct(50);
-  s.p90_us = pct(90);
-  s.p99_us = pct(99);
-  s.max_us = seconds.back() * 1e6;
-  double sum = 0.0;
-  for (double v : seconds) sum += v;
-  s.mean_us = sum / double(seconds.size()) * 1e6;
-  return s;
-}
-
 Json timing_json(const TimingStats& s) {
   return Json{{"p50", s.p50_us}, {"p90", s.p90_us}, {"p99", s.p99_us}, {"max", s.max_us},
               {"mean", s.mean_us}};
 }
 
-Json summary_json(const Scenario& sc, const RunResult& r) {
+Json summary_json(const io::Scenario& sc, const RunResult& r) {
   Json inputs;
   inputs["scenario"] = sc.source_path.string();
   inputs["name"] = sc.name;
@@ -179,14 +113,6 @@ Json summary_json(const Scenario& sc, const RunResult& r) {
   return out;
 }
 
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) fail_file(path, std::string("cannot create: ") + std::strerror(errno));
-  f << text;
-  f.close();
-  if (!f) fail_file(path, std::string("write failed: ") + std::strerror(errno));
-}
-
 // Writes a progress line about once a second after the first progress_after_s.
 class Progress {
  public:
@@ -227,10 +153,13 @@ class Progress {
   bool printed_ = false;
 };
 
-RunResult run_into(const Scenario& sc, const RunOptions& options) {
+RunResult run_into(const Scenario& scenario, const RunOptions& options) {
+  const io::Scenario& sc = scenario.base;
   const std::filesystem::path& dir = options.out_dir;
-  const SimParams params = sim_params(sc);
-  Simulation sim(params, build_initial_heights(sc));
+  WorldOptions wo;
+  wo.bodies_csv = dir / "bodies.csv";
+  World world(scenario, wo);
+  Simulation& sim = world.simulation();
 
   // Steps per cut: samples at t = i / rate for i = 0..n, n = round(duration * rate).
   std::vector<std::int64_t> cut_steps;
@@ -250,8 +179,11 @@ RunResult run_into(const Scenario& sc, const RunOptions& options) {
   cut_s.reserve(std::size_t(total_steps));
   step_s.reserve(std::size_t(total_steps));
 
-  for (RunObserver* o : options.observers) o->start(sim, dir);
-  CsvWriter csv(dir / "contact.csv");
+  // Real-time pacing: each step starts on its deadline; the first anchors the schedule.
+  std::optional<haptics::Pacer> pacer;
+  if (options.realtime) pacer.emplace(haptics::PacerSettings{.rate_hz = sc.rate_hz});
+
+  io::ContactCsvWriter csv(dir / "contact.csv");
   Progress progress(options, total_steps);
   const Clock::time_point loop_start = Clock::now();
   std::int64_t done = 0;
@@ -267,13 +199,17 @@ RunResult run_into(const Scenario& sc, const RunOptions& options) {
 
     // Each cut is a separate stroke: nothing is swept from the previous cut's end.
     sim.lift();
-    for (RunObserver* o : options.observers) o->lifted();
     for (std::int64_t i = 0; i < cut_steps[k]; ++i) {
       const BladePose pose = motion.sample(double(i) / sc.rate_hz);
-      for (RunObserver* o : options.observers) o->before_step();
+      if (pacer) {
+        if (done == 0)
+          pacer->start();
+        else
+          pacer->wait_next();
+      }
       const StepOutput& out = sim.step(pose);
-      for (RunObserver* o : options.observers) o->stepped(out);
-      StepRecord rec;
+      if (pacer) pacer->record_compute(out.timers.total_s);
+      io::StepRecord rec;
       rec.t_s = out.t_s;
       rec.cut = cut_index;
       rec.sequence_index = int(k);
@@ -310,39 +246,25 @@ RunResult run_into(const Scenario& sc, const RunOptions& options) {
   result.contact_timing = timing_stats(contact_s);
   result.cut_timing = timing_stats(cut_s);
   result.step_timing = timing_stats(step_s);
+  if (pacer) result.realtime = pacer->stats();
 
-  write_npy(dir / "height.npy", grid.heights(), grid.rows(), grid.cols());
-  write_npy(dir / "removed.npy", grid.removed(), grid.rows(), grid.cols());
-  write_png16(dir / "height.png", grid.heights(), grid.cols(), grid.rows(), sc.full_scale_m);
-  write_png16(dir / "removed.png", grid.removed(), grid.cols(), grid.rows(), sc.full_scale_m);
-  for (RunObserver* o : options.observers) o->finish();
+  io::write_npy(dir / "height.npy", grid.heights(), grid.rows(), grid.cols());
+  io::write_npy(dir / "removed.npy", grid.removed(), grid.rows(), grid.cols());
+  io::write_png16(dir / "height.png", grid.heights(), grid.cols(), grid.rows(), sc.full_scale_m);
+  io::write_png16(dir / "removed.png", grid.removed(), grid.cols(), grid.rows(), sc.full_scale_m);
+  world.finish();
   nlohmann::json summary = summary_json(sc, result);
-  for (RunObserver* o : options.observers) {
-    if (!o->summary_key().empty()) summary[o->summary_key()] = nlohmann::json::parse(o->summary_json());
-  }
-  write_text(dir / "summary.json", summary.dump(2) + "\n");
+  if (world.bodies()) summary["bodies"] = detail::bodies_json(world, detail::BodiesEntry::kRun);
+  if (result.realtime) summary["realtime"] = nlohmann::json::parse(realtime_json(*result.realtime));
+  io::write_text_file(dir / "summary.json", summary.dump(2) + "\n");
   return result;
 }
 
 }  // namespace
 
-SimParams sim_params(const Scenario& scenario) {
-  SimParams params;
-  params.grid = grid_spec(scenario);
-  params.representation = scenario.representation;
-  params.rate_hz = scenario.rate_hz;
-  params.blade = scenario.blade;
-  return params;
-}
-
 RunResult run_scenario(const Scenario& scenario, const RunOptions& options) {
   const std::filesystem::path& dir = options.out_dir;
-  if (dir.empty()) throw InputError("--out: no output folder given");
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir))
-    throw InputError(dir.string() + ": cannot create the output folder" +
-                     (ec ? ": " + ec.message() : std::string(": a file of that name exists")));
+  io::make_output_folder(dir);
 
   // Old outputs go first, so a failed run never leaves results that look current.
   remove_outputs(dir);
@@ -354,4 +276,26 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options) {
   }
 }
 
-}  // namespace terracut::io
+namespace {
+
+nlohmann::json to_json_us(const haptics::TimeStats& s) {
+  return {{"p50_us", s.p50_s * 1e6}, {"p99_us", s.p99_s * 1e6}, {"max_us", s.max_s * 1e6},
+          {"mean_us", s.mean_s * 1e6}, {"count", s.count}};
+}
+
+}  // namespace
+
+std::string realtime_json(const haptics::LoopStats& s) {
+  nlohmann::json j;
+  j["rate_hz"] = s.rate_hz;
+  j["period_us"] = 1e6 / s.rate_hz;
+  j["ticks"] = s.ticks;
+  j["missed_deadlines"] = s.missed_deadlines;
+  j["skipped_slots"] = s.skipped_slots;
+  j["step_time"] = to_json_us(s.compute);
+  j["period_jitter"] = to_json_us(s.period_jitter);
+  j["wake_latency"] = to_json_us(s.wake_latency);
+  return j.dump();
+}
+
+}  // namespace terracut::session

@@ -1,6 +1,6 @@
-// Sessions: scenario loading (with the haptics section hidden from the
-// scenario loader, line numbers kept), --device parsing, outputs.
-#include "terracut/haptics/session.hpp"
+// Haptic sessions: scenario loading (the haptics section read by its own
+// reader, line numbers kept), --device parsing, outputs.
+#include "terracut/session/haptic.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,13 +12,26 @@
 #include <sstream>
 #include <string>
 
-#include "haptics_fixture.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/haptics/device_option.hpp"
+#include "terracut/haptics/haptics_csv.hpp"
 
-namespace terracut::haptics {
+namespace terracut::session {
 namespace {
 
 namespace fs = std::filesystem;
+using haptics::DeviceOption;
+using haptics::parse_device_option;
+
+namespace test {
+fs::path trench_path() {
+  return fs::path(TERRACUT_SOURCE_DIR) / "scenarios/trench_dry_sand.yaml";
+}
+const Scenario& trench() {
+  static const Scenario s = load_scenario(trench_path());
+  return s;
+}
+}  // namespace test
 
 fs::path scratch(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("terracut_session_test_" + name);
@@ -44,10 +57,10 @@ std::string read(const fs::path& p) {
 }
 
 TEST(Session, LoadsTheTrenchScenario) {
-  const HapticScenario& s = test::trench();
-  EXPECT_EQ(s.scenario.name, "trench_dry_sand");
-  ASSERT_EQ(s.scenario.cuts.size(), 1u);
-  EXPECT_EQ(s.scenario.cuts[0].name, "trench");
+  const Scenario& s = test::trench();
+  EXPECT_EQ(s.base.name, "trench_dry_sand");
+  ASSERT_EQ(s.base.cuts.size(), 1u);
+  EXPECT_EQ(s.base.cuts[0].name, "trench");
   EXPECT_EQ(s.haptics.device, DeviceKind::kSim);
   EXPECT_EQ(s.haptics.forces.cutting, CuttingModel::kEarthmoving);
 }
@@ -58,7 +71,7 @@ TEST(Session, ScenarioErrorsAfterTheHapticsSectionKeepTheirLine) {
   std::string text = read(test::trench_path()) + "blade_extra: 1\n";
   std::ofstream(dir / "broken.yaml") << text;
   const int line = int(std::count(text.begin(), text.end(), '\n'));
-  const std::string e = error_of([&] { load_haptic_scenario(dir / "broken.yaml"); });
+  const std::string e = error_of([&] { load_scenario(dir / "broken.yaml"); });
   EXPECT_NE(e.find("broken.yaml:" + std::to_string(line) + ":"), std::string::npos) << e;
   EXPECT_NE(e.find("blade_extra"), std::string::npos) << e;
   // An error inside the haptics section names it, at its line.
@@ -67,7 +80,7 @@ TEST(Session, ScenarioErrorsAfterTheHapticsSectionKeepTheirLine) {
   bad.replace(at, 13, "    scale: -1");
   std::ofstream(dir / "bad_scale.yaml") << bad;
   const int scale_line = int(std::count(bad.begin(), bad.begin() + std::ptrdiff_t(at), '\n')) + 1;
-  const std::string e2 = error_of([&] { load_haptic_scenario(dir / "bad_scale.yaml"); });
+  const std::string e2 = error_of([&] { load_scenario(dir / "bad_scale.yaml"); });
   EXPECT_NE(e2.find("bad_scale.yaml:" + std::to_string(scale_line) + ": haptics.workspace.scale"),
             std::string::npos)
       << e2;
@@ -96,24 +109,24 @@ TEST(Session, DeviceOption) {
 }
 
 TEST(Session, RefusesWhatCannotRun) {
-  const HapticScenario& in = test::trench();
+  const Scenario& in = test::trench();
   SessionOptions o;
   o.device = DeviceKind::kUdp;
   o.clock = ClockMode::kFake;
-  EXPECT_NE(error_of([&] { Session s(in, o); }).find("--clock fake"), std::string::npos);
-  HapticScenario other = in;
+  EXPECT_NE(error_of([&] { HapticSession s(in, o); }).find("--clock fake"), std::string::npos);
+  Scenario other = in;
   other.haptics.cut = "no_such_cut";
-  EXPECT_NE(error_of([&] { Session s(other, SessionOptions{}); }).find("haptics.cut: no cut named"),
+  EXPECT_NE(error_of([&] { HapticSession s(other, SessionOptions{}); }).find("haptics.cut: no cut named"),
             std::string::npos);
   SessionOptions d;
   d.duration_s = -1.0;
-  EXPECT_NE(error_of([&] { Session s(in, d); }).find("--duration"), std::string::npos);
+  EXPECT_NE(error_of([&] { HapticSession s(in, d); }).find("--duration"), std::string::npos);
 }
 
 TEST(Session, ScriptSessionWritesConsistentOutputs) {
   SessionOptions o;
   o.device = DeviceKind::kScript;
-  Session session(test::trench(), o);
+  HapticSession session(test::trench(), o);
   EXPECT_EQ(session.clock(), ClockMode::kFake);
   session.run();
   const fs::path dir = scratch("outputs");
@@ -123,7 +136,7 @@ TEST(Session, ScriptSessionWritesConsistentOutputs) {
   std::ifstream csv(dir / "haptics.csv");
   std::string header, line;
   std::getline(csv, header);
-  EXPECT_EQ(header, kHapticsCsvColumns);
+  EXPECT_EQ(header, haptics::kHapticsCsvColumns);
   const int columns = int(std::count(header.begin(), header.end(), ',')) + 1;
   int rows = 0, clamped = 0, rate_limited = 0;
   while (std::getline(csv, line)) {
@@ -138,7 +151,7 @@ TEST(Session, ScriptSessionWritesConsistentOutputs) {
     }
   }
   const double duration =
-      test::trench().scenario.cuts[0].duration_s() + test::trench().haptics.settle_s;
+      test::trench().base.cuts[0].duration_s() + test::trench().haptics.settle_s;
   EXPECT_EQ(rows, std::lround(duration * 1000.0));
 
   // summary.json agrees with the log and the loop.
@@ -161,7 +174,7 @@ TEST(Session, ScriptSessionWritesConsistentOutputs) {
 TEST(Session, SimSessionReportsTheHand) {
   SessionOptions o;
   o.clock = ClockMode::kFake;
-  Session session(test::trench(), o);
+  HapticSession session(test::trench(), o);
   session.run();
   const nlohmann::json j = nlohmann::json::parse(session.summary_json());
   EXPECT_EQ(j["device"], "sim");
@@ -170,4 +183,4 @@ TEST(Session, SimSessionReportsTheHand) {
 }
 
 }  // namespace
-}  // namespace terracut::haptics
+}  // namespace terracut::session

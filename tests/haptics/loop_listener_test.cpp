@@ -1,8 +1,8 @@
-// The haptic loop's engine hook (LoopEngine) with a test engine, no physics:
-// when it is called (attach once, after_cut on every stepped tick and only
-// then, lifted on a reconnection, fill_frame before each publish, detach on
-// destruction), how its force joins the world force and is scaled to the
-// device like the force models', and the bodies it writes into viewer frames.
+// The haptic loop with a step listener on its simulation (a test listener,
+// no physics): when it is called (on_step on every stepped tick and only
+// then, on_lift on a reconnection, its bodies read before each publish), how
+// its force joins the world force and is scaled to the device like the force
+// models', and the bodies it writes into viewer frames.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,16 +12,15 @@
 #include "haptics_fixture.hpp"
 #include "terracut/haptics/loop.hpp"
 #include "terracut/haptics/script_device.hpp"
-#include "terracut/io/run.hpp"
 
 namespace terracut::haptics {
 namespace {
 
 using test::trench;
 
-// An engine that pushes back on the tool with a fixed world force while the
-// tool is below `below_y_m`, and records every call.
-class TestEngine final : public LoopEngine {
+// A listener that pushes back on the tool with a fixed world force while the
+// tool is below `below_y_m`, says it has two bodies, and records every call.
+class TestEngine final : public StepListener, public BodySource {
  public:
   Vec3 force_n{0.0, 0.0, 0.0};
   double below_y_m = 1e9;
@@ -32,34 +31,55 @@ class TestEngine final : public LoopEngine {
   std::int64_t last_step = -1;
   Vec3 last_tool_m{};
 
-  void attach(Simulation& s) override {
+  void attach(Simulation& s) {
     ++attached;
     sim = &s;
+    s.add_listener(*this);
   }
-  Vec3 after_cut(const StepOutput& out) noexcept override {
+  void detach() {
+    ++detached;
+    const_cast<Simulation*>(sim)->remove_listener(*this);
+    sim = nullptr;
+  }
+  Vec3 on_step(const StepOutput& out) noexcept override {
     ++steps;
     last_step = out.step;
     last_tool_m = out.pose.position_m;
     return out.pose.position_m.y < below_y_m ? force_n : Vec3{};
   }
-  void lifted() noexcept override { ++lifts; }
-  void fill_frame(ViewFrame& f) const noexcept override {
+  void on_lift() noexcept override { ++lifts; }
+  int body_total() const noexcept override { return 2; }
+  int write_bodies(std::span<BodyView> out) const noexcept override {
     ++fills;
     // One sphere riding on the tool, and a box at the origin.
-    f.body_total = 2;
-    f.body_count = 2;
-    f.bodies[0].shape = BodyShape::kSphere;
-    f.bodies[0].half_extents_m = {0.05, 0.05, 0.05};
-    f.bodies[0].position_m = last_tool_m;
-    f.bodies[1].shape = BodyShape::kBox;
-    f.bodies[1].half_extents_m = {0.1, 0.2, 0.3};
-    f.bodies[1].position_m = {};
-    f.bodies[1].orientation = {};
+    out[0].shape = BodyShape::kSphere;
+    out[0].half_extents_m = {0.05, 0.05, 0.05};
+    out[0].position_m = last_tool_m;
+    out[1].shape = BodyShape::kBox;
+    out[1].half_extents_m = {0.1, 0.2, 0.3};
+    out[1].position_m = {};
+    out[1].orientation = {};
+    return 2;
   }
-  void detach() noexcept override {
-    ++detached;
-    sim = nullptr;
+};
+
+// A loop whose simulation has the engine as its listener (attached before
+// the first tick, detached when the rig goes), and its bodies for the frames.
+struct EngineRig {
+  test::LoopRig rig;
+  TestEngine* engine = nullptr;
+  ~EngineRig() {
+    if (engine) {
+      rig.loop.reset();
+      engine->detach();
+    }
   }
+};
+
+// The rig, used through its loop.
+struct EngineLoop {
+  std::unique_ptr<EngineRig> rig;
+  HapticLoop* operator->() const { return rig->rig.loop.get(); }
 };
 
 const Motion& trench_cut() { return trench().scenario.cuts[0]; }
@@ -68,21 +88,26 @@ std::int64_t ticks_of(const HapticSettings& s) {
   return std::llround((trench_cut().duration_s() + s.settle_s) * s.rate_hz);
 }
 
-std::unique_ptr<HapticLoop> make_loop(Device& device, std::int64_t ticks, LoopEngine* engine,
-                                      SnapshotExchange* snapshot = nullptr) {
+EngineLoop make_loop(Device& device, std::int64_t ticks, TestEngine* engine,
+                     SnapshotExchange* snapshot = nullptr) {
   const io::Scenario& sc = trench().scenario;
   LoopOptions o;
   o.ticks = ticks;
   o.record_capacity = std::size_t(ticks);
   o.realtime = false;
-  o.engine = engine;
+  o.bodies = engine;
   o.snapshot = snapshot;
-  return std::make_unique<HapticLoop>(trench().haptics, io::sim_params(sc),
-                                      io::build_initial_heights(sc),
-                                      trench_cut().keyframes[0].pose.orientation, device, o);
+  auto r = std::make_unique<EngineRig>();
+  r->rig = test::make_loop_rig(trench().haptics, sc, trench_cut().keyframes[0].pose.orientation,
+                               device, o);
+  if (engine) {
+    engine->attach(*r->rig.sim);
+    r->engine = engine;
+  }
+  return {std::move(r)};
 }
 
-TEST(LoopEngine, ForceJoinsTheWorldForceAndIsScaledToTheDeviceTheSameWay) {
+TEST(LoopListener, ForceJoinsTheWorldForceAndIsScaledToTheDeviceTheSameWay) {
   const HapticSettings& s = trench().haptics;
   const std::int64_t ticks = ticks_of(s);
   // A force against the cut's motion (-Z) and sideways, while the blade is in
@@ -95,7 +120,7 @@ TEST(LoopEngine, ForceJoinsTheWorldForceAndIsScaledToTheDeviceTheSameWay) {
     ScriptDevice device(DevicePath(trench_cut(), Workspace(s.workspace)));
     auto loop = make_loop(device, ticks, &engine);
     EXPECT_EQ(engine.attached, 1);
-    EXPECT_EQ(engine.sim, &loop->simulation());  // built over the loop's own simulation
+    EXPECT_EQ(engine.sim, &loop->simulation());  // a listener of the loop's simulation
     loop->run_deterministic();
     with = loop->records();
     EXPECT_EQ(engine.steps, ticks);  // every tick was stepped (the script never fails)
@@ -105,7 +130,7 @@ TEST(LoopEngine, ForceJoinsTheWorldForceAndIsScaledToTheDeviceTheSameWay) {
     EXPECT_DOUBLE_EQ(loop->max_body_force_n(), length(engine.force_n));
     EXPECT_EQ(engine.detached, 0);
   }
-  EXPECT_EQ(engine.detached, 1);  // let go when the loop went
+  EXPECT_EQ(engine.detached, 1);  // removed when the loop went
   EXPECT_EQ(engine.sim, nullptr);
   {
     ScriptDevice device(DevicePath(trench_cut(), Workspace(s.workspace)));
@@ -147,7 +172,7 @@ TEST(LoopEngine, ForceJoinsTheWorldForceAndIsScaledToTheDeviceTheSameWay) {
   EXPECT_GT(unlimited, 1000);
 }
 
-TEST(LoopEngine, NotCalledWhenTheSimulationIsNotStepped) {
+TEST(LoopListener, NotCalledWhenTheSimulationIsNotStepped) {
   const HapticSettings& s = trench().haptics;
   ScriptDevice script(DevicePath(trench_cut(), Workspace(s.workspace)));
   // Ten NaN samples in the cut: the simulation (and so the engine) stands still.
@@ -187,7 +212,7 @@ class ReconnectingDevice final : public Device {
   std::int64_t reads_ = 0;
 };
 
-TEST(LoopEngine, LiftedWhenTheDeviceReconnects) {
+TEST(LoopListener, LiftedWhenTheDeviceReconnects) {
   const HapticSettings& s = trench().haptics;
   ScriptDevice script(DevicePath(trench_cut(), Workspace(s.workspace)));
   ReconnectingDevice device(script, 1500);
@@ -199,13 +224,13 @@ TEST(LoopEngine, LiftedWhenTheDeviceReconnects) {
   EXPECT_EQ(engine.steps, 2000);
 }
 
-TEST(LoopEngine, FillsTheBodiesOfEveryPublishedFrame) {
+TEST(LoopListener, FillsTheBodiesOfEveryPublishedFrame) {
   const HapticSettings& s = trench().haptics;
   const io::Scenario& sc = trench().scenario;
   const std::int64_t ticks = 1800;
   HeightGrid grid(io::grid_spec(sc), io::build_initial_heights(sc));
   SnapshotExchange exchange(grid);
-  EXPECT_EQ(exchange.front().body_count, 0);  // none before the engine speaks
+  EXPECT_EQ(exchange.front().body_count, 0);  // none before the listener speaks
   TestEngine engine;
   ScriptDevice device(DevicePath(trench_cut(), Workspace(s.workspace)));
   auto loop = make_loop(device, ticks, &engine, &exchange);

@@ -1,0 +1,143 @@
+// Haptic runs of a scenario, assembled once here for every program:
+//
+//  - HapticRig: the scenario's world (simulation + listeners, world.hpp) and
+//    a HapticLoop over it, with the loop's parameters validated once
+//    (haptics::LoopParams) and a device of the caller's. The viewer builds
+//    its rig with its own virtual device.
+//  - HapticSession: what `terracut haptics` does: a device backend from the
+//    settings (script, sim, udp), a rig, the loop run for a duration, and
+//    its outputs:
+//
+//   haptics.csv   one row per tick (haptics/haptics_csv.hpp; docs/haptics.md)
+//   bodies.csv    only when the scenario has bodies
+//   summary.json  settings used, loop timing percentiles, missed deadlines,
+//                 counters (loop, safety, rejected packets by reason), forces,
+//                 cutting totals and warnings, and the bodies' entry
+#pragma once
+
+#include <atomic>
+#include <filesystem>
+#include <iosfwd>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "terracut/core/haptic_settings.hpp"
+#include "terracut/haptics/device.hpp"
+#include "terracut/haptics/loop.hpp"
+#include "terracut/session/scenario.hpp"
+#include "terracut/session/world.hpp"
+
+namespace terracut::session {
+
+/// How a rig is built.
+struct RigOptions {
+  /// The loop's options (ticks, records, real time, clock, snapshot). Its
+  /// `bodies` is set by the rig from the world.
+  haptics::LoopOptions loop;
+  /// bodies.csv of the world's bodies; empty: not written.
+  std::filesystem::path bodies_csv;
+};
+
+/// A haptic loop over a scenario's world.
+class HapticRig {
+ public:
+  /// params: the loop's parameters (validated once, by their constructor);
+  /// the world's simulation runs at params.rate_hz(). default_orientation:
+  /// the tool orientation when neither the settings nor the device give one.
+  /// The device must outlive the rig. Throws InputError naming the field.
+  HapticRig(const Scenario& scenario, const haptics::LoopParams& params,
+            Quat default_orientation, haptics::Device& device, const RigOptions& options);
+  ~HapticRig();
+
+  World& world() { return *world_; }
+  const World& world() const { return *world_; }
+  haptics::HapticLoop& loop() { return *loop_; }
+  const haptics::HapticLoop& loop() const { return *loop_; }
+
+  /// What the device check of the force model changed, one sentence each
+  /// (e.g. "forces.surface.stiffness_n_per_m lowered to ..."); empty when
+  /// nothing was lowered.
+  std::vector<std::string> rendering_changes() const;
+
+ private:
+  std::unique_ptr<World> world_;
+  std::unique_ptr<haptics::HapticLoop> loop_;
+};
+
+/// How the loop is clocked.
+enum class ClockMode {
+  kReal,  ///< its own thread, paced at the rate by the wall clock
+  kFake,  ///< synchronous, no sleeping, t = i / rate (reproducible)
+};
+
+/// Command-line choices over the scenario's settings.
+struct SessionOptions {
+  std::optional<DeviceKind> device;        ///< overrides haptics.device
+  std::optional<std::string> udp_address;  ///< overrides haptics.udp.address
+  std::optional<int> udp_port;             ///< overrides haptics.udp.port (0: any free port)
+  std::optional<double> duration_s;        ///< overrides haptics.duration_s, (0, 86400]
+  /// nullopt: kFake for script, kReal for sim and udp. kFake with udp is refused.
+  std::optional<ClockMode> clock;
+  bool realtime = true;  ///< ask for SCHED_FIFO and locked memory (kReal)
+  /// Records kept, at most; a longer session keeps its newest records.
+  std::size_t max_records = 600000;
+  std::ostream* log = nullptr;           ///< one-line messages (e.g. &std::cerr), or nullptr
+  haptics::SnapshotExchange* snapshot = nullptr;  ///< optional viewer feed
+  /// Where bodies.csv goes when the scenario has bodies (the folder must
+  /// exist); empty: not written.
+  std::filesystem::path bodies_csv;
+  /// Polled every 10 ms while a real-time loop runs; true stops it (e.g. set by SIGINT).
+  const std::atomic<bool>* interrupt = nullptr;
+};
+
+/// A built, ready-to-run session of `terracut haptics`.
+class HapticSession {
+ public:
+  /// Builds the device and the rig. Throws InputError naming the field or
+  /// option (an unknown cut, a port in use, udp with the fake clock, ...).
+  HapticSession(const Scenario& scenario, const SessionOptions& options);
+  ~HapticSession();
+
+  /// Runs the loop to its end (or an interrupt). Call once.
+  void run();
+
+  /// Writes haptics.csv and summary.json into out_dir (created if missing),
+  /// after closing the world's files (bodies.csv). Throws InputError naming
+  /// the file when it cannot be written.
+  void write_outputs(const std::filesystem::path& out_dir);
+
+  /// One line: device, ticks, jitter and compute p99, max force, warnings.
+  std::string summary_line() const;
+
+  const haptics::HapticLoop& loop() const { return rig_->loop(); }
+  const World& world() const { return rig_->world(); }
+  const haptics::Device& device() const { return *device_; }
+  /// The UDP device's bound port (udp only; -1 otherwise).
+  int udp_port() const;
+  DeviceKind device_kind() const { return kind_; }
+  ClockMode clock() const { return clock_; }
+  double duration_s() const { return duration_s_; }
+  /// Warnings collected at build and after the run (rendering limited,
+  /// real-time refused, bad samples, missed deadlines, ...).
+  std::vector<std::string> warnings() const;
+  /// summary.json's text.
+  std::string summary_json() const;
+
+ private:
+  std::filesystem::path source_;
+  std::string name_;
+  std::string cut_name_;
+  DeviceKind kind_ = DeviceKind::kSim;
+  ClockMode clock_ = ClockMode::kReal;
+  double duration_s_ = 0.0;
+  SessionOptions options_;
+  std::vector<std::string> build_warnings_;
+  std::unique_ptr<haptics::Device> device_;
+  std::unique_ptr<HapticRig> rig_;
+  double wall_s_ = 0.0;
+  bool interrupted_ = false;
+};
+
+}  // namespace terracut::session

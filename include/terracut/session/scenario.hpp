@@ -1,0 +1,38 @@
+// A scenario with every section read, for the programs: the terrain,
+// representation, rate, blade and cuts (the io layer's reader), the haptic
+// loop's settings (`haptics:`, the haptics layer's reader) and the rigid
+// bodies (`bodies:`, the Bullet layer's reader). Each section is read by the
+// layer that owns it; the session layer puts them together once.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "terracut/core/bodies.hpp"
+#include "terracut/core/haptic_settings.hpp"
+#include "terracut/io/scenario.hpp"
+
+namespace terracut::session {
+
+/// A loaded, validated scenario.
+struct Scenario {
+  /// Terrain, representation, step rate, blade and cuts (io/scenario.hpp).
+  io::Scenario base;
+  /// The `haptics:` section (docs/haptics.md), or HapticSettings' defaults.
+  HapticSettings haptics{};
+  /// The `bodies:` list (docs/bullet.md); empty when not given.
+  std::vector<BodySpec> bodies;
+};
+
+/// Reads and validates a scenario file with all its sections. Throws
+/// InputError ("FILE:LINE: field.path: what").
+Scenario load_scenario(const std::filesystem::path& path);
+
+/// A bare heightmap as a scenario (the viewer's PNG input): the image at its
+/// own resolution over extent_m x extent_m, a white pixel full_scale_m high,
+/// a blade half the extent long, no cuts, default haptic settings. Throws
+/// InputError naming the file, or "--extent and --full-scale must be > 0".
+Scenario heightmap_scenario(const std::filesystem::path& png, double extent_m,
+                            double full_scale_m);
+
+}  // namespace terracut::session

@@ -1,0 +1,71 @@
+// The simulated world of a run, built once from a scenario and shared by
+// every program: the Simulation (terrain, representation, blade, rate) and
+// the step listeners attached to it (today: the rigid bodies, a Bullet world
+// over the same height array, when the scenario has `bodies:`). A batch run
+// steps it directly; the haptic loop and the viewer's loop step it through
+// HapticLoop. Whatever drives it, the same listeners see every step.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "terracut/core/bodies.hpp"
+#include "terracut/core/simulation.hpp"
+#include "terracut/session/scenario.hpp"
+
+namespace terracut::bullet {
+class BodiesListener;
+struct BodiesReport;
+}  // namespace terracut::bullet
+
+namespace terracut::session {
+
+/// True when this build has the rigid-body engine (Bullet).
+bool bodies_available();
+
+/// The message of the InputError a build without Bullet gives for a
+/// scenario with bodies (the one place it is written).
+std::string bodies_unavailable_message();
+
+/// How to build a world.
+struct WorldOptions {
+  /// The simulation's step rate, Hz; nullopt: the scenario's rate_hz. The
+  /// haptic loop gives its own (haptics.rate_hz).
+  std::optional<double> rate_hz;
+  /// Where the bodies' per-step states go (bodies.csv); empty: not written.
+  /// Only used when the scenario has bodies; the folder must exist.
+  std::filesystem::path bodies_csv;
+};
+
+class World {
+ public:
+  /// Builds the simulation and its listeners. Throws InputError naming the
+  /// field (a bad body, a simulation parameter) or bodies_unavailable_message()
+  /// when the scenario has bodies and this build has no Bullet.
+  World(const Scenario& scenario, const WorldOptions& options = {});
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  Simulation& simulation() { return *sim_; }
+  const Simulation& simulation() const { return *sim_; }
+
+  /// The rigid bodies' listener as a BodySource (for viewer frames), or null
+  /// when the scenario has none.
+  const BodySource* bodies() const;
+  /// The Bullet listener, or null when the scenario has no bodies.
+  bullet::BodiesListener* bodies_listener() { return bodies_.get(); }
+  const bullet::BodiesListener* bodies_listener() const { return bodies_.get(); }
+
+  /// After the run: flushes and closes the listeners' files (bodies.csv).
+  /// Throws InputError naming a file that could not be written.
+  void finish();
+
+ private:
+  std::unique_ptr<Simulation> sim_;
+  std::unique_ptr<bullet::BodiesListener> bodies_;
+};
+
+}  // namespace terracut::session

@@ -1,0 +1,77 @@
+// The rigid bodies as a step listener. See bodies_listener.hpp.
+#include "terracut/bullet/bodies_listener.hpp"
+
+#include <algorithm>
+
+namespace terracut::bullet {
+
+BodiesListener::BodiesListener(Simulation& sim, std::vector<BodySpec> bodies,
+                               const BodiesListenerOptions& options)
+    : sim_(sim), bodies_(std::move(bodies)), options_(options) {
+  world_ = std::make_unique<TerrainWorld>(sim, bodies_, options_.world);
+  // Shapes and sizes never change: kept for the viewer's frames.
+  for (const BodySpec& b : bodies_) half_extents_.push_back(half_extents_m(b));
+  if (!options_.csv_path.empty()) {
+    csv_ = std::make_unique<BodiesCsvWriter>(options_.csv_path);
+    csv_->write_step(*world_);  // the initial state, t = 0
+  }
+  sim_.add_listener(*this);
+}
+
+BodiesListener::~BodiesListener() { sim_.remove_listener(*this); }
+
+Vec3 BodiesListener::on_step(const StepOutput& out) noexcept {
+  world_->step(out);
+  if (csv_) csv_->write_step(*world_);
+  const WorldStepInfo& info = world_->last();
+  peak_tool_force_n_ = std::max(peak_tool_force_n_, length(info.tool_force_n));
+  if (info.tool_contact_points > 0) ++steps_touching_;
+  ++steps_;
+  physics_sum_s_ += info.physics_s;
+  physics_max_s_ = std::max(physics_max_s_, info.physics_s);
+  return info.tool_force_n;
+}
+
+void BodiesListener::on_lift() noexcept { world_->lift_tool(); }
+
+int BodiesListener::write_bodies(std::span<BodyView> out) const noexcept {
+  const int n = std::min(world_->body_count(), int(out.size()));
+  for (int i = 0; i < n; ++i) {
+    const BodyState s = world_->body_state(i);
+    BodyView& v = out[std::size_t(i)];
+    v.shape = bodies_[std::size_t(i)].shape;
+    v.half_extents_m = half_extents_[std::size_t(i)];
+    v.position_m = s.position_m;
+    v.orientation = s.orientation;
+    v.active = s.active;
+  }
+  return n;
+}
+
+void BodiesListener::finish() {
+  if (csv_) csv_->close();
+}
+
+std::string BodiesListener::csv_name() const {
+  return options_.csv_path.empty() ? std::string() : options_.csv_path.filename().string();
+}
+
+BodiesReport BodiesListener::report() const {
+  BodiesReport r;
+  r.count = int(bodies_.size());
+  r.peak_tool_force_n = peak_tool_force_n_;
+  r.steps_touching_tool = steps_touching_;
+  r.steps = steps_;
+  r.physics_mean_s = steps_ > 0 ? physics_sum_s_ / double(steps_) : 0.0;
+  r.physics_max_s = physics_max_s_;
+  r.min_height_m = world_->bounds().min_height_m;
+  r.max_height_m = world_->bounds().max_height_m;
+  r.samples_clamped = world_->bounds().clamped_total;
+  for (int i = 0; i < world_->body_count(); ++i) {
+    r.names.push_back(bodies_[std::size_t(i)].name);
+    r.final_position_m.push_back(world_->body_state(i).position_m);
+  }
+  return r;
+}
+
+}  // namespace terracut::bullet

@@ -1,0 +1,58 @@
+// The simulated world of a run. See world.hpp.
+#include "terracut/session/world.hpp"
+
+#include "terracut/core/error.hpp"
+
+#ifdef TERRACUT_HAVE_BULLET
+#include "terracut/bullet/bodies_listener.hpp"
+#else
+namespace terracut::bullet {
+class BodiesListener {};  // never built: a world with bodies throws without Bullet
+}  // namespace terracut::bullet
+#endif
+
+namespace terracut::session {
+
+#ifdef TERRACUT_HAVE_BULLET
+bool bodies_available() { return true; }
+#else
+bool bodies_available() { return false; }
+#endif
+
+std::string bodies_unavailable_message() {
+  return "bodies: this terracut was built without Bullet (libbullet-dev was not found when it "
+         "was configured), so the scenario's rigid bodies cannot be simulated; install "
+         "libbullet-dev and rebuild, or remove the `bodies:` list";
+}
+
+World::World(const Scenario& scenario, const WorldOptions& options) {
+  const io::Scenario& sc = scenario.base;
+  sim_ = std::make_unique<Simulation>(io::sim_params(sc, options.rate_hz),
+                                      io::build_initial_heights(sc));
+  if (scenario.bodies.empty()) return;
+#ifdef TERRACUT_HAVE_BULLET
+  bullet::BodiesListenerOptions bo;
+  bo.csv_path = options.bodies_csv;
+  bodies_ = std::make_unique<bullet::BodiesListener>(*sim_, scenario.bodies, bo);
+#else
+  throw InputError(bodies_unavailable_message());
+#endif
+}
+
+World::~World() = default;
+
+const BodySource* World::bodies() const {
+#ifdef TERRACUT_HAVE_BULLET
+  return bodies_.get();
+#else
+  return nullptr;
+#endif
+}
+
+void World::finish() {
+#ifdef TERRACUT_HAVE_BULLET
+  if (bodies_) bodies_->finish();
+#endif
+}
+
+}  // namespace terracut::session
