@@ -15,12 +15,17 @@
 #include "terracut/core/error.hpp"
 #include "terracut/io/bodies_yaml.hpp"
 #include "terracut/io/haptics_yaml.hpp"
-#include "yaml_util.hpp"
+#include "terracut/io/yaml_reader.hpp"
 
 namespace terracut::io {
 namespace {
 
-using detail::describe;
+using yaml::child_path;
+using yaml::Context;
+using yaml::Field;
+using yaml::format_number;
+using yaml::join;
+using yaml::Map;
 
 // Largest scenario file read (a scenario is a few kilobytes; this only stops a
 // wrong path to a huge file from being read into memory).
@@ -31,8 +36,6 @@ constexpr double kMaxStepsPerCut = 1e8;
 /// Largest number of steps of a whole run (the sequence); each step is a row
 /// of contact.csv (about 200 bytes), so 1e8 steps is about 20 GB.
 constexpr double kMaxStepsPerRun = 1e8;
-/// Largest magnitude of any number in a scenario file.
-constexpr double kMaxMagnitude = 1e9;
 
 // Steps of the whole sequence: each cut runs round(duration * rate) + 1 steps.
 double sequence_steps(const Scenario& sc) {
@@ -42,221 +45,6 @@ double sequence_steps(const Scenario& sc) {
   return total;
 }
 constexpr double kMaxRateHz = 1e6;
-
-std::string join(const std::vector<std::string>& items, std::string_view sep = ", ") {
-  std::string out;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    if (i) out += sep;
-    out += items[i];
-  }
-  return out;
-}
-
-std::string format_number(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
-
-// Where an error is reported: the file and the 1-based line of a YAML mark.
-struct Context {
-  std::string file;
-
-  std::string where(const YAML::Mark& mark) const {
-    if (mark.is_null() || mark.line < 0) return file;
-    return file + ":" + std::to_string(mark.line + 1);
-  }
-  [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path,
-                         const std::string& what) const {
-    throw InputError(where(mark) + ": " + (path.empty() ? std::string() : path + ": ") + what);
-  }
-};
-
-std::string child_path(const std::string& parent, std::string_view key) {
-  return parent.empty() ? std::string(key) : parent + "." + std::string(key);
-}
-
-// One value in the document with its field path and a line to report (its own
-// mark, or the mark of its key when the value has none).
-class Field {
- public:
-  // fallback: the mark of the key that introduced the value (or of the list
-  // holding it), used when the value has no mark of its own and for errors
-  // about fields missing inside it.
-  Field(const Context& ctx, YAML::Node node, std::string path, YAML::Mark fallback)
-      : ctx_(&ctx), node_(std::move(node)), path_(std::move(path)), fallback_(fallback) {}
-
-  const YAML::Node& node() const { return node_; }
-  const std::string& path() const { return path_; }
-  const Context& ctx() const { return *ctx_; }
-  YAML::Mark mark() const {
-    YAML::Mark m = node_.Mark();
-    return m.is_null() ? fallback_ : m;
-  }
-  // Where the field is introduced: its key's line for a mapping value.
-  YAML::Mark key_mark() const { return fallback_.is_null() ? mark() : fallback_; }
-  [[noreturn]] void fail(const std::string& what) const { ctx_->fail(mark(), path_, what); }
-
-  bool is_sequence() const { return node_.IsSequence(); }
-  bool is_scalar() const { return node_.IsScalar(); }
-
-  std::string string() const {
-    if (!node_.IsScalar()) fail("expected a text value, got " + describe(node_));
-    return node_.Scalar();
-  }
-
-  double number() const {
-    if (!node_.IsScalar()) fail("expected a number, got " + describe(node_));
-    double v = 0.0;
-    try {
-      v = node_.as<double>();
-    } catch (const YAML::Exception&) {
-      fail("expected a number, got " + describe(node_));
-    }
-    if (!std::isfinite(v)) fail("must be a finite number, got " + describe(node_));
-    // No length, height, time or rate in a scenario comes near 1e9 in SI
-    // units; larger values would overflow float heights or volumes.
-    if (std::abs(v) > kMaxMagnitude)
-      fail("must be within +-1e9 (SI units), got " + describe(node_));
-    return v;
-  }
-
-  double positive() const {
-    const double v = number();
-    if (!(v > 0.0)) fail("must be > 0, got " + format_number(v));
-    return v;
-  }
-
-  double non_negative() const {
-    const double v = number();
-    if (!(v >= 0.0)) fail("must be >= 0, got " + format_number(v));
-    return v;
-  }
-
-  long long integer() const {
-    if (!node_.IsScalar()) fail("expected a whole number, got " + describe(node_));
-    const std::string& s = node_.Scalar();
-    long long v = 0;
-    const char* first = s.data();
-    const char* last = s.data() + s.size();
-    if (first != last && *first == '+') ++first;
-    const auto [ptr, ec] = std::from_chars(first, last, v);
-    if (ec == std::errc::result_out_of_range) fail("whole number " + describe(node_) + " is out of range");
-    if (ec != std::errc() || ptr != last || first == last)
-      fail("expected a whole number, got " + describe(node_));
-    return v;
-  }
-
-  // Elements of a list, each with its path "path[i]".
-  std::vector<Field> elements() const {
-    if (!node_.IsSequence()) fail("expected a list, got " + describe(node_));
-    std::vector<Field> out;
-    std::size_t i = 0;
-    for (const auto& element : node_) {
-      const YAML::Mark m = element.Mark().is_null() ? mark() : element.Mark();
-      out.emplace_back(*ctx_, element, path_ + "[" + std::to_string(i) + "]", m);
-      ++i;
-    }
-    return out;
-  }
-
-  // A list of exactly n finite numbers.
-  std::vector<double> numbers(std::size_t n) const {
-    if (!node_.IsSequence())
-      fail("expected a list of " + std::to_string(n) + " numbers, got " + describe(node_));
-    const std::vector<Field> items = elements();
-    if (items.size() != n)
-      fail("expected a list of " + std::to_string(n) + " numbers, got " +
-           std::to_string(items.size()));
-    std::vector<double> out;
-    for (const Field& f : items) out.push_back(f.number());
-    return out;
-  }
-
- private:
-  const Context* ctx_;
-  YAML::Node node_;
-  std::string path_;
-  YAML::Mark fallback_;
-};
-
-// A mapping with a fixed set of allowed keys. Unknown and repeated keys are
-// refused at construction. Values are looked up without yaml-cpp's operator[]
-// (which would invent missing nodes).
-class Map {
- public:
-  Map(const Field& field, std::vector<std::string_view> allowed)
-      : field_(field), allowed_(std::move(allowed)) {
-    const YAML::Node& node = field.node();
-    if (!node.IsMap())
-      field.fail("expected a mapping with keys " + allowed_list() + ", got " +
-                 describe(node));
-    for (const auto& kv : node) {
-      const YAML::Node& key = kv.first;
-      YAML::Mark key_mark = key.Mark().is_null() ? field.mark() : key.Mark();
-      if (!key.IsScalar())
-        field.ctx().fail(key_mark, field.path(), "keys must be plain names, got " +
-                                                     describe(key));
-      const std::string name = key.Scalar();
-      const std::string path = child_path(field.path(), name);
-      if (std::find(allowed_.begin(), allowed_.end(), name) == allowed_.end())
-        field.ctx().fail(key_mark, path, "unknown key '" + name + "'; allowed keys here: " +
-                                             allowed_list());
-      for (const Entry& e : entries_)
-        if (e.name == name)
-          field.ctx().fail(key_mark, path,
-                           "key given twice (first at line " + std::to_string(e.key_mark.line + 1) +
-                               ")");
-      entries_.push_back({name, key_mark, kv.second});
-    }
-  }
-
-  const Field& field() const { return field_; }
-
-  bool has(std::string_view key) const { return find(key) != nullptr; }
-
-  // The value of key, or nullopt. A key given with no value ("key:") is an error.
-  std::optional<Field> get(std::string_view key) const {
-    const Entry* e = find(key);
-    if (!e) return std::nullopt;
-    const std::string path = child_path(field_.path(), key);
-    if (e->value.IsNull()) field_.ctx().fail(e->key_mark, path, "no value given");
-    return Field(field_.ctx(), e->value, path, e->key_mark);
-  }
-
-  Field require(std::string_view key) const {
-    std::optional<Field> f = get(key);
-    if (!f)
-      field_.ctx().fail(field_.key_mark(), child_path(field_.path(), key),
-                        "missing required field '" + std::string(key) + "'" +
-                            (field_.path().empty() ? std::string()
-                                                   : " in '" + field_.path() + "'"));
-    return *f;
-  }
-
- private:
-  struct Entry {
-    std::string name;
-    YAML::Mark key_mark;
-    YAML::Node value;
-  };
-
-  const Entry* find(std::string_view key) const {
-    for (const Entry& e : entries_)
-      if (e.name == key) return &e;
-    return nullptr;
-  }
-
-  std::string allowed_list() const {
-    std::vector<std::string> names(allowed_.begin(), allowed_.end());
-    return join(names);
-  }
-
-  Field field_;
-  std::vector<std::string_view> allowed_;
-  std::vector<Entry> entries_;
-};
 
 void check_resolution(const Field& f, long long cols, long long rows) {
   if (cols < 1 || rows < 1)
@@ -286,6 +74,15 @@ Resolution parse_resolution_field(const Field& f) {
   return {int(cols), int(rows)};
 }
 
+// A point [x, z] of the ground plane, read when key is given.
+void read_xz(const Map& map, std::string_view key, double& x_m, double& z_m) {
+  if (const auto f = map.get(key)) {
+    const std::vector<double> v = f->numbers(2);
+    x_m = v[0];
+    z_m = v[1];
+  }
+}
+
 bool valid_cut_name(const std::string& name) {
   if (name.empty()) return false;
   for (char ch : name) {
@@ -295,8 +92,16 @@ bool valid_cut_name(const std::string& name) {
   return true;
 }
 
-void parse_terrain(const Context& ctx, const Field& field, const std::filesystem::path& base_dir,
-                   Scenario& sc) {
+// An image terrain whose file is read once the rest of the document is
+// checked (a mistake anywhere is reported before a large image is decoded).
+struct PendingImage {
+  Field image;
+  std::optional<Resolution> resolution;
+};
+
+// The terrain block; a generator terrain is complete on return, an image
+// terrain is returned to read_terrain_image.
+std::optional<PendingImage> parse_terrain(const Context& ctx, const Field& field, Scenario& sc) {
   const Map terrain(field, {"image", "generator", "resolution", "size_m", "origin_m",
                             "full_scale_m", "mound", "box", "plane"});
   const std::optional<Field> image = terrain.get("image");
@@ -308,27 +113,21 @@ void parse_terrain(const Context& ctx, const Field& field, const std::filesystem
              "missing 'image' or 'generator' (one of them is required)");
 
   // Extent, origin and full scale.
-  const std::vector<double> size = terrain.require("size_m").numbers(2);
-  for (int i = 0; i < 2; ++i)
-    if (!(size[i] > 0.0))
-      terrain.require("size_m").elements()[i].fail("must be > 0, got " + format_number(size[i]));
-  sc.size_x_m = size[0];
-  sc.size_z_m = size[1];
-  if (const auto origin = terrain.get("origin_m")) {
-    const std::vector<double> o = origin->numbers(3);
-    sc.origin_m = {o[0], o[1], o[2]};
-  }
+  const Field size = terrain.require("size_m");
+  size.numbers(2);  // the shape first: a list of two numbers
+  const std::vector<Field> sides = size.elements();
+  sc.size_x_m = sides[0].positive();
+  sc.size_z_m = sides[1].positive();
+  if (const auto origin = terrain.get("origin_m")) sc.origin_m = origin->vec3();
   sc.full_scale_m = terrain.require("full_scale_m").positive();
 
   std::optional<Resolution> resolution;
   if (const auto res = terrain.get("resolution")) resolution = parse_resolution_field(*res);
 
   std::optional<GeneratorKind> kind;
-  if (generator) {
-    const std::string kind_name = generator->string();
-    kind = parse_generator_kind(kind_name);
-    if (!kind) generator->fail("unknown generator '" + kind_name + "'; allowed: mound, box, plane");
-  }
+  if (generator)
+    kind = generator->choice({GeneratorKind::kMound, GeneratorKind::kBox, GeneratorKind::kPlane},
+                             "generator");
 
   // Generator parameter blocks are only accepted with their generator.
   for (std::string_view block : {"mound", "box", "plane"}) {
@@ -348,25 +147,13 @@ void parse_terrain(const Context& ctx, const Field& field, const std::filesystem
     Generator gen = default_generator(*kind, grid_spec(sc));
     if (const auto m = terrain.get("mound")) {
       const Map mound(*m, {"centre_m", "radius_m"});
-      if (const auto c = mound.get("centre_m")) {
-        const std::vector<double> v = c->numbers(2);
-        gen.mound.centre_x_m = v[0];
-        gen.mound.centre_z_m = v[1];
-      }
+      read_xz(mound, "centre_m", gen.mound.centre_x_m, gen.mound.centre_z_m);
       if (const auto r = mound.get("radius_m")) gen.mound.radius_m = r->positive();
     }
     if (const auto b = terrain.get("box")) {
       const Map box(*b, {"min_m", "max_m"});
-      if (const auto lo = box.get("min_m")) {
-        const std::vector<double> v = lo->numbers(2);
-        gen.box.min_x_m = v[0];
-        gen.box.min_z_m = v[1];
-      }
-      if (const auto hi = box.get("max_m")) {
-        const std::vector<double> v = hi->numbers(2);
-        gen.box.max_x_m = v[0];
-        gen.box.max_z_m = v[1];
-      }
+      read_xz(box, "min_m", gen.box.min_x_m, gen.box.min_z_m);
+      read_xz(box, "max_m", gen.box.max_x_m, gen.box.max_z_m);
       if (!(gen.box.min_x_m <= gen.box.max_x_m) || !(gen.box.min_z_m <= gen.box.max_z_m))
         b->fail("min_m must be <= max_m in X and in Z");
     }
@@ -377,31 +164,35 @@ void parse_terrain(const Context& ctx, const Field& field, const std::filesystem
     const std::string problem = validate(gen);
     if (!problem.empty()) generator->fail(problem);
     sc.generator = gen;
-    return;
+    return std::nullopt;
   }
+  return PendingImage{*image, resolution};
+}
 
-  // Image terrain: the path is relative to the scenario's folder.
-  const std::string relative = image->string();
-  if (relative.empty()) image->fail("the image path is empty");
+// Image terrain: the path is relative to the scenario's folder.
+void read_terrain_image(const PendingImage& pending, const std::filesystem::path& base_dir,
+                        Scenario& sc) {
+  const Field& image = pending.image;
+  const std::string relative = image.text();
+  if (relative.empty()) image.fail("the image path is empty");
   std::filesystem::path path(relative);
   if (path.is_relative()) path = base_dir / path;
   std::error_code ec;
   if (!std::filesystem::exists(path, ec))
-    image->fail("image file '" + path.string() + "' not found (relative paths are read from the "
-                "scenario file's folder)");
+    image.fail("image file '" + path.string() + "' not found (relative paths are read from the "
+               "scenario file's folder)");
   if (!std::filesystem::is_regular_file(path, ec))
-    image->fail("image '" + path.string() + "' is not a regular file");
+    image.fail("image '" + path.string() + "' is not a regular file");
   try {
     sc.image = read_png(path);
   } catch (const InputError& e) {
-    image->fail(std::string("cannot read image: ") + e.what());
+    image.fail(std::string("cannot read image: ") + e.what());
   }
   sc.image_path = path;
-  if (resolution) {
-    sc.resolution = *resolution;
+  if (pending.resolution) {
+    sc.resolution = *pending.resolution;
   } else {
-    const Field f = *image;
-    check_resolution(f, sc.image.cols, sc.image.rows);
+    check_resolution(image, sc.image.cols, sc.image.rows);
     sc.resolution = {sc.image.cols, sc.image.rows};
   }
 }
@@ -417,7 +208,7 @@ ParsedCut parse_cut(const Field& field) {
   const Map cut(field, {"name", "keyframes"});
   Motion motion;
   const Field name = cut.require("name");
-  motion.name = name.string();
+  motion.name = name.text();
   if (!valid_cut_name(motion.name))
     name.fail("cut name '" + motion.name +
               "' must be non-empty and use only letters, digits, '_', '-' and '.'");
@@ -434,13 +225,9 @@ ParsedCut parse_cut(const Field& field) {
     if (!motion.keyframes.empty() && !(k.t_s > motion.keyframes.back().t_s))
       t.fail("t_s " + format_number(k.t_s) + " is not after the previous keyframe's " +
              format_number(motion.keyframes.back().t_s) + " (times must strictly increase)");
-    const std::vector<double> p = kf.require("position_m").numbers(3);
-    k.pose.position_m = {p[0], p[1], p[2]};
+    k.pose.position_m = kf.require("position_m").vec3();
     Vec3 euler{};
-    if (const auto r = kf.get("rotation_deg")) {
-      const std::vector<double> v = r->numbers(3);
-      euler = {v[0], v[1], v[2]};
-    }
+    kf.read_vec3("rotation_deg", euler);
     k.pose.orientation = quat_from_euler_deg(euler);
     motion.keyframes.push_back(k);
     last_t = t;
@@ -462,17 +249,14 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
                             "cuts", "sequence", "reference", "bodies", "haptics"});
 
   if (const auto f = top.get("name")) {
-    sc.name = f->string();
+    sc.name = f->text();
     if (sc.name.empty()) f->fail("the name is empty");
   }
-  if (const auto f = top.get("description")) sc.description = f->string();
+  if (const auto f = top.get("description")) sc.description = f->text();
 
-  if (const auto f = top.get("representation")) {
-    const std::string rep = f->string();
-    const std::optional<Representation> parsed = parse_representation(rep);
-    if (!parsed) f->fail("unknown representation '" + rep + "'; allowed: surface, columns");
-    sc.representation = *parsed;
-  }
+  if (const auto f = top.get("representation"))
+    sc.representation =
+        f->choice({Representation::kSurface, Representation::kColumns}, "representation");
   if (const auto f = top.get("rate_hz")) {
     sc.rate_hz = f->positive();
     if (sc.rate_hz > kMaxRateHz) f->fail("rate_hz above 1e6 is absurd, got " + format_number(sc.rate_hz));
@@ -481,7 +265,7 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
   const Map blade(top.require("blade"), {"length_m"});
   sc.blade.length_m = blade.require("length_m").positive();
 
-  parse_terrain(ctx, top.require("terrain"), source_name.parent_path(), sc);
+  const std::optional<PendingImage> image = parse_terrain(ctx, top.require("terrain"), sc);
 
   // Cuts: unique names, and a bounded number of steps each.
   const Field cuts = top.require("cuts");
@@ -506,7 +290,7 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     const std::vector<Field> items = f->elements();
     if (items.empty()) f->fail("the sequence is empty; leave it out to run the cuts as listed");
     for (const Field& item : items) {
-      const std::string name = item.string();
+      const std::string name = item.text();
       const int index = sc.find_cut(name);
       if (index < 0) {
         std::vector<std::string> names;
@@ -526,9 +310,9 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
   }
 
   // Rigid bodies (format in bodies_yaml.hpp); an empty list is allowed.
-  if (const auto f = top.get("bodies")) sc.bodies = parse_bodies(f->node(), ctx.file);
+  if (const auto f = top.get("bodies")) sc.bodies = parse_bodies(f->node(), ctx.file());
   // The haptic loop's settings (format in haptics_yaml.hpp).
-  if (const auto f = top.get("haptics")) sc.haptics = parse_haptics(f->node(), ctx.file);
+  if (const auto f = top.get("haptics")) sc.haptics = parse_haptics(f->node(), ctx.file());
 
   if (const auto f = top.get("reference")) {
     const Map reference(*f, {"mound"});
@@ -541,6 +325,9 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     shape.height_m = mound.require("height_m").positive();
     sc.reference_mound = shape;
   }
+
+  // Last, once everything else is known to be valid: the (possibly large) image.
+  if (image) read_terrain_image(*image, source_name.parent_path(), sc);
   return sc;
 }
 
@@ -563,13 +350,8 @@ std::vector<std::string> Scenario::sequence_names() const {
 }
 
 Scenario parse_scenario(const std::string& text, const std::filesystem::path& source_name) {
-  const Context ctx{source_name.string()};
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    ctx.fail(e.mark, "", "malformed YAML: " + e.msg);
-  }
+  const Context ctx(source_name.string());
+  const YAML::Node root = yaml::parse_text(ctx, text);
   try {
     return parse_document(ctx, root, source_name);
   } catch (const YAML::Exception& e) {
