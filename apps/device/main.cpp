@@ -47,7 +47,7 @@ struct Options {
 
 int run(const Options& opt) {
   const session::Scenario input = session::load_scenario(opt.scenario);
-  const HapticSettings& s = input.haptics;
+  const haptics::HapticSettings& s = input.haptics;
   const io::Scenario& sc = input.base;
 
   // The cut to follow (as the loop's script and sim devices do).

@@ -165,7 +165,7 @@ Command add_haptics_command(CLI::App& app) {
     if (session.world().bodies())
       say(std::to_string(input.bodies.size()) +
           " rigid bodies (Bullet) on the terrain: their force on the blade is felt");
-    if (session.device_kind() == DeviceKind::kUdp)
+    if (session.device_kind() == haptics::DeviceKind::kUdp)
       say("listening for a device on udp " + session.loop().settings().udp.address + ":" +
           std::to_string(session.udp_port()) +
           " (the session clock runs from now; until poses arrive the force is zero and the "

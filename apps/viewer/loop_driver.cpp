@@ -9,12 +9,12 @@
 
 namespace terracut::viewer {
 
-HapticSettings viewer_settings(HapticSettings settings) {
+haptics::HapticSettings viewer_settings(haptics::HapticSettings settings) {
   settings.tool_rotation_deg.reset();
   return settings;
 }
 
-LoopDriver::LoopDriver(const session::Scenario& scenario, const HapticSettings& settings,
+LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticSettings& settings,
                        const DriverOptions& options, LoopTiming* timing)
     : scenario_(scenario),
       params_(settings, scenario.base.blade),

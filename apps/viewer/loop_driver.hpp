@@ -28,7 +28,7 @@
 #include <thread>
 #include <vector>
 
-#include "terracut/core/haptic_settings.hpp"
+#include "terracut/haptics/settings.hpp"
 #include "terracut/haptics/loop.hpp"
 #include "terracut/haptics/snapshot.hpp"
 #include "terracut/io/scenario.hpp"
@@ -61,7 +61,7 @@ class LoopDriver {
   /// (paced mode; may be shared by successive sessions), or nullptr.
   /// settings: the haptic settings to run with (the viewer's, which may
   /// differ from scenario.haptics after the panel's edits).
-  LoopDriver(const session::Scenario& scenario, const HapticSettings& settings,
+  LoopDriver(const session::Scenario& scenario, const haptics::HapticSettings& settings,
              const DriverOptions& options, LoopTiming* timing);
   ~LoopDriver();
   LoopDriver(const LoopDriver&) = delete;
@@ -82,7 +82,7 @@ class LoopDriver {
   /// The loop's force model (const after construction).
   const ForceModel& force_model() const { return params_.force_model(); }
   /// The settings in use (validated, derived fields filled in).
-  const HapticSettings& settings() const { return params_.settings(); }
+  const haptics::HapticSettings& settings() const { return params_.settings(); }
   const Tour& tour() const { return tour_; }
   /// Ticks that play the whole script once: round(duration * rate) + 1.
   std::int64_t script_ticks() const { return script_ticks_; }
@@ -125,6 +125,6 @@ class LoopDriver {
 /// The haptic settings the viewer uses: the scenario's `haptics:` section (or
 /// the defaults), with a fixed tool rotation dropped (the viewer's device
 /// gives the orientation, so the keys can turn the tool).
-HapticSettings viewer_settings(HapticSettings settings);
+haptics::HapticSettings viewer_settings(haptics::HapticSettings settings);
 
 }  // namespace terracut::viewer

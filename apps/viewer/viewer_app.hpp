@@ -148,7 +148,7 @@ class ViewerApp {
   ViewerOptions options_;
   session::Scenario base_scenario_;  // as loaded (overrides applied)
   session::Scenario scenario_;       // the running session's
-  HapticSettings haptics_;
+  haptics::HapticSettings haptics_;
   DriverOptions driver_options_;
   LoopTiming timing_;  // the loop's period and compute time, shared by sessions
   std::unique_ptr<LoopDriver> driver_;
@@ -169,7 +169,7 @@ class ViewerApp {
   // Panel edits that apply on "Apply (reset)".
   Representation pending_representation_ = Representation::kSurface;
   int pending_resolution_[2] = {0, 0};
-  HapticSettings pending_haptics_;
+  haptics::HapticSettings pending_haptics_;
   int pending_soil_ = 0;  // index of SoilPreset
   std::string panel_error_;
 

@@ -13,8 +13,6 @@
 #include <system_error>
 
 #include "terracut/core/error.hpp"
-#include "terracut/io/bodies_yaml.hpp"
-#include "terracut/io/haptics_yaml.hpp"
 #include "terracut/io/yaml_reader.hpp"
 
 namespace terracut::io {
@@ -236,7 +234,8 @@ ParsedCut parse_cut(const Field& field) {
 }
 
 Scenario parse_document(const Context& ctx, const YAML::Node& root,
-                        const std::filesystem::path& source_name) {
+                        const std::filesystem::path& source_name,
+                        std::span<SectionReader* const> sections) {
   Scenario sc;
   sc.source_path = source_name;
   sc.name = source_name.stem().string();
@@ -245,8 +244,11 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
   if (root.IsNull() || !root.IsDefined())
     ctx.fail(YAML::Mark(), "", "the scenario is empty; expected a mapping with 'terrain', "
                                       "'blade' and 'cuts'");
-  const Map top(top_field, {"name", "description", "terrain", "representation", "rate_hz", "blade",
-                            "cuts", "sequence", "reference", "bodies", "haptics"});
+  std::vector<std::string_view> keys = {"name",     "description", "terrain",  "representation",
+                                        "rate_hz",  "blade",       "cuts",     "sequence",
+                                        "reference"};
+  for (const SectionReader* reader : sections) keys.push_back(reader->key());
+  const Map top(top_field, std::move(keys));
 
   if (const auto f = top.get("name")) {
     sc.name = f->text();
@@ -309,10 +311,9 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     top_field.fail(what);
   }
 
-  // Rigid bodies (format in bodies_yaml.hpp); an empty list is allowed.
-  if (const auto f = top.get("bodies")) sc.bodies = parse_bodies(f->node(), ctx.file());
-  // The haptic loop's settings (format in haptics_yaml.hpp).
-  if (const auto f = top.get("haptics")) sc.haptics = parse_haptics(f->node(), ctx.file());
+  // The other layers' sections (e.g. bodies:, haptics:), by their readers.
+  for (SectionReader* reader : sections)
+    if (const auto f = top.get(reader->key())) reader->read(f->node(), ctx.file());
 
   if (const auto f = top.get("reference")) {
     const Map reference(*f, {"mound"});
@@ -349,18 +350,20 @@ std::vector<std::string> Scenario::sequence_names() const {
   return names;
 }
 
-Scenario parse_scenario(const std::string& text, const std::filesystem::path& source_name) {
+Scenario parse_scenario(const std::string& text, const std::filesystem::path& source_name,
+                        std::span<SectionReader* const> sections) {
   const Context ctx(source_name.string());
   const YAML::Node root = yaml::parse_text(ctx, text);
   try {
-    return parse_document(ctx, root, source_name);
+    return parse_document(ctx, root, source_name, sections);
   } catch (const YAML::Exception& e) {
     // Any yaml-cpp error not caught field by field (not expected) still names the place.
     ctx.fail(e.mark, "", "invalid scenario: " + e.msg);
   }
 }
 
-Scenario load_scenario(const std::filesystem::path& path) {
+Scenario load_scenario(const std::filesystem::path& path,
+                       std::span<SectionReader* const> sections) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec))
     throw InputError(path.string() + ": scenario file not found");
@@ -376,7 +379,7 @@ Scenario load_scenario(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw InputError(path.string() + ": error while reading the scenario file");
-  return parse_scenario(text.str(), path);
+  return parse_scenario(text.str(), path, sections);
 }
 
 Resolution parse_resolution(std::string_view text, std::string_view option_name) {

@@ -1,17 +1,40 @@
 // Loading a scenario with all its sections. See scenario.hpp.
 #include "terracut/session/scenario.hpp"
 
+#include "terracut/bullet/bodies_yaml.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/haptics/settings_yaml.hpp"
 #include "terracut/io/image.hpp"
 
 namespace terracut::session {
 
-Scenario load_scenario(const std::filesystem::path& path) {
+namespace {
+
+// Reads a scenario with each of its sections by the reader of the layer that
+// owns it (bodies before haptics: the order in which their errors are found).
+template <class Load>
+Scenario read_with_sections(Load&& load) {
+  bullet::BodiesReader bodies;
+  haptics::SettingsReader settings;
+  io::SectionReader* const sections[] = {&bodies, &settings};
   Scenario out;
-  out.base = io::load_scenario(path);
-  out.haptics = out.base.haptics.value_or(HapticSettings{});
-  out.bodies = out.base.bodies;
+  out.base = load(std::span<io::SectionReader* const>(sections));
+  out.haptics = std::move(settings.settings);
+  out.bodies = std::move(bodies.bodies);
   return out;
+}
+
+}  // namespace
+
+Scenario load_scenario(const std::filesystem::path& path) {
+  return read_with_sections(
+      [&](std::span<io::SectionReader* const> sections) { return io::load_scenario(path, sections); });
+}
+
+Scenario parse_scenario(const std::string& text, const std::filesystem::path& source_name) {
+  return read_with_sections([&](std::span<io::SectionReader* const> sections) {
+    return io::parse_scenario(text, source_name, sections);
+  });
 }
 
 Scenario heightmap_scenario(const std::filesystem::path& png, double extent_m,

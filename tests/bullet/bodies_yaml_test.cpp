@@ -7,14 +7,14 @@
 
 #include "terracut/core/bodies.hpp"
 #include "terracut/core/error.hpp"
-#include "terracut/io/bodies_yaml.hpp"
+#include "terracut/bullet/bodies_yaml.hpp"
 
 namespace terracut {
 namespace {
 
 std::vector<BodySpec> parse(const std::string& text) {
   const YAML::Node root = YAML::Load(text);
-  return io::parse_bodies(root["bodies"], "scene.yaml");
+  return bullet::parse_bodies(root["bodies"], "scene.yaml");
 }
 
 // The message of the InputError that parsing text throws ("" if none).

@@ -1,6 +1,6 @@
 // Runs a scenario with rigid bodies end to end, in memory, the way `terracut
-// run` drives the Bullet world: load_scenario reads `bodies:` into
-// Scenario::bodies; then the bodies' listener (bullet/bodies_listener.hpp)
+// run` drives the Bullet world: load_scenario reads `bodies:` with the
+// bodies' own reader (BodiesReader); then the bodies' listener (bullet/bodies_listener.hpp)
 // on the Simulation, which lifts its plate with sim.lift(), steps the world
 // at the end of each sim.step and writes DIR/bodies.csv. Used by the rescue
 // test, which checks every step's body states.
@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "terracut/bullet/bodies_listener.hpp"
+#include "terracut/bullet/bodies_yaml.hpp"
 #include "terracut/io/scenario.hpp"
 
 namespace terracut::test {
@@ -33,10 +34,27 @@ struct BodiesRun {
   }
 };
 
+/// A scenario and its `bodies:` list.
+struct BodiesScenario {
+  io::Scenario base;
+  std::vector<BodySpec> bodies;
+};
+
+/// Reads a scenario file with its `bodies:` section.
+inline BodiesScenario load_with_bodies(const std::filesystem::path& path) {
+  bullet::BodiesReader reader;
+  io::SectionReader* const sections[] = {&reader};
+  BodiesScenario out;
+  out.base = io::load_scenario(path, sections);
+  out.bodies = std::move(reader.bodies);
+  return out;
+}
+
 /// Runs the scenario's sequence with its bodies; writes out_dir/bodies.csv
 /// when out_dir is not empty.
-inline BodiesRun run_with_bodies(const io::Scenario& sc, const std::filesystem::path& out_dir,
+inline BodiesRun run_with_bodies(const BodiesScenario& input, const std::filesystem::path& out_dir,
                                  const bullet::TerrainWorldParams& params = {}) {
+  const io::Scenario& sc = input.base;
   Simulation sim(io::sim_params(sc), io::build_initial_heights(sc));
   bullet::BodiesListenerOptions options;
   options.world = params;
@@ -44,11 +62,11 @@ inline BodiesRun run_with_bodies(const io::Scenario& sc, const std::filesystem::
     std::filesystem::create_directories(out_dir);
     options.csv_path = out_dir / "bodies.csv";
   }
-  bullet::BodiesListener listener(sim, sc.bodies, options);
+  bullet::BodiesListener listener(sim, input.bodies, options);
   const bullet::TerrainWorld& world = listener.world();
 
   BodiesRun run;
-  run.bodies = sc.bodies;
+  run.bodies = input.bodies;
   auto record = [&](int sequence_index) {
     run.t_s.push_back(world.time_s());
     run.sequence_index.push_back(sequence_index);

@@ -34,11 +34,12 @@ int index_of(const BodiesRun& run, const std::string& name) {
 class Rescue {
  public:
   Rescue()
-      : input_(io::load_scenario(std::filesystem::path(TERRACUT_SOURCE_DIR) /
-                                 "scenarios/rescue.yaml")),
+      : file_(load_with_bodies(std::filesystem::path(TERRACUT_SOURCE_DIR) /
+                               "scenarios/rescue.yaml")),
+        input_(file_.base),
         dir_(std::filesystem::temp_directory_path() /
              ("terracut_rescue_" + std::to_string(::getpid()))),
-        run_(run_with_bodies(input_, dir_)) {}
+        run_(run_with_bodies(file_, dir_)) {}
   ~Rescue() { std::filesystem::remove_all(dir_); }
 
   void writes_bodies_csv();
@@ -59,7 +60,8 @@ class Rescue {
   // Resting tolerance: the bodies' collision margin (see terrain_world_test).
   static double tol() { return bullet::TerrainWorldParams{}.convex_margin_m; }
 
-  io::Scenario input_;
+  BodiesScenario file_;
+  const io::Scenario& input_;
   std::filesystem::path dir_;
   BodiesRun run_;
 };

@@ -11,7 +11,7 @@
 #include "terracut/core/step_listener.hpp"
 #include "terracut/haptics/device.hpp"
 #include "terracut/haptics/loop.hpp"
-#include "terracut/io/haptics_yaml.hpp"
+#include "terracut/haptics/settings_yaml.hpp"
 #include "terracut/io/scenario.hpp"
 
 namespace terracut::haptics::test {
@@ -26,8 +26,17 @@ struct HapticScenario {
   HapticSettings haptics;
 };
 
+/// Reads a scenario file with its `haptics:` section.
+inline HapticScenario load_with_haptics(const std::filesystem::path& path) {
+  SettingsReader reader;
+  io::SectionReader* const sections[] = {&reader};
+  HapticScenario out{io::load_scenario(path, sections), {}};
+  out.haptics = reader.settings;
+  return out;
+}
+
 inline const HapticScenario& trench() {
-  static const HapticScenario s{io::load_scenario(trench_path()), io::load_haptics(trench_path())};
+  static const HapticScenario s = load_with_haptics(trench_path());
   return s;
 }
 

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "terracut/core/error.hpp"
-#include "terracut/core/haptic_settings.hpp"
+#include "terracut/core/contact.hpp"
 
 namespace terracut::io::yaml {
 namespace {
@@ -169,13 +169,13 @@ TEST(YamlReader, TextAndBooleans) {
 }
 
 TEST(YamlReader, ChoicesListTheAllowedNames) {
-  EXPECT_EQ(value_of("v: udp").choice({DeviceKind::kScript, DeviceKind::kSim, DeviceKind::kUdp}),
-            DeviceKind::kUdp);
+  EXPECT_EQ(value_of("v: columns").choice({Representation::kSurface, Representation::kColumns}),
+            Representation::kColumns);
   EXPECT_EQ(error_of([] {
-              value_of("v: falcon").choice({DeviceKind::kScript, DeviceKind::kSim, DeviceKind::kUdp},
-                                           "device");
+              value_of("v: voxels").choice({Representation::kSurface, Representation::kColumns},
+                                           "representation");
             }),
-            "doc.yaml:1: v: unknown device 'falcon'; allowed: script, sim, udp");
+            "doc.yaml:1: v: unknown representation 'voxels'; allowed: surface, columns");
   EXPECT_EQ(value_of("v: b").choose({"a", "b"}), 1u);
   EXPECT_EQ(error_of([] { value_of("v: c").choose({"a", "b"}); }),
             "doc.yaml:1: v: unknown value 'c'; allowed: a, b");

@@ -59,7 +59,7 @@ RockRun run_rock(bool with_bodies, const fs::path& dir) {
   if (!with_bodies) input.bodies.clear();
   fs::create_directories(dir);
   SessionOptions so;
-  so.device = DeviceKind::kScript;
+  so.device = haptics::DeviceKind::kScript;
   so.clock = ClockMode::kFake;
   so.realtime = false;
   const io::Scenario& sc = input.base;
@@ -113,7 +113,7 @@ struct Geometry {
   double mu_m_g;      // the rock's sliding friction force on the sand, N
   Geometry() {
     const io::Scenario& sc = rock_scenario().base;
-    rock = sc.bodies.at(0);
+    rock = rock_scenario().bodies.at(0);
     const bullet::TerrainWorldParams world{};
     touch_z = rock.position_m.z + 0.5 * rock.size_m.z + 0.5 * world.tool.thickness_m;
     const Motion& cut = sc.cuts.at(0);

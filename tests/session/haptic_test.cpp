@@ -61,7 +61,7 @@ TEST(Session, LoadsTheTrenchScenario) {
   EXPECT_EQ(s.base.name, "trench_dry_sand");
   ASSERT_EQ(s.base.cuts.size(), 1u);
   EXPECT_EQ(s.base.cuts[0].name, "trench");
-  EXPECT_EQ(s.haptics.device, DeviceKind::kSim);
+  EXPECT_EQ(s.haptics.device, haptics::DeviceKind::kSim);
   EXPECT_EQ(s.haptics.forces.cutting, CuttingModel::kEarthmoving);
 }
 
@@ -88,10 +88,10 @@ TEST(Session, ScenarioErrorsAfterTheHapticsSectionKeepTheirLine) {
 }
 
 TEST(Session, DeviceOption) {
-  EXPECT_EQ(parse_device_option("script").kind, DeviceKind::kScript);
-  EXPECT_EQ(parse_device_option("sim").kind, DeviceKind::kSim);
+  EXPECT_EQ(parse_device_option("script").kind, haptics::DeviceKind::kScript);
+  EXPECT_EQ(parse_device_option("sim").kind, haptics::DeviceKind::kSim);
   const DeviceOption u = parse_device_option("udp");
-  EXPECT_EQ(u.kind, DeviceKind::kUdp);
+  EXPECT_EQ(u.kind, haptics::DeviceKind::kUdp);
   EXPECT_FALSE(u.address && u.port);
   const DeviceOption a = parse_device_option("udp:127.0.0.1:47001");
   EXPECT_EQ(*a.address, "127.0.0.1");
@@ -111,7 +111,7 @@ TEST(Session, DeviceOption) {
 TEST(Session, RefusesWhatCannotRun) {
   const Scenario& in = test::trench();
   SessionOptions o;
-  o.device = DeviceKind::kUdp;
+  o.device = haptics::DeviceKind::kUdp;
   o.clock = ClockMode::kFake;
   EXPECT_NE(error_of([&] { HapticSession s(in, o); }).find("--clock fake"), std::string::npos);
   Scenario other = in;
@@ -125,7 +125,7 @@ TEST(Session, RefusesWhatCannotRun) {
 
 TEST(Session, ScriptSessionWritesConsistentOutputs) {
   SessionOptions o;
-  o.device = DeviceKind::kScript;
+  o.device = haptics::DeviceKind::kScript;
   HapticSession session(test::trench(), o);
   EXPECT_EQ(session.clock(), ClockMode::kFake);
   session.run();

@@ -79,7 +79,7 @@ TEST(ViewerTour, PlaysEachCutThenRisesOverTheTerrainToTheNext) {
 struct ViewerDeviceTest : ::testing::Test {
   io::Scenario sc = io::parse_scenario(kTwoCuts, "two_cuts.yaml");
   Tour tour{sc, kClearance, kSpeed};
-  WorkspaceMapping mapping{12.0, {0.5, 0.3, 0.5}, 30.0};
+  haptics::WorkspaceMapping mapping{12.0, {0.5, 0.3, 0.5}, 30.0};
   haptics::Workspace ws{mapping};
   static constexpr double kRate = 1000.0;
 

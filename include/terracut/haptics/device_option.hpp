@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-#include "terracut/core/haptic_settings.hpp"
+#include "terracut/haptics/settings.hpp"
 
 namespace terracut::haptics {
 

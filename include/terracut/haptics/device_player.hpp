@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "terracut/core/haptic_settings.hpp"
+#include "terracut/haptics/settings.hpp"
 #include "terracut/haptics/sim_hand.hpp"
 #include "terracut/haptics/udp_device.hpp"
 

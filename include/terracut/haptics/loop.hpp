@@ -35,7 +35,7 @@
 #include <vector>
 
 #include "terracut/core/forces.hpp"
-#include "terracut/core/haptic_settings.hpp"
+#include "terracut/haptics/settings.hpp"
 #include "terracut/core/safety.hpp"
 #include "terracut/core/simulation.hpp"
 #include "terracut/core/stats.hpp"

@@ -15,7 +15,7 @@
 
 #include <cstdint>
 
-#include "terracut/core/haptic_settings.hpp"
+#include "terracut/haptics/settings.hpp"
 #include "terracut/haptics/device.hpp"
 #include "terracut/haptics/script_device.hpp"
 

@@ -1,7 +1,7 @@
 // The mapping between a haptic device's workspace and the world, as haptics
 // frameworks do it: a scale, an offset and a fixed rotation from the
 // device's axes (CHAI3D: x toward the operator, y right, z up) to the world's
-// (Y up). See terracut/core/haptic_settings.hpp for the convention:
+// (Y up). See terracut/haptics/settings.hpp for the convention:
 //
 //   world position = offset + scale * R * device position,  R = Ry(yaw) * P
 //   P: device x -> world +Z, device y -> world +X, device z -> world +Y
@@ -11,7 +11,7 @@
 // about a device axis is a turn about the matching world axis.
 #pragma once
 
-#include "terracut/core/haptic_settings.hpp"
+#include "terracut/haptics/settings.hpp"
 #include "terracut/core/math.hpp"
 
 namespace terracut::haptics {

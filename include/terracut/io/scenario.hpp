@@ -8,20 +8,41 @@
 
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "terracut/core/blade.hpp"
-#include "terracut/core/bodies.hpp"
 #include "terracut/core/contact.hpp"
 #include "terracut/core/generators.hpp"
-#include "terracut/core/haptic_settings.hpp"
 #include "terracut/core/grid.hpp"
 #include "terracut/core/simulation.hpp"
 #include "terracut/io/image.hpp"
 
+namespace YAML {
+class Node;
+}
+
 namespace terracut::io {
+
+/// A reader of one top-level section of a scenario file that belongs to
+/// another layer (`haptics:` to the haptic loop, `bodies:` to the rigid-body
+/// engine): the layer that owns the section provides the reader, and the
+/// scenario loader hands it the section's value while it reads the file, so
+/// its errors carry the file's line numbers. Built with the one YAML
+/// toolkit (io/yaml_reader.hpp), so every section has the same errors and
+/// limits.
+class SectionReader {
+ public:
+  virtual ~SectionReader() = default;
+  /// The section's top-level key, e.g. "haptics".
+  virtual std::string_view key() const = 0;
+  /// Reads the section's value (called at most once, only when the key is
+  /// in the file). file names the scenario in messages. Throws InputError
+  /// "FILE:LINE: key.field: what".
+  virtual void read(const YAML::Node& value, const std::string& file) = 0;
+};
 
 /// Largest accepted total sample count in a scenario (2^28 samples, 3 GiB of
 /// float layers); more is refused as absurd.
@@ -71,16 +92,6 @@ struct Scenario {
   /// Order in which cuts are run: indices into `cuts` (names may repeat).
   std::vector<int> sequence;
 
-  /// Rigid bodies resting on the terrain (`bodies:`, format in
-  /// terracut/io/bodies_yaml.hpp); empty when not given. The core simulation
-  /// ignores them; an engine (the Bullet world) simulates them.
-  std::vector<BodySpec> bodies;
-
-  /// Settings of the haptic loop (`haptics:`, format in
-  /// terracut/io/haptics_yaml.hpp); nullopt when not given (the loop then
-  /// uses HapticSettings' defaults). Only `terracut haptics` reads them.
-  std::optional<HapticSettings> haptics;
-
   /// The exact shape the terrain was made from, for error reports
   /// (`reference: mound:`); nullopt when not given.
   std::optional<MoundShape> reference_mound;
@@ -91,14 +102,18 @@ struct Scenario {
   std::vector<std::string> sequence_names() const;
 };
 
-/// Reads and validates a scenario file. Throws terracut::InputError
+/// Reads and validates a scenario file: its own keys, and the sections of
+/// `sections` (each read by its reader, after the cuts and the sequence; a
+/// top-level key that is neither is refused). Throws terracut::InputError
 /// ("FILE:LINE: field: what") on any problem, including a missing file,
 /// malformed YAML and a missing or unreadable terrain image.
-Scenario load_scenario(const std::filesystem::path& path);
+Scenario load_scenario(const std::filesystem::path& path,
+                       std::span<SectionReader* const> sections = {});
 
 /// Parses scenario text as if it were the file `source_name` (used in error
 /// messages; relative image paths are resolved against its parent folder).
-Scenario parse_scenario(const std::string& text, const std::filesystem::path& source_name);
+Scenario parse_scenario(const std::string& text, const std::filesystem::path& source_name,
+                        std::span<SectionReader* const> sections = {});
 
 /// Command-line overrides: each given value replaces the scenario's. The
 /// sequence is a list of cut names. Throws terracut::InputError naming the

@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "terracut/core/haptic_settings.hpp"
+#include "terracut/haptics/settings.hpp"
 #include "terracut/haptics/device.hpp"
 #include "terracut/haptics/loop.hpp"
 #include "terracut/session/scenario.hpp"
@@ -74,7 +74,7 @@ enum class ClockMode {
 
 /// Command-line choices over the scenario's settings.
 struct SessionOptions {
-  std::optional<DeviceKind> device;        ///< overrides haptics.device
+  std::optional<haptics::DeviceKind> device;        ///< overrides haptics.device
   std::optional<std::string> udp_address;  ///< overrides haptics.udp.address
   std::optional<int> udp_port;             ///< overrides haptics.udp.port (0: any free port)
   std::optional<double> duration_s;        ///< overrides haptics.duration_s, (0, 86400]
@@ -116,7 +116,7 @@ class HapticSession {
   const haptics::Device& device() const { return *device_; }
   /// The UDP device's bound port (udp only; -1 otherwise).
   int udp_port() const;
-  DeviceKind device_kind() const { return kind_; }
+  haptics::DeviceKind device_kind() const { return kind_; }
   ClockMode clock() const { return clock_; }
   double duration_s() const { return duration_s_; }
   /// Warnings collected at build and after the run (rendering limited,
@@ -129,7 +129,7 @@ class HapticSession {
   std::filesystem::path source_;
   std::string name_;
   std::string cut_name_;
-  DeviceKind kind_ = DeviceKind::kSim;
+  haptics::DeviceKind kind_ = haptics::DeviceKind::kSim;
   ClockMode clock_ = ClockMode::kReal;
   double duration_s_ = 0.0;
   SessionOptions options_;

@@ -6,10 +6,11 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "terracut/core/bodies.hpp"
-#include "terracut/core/haptic_settings.hpp"
+#include "terracut/haptics/settings.hpp"
 #include "terracut/io/scenario.hpp"
 
 namespace terracut::session {
@@ -19,7 +20,7 @@ struct Scenario {
   /// Terrain, representation, step rate, blade and cuts (io/scenario.hpp).
   io::Scenario base;
   /// The `haptics:` section (docs/haptics.md), or HapticSettings' defaults.
-  HapticSettings haptics{};
+  haptics::HapticSettings haptics{};
   /// The `bodies:` list (docs/bullet.md); empty when not given.
   std::vector<BodySpec> bodies;
 };
@@ -27,6 +28,11 @@ struct Scenario {
 /// Reads and validates a scenario file with all its sections. Throws
 /// InputError ("FILE:LINE: field.path: what").
 Scenario load_scenario(const std::filesystem::path& path);
+
+/// Parses scenario text with all its sections as if it were the file
+/// source_name (used in messages; relative image paths are resolved against
+/// its folder). Throws InputError as load_scenario.
+Scenario parse_scenario(const std::string& text, const std::filesystem::path& source_name);
 
 /// A bare heightmap as a scenario (the viewer's PNG input): the image at its
 /// own resolution over extent_m x extent_m, a white pixel full_scale_m high,

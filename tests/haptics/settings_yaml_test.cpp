@@ -1,6 +1,6 @@
 // The `haptics:` section reader: defaults, every block, units (degrees in the
 // file, radians in the structs) and errors that name the file, line and field.
-#include "terracut/io/haptics_yaml.hpp"
+#include "terracut/haptics/settings_yaml.hpp"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -13,7 +13,7 @@
 
 #include "terracut/core/error.hpp"
 
-namespace terracut::io {
+namespace terracut::haptics {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
@@ -210,4 +210,4 @@ TEST(HapticsYaml, LoadHapticsErrors) {
 }
 
 }  // namespace
-}  // namespace terracut::io
+}  // namespace terracut::haptics

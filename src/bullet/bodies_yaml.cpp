@@ -1,13 +1,15 @@
 // The `bodies:` list of a scenario file -> validated BodySpec list.
 // Written with the section-reader toolkit (yaml_reader.hpp) alone, so that it
 // refuses what the scenario reader refuses, with the same messages.
-#include "terracut/io/bodies_yaml.hpp"
+#include "terracut/bullet/bodies_yaml.hpp"
 
 #include <string_view>
 
 #include "terracut/io/yaml_reader.hpp"
 
-namespace terracut::io {
+namespace terracut::bullet {
+
+namespace yaml = io::yaml;
 namespace {
 
 // Fields that belong to each shape; any other dimension field is refused.
@@ -83,4 +85,4 @@ std::vector<BodySpec> parse_bodies(const YAML::Node& node, const std::string& fi
   return bodies;
 }
 
-}  // namespace terracut::io
+}  // namespace terracut::bullet

@@ -20,12 +20,13 @@
 #include <vector>
 
 #include "terracut/core/bodies.hpp"
+#include "terracut/io/scenario.hpp"
 
 namespace YAML {
 class Node;
 }
 
-namespace terracut::io {
+namespace terracut::bullet {
 
 /// Parses the value of a scenario's `bodies:` key (a list of mappings, may be
 /// empty). `file` names the scenario in error messages. Every error is a
@@ -33,4 +34,17 @@ namespace terracut::io {
 /// (LINE 1-based). The returned list passes terracut::validate(bodies).
 std::vector<BodySpec> parse_bodies(const YAML::Node& node, const std::string& file);
 
-}  // namespace terracut::io
+/// The `bodies:` section's reader for io::load_scenario: after the load,
+/// bodies holds the section's list (parse_bodies), empty when the file has
+/// none. Needs no Bullet (terracut::bodies), so a build without Bullet can
+/// still read a scenario and say why its bodies cannot be simulated.
+class BodiesReader final : public io::SectionReader {
+ public:
+  std::string_view key() const override { return "bodies"; }
+  void read(const YAML::Node& value, const std::string& file) override {
+    bodies = parse_bodies(value, file);
+  }
+  std::vector<BodySpec> bodies;
+};
+
+}  // namespace terracut::bullet

@@ -1,5 +1,5 @@
 // The `haptics:` section of a scenario file -> HapticSettings
-// (terracut/core/haptic_settings.hpp). Every key is optional; what is not
+// (terracut/haptics/settings.hpp). Every key is optional; what is not
 // given keeps the default of HapticSettings. Full reference: docs/haptics.md.
 //
 //   haptics:
@@ -42,13 +42,14 @@
 #include <filesystem>
 #include <string>
 
-#include "terracut/core/haptic_settings.hpp"
+#include "terracut/haptics/settings.hpp"
+#include "terracut/io/scenario.hpp"
 
 namespace YAML {
 class Node;
 }
 
-namespace terracut::io {
+namespace terracut::haptics {
 
 /// Parses the value of a scenario's `haptics:` key (a mapping; null gives the
 /// defaults). `file` names the scenario in error messages. Every error is a
@@ -63,4 +64,16 @@ HapticSettings parse_haptics(const YAML::Node& node, const std::string& file);
 /// valid YAML, or as parse_haptics.
 HapticSettings load_haptics(const std::filesystem::path& scenario_path);
 
-}  // namespace terracut::io
+/// The `haptics:` section's reader for io::load_scenario: after the load,
+/// settings holds the section (parse_haptics), or the defaults when the file
+/// has none.
+class SettingsReader final : public io::SectionReader {
+ public:
+  std::string_view key() const override { return "haptics"; }
+  void read(const YAML::Node& value, const std::string& file) override {
+    settings = parse_haptics(value, file);
+  }
+  HapticSettings settings{};
+};
+
+}  // namespace terracut::haptics

@@ -1,7 +1,7 @@
 // The `haptics:` section of a scenario file -> validated HapticSettings.
 // Written with the section-reader toolkit (yaml_reader.hpp) alone, so that it
 // refuses what the scenario reader refuses, with the same messages.
-#include "terracut/io/haptics_yaml.hpp"
+#include "terracut/haptics/settings_yaml.hpp"
 
 #include <fstream>
 #include <numbers>
@@ -10,7 +10,9 @@
 
 #include "terracut/io/yaml_reader.hpp"
 
-namespace terracut::io {
+namespace terracut::haptics {
+
+namespace yaml = io::yaml;
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
@@ -169,4 +171,4 @@ HapticSettings load_haptics(const std::filesystem::path& scenario_path) {
   return haptics ? parse_haptics(haptics->node(), ctx.file()) : HapticSettings{};
 }
 
-}  // namespace terracut::io
+}  // namespace terracut::haptics

@@ -1,0 +1,106 @@
+// A scenario with all its sections: each section is read by the reader of
+// the layer that owns it (bodies:, haptics:), and its errors still name the
+// file and the line.
+#include "terracut/session/scenario.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "terracut/core/error.hpp"
+
+namespace terracut::session {
+namespace {
+
+namespace fs = std::filesystem;
+
+// 1-based line of the first line containing needle.
+int line_of(const std::string& text, const std::string& needle) {
+  const std::size_t pos = text.find(needle);
+  EXPECT_NE(pos, std::string::npos) << needle;
+  int line = 1;
+  for (std::size_t i = 0; i < pos; ++i)
+    if (text[i] == '\n') ++line;
+  return line;
+}
+
+// Replaces the first occurrence of from by to.
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  if (pos != std::string::npos) text.replace(pos, from.size(), to);
+  return text;
+}
+
+// Expects an InputError naming the file, the line and the field, with a fragment.
+void expect_error(const std::string& text, int line, const std::string& field,
+                  const std::string& fragment) {
+  std::string message;
+  try {
+    parse_scenario(text, "/some/folder/bad.yaml");
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  const std::string where = "/some/folder/bad.yaml:" + std::to_string(line) + ": ";
+  EXPECT_EQ(message.rfind(where, 0), 0u) << "message: " << message << "\nexpected start: " << where;
+  EXPECT_NE(message.find(field), std::string::npos) << "message: " << message;
+  EXPECT_NE(message.find(fragment), std::string::npos) << "message: " << message;
+}
+
+const std::string kGood = R"(name: small
+terrain: {generator: plane, resolution: 8, size_m: [1.0, 1.0], full_scale_m: 0.2}
+blade: {length_m: 0.5}
+cuts:
+  - name: A
+    keyframes:
+      - {t_s: 0.0, position_m: [0.5, 0.1, 0.0]}
+      - {t_s: 0.5, position_m: [0.5, 0.1, 1.0]}
+)";
+
+TEST(ScenarioBodies, BodiesAreParsedAndTheirErrorsNameFileAndLine) {
+  const std::string text = kGood + R"(bodies:
+  - name: rock
+    shape: sphere
+    radius_m: 0.1
+    mass_kg: 2
+    position_m: [0.0, 0.4, 3.5]
+)";
+  const Scenario sc = parse_scenario(text, "/some/folder/bad.yaml");
+  ASSERT_EQ(sc.bodies.size(), 1u);
+  EXPECT_EQ(sc.bodies[0].name, "rock");
+  EXPECT_EQ(sc.bodies[0].shape, BodyShape::kSphere);
+  EXPECT_DOUBLE_EQ(sc.bodies[0].radius_m, 0.1);
+  const std::string bad = replace(text, "radius_m: 0.1\n", "radius_m: -0.1\n");
+  expect_error(bad, line_of(bad, "radius_m: -0.1"), "bodies[0]", "radius_m");
+  EXPECT_TRUE(parse_scenario(kGood, "x.yaml").bodies.empty());
+}
+
+TEST(ScenarioSections, EachSectionIsReadByItsOwnLayer) {
+  // The haptics section by the haptics reader; absent, its defaults.
+  const Scenario plain = parse_scenario(kGood, "x.yaml");
+  EXPECT_EQ(plain.haptics.rate_hz, haptics::HapticSettings{}.rate_hz);
+  const Scenario with = parse_scenario(kGood + "haptics: {rate_hz: 500, device: script}\n", "x.yaml");
+  EXPECT_EQ(with.haptics.rate_hz, 500.0);
+  EXPECT_EQ(with.haptics.device, haptics::DeviceKind::kScript);
+  // A key no layer reads is refused, and the message lists every section.
+  const std::string unknown = kGood + "soil_typo: 1\n";
+  expect_error(unknown, line_of(unknown, "soil_typo"), "soil_typo", "haptics");
+  // An error inside a section names the section's field at its line.
+  const std::string bad = kGood + "haptics:\n  rate_hz: 5\n";
+  expect_error(bad, line_of(bad, "rate_hz: 5"), "haptics.rate_hz", "[10, 10000]");
+}
+
+// Every shipped scenario loads, with all its sections.
+TEST(ShippedScenarios, EveryScenarioFileLoads) {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(TERRACUT_SOURCE_DIR) / "scenarios")) {
+    if (entry.path().extension() != ".yaml") continue;
+    EXPECT_NO_THROW(load_scenario(entry.path())) << entry.path();
+    ++count;
+  }
+  EXPECT_GE(count, 3);
+}
+
+}  // namespace
+}  // namespace terracut::session
