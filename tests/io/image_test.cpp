@@ -9,7 +9,6 @@
 #include <zlib.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <csetjmp>
 #include <cstdint>
@@ -844,16 +843,14 @@ TEST(Resample, RefusesBadSizes) {
 }
 
 // ---------------------------------------------------------------------------
-// Speed on a large height map. Skipped unless TERRACUT_IO_PERF is set (it
-// writes two 8192 x 8192 16-bit images, ~20 s, and its limits hold only in
-// Release):
-//   TERRACUT_IO_PERF=1 build-io/tests/io/io_image_test --gtest_filter='*Large*'
-// Two files: one from write_png16, one written with libpng's default
-// settings (zlib level 6, adaptive filters) as other tools write them.
+// A large height map, read back and resampled: every run, at a size CI can
+// afford (2048^2, 16-bit, two files: one from write_png16, one written with
+// libpng's default settings, zlib level 6 and adaptive filters, as other
+// tools write them). The speed at 8192^2 is measured by the benchmark
+// (bench/image_bench.cpp, scripts/bench.sh), not by a timed test.
 
-TEST_F(ImageTest, LargePng16ReadAndResampleTiming) {
-  if (std::getenv("TERRACUT_IO_PERF") == nullptr) GTEST_SKIP() << "set TERRACUT_IO_PERF=1 to run";
-  const int n = 8192;
+TEST_F(ImageTest, LargePng16ReadsBackAndResamplesConservingTheMean) {
+  const int n = 2048;
   // A smooth terrain with some fine noise, like a scanned height map.
   std::vector<float> v(static_cast<std::size_t>(n) * n);
   std::mt19937 rng(1);
@@ -861,14 +858,11 @@ TEST_F(ImageTest, LargePng16ReadAndResampleTiming) {
   for (int r = 0; r < n; ++r) {
     for (int c = 0; c < n; ++c) {
       v[static_cast<std::size_t>(r) * n + c] =
-          0.5F + 0.3F * std::sin(c * 0.003F) * std::cos(r * 0.002F) + 0.1F * std::sin((c + r) * 0.02F) + noise(rng);
+          0.5F + 0.3F * std::sin(c * 0.012F) * std::cos(r * 0.008F) + 0.1F * std::sin((c + r) * 0.08F) + noise(rng);
     }
   }
-  using Clock = std::chrono::steady_clock;
-  const auto seconds = [](auto d) { return std::chrono::duration<double>(d).count(); };
   for (const bool ours : {true, false}) {
     const fs::path path = file(ours ? "large_ours.png" : "large_libpng_defaults.png");
-    const auto t0 = Clock::now();
     if (ours) {
       write_png16(path, v.data(), n, n, 1.0);
     } else {
@@ -879,31 +873,17 @@ TEST_F(ImageTest, LargePng16ReadAndResampleTiming) {
       }
       write_raw_png(path, p);
     }
-    const auto t1 = Clock::now();
     const Image image = read_png(path);
-    const auto t2 = Clock::now();
-    const Image half = resample(image, 4096, 4096);
-    const auto t3 = Clock::now();
-    const Image small = resample(image, 1000, 1000);
-    const auto t4 = Clock::now();
-    const double read_s = seconds(t2 - t1);
-    const double half_s = seconds(t3 - t2);
-    const double small_s = seconds(t4 - t3);
-    std::printf("%s: 8192x8192 16-bit PNG, %.1f MiB: write %.2f s, read %.3f s, resample to 4096^2 %.3f s, "
-                "to 1000^2 %.3f s; read + resample to 4096^2 %.3f s\n",
-                ours ? "write_png16" : "libpng defaults", static_cast<double>(fs::file_size(path)) / (1 << 20),
-                seconds(t1 - t0), read_s, half_s, small_s, read_s + half_s);
     ASSERT_EQ(image.cols, n);
     ASSERT_EQ(image.rows, n);
-    for (std::size_t i = 0; i < v.size(); i += 9973) EXPECT_NEAR(image.values[i], v[i], 0.5 / 65535.0 + 2e-7);
+    // Every sample within half a 16-bit step (plus float rounding).
+    for (std::size_t i = 0; i < v.size(); i += 997) EXPECT_NEAR(image.values[i], v[i], 0.5 / 65535.0 + 2e-7);
+    // Shrinking by 2 (exact box filter) and by a non-integer factor keep the
+    // mean (area averaging conserves the volume).
+    const Image half = resample(image, n / 2, n / 2);
+    const Image small = resample(image, 1000, 1000);
     EXPECT_NEAR(mean_of(half), mean_of(image), 1e-5);
     EXPECT_NEAR(mean_of(small), mean_of(image), 1e-5);
-#ifdef NDEBUG
-    EXPECT_LT(half_s, 1.0);
-    EXPECT_LT(small_s, 1.0);
-    EXPECT_LT(read_s + half_s, 3.0);
-    EXPECT_LT(read_s + small_s, 3.0);
-#endif
     fs::remove(path);
   }
 }
