@@ -219,9 +219,11 @@ SurfaceForce surface_force(const SurfaceParams& params, Vec3 device_point_m, Vec
 // Device limits and the passivity rule
 // ---------------------------------------------------------------------------
 
-/// What the haptic device can render; defaults: the Novint Falcon figures of
-/// CHAI3D's device table (DEPENDENCIES.md). Device units (device metres,
-/// device newtons).
+/// What the haptic device can render; defaults: a Novint Falcon, from
+/// CHAI3D's Novint Falcon device specification (cFalconDevice, in CHAI3D's
+/// src/devices/CFalconDevice.cpp; www.chai3d.org): max force 8 N, max
+/// stiffness 3000 N/m, max damping 20 N/(m/s), workspace radius 0.04 m.
+/// Device units (device metres, device newtons).
 struct DeviceLimits {
   double max_force_n = 8.0;               ///< largest force, N, finite, > 0
   double max_stiffness_n_per_m = 3000.0;  ///< largest stable stiffness at 1 kHz, N/m, finite, > 0

@@ -29,7 +29,8 @@ namespace terracut {
 /// Limits of the safety limiter; read-only during a run. Device units.
 struct SafetyParams {
   /// Largest force magnitude sent to the device, N, finite, > 0. Default: the
-  /// Novint Falcon's maximum (DEPENDENCIES.md).
+  /// Novint Falcon's maximum, 8 N (CHAI3D's Novint Falcon device
+  /// specification, cFalconDevice; www.chai3d.org).
   double max_force_n = 8.0;
   /// Largest growth of the force vector per second, N/s, finite, > 0. The
   /// default lets the full 8 N build up in 8 ms: above the rate of a hand
