@@ -20,7 +20,7 @@ python=/usr/bin/python3   # the one with matplotlib (another python3 may come fi
 
 # shellcheck disable=SC2086
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTERRACUT_BUILD_BENCH=ON ${CMAKE_ARGS:-} >/dev/null
-cmake --build "$build" -j"$jobs" --target terracut_bench terracut_bench_io
+cmake --build "$build" -j"$jobs" --target terracut_bench terracut_bench_io terracut_bench_soil
 mkdir -p "$out"
 
 # The machine the figures belong to.
@@ -45,5 +45,10 @@ echo "== step cases (contact + cut, scaling, brute force, memory)"
 echo "== loading an 8192x8192 16-bit PNG"
 "$build/bench/terracut_bench_io" --benchmark_out="$out/io.json" --benchmark_out_format=json
 
+echo "== the soil phase (soil: flow)"
+"$build/bench/terracut_bench_soil" "$out/soil.md"
+
 "$python" "$root/tools/plot_bench.py" --step "$out/step.json" --io "$out/io.json" \
   --machine "$out/machine.json" --out "$out" --command "scripts/bench.sh"
+# The soil table goes under the step tables.
+{ echo; echo "## Soil flow (\`terracut_bench_soil\`)"; echo; cat "$out/soil.md"; } >> "$out/results.md"

@@ -243,7 +243,7 @@ TerrainWorld::~TerrainWorld() = default;
 
 void TerrainWorld::step(const StepOutput& out) {
   const double start = now_s();
-  terrain_changed(out.cut.changed);
+  terrain_changed(out.changed);
   set_tool_pose(out.pose);
   advance();
   info_.total_s = now_s() - start;

@@ -35,6 +35,8 @@ std::string validate(const SimParams& params) {
   } else if (params.representation != Representation::kColumns &&
              params.representation != Representation::kSurface) {
     msg << "representation must be columns or surface";
+  } else if (std::string soil = validate(params.soil); !soil.empty()) {
+    msg << soil;
   }
   return msg.str();
 }
@@ -45,7 +47,9 @@ static const SimParams& checked(const SimParams& params) {
 }
 
 Simulation::Simulation(const SimParams& params, std::vector<float> initial_heights_m)
-    : params_(checked(params)), grid_(params.grid, std::move(initial_heights_m)) {}
+    : params_(checked(params)), grid_(params.grid, std::move(initial_heights_m)) {
+  if (params_.soil.model == SoilModel::kFlow) soil_ = std::make_unique<SoilFlow>(params_.soil, grid_);
+}
 
 const StepOutput& Simulation::begin_step(const BladePose& pose) {
   begin_clock_s_ = now_s();
@@ -61,6 +65,8 @@ const StepOutput& Simulation::begin_step(const BladePose& pose) {
   out_.edge = blade_segment(params_.blade, out_.pose);
   out_.contact = valid ? measure_contact(grid_, params_.representation, out_.edge) : ContactResult{};
   out_.cut = {};
+  out_.soil = {};
+  out_.changed = {};
   out_.substeps = 0;
   out_.listener_force_world_n = {};
   out_.timers = {};
@@ -86,6 +92,8 @@ const StepOutput& Simulation::finish_step() {
     substeps = std::clamp(int(std::ceil(angle / max_angle)), 1, kMaxSubsteps);
   }
   Segment previous = blade_segment(params_.blade, from);
+  const Segment step_from = previous;
+  if (soil_) soil_->before_cut(grid_, step_from, out_.edge);
   for (int k = 1; k <= substeps; ++k) {
     double t = double(k) / substeps;
     BladePose pose = k == substeps ? out_.pose
@@ -105,6 +113,16 @@ const StepOutput& Simulation::finish_step() {
   ++step_count_;
   const double cut_end = now_s();
   out_.timers.cut_s = cut_end - cut_start;
+  out_.changed = out_.cut.changed;
+
+  // Soil that flows: what was cut goes ahead of the blade, slopes relax.
+  double soil_end = cut_end;
+  if (soil_) {
+    out_.soil = soil_->after_cut(grid_, step_from, out_.edge);
+    out_.changed.include(out_.soil.changed);
+    soil_end = now_s();
+    out_.timers.soil_s = soil_end - cut_end;
+  }
 
   // The listeners see the finished step (its cut and changed rectangle) and
   // may push on the tool.
@@ -113,7 +131,7 @@ const StepOutput& Simulation::finish_step() {
   out_.listener_force_world_n = listener_force;
   in_step_ = false;
   const double end = now_s();
-  out_.timers.listeners_s = end - cut_end;
+  out_.timers.listeners_s = end - soil_end;
   out_.timers.total_s = end - begin_clock_s_;
   return out_;
 }
@@ -137,6 +155,7 @@ void Simulation::remove_listener(StepListener& listener) {
 
 void Simulation::reset() {
   grid_.reset();
+  if (soil_) soil_ = std::make_unique<SoilFlow>(params_.soil, grid_);
   has_previous_ = false;
   in_step_ = false;
   step_count_ = 0;

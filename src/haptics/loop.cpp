@@ -242,7 +242,7 @@ void HapticLoop::publish_frame(const StepOutput& out, const ForceOutput& force,
                                const DeviceCommand& command, double period_s,
                                double compute_s) noexcept {
   SnapshotExchange& x = *options_.snapshot;
-  x.note_changed(out.cut.changed);
+  x.note_changed(out.changed);
   ViewFrame& f = x.back();
   f.t_s = t_s_;
   f.step = out.step;

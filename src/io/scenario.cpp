@@ -246,7 +246,7 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
                                       "'blade' and 'cuts'");
   std::vector<std::string_view> keys = {"name",     "description", "terrain",  "representation",
                                         "rate_hz",  "blade",       "cuts",     "sequence",
-                                        "reference"};
+                                        "reference", "soil"};
   for (const SectionReader* reader : sections) keys.push_back(reader->key());
   const Map top(top_field, std::move(keys));
 
@@ -309,6 +309,16 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
                              " steps at rate_hz in total; more than 1e8 steps is absurd";
     if (const auto f = top.get("sequence")) f->fail(what);
     top_field.fail(what);
+  }
+
+  // What happens to the cut soil (soil.hpp): vanish, or flow to the repose angle.
+  if (const auto f = top.get("soil")) {
+    const Map soil(*f, {"model", "repose_deg", "max_pair_checks_per_step"});
+    if (const auto m = soil.get("model"))
+      sc.soil.model = m->choice({SoilModel::kVanish, SoilModel::kFlow}, "soil model");
+    if (const auto a = soil.get("repose_deg")) sc.soil.repose_deg = a->in_range(0.0, 80.0, yaml::Field::Ends::kOpenLow);
+    if (const auto w = soil.get("max_pair_checks_per_step"))
+      sc.soil.max_pair_checks_per_step = w->integer_in(1000, 1000000000);
   }
 
   // The other layers' sections (e.g. bodies:, haptics:), by their readers.
@@ -463,6 +473,7 @@ SimParams sim_params(const Scenario& scenario, std::optional<double> rate_hz) {
   params.representation = scenario.representation;
   params.rate_hz = rate_hz.value_or(scenario.rate_hz);
   params.blade = scenario.blade;
+  params.soil = scenario.soil;
   return params;
 }
 

@@ -27,7 +27,7 @@ using Json = nlohmann::ordered_json;
 // Removes the named outputs from the folder (ignoring ones that do not exist).
 void remove_outputs(const std::filesystem::path& dir) {
   for (const char* name : {"contact.csv", "height.npy", "removed.npy", "height.png", "removed.png",
-                           "summary.json", "bodies.csv"}) {
+                           "summary.json", "bodies.csv", "deposited.npy", "deposited.png"}) {
     std::error_code ec;
     std::filesystem::remove(dir / name, ec);
   }
@@ -105,11 +105,32 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
                     {"removed_npy", "removed.npy"}, {"height_png", "height.png"},
                     {"removed_png", "removed.png"}};
   // The only content that differs between two runs of the same scenario.
+  if (r.soil) {
+    const SoilRunStats& s = *r.soil;
+    out["soil"] = {{"model", "flow"},
+                   {"repose_deg", sc.soil.repose_deg},
+                   {"edge", "wall"},
+                   {"volume_m3",
+                    {{"initial", r.initial_volume_m3},
+                     {"final", r.final_volume_m3},
+                     {"left_over_edge", 0.0},
+                     {"error", r.volume_error_m3}}},
+                   {"displaced_volume_m3", s.displaced_volume_m3},
+                   {"relaxation",
+                    {{"passes", s.passes},
+                     {"pair_checks", s.pair_checks},
+                     {"max_backlog_cells", s.max_backlog_cells},
+                     {"final_backlog_cells", s.final_backlog_cells},
+                     {"max_pair_checks_per_step", sc.soil.max_pair_checks_per_step}}}};
+    out["outputs"]["deposited_npy"] = "deposited.npy";
+    out["outputs"]["deposited_png"] = "deposited.png";
+  }
   out["timing"] = {{"unit", "us"},
                    {"contact_us", timing_json(r.contact_timing)},
                    {"cut_us", timing_json(r.cut_timing)},
                    {"step_us", timing_json(r.step_timing)},
                    {"wall_s", r.wall_s}};
+  if (r.soil) out["timing"]["soil_us"] = timing_json(r.soil->soil_timing);
   return out;
 }
 
@@ -174,7 +195,10 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
   RunResult result;
   result.initial_volume_m3 = sim.grid().volume_m3();
   if (options.keep_records) result.records.reserve(std::size_t(total_steps));
-  std::vector<double> contact_s, cut_s, step_s;
+  const bool flow = sim.params().soil.model == SoilModel::kFlow;
+  SoilRunStats soil;
+  std::vector<double> contact_s, cut_s, step_s, soil_s;
+  if (flow) soil_s.reserve(std::size_t(total_steps));
   contact_s.reserve(std::size_t(total_steps));
   cut_s.reserve(std::size_t(total_steps));
   step_s.reserve(std::size_t(total_steps));
@@ -224,6 +248,13 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
       contact_s.push_back(out.timers.contact_s);
       cut_s.push_back(out.timers.cut_s);
       step_s.push_back(out.timers.total_s);
+      if (flow) {
+        soil.displaced_volume_m3 += out.soil.displaced_volume_m3;
+        soil.passes += out.soil.passes;
+        soil.pair_checks += out.soil.pair_checks;
+        soil.max_backlog_cells = std::max(soil.max_backlog_cells, out.soil.backlog_cells);
+        soil_s.push_back(out.timers.soil_s);
+      }
       if (options.keep_records) result.records.push_back(rec);
       ++done;
       progress.maybe_report(done, motion.name);
@@ -241,17 +272,37 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
   result.steps = done;
   result.final_volume_m3 = grid.volume_m3();
   result.max_sample_error_m = grid.conservation_error_m();
-  result.volume_error_m3 =
-      result.initial_volume_m3 - result.final_volume_m3 - result.removed_volume_m3;
+  // With flow nothing vanishes: what was cut is still on the grid.
+  const double vanished_m3 = flow ? 0.0 : result.removed_volume_m3;
+  result.volume_error_m3 = result.initial_volume_m3 - result.final_volume_m3 - vanished_m3;
   result.contact_timing = timing_stats(contact_s);
   result.cut_timing = timing_stats(cut_s);
   result.step_timing = timing_stats(step_s);
   if (pacer) result.realtime = pacer->stats();
+  if (flow) {
+    soil.final_backlog_cells = sim.soil()->active_cells();
+    soil.soil_timing = timing_stats(soil_s);
+    result.soil = soil;
+  }
 
   io::write_npy(dir / "height.npy", grid.heights(), grid.rows(), grid.cols());
-  io::write_npy(dir / "removed.npy", grid.removed(), grid.rows(), grid.cols());
   io::write_png16(dir / "height.png", grid.heights(), grid.cols(), grid.rows(), sc.full_scale_m);
-  io::write_png16(dir / "removed.png", grid.removed(), grid.cols(), grid.rows(), sc.full_scale_m);
+  if (!flow) {
+    io::write_npy(dir / "removed.npy", grid.removed(), grid.rows(), grid.cols());
+    io::write_png16(dir / "removed.png", grid.removed(), grid.cols(), grid.rows(), sc.full_scale_m);
+  } else {
+    // The signed removed layer as its two parts: taken from, put down on.
+    std::vector<float> taken(std::size_t(grid.spec().sample_count()));
+    std::vector<float> put(taken.size());
+    for (std::size_t i = 0; i < taken.size(); ++i) {
+      taken[i] = std::max(0.0f, grid.removed()[i]);
+      put[i] = std::max(0.0f, -grid.removed()[i]);
+    }
+    io::write_npy(dir / "removed.npy", taken.data(), grid.rows(), grid.cols());
+    io::write_png16(dir / "removed.png", taken.data(), grid.cols(), grid.rows(), sc.full_scale_m);
+    io::write_npy(dir / "deposited.npy", put.data(), grid.rows(), grid.cols());
+    io::write_png16(dir / "deposited.png", put.data(), grid.cols(), grid.rows(), sc.full_scale_m);
+  }
   world.finish();
   nlohmann::json summary = summary_json(sc, result);
   if (world.bodies()) summary["bodies"] = detail::bodies_json(world, detail::BodiesEntry::kRun);

@@ -221,6 +221,23 @@ TEST_F(ScenarioTest, OverridesReplaceResolutionRepresentationAndSequence) {
   EXPECT_THROW(apply_overrides(sc, Resolution{0, 5}, std::nullopt, std::nullopt), InputError);
 }
 
+TEST(ScenarioSoil, TheSoilSectionChoosesTheModel) {
+  // Absent: the paper's model.
+  EXPECT_EQ(parse_scenario(kGood, "x.yaml").soil.model, SoilModel::kVanish);
+  const std::string text = kGood + "soil:\n  model: flow\n  repose_deg: 40\n";
+  const Scenario sc = parse_scenario(text, "x.yaml");
+  EXPECT_EQ(sc.soil.model, SoilModel::kFlow);
+  EXPECT_EQ(sc.soil.repose_deg, 40.0);
+  EXPECT_EQ(sim_params(sc).soil.repose_deg, 40.0);
+  // Errors name the file, the line and the field.
+  const std::string zero = replace(text, "repose_deg: 40", "repose_deg: 0");
+  expect_error(zero, line_of(zero, "repose_deg: 0"), "soil.repose_deg", "(0, 80]");
+  const std::string mud = replace(text, "model: flow", "model: mud");
+  expect_error(mud, line_of(mud, "model: mud"), "soil.model", "allowed: vanish, flow");
+  const std::string typo = text + "  repose: 30\n";
+  expect_error(typo, line_of(typo, "repose: 30"), "soil.repose", "unknown key");
+}
+
 TEST(ScenarioOptions, ParseResolutionAndNameLists) {
   EXPECT_EQ(parse_resolution("50"), (Resolution{50, 50}));
   EXPECT_EQ(parse_resolution("64x32"), (Resolution{64, 32}));

@@ -167,6 +167,45 @@ TEST_F(RunTest, OutputsConserveMaterial) {
   EXPECT_NEAR(csv_sum, result.removed_volume_m3, 1e-8 * (1.0 + result.removed_volume_m3));
 }
 
+TEST_F(RunTest, FlowingSoilIsConservedAndWrittenAsTakenAndDeposited) {
+  // The same cuts with soil that flows: nothing vanishes.
+  Scenario sc;
+  sc.base = parse_scenario(kScenario + "soil: {model: flow, repose_deg: 34}\n", dir_ / "small.yaml");
+  ASSERT_EQ(sc.base.soil.model, SoilModel::kFlow);
+  const RunResult result = run(sc, dir_ / "out");
+  ASSERT_TRUE(result.soil);
+  EXPECT_GT(result.removed_volume_m3, 0.0);  // the blade cut ...
+  EXPECT_NEAR(result.soil->displaced_volume_m3, result.removed_volume_m3,
+              1e-6 * result.removed_volume_m3);  // ... and moved all of it
+  EXPECT_NEAR(result.final_volume_m3, result.initial_volume_m3, 1e-6 * result.initial_volume_m3);
+  int rows = 0, cols = 0;
+  const std::vector<float> initial = io::build_initial_heights(sc.base);
+  const std::vector<float> height = read_npy(dir_ / "out" / "height.npy", &rows, &cols);
+  const std::vector<float> removed = read_npy(dir_ / "out" / "removed.npy", &rows, &cols);
+  const std::vector<float> deposited = read_npy(dir_ / "out" / "deposited.npy", &rows, &cols);
+  ASSERT_EQ(deposited.size(), initial.size());
+  // height = initial - removed + deposited, each part never negative.
+  int put = 0;
+  for (std::size_t i = 0; i < initial.size(); ++i) {
+    EXPECT_GE(removed[i], 0.0f);
+    EXPECT_GE(deposited[i], 0.0f);
+    EXPECT_TRUE(removed[i] == 0.0f || deposited[i] == 0.0f) << i;
+    EXPECT_NEAR(double(height[i]), double(initial[i]) - removed[i] + deposited[i], 1e-6) << i;
+    if (deposited[i] > 0.0f) ++put;
+  }
+  EXPECT_GT(put, 5);
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "deposited.png"));
+  const nlohmann::json j = nlohmann::json::parse(read_bytes(dir_ / "out" / "summary.json"));
+  EXPECT_EQ(j["soil"]["model"], "flow");
+  EXPECT_NEAR(j["soil"]["volume_m3"]["error"].get<double>(), 0.0, 1e-6 * result.initial_volume_m3);
+  EXPECT_NEAR(j["conservation"]["volume_error_m3"].get<double>(), 0.0,
+              1e-6 * result.initial_volume_m3);
+  // The same scenario twice: the same bits.
+  const RunResult again = run(sc, dir_ / "again");
+  EXPECT_EQ(read_bytes(dir_ / "out" / "height.npy"), read_bytes(dir_ / "again" / "height.npy"));
+  EXPECT_EQ(again.soil->pair_checks, result.soil->pair_checks);
+}
+
 TEST_F(RunTest, ContactCsvHasOneRowPerStepInSequenceOrder) {
   const Scenario sc = scenario();
   const RunResult result = run(sc, dir_ / "out", true);

@@ -142,7 +142,7 @@ class TerrainWorld {
   const TerrainWorldParams& params() const { return params_; }
   double dt_s() const { return dt_s_; }
 
-  /// One step after Simulation::step: terrain_changed(out.cut.changed),
+  /// One step after Simulation::step: terrain_changed(out.changed),
   /// set_tool_pose(out.pose), advance(). Allocation-free once warm; never throws.
   void step(const StepOutput& out);
 

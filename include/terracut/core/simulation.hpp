@@ -6,17 +6,21 @@
 //      the terrain as it was before this step's cut, so a cut never hides the
 //      contact that caused it.
 //   2. finish_step(): the region the edge swept since the previous pose is
-//      cut; then every StepListener added (step_listener.hpp: the rigid-body
+//      cut; with SoilModel::kFlow the cut soil is put down ahead of the
+//      blade and slopes relax to the angle of repose (soil.hpp); then every
+//      StepListener added (step_listener.hpp: the rigid-body
 //      world, recorders, ...) sees the step's output and the rectangle it
 //      changed, and may put a force on the tool.
 // step(pose) does both. A step allocates nothing (nor may its listeners).
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "terracut/core/cut.hpp"
+#include "terracut/core/soil.hpp"
 #include "terracut/core/step_listener.hpp"
 
 namespace terracut {
@@ -31,6 +35,8 @@ struct SimParams {
   /// more than this fraction of a cell is split into sub-steps (slerp), so a
   /// fast rotation still sweeps its true arc. In (0, 1].
   double max_arc_error_cells = 0.25;
+  /// What happens to the soil the blade cuts (soil.hpp); kVanish by default.
+  SoilFlowParams soil{};
 };
 
 /// Returns an empty string when params are valid, else a message naming the field.
@@ -40,6 +46,7 @@ std::string validate(const SimParams& params);
 struct StepTimers {
   double contact_s = 0.0;
   double cut_s = 0.0;
+  double soil_s = 0.0;       ///< displacement and relaxation (kFlow)
   double listeners_s = 0.0;  ///< all step listeners together (e.g. the Bullet world)
   double total_s = 0.0;
 };
@@ -52,6 +59,11 @@ struct StepOutput {
   Segment edge{};            ///< cutting edge during the step, world metres
   ContactResult contact{};   ///< measured before the cut
   CutResult cut{};           ///< what the sweep since the previous pose removed
+  SoilStepResult soil{};     ///< what the soil phase moved (kFlow; empty with kVanish)
+  /// Every sample whose height the step changed: the cut's and the soil
+  /// phase's rectangles together. Whoever caches heights (the Bullet world,
+  /// a renderer, a network sender) reads this rectangle.
+  Rect changed{};
   int substeps = 0;          ///< sweep sub-steps used (0 when the blade was lifted)
   /// Sum of the step listeners' forces on the tool (StepListener::on_step),
   /// world N; zero without listeners.
@@ -81,6 +93,9 @@ class Simulation {
   void remove_listener(StepListener& listener);
   /// The listeners, in the order they run.
   const std::vector<StepListener*>& listeners() const { return listeners_; }
+
+  /// The soil phase's state (kFlow), or null with kVanish.
+  const SoilFlow* soil() const { return soil_.get(); }
 
   /// Phase 1: move the blade and measure contact before any cut.
   const StepOutput& begin_step(const BladePose& pose);
@@ -113,6 +128,7 @@ class Simulation {
   StepOutput out_{};
   double begin_clock_s_ = 0.0;
   std::vector<StepListener*> listeners_;
+  std::unique_ptr<SoilFlow> soil_;  // kFlow only
 };
 
 }  // namespace terracut

@@ -8,7 +8,7 @@
 // cut -> [soil flow, when it exists] -> listeners. The listeners run at the
 // end of Simulation::finish_step, in the order they were added, on the
 // stepping thread; each sees the step's output, including the rectangle of
-// samples the step changed (StepOutput::cut.changed), and may put a force on
+// samples the step changed (StepOutput::changed), and may put a force on
 // the tool, which the step sums into StepOutput::listener_force_world_n (the
 // haptic loop adds it to the force models' force before device scaling and
 // safety).

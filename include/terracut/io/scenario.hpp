@@ -92,6 +92,10 @@ struct Scenario {
   /// Order in which cuts are run: indices into `cuts` (names may repeat).
   std::vector<int> sequence;
 
+  /// What happens to the soil the blade cuts (`soil:`; docs/scenario-format.md):
+  /// vanish (the paper's, the default) or flow.
+  SoilFlowParams soil{};
+
   /// The exact shape the terrain was made from, for error reports
   /// (`reference: mound:`); nullopt when not given.
   std::optional<MoundShape> reference_mound;

@@ -9,6 +9,9 @@
 //   removed.npy   float32 (rows, cols) removed material, metres
 //   height.png    16-bit grey, pixel = height / full_scale_m
 //   removed.png   16-bit grey, pixel = removed / full_scale_m
+//   deposited.npy, deposited.png   with soil flow only: soil put down on
+//                 each sample (height above its initial height), metres;
+//                 removed is then the soil taken from it (never negative)
 //   bodies.csv    only when the scenario has bodies (bullet/bodies_csv.hpp)
 //   summary.json  inputs, step count, volumes, conservation error, per-cut
 //                 results, per-step timing percentiles, the bodies' entry
@@ -71,18 +74,32 @@ struct CutStats {
   double removed_volume_m3 = 0.0;  ///< volume it cut, m^3
 };
 
+/// What the soil phase did over a run (SoilModel::kFlow).
+struct SoilRunStats {
+  double displaced_volume_m3 = 0.0;  ///< cut soil put down ahead of the blade, m^3
+  std::int64_t passes = 0;           ///< relaxation passes
+  std::int64_t pair_checks = 0;      ///< neighbour pairs examined
+  std::int64_t max_backlog_cells = 0;  ///< largest number of cells carried to the next step
+  std::int64_t final_backlog_cells = 0;  ///< cells still active at the end
+  TimingStats soil_timing{};          ///< StepTimers::soil_s
+};
+
 /// What a run did.
 struct RunResult {
   std::int64_t steps = 0;            ///< steps simulated in total
   double initial_volume_m3 = 0.0;    ///< material before the first cut, m^3
   double final_volume_m3 = 0.0;      ///< material after the last cut, m^3
-  double removed_volume_m3 = 0.0;    ///< sum of every step's removed volume, m^3
+  double removed_volume_m3 = 0.0;    ///< sum of every step's cut volume, m^3 (vanished with kVanish, moved with kFlow)
   double max_sample_error_m = 0.0;   ///< max over samples of |height + removed - initial|, metres
-  double volume_error_m3 = 0.0;      ///< initial - final - removed, m^3
+  /// initial - final - vanished, m^3 (vanished: the cut volume with
+  /// kVanish, 0 with kFlow, where nothing leaves the grid).
+  double volume_error_m3 = 0.0;
   std::vector<CutStats> cuts;        ///< one per entry of the sequence
   TimingStats contact_timing{};      ///< StepTimers::contact_s
   TimingStats cut_timing{};          ///< StepTimers::cut_s
   TimingStats step_timing{};         ///< StepTimers::total_s
+  /// The soil phase's figures, with SoilModel::kFlow.
+  std::optional<SoilRunStats> soil;
   /// The pacer's figures, with RunOptions::realtime.
   std::optional<haptics::LoopStats> realtime;
   std::vector<io::StepRecord> records;  ///< every step, when RunOptions::keep_records

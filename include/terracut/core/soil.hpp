@@ -1,0 +1,160 @@
+// Soil that flows: the soil phase of a step (simulation.hpp), between the cut
+// and the step listeners.
+//
+// Two models, chosen by SoilFlowParams::model:
+//  - kVanish (the paper's): what the blade cuts is gone. The phase does
+//    nothing; per sample height + removed = initial with removed >= 0.
+//  - kFlow: nothing vanishes. What the blade cut in the step is put down
+//    just ahead of the blade (displacement), then every slope steeper than
+//    the angle of repose slides until it is not (relaxation). The total
+//    volume of soil on the grid is conserved; removed = initial - height is
+//    then signed: > 0 where soil was taken, < 0 where it was deposited.
+//
+// Displacement. Each sample the cut lowered gives its lost height to the
+// cell straight ahead of the blade: along the edge's horizontal normal, on
+// the side the edge moved to, one and a half cells beyond the edge's current
+// line. The blade is a wall for the flowing soil: no soil moves between two
+// cells whose centres lie on the two sides of the edge (in plan, within its
+// length) where the soil there stands above the edge, so soil never flows
+// through or under the blade into the cut behind it; the pile in front grows
+// as the blade pushes, and spills around the blade's ends and to the sides
+// as it relaxes (windrows). The blade's face is taken as tall as the pile.
+//
+// Relaxation. Between a cell and each of its 8 neighbours (axis distance dx
+// or dz, diagonal distance sqrt(dx^2 + dz^2)), the excess is the height
+// difference above tan(repose) x distance. Per pass, a cell whose excess
+// toward some neighbours is above a tolerance (1e-4 of a cell) sheds half
+// of its largest excess, shared among those neighbours in proportion to
+// their excess (the thermal-erosion rule of Musgrave, Kolb & Mace,
+// SIGGRAPH 1989). A pass's fluxes are computed from the heights frozen at
+// its start (Jacobi) and then applied, so the result does not depend on
+// the order of the cells: a mirrored terrain gives the mirrored result (to
+// float rounding), the same inputs the same bits. With the diagonals the repose angle holds along the
+// axes and the diagonals and is about 2 degrees steeper in between (a
+// 4-neighbour stencil makes diagonals about 9 degrees too steep), so a pile
+// poured at a point settles into a round cone.
+//
+// Cost follows activity: only cells whose height changed (and, once, at
+// construction, every cell steeper than the repose angle) are examined, and
+// a pass examines each active cell's 8 pairs; a cell that changed, and the
+// neighbours of one that fell, are examined in the next pass. A step runs
+// whole passes while
+// it has done fewer than max_pair_checks_per_step pair checks; what is left
+// active is carried to the next step (the backlog), so a large collapse is
+// spread over ticks and the 1 kHz loop keeps its millisecond.
+//
+// The rigid floor stays: heights never go below 0 (a flux moves at most an
+// eighth of a height difference). The grid's edge is a wall: no soil leaves.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <optional>
+#include <vector>
+
+#include "terracut/core/blade.hpp"
+#include "terracut/core/grid.hpp"
+
+namespace terracut {
+
+/// What happens to the soil the blade cuts.
+enum class SoilModel {
+  kVanish,  ///< it is gone (the paper's model; the default)
+  kFlow,    ///< it is pushed ahead of the blade and slides to its angle of repose
+};
+/// "vanish" or "flow".
+std::string_view to_string(SoilModel model);
+/// Inverse of to_string; nullopt for anything else.
+std::optional<SoilModel> parse_soil_model(std::string_view name);
+
+/// Soil parameters; read-only during a run.
+struct SoilFlowParams {
+  SoilModel model = SoilModel::kVanish;
+  /// Angle of repose (the stopping angle of a flowing slope), degrees, in
+  /// (0, 80]. Dry sand about 34, wet sand about 45, saturated 15-30
+  /// (Al-Hashemi & Al-Amoudi, Powder Technology 330 (2018) 397).
+  double repose_deg = 34.0;
+  /// Work cap of one step's relaxation: pair checks, in [1000, 1e9]. A pass
+  /// checks 8 pairs per active cell; passes stop once this many were done.
+  std::int64_t max_pair_checks_per_step = 200000;
+};
+
+/// Returns an empty string when params are valid, else a message naming the field.
+std::string validate(const SoilFlowParams& params);
+
+/// What the soil phase did in one step.
+struct SoilStepResult {
+  double displaced_volume_m3 = 0.0;  ///< cut soil put down ahead of the blade, m^3
+  int passes = 0;                    ///< relaxation passes run
+  std::int64_t pair_checks = 0;      ///< neighbour pairs examined
+  std::int64_t moved_pairs = 0;      ///< pairs that exchanged soil
+  std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
+  Rect changed{};                    ///< samples whose height the phase changed
+};
+
+/// The soil phase's state (kFlow): the active cells and the scratch of the
+/// passes, sized at construction (about 10 bytes per sample) so that a step
+/// allocates nothing once its scratch has grown to the blade's footprint.
+class SoilFlow {
+ public:
+  /// Builds the state over the grid (which must outlive it) and marks every
+  /// cell steeper than the repose angle active. Throws InputError naming the
+  /// field on bad params.
+  SoilFlow(const SoilFlowParams& params, const HeightGrid& grid);
+
+  /// Before the cut of a step: remembers the heights under the region the
+  /// edge may sweep from `from` to `to` (their bounding rectangle plus a
+  /// cell), so that the cut's change of each sample is known afterwards.
+  void before_cut(const HeightGrid& grid, const Segment& from, const Segment& to);
+
+  /// After the cut: displacement of what was cut ahead of the edge `to`
+  /// (moving from `from`), the edge's cells capped, then relaxation.
+  SoilStepResult after_cut(HeightGrid& grid, const Segment& from, const Segment& to);
+
+  /// Relaxation only (no blade): e.g. between strokes, or a settling run.
+  SoilStepResult relax(HeightGrid& grid);
+
+  /// Cells still active (the backlog).
+  std::int64_t active_cells() const { return std::int64_t(active_.size()); }
+  const SoilFlowParams& params() const { return params_; }
+
+ private:
+  void activate(std::uint32_t cell);
+  void mark_blade(const HeightGrid& grid, const Segment& edge);
+  void clear_blade();
+  bool blade_separates(std::uint32_t a, std::uint32_t b, float top_m) const;
+  void displace(HeightGrid& grid, const Segment& from, const Segment& to, SoilStepResult& out);
+  void run_passes(HeightGrid& grid, SoilStepResult& out);
+
+  SoilFlowParams params_;
+  int cols_ = 0;
+  int rows_ = 0;
+  double dx_ = 0.0;
+  double dz_ = 0.0;
+  double limit_[3] = {0.0, 0.0, 0.0};  // tan(repose) x distance: along X, along Z, diagonal
+  float tolerance_m_ = 0.0f;
+  double origin_x_ = 0.0;
+  double origin_z_ = 0.0;
+
+  // The blade of the step, in plan relative to the grid: its first end, its
+  // span, and its edge height above the ground at the first end and along it.
+  struct BladeLine {
+    double ax = 0.0, az = 0.0, dx = 0.0, dz = 0.0, ay = 0.0, dy = 0.0;
+    bool present = false;
+  };
+  BladeLine blade_{};
+
+  std::vector<std::uint32_t> active_;  // cells to examine in the next pass
+  std::vector<std::uint32_t> next_;    // built during a pass
+  std::vector<std::uint8_t> queued_;   // per cell: 1 while in active_ (or next_)
+  std::vector<float> delta_;           // per cell: the pass's net flux, metres
+  std::vector<std::uint32_t> touched_;  // cells with a delta this pass
+  std::vector<std::uint8_t> near_blade_;  // per cell: 1 within reach of the step's blade
+  std::vector<std::uint32_t> marked_;     // cells with near_blade_ set
+
+  Rect before_rect_{};        // where before_ holds the pre-cut heights
+  std::vector<float> before_;  // (rect rows) x (rect cols), row-major
+};
+
+}  // namespace terracut

@@ -1,0 +1,401 @@
+// Soil that flows: displacement ahead of the blade and relaxation to the
+// angle of repose. See soil.hpp.
+#include "terracut/core/soil.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "terracut/core/error.hpp"
+
+namespace terracut {
+namespace {
+
+/// Fraction of its steepest excess a cell sheds per pass (as thermal erosion
+/// does: half moves the pair to the limit when it is the only one).
+constexpr float kShedFraction = 0.5f;
+/// Radius around the edge, in cells, of the cells whose pairs are tested
+/// against the blade (a pair is at most one diagonal long).
+constexpr double kBladeRadiusCells = 1.5;
+/// Distance beyond the edge's line, in cells, where displaced soil is put.
+constexpr double kDepositAheadCells = 1.5;
+/// A slope moves only when it exceeds the repose limit of a cell pair by
+/// more than this fraction of the limit: 2 % of tan(repose), at most about
+/// 0.5 degree above the repose angle (34 degrees: 34.4). Smaller tolerances
+/// only lengthen the tail of a settling pile.
+constexpr double kToleranceOfLimit = 0.02;
+/// Longest run of cells the blade pushes ahead of it, per cut sample.
+constexpr int kMaxPushCells = 512;
+
+// The 8 neighbours: offsets and which limit applies (0 along X, 1 along Z, 2 diagonal).
+struct Neighbour {
+  int dc;
+  int dr;
+  int kind;
+};
+constexpr Neighbour kNeighbours[8] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 1},  {0, -1, 1},
+                                      {1, 1, 2},  {-1, 1, 2}, {1, -1, 2}, {-1, -1, 2}};
+
+double to_cells(double v, double origin, double cell) { return (v - origin) / cell; }
+
+}  // namespace
+
+std::string_view to_string(SoilModel model) {
+  return model == SoilModel::kFlow ? "flow" : "vanish";
+}
+
+std::optional<SoilModel> parse_soil_model(std::string_view name) {
+  if (name == "vanish") return SoilModel::kVanish;
+  if (name == "flow") return SoilModel::kFlow;
+  return std::nullopt;
+}
+
+std::string validate(const SoilFlowParams& p) {
+  if (p.model != SoilModel::kVanish && p.model != SoilModel::kFlow)
+    return "soil.model must be vanish or flow";
+  if (!(std::isfinite(p.repose_deg) && p.repose_deg > 0.0 && p.repose_deg <= 80.0))
+    return "soil.repose_deg must be in (0, 80] degrees, got " + std::to_string(p.repose_deg);
+  if (!(p.max_pair_checks_per_step >= 1000 && p.max_pair_checks_per_step <= 1000000000))
+    return "soil.max_pair_checks_per_step must be in [1000, 1e9], got " +
+           std::to_string(p.max_pair_checks_per_step);
+  return {};
+}
+
+SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid)
+    : params_(params), cols_(grid.cols()), rows_(grid.rows()) {
+  if (std::string m = validate(params); !m.empty()) throw InputError(m);
+  const GridSpec& spec = grid.spec();
+  dx_ = spec.cell_x_m();
+  dz_ = spec.cell_z_m();
+  const double slope = std::tan(params.repose_deg * std::numbers::pi / 180.0);
+  limit_[0] = slope * dx_;
+  limit_[1] = slope * dz_;
+  limit_[2] = slope * std::hypot(dx_, dz_);
+  tolerance_m_ = float(kToleranceOfLimit * std::min(limit_[0], limit_[1]));
+  origin_x_ = spec.origin_m.x;
+  origin_z_ = spec.origin_m.z;
+
+  const std::size_t n = std::size_t(grid.spec().sample_count());
+  queued_.assign(n, 0);
+  delta_.assign(n, 0.0f);
+  near_blade_.assign(n, 0);
+
+  // Every cell of a slope already steeper than the repose angle starts active.
+  const float* h = grid.heights();
+  for (int r = 0; r < rows_; ++r)
+    for (int c = 0; c < cols_; ++c) {
+      const std::uint32_t a = std::uint32_t(std::int64_t(r) * cols_ + c);
+      for (const Neighbour& nb : kNeighbours) {
+        const int c2 = c + nb.dc, r2 = r + nb.dr;
+        if (c2 < 0 || r2 < 0 || c2 >= cols_ || r2 >= rows_) continue;
+        const std::uint32_t b = std::uint32_t(std::int64_t(r2) * cols_ + c2);
+        if (double(h[a]) - double(h[b]) > limit_[nb.kind] + tolerance_m_) {
+          activate(a);
+          activate(b);
+        }
+      }
+    }
+}
+
+void SoilFlow::activate(std::uint32_t cell) {
+  if (queued_[cell]) return;
+  queued_[cell] = 1;
+  active_.push_back(cell);
+}
+
+void SoilFlow::before_cut(const HeightGrid& grid, const Segment& from, const Segment& to) {
+  // The bounding rectangle of the four endpoints, plus a cell.
+  const GridSpec& spec = grid.spec();
+  double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
+  for (const Vec3& p : {from.a, from.b, to.a, to.b}) {
+    const double u = to_cells(p.x, spec.origin_m.x, dx_), v = to_cells(p.z, spec.origin_m.z, dz_);
+    u0 = std::min(u0, u);
+    u1 = std::max(u1, u);
+    v0 = std::min(v0, v);
+    v1 = std::max(v1, v);
+  }
+  Rect r;
+  r.c0 = int(std::clamp(std::floor(u0) - 1.0, 0.0, double(cols_)));
+  r.c1 = int(std::clamp(std::floor(u1) + 2.0, 0.0, double(cols_)));
+  r.r0 = int(std::clamp(std::floor(v0) - 1.0, 0.0, double(rows_)));
+  r.r1 = int(std::clamp(std::floor(v1) + 2.0, 0.0, double(rows_)));
+  before_rect_ = r;
+  before_.resize(std::size_t(r.area()));
+  const float* h = grid.heights();
+  std::size_t k = 0;
+  for (int row = r.r0; row < r.r1; ++row)
+    for (int c = r.c0; c < r.c1; ++c) before_[k++] = h[std::int64_t(row) * cols_ + c];
+}
+
+void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
+  // Points every half cell along the edge; each marks the 5 x 5 cells around
+  // it that lie within kBladeRadiusCells of the edge in plan.
+  const GridSpec& spec = grid.spec();
+  const double radius = kBladeRadiusCells * std::max(dx_, dz_);
+  const Vec3 d = edge.b - edge.a;
+  const double plan_length = std::hypot(d.x, d.z);
+  blade_ = {edge.a.x, edge.a.z, d.x, d.z, edge.a.y - spec.origin_m.y, d.y, plan_length > 0.0};
+  if (!blade_.present) return;
+  const int points = int(std::ceil(plan_length / (0.5 * std::min(dx_, dz_)))) + 1;
+  for (int k = 0; k < points; ++k) {
+    const double t = double(k) / double(points - 1);
+    const int pc = int(std::floor(to_cells(edge.a.x + d.x * t, spec.origin_m.x, dx_)));
+    const int pr = int(std::floor(to_cells(edge.a.z + d.z * t, spec.origin_m.z, dz_)));
+    for (int r = pr - 2; r <= pr + 2; ++r)
+      for (int c = pc - 2; c <= pc + 2; ++c) {
+        if (c < 0 || r < 0 || c >= cols_ || r >= rows_) continue;
+        const std::uint32_t i = std::uint32_t(std::int64_t(r) * cols_ + c);
+        if (near_blade_[i]) continue;
+        const double x = spec.origin_m.x + (c + 0.5) * dx_;
+        const double z = spec.origin_m.z + (r + 0.5) * dz_;
+        const double s = std::clamp(((x - edge.a.x) * d.x + (z - edge.a.z) * d.z) /
+                                        (plan_length * plan_length),
+                                    0.0, 1.0);
+        if (std::hypot(x - (edge.a.x + d.x * s), z - (edge.a.z + d.z * s)) > radius) continue;
+        near_blade_[i] = 1;
+        marked_.push_back(i);
+      }
+  }
+}
+
+void SoilFlow::clear_blade() {
+  for (std::uint32_t i : marked_) near_blade_[i] = 0;
+  marked_.clear();
+  blade_.present = false;
+}
+
+bool SoilFlow::blade_separates(std::uint32_t a, std::uint32_t b, float top_m) const {
+  // Cell centres relative to the edge's first end, in plan.
+  const auto centre = [&](std::uint32_t i, double& x, double& z) {
+    x = (double(i % std::uint32_t(cols_)) + 0.5) * dx_ + origin_x_ - blade_.ax;
+    z = (double(i / std::uint32_t(cols_)) + 0.5) * dz_ + origin_z_ - blade_.az;
+  };
+  double xa, za, xb, zb;
+  centre(a, xa, za);
+  centre(b, xb, zb);
+  const double sa = blade_.dx * za - blade_.dz * xa;
+  const double sb = blade_.dx * zb - blade_.dz * xb;
+  if ((sa > 0.0) == (sb > 0.0)) return false;  // same side of the edge's line
+  // Where the pair's segment meets the line, as a fraction of the edge.
+  const double w = sa / (sa - sb);
+  const double px = xa + (xb - xa) * w, pz = za + (zb - za) * w;
+  const double len2 = blade_.dx * blade_.dx + blade_.dz * blade_.dz;
+  const double t = (px * blade_.dx + pz * blade_.dz) / len2;
+  if (t < 0.0 || t > 1.0) return false;  // around an end of the blade
+  // The blade stops soil whose surface there is above its edge.
+  return double(top_m) > blade_.ay + blade_.dy * t;
+}
+
+void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to,
+                        SoilStepResult& out) {
+  const GridSpec& spec = grid.spec();
+  const double cell = std::max(dx_, dz_);
+  // The edge's horizontal normal, turned to the side it moved to.
+  const Vec3 e = to.b - to.a;
+  double nx = -e.z, nz = e.x;
+  const double plan_length = std::hypot(nx, nz);
+  const double mx = 0.5 * ((to.a.x + to.b.x) - (from.a.x + from.b.x));
+  const double mz = 0.5 * ((to.a.z + to.b.z) - (from.a.z + from.b.z));
+  if (plan_length > 1e-12) {
+    nx /= plan_length;
+    nz /= plan_length;
+  } else {
+    // An edge seen end-on: push along the motion, or along +X at rest.
+    const double m = std::hypot(mx, mz);
+    nx = m > 1e-12 ? mx / m : 1.0;
+    nz = m > 1e-12 ? mz / m : 0.0;
+  }
+  // One cell along the push (the longer cell side across it, so the roll
+  // never skips a cell).
+  const double step = std::min(dx_ / std::max(std::abs(nx), 1e-9), dz_ / std::max(std::abs(nz), 1e-9));
+  // The repose drop over one such cell.
+  const double limit_step = std::tan(params_.repose_deg * std::numbers::pi / 180.0) * step *
+                            std::hypot(nx, nz);
+  const double along_motion = nx * mx + nz * mz;
+  const bool moving = std::abs(along_motion) > 0.01 * cell;
+  if (moving && along_motion < 0.0) {
+    nx = -nx;
+    nz = -nz;
+  }
+
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  const Rect& r = before_rect_;
+  std::size_t k = 0;
+  for (int row = r.r0; row < r.r1; ++row)
+    for (int c = r.c0; c < r.c1; ++c, ++k) {
+      const std::int64_t i = std::int64_t(row) * cols_ + c;
+      const float lost = before_[k] - layers.height_m[i];
+      if (!(lost > 0.0f)) continue;
+      activate(std::uint32_t(i));  // its walls may now be too steep
+      // Straight ahead of the edge: the cell centre's distance to the edge's
+      // line along the normal, plus kDepositAheadCells. At rest, away from
+      // the line on the cell's own side.
+      const double x = spec.origin_m.x + (c + 0.5) * dx_;
+      const double z = spec.origin_m.z + (row + 0.5) * dz_;
+      const double s = (x - to.a.x) * nx + (z - to.a.z) * nz;
+      const double side = moving || s >= 0.0 ? 1.0 : -1.0;
+      const double go = side * (kDepositAheadCells * cell) - s;
+      // The grid's edge is a wall: a target beyond it is its last cell.
+      const auto cell_at = [&](double along) {
+        const int tc = std::clamp(int(std::floor(to_cells(x + nx * along, spec.origin_m.x, dx_))),
+                                  0, cols_ - 1);
+        const int tr = std::clamp(int(std::floor(to_cells(z + nz * along, spec.origin_m.z, dz_))),
+                                  0, rows_ - 1);
+        return std::int64_t(tr) * cols_ + tc;
+      };
+      // The blade pushes what stands in front of it: along the push, the
+      // descending profile ahead (cells above the edge's height) moves on by
+      // one cell, the cut column's height taking the first cell's place, as
+      // a pile pushed by a blade does; what the shift does not account for
+      // (the cut layer itself) is put down just beyond the pile's toe. On
+      // flat ground nothing shifts and the cut soil is put down ahead.
+      const float edge_top = before_[k] - lost;  // the cut column's new height
+      std::int64_t ray[kMaxPushCells];
+      int length = 0;
+      ray[length++] = cell_at(go);
+      float previous = before_[k];
+      if (layers.height_m[ray[0]] < previous && !(layers.height_m[ray[0]] < edge_top)) {
+        while (length < kMaxPushCells) {
+          const std::int64_t next = cell_at(go + side * length * step);
+          if (next == ray[length - 1]) break;  // against the grid's edge
+          const float here = layers.height_m[ray[length - 1]], ahead = layers.height_m[next];
+          if (!(ahead < here) || ahead < edge_top) break;
+          ray[length++] = next;
+        }
+        for (int j = 0; j < length; ++j) {
+          const std::int64_t cell_j = ray[j];
+          const float old = layers.height_m[cell_j];
+          layers.height_m[cell_j] = previous;
+          layers.removed_m[cell_j] = layers.initial_m[cell_j] - previous;
+          out.changed.include(int(cell_j % cols_), int(cell_j / cols_));
+          activate(std::uint32_t(cell_j));
+          previous = old;
+        }
+      } else {
+        length = 0;  // nothing to push: the cut soil goes to the first cell ahead
+        previous = layers.height_m[ray[0]];
+      }
+      // What is left: the lost height less what the shift raised (which
+      // telescopes to the cut column's old height less the toe's old
+      // height). It extends the pile beyond its toe at the repose slope,
+      // cell by cell along the push; the rest of it stays on the last cell.
+      const float raised = length > 0 ? before_[k] - previous : 0.0f;
+      float rest = lost - raised;
+      out.displaced_volume_m3 += double(lost) * spec.cell_area_m2();
+      std::int64_t t = length > 0 ? ray[length - 1] : ray[0];
+      float level = length > 0 ? layers.height_m[t] : before_[k];
+      for (int m = length > 0 ? length : 0; m < kMaxPushCells && rest > 0.0f; ++m) {
+        const std::int64_t u = cell_at(go + side * m * step);
+        if (u == t && m > 0) break;  // against the grid's edge
+        const float top = level - float(limit_step);
+        const float room = top - layers.height_m[u];
+        t = u;
+        if (!(room > 0.0f)) {
+          if (m > 0 || length > 0) break;
+          continue;
+        }
+        const float add = std::min(rest, room);
+        layers.height_m[u] += add;
+        rest -= add;
+        level = layers.height_m[u];
+        layers.removed_m[u] = layers.initial_m[u] - layers.height_m[u];
+        out.changed.include(int(u % cols_), int(u / cols_));
+        activate(std::uint32_t(u));
+      }
+      // What did not fit (or, by rounding, came out negative) is settled on
+      // the last cell reached, keeping the volume.
+      if (rest != 0.0f) {
+        layers.height_m[t] = std::max(0.0f, layers.height_m[t] + rest);
+        layers.removed_m[t] = layers.initial_m[t] - layers.height_m[t];
+        out.changed.include(int(t % cols_), int(t / cols_));
+        activate(std::uint32_t(t));
+      }
+    }
+}
+
+void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  float* h = layers.height_m;
+  const float tol = tolerance_m_;
+  const bool blade = blade_.present;
+  while (!active_.empty() && out.pair_checks < params_.max_pair_checks_per_step) {
+    ++out.passes;
+    // Each active cell sheds half of its steepest excess, shared among its
+    // lower neighbours in proportion to their excess (from the heights
+    // frozen at the pass's start).
+    for (std::uint32_t a : active_) {
+      queued_[a] = 0;
+      const int ca = int(a % std::uint32_t(cols_)), ra = int(a / std::uint32_t(cols_));
+      const float ha = h[a];
+      std::uint32_t lower[8];
+      float excess[8];
+      int n = 0;
+      float max_excess = 0.0f, sum_excess = 0.0f;
+      for (const Neighbour& nb : kNeighbours) {
+        const int cb = ca + nb.dc, rb = ra + nb.dr;
+        if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_) continue;
+        const std::uint32_t b = std::uint32_t(std::int64_t(rb) * cols_ + cb);
+        const float e = ha - h[b] - float(limit_[nb.kind]);
+        if (!(e > tol)) continue;
+        // The blade is a wall between the cells on its two sides.
+        if (blade && near_blade_[a] && near_blade_[b] && blade_separates(a, b, ha)) continue;
+        lower[n] = b;
+        excess[n] = e;
+        ++n;
+        max_excess = std::max(max_excess, e);
+        sum_excess += e;
+      }
+      out.pair_checks += 8;
+      if (n == 0) continue;
+      const float share = kShedFraction * max_excess / sum_excess;
+      if (delta_[a] == 0.0f) touched_.push_back(a);
+      for (int k = 0; k < n; ++k) {
+        const float flux = share * excess[k];
+        if (delta_[lower[k]] == 0.0f) touched_.push_back(lower[k]);
+        delta_[lower[k]] += flux;
+        delta_[a] -= flux;
+      }
+      out.moved_pairs += n;
+    }
+    active_.clear();
+    // Apply the pass. A cell that rose may now be too steep toward its
+    // lower neighbours; one that fell may have made its higher neighbours
+    // too steep toward it: they are examined in the next pass.
+    for (std::uint32_t t : touched_) {
+      const float d = delta_[t];
+      delta_[t] = 0.0f;
+      if (d == 0.0f) continue;  // fluxes that cancelled
+      h[t] = std::max(0.0f, h[t] + d);
+      layers.removed_m[t] = layers.initial_m[t] - h[t];
+      const int ct = int(t % std::uint32_t(cols_)), rt = int(t / std::uint32_t(cols_));
+      out.changed.include(ct, rt);
+      activate(t);
+      if (d < 0.0f)
+        for (const Neighbour& nb : kNeighbours) {
+          const int c = ct + nb.dc, r = rt + nb.dr;
+          if (c >= 0 && r >= 0 && c < cols_ && r < rows_)
+            activate(std::uint32_t(std::int64_t(r) * cols_ + c));
+        }
+    }
+    touched_.clear();
+  }
+  out.backlog_cells = std::int64_t(active_.size());
+}
+
+SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const Segment& to) {
+  SoilStepResult out;
+  mark_blade(grid, to);
+  displace(grid, from, to, out);
+  run_passes(grid, out);
+  clear_blade();
+  return out;
+}
+
+SoilStepResult SoilFlow::relax(HeightGrid& grid) {
+  SoilStepResult out;
+  run_passes(grid, out);
+  return out;
+}
+
+}  // namespace terracut

@@ -1,0 +1,316 @@
+// Soil that flows (soil.hpp): relaxation to the angle of repose (a column of
+// sand collapses into a round cone at the repose angle in every direction,
+// a gentler slope stays put, the volume is conserved, the result is
+// deterministic and mirror-symmetric, the work per step is capped), and
+// displacement by the blade (the cut soil is pushed into a pile ahead of
+// it whose size follows the bulldozing mass balance; the cut behind stays
+// open). Tolerances come from the cell size and the stated tolerance of the
+// relaxation (2 % of the repose slope).
+#include "terracut/core/soil.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "terracut/core/error.hpp"
+#include "terracut/core/simulation.hpp"
+
+namespace terracut {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+GridSpec square_grid(int n, double cell_m) {
+  GridSpec s;
+  s.cols = n;
+  s.rows = n;
+  s.size_x_m = n * cell_m;
+  s.size_z_m = n * cell_m;
+  s.full_scale_m = 1.0;
+  return s;
+}
+
+SoilFlowParams flow(double repose_deg, std::int64_t checks = 200000) {
+  SoilFlowParams p;
+  p.model = SoilModel::kFlow;
+  p.repose_deg = repose_deg;
+  p.max_pair_checks_per_step = checks;
+  return p;
+}
+
+double sum_heights(const HeightGrid& g) {
+  double s = 0.0;
+  for (std::int64_t i = 0; i < g.spec().sample_count(); ++i) s += g.heights()[i];
+  return s;
+}
+
+// Relaxes until nothing is active (or a bound on steps); returns the steps.
+int settle(SoilFlow& f, HeightGrid& g, int max_steps = 100000) {
+  int steps = 0;
+  while (f.active_cells() > 0 && steps < max_steps) {
+    f.relax(g);
+    ++steps;
+  }
+  return steps;
+}
+
+// Bilinear height of the grid at cell coordinates (u, v) (sample centres at
+// integer + 0.5 are the nodes).
+double height_at(const HeightGrid& g, double u, double v) {
+  const double x = u - 0.5, z = v - 0.5;
+  const int c = int(std::floor(x)), r = int(std::floor(z));
+  const double fx = x - c, fz = z - r;
+  const auto h = [&](int cc, int rr) {
+    cc = std::clamp(cc, 0, g.cols() - 1);
+    rr = std::clamp(rr, 0, g.rows() - 1);
+    return double(g.height(cc, rr));
+  };
+  return h(c, r) * (1 - fx) * (1 - fz) + h(c + 1, r) * fx * (1 - fz) + h(c, r + 1) * (1 - fx) * fz +
+         h(c + 1, r + 1) * fx * fz;
+}
+
+// The cone's slope along a ray from the centre (cell coordinates), degrees:
+// the mean slope between where the surface falls below 80 % and 20 % of the
+// peak (away from the rounded tip and the toe).
+double flank_angle_deg(const HeightGrid& g, double cu, double cv, double dir_deg, double cell_m) {
+  const double a = dir_deg * kDeg;
+  const double peak = height_at(g, cu, cv);
+  double s80 = -1.0, s20 = -1.0;
+  for (double s = 0.0; s < g.cols(); s += 0.02) {
+    const double v = height_at(g, cu + s * std::cos(a), cv + s * std::sin(a));
+    if (s80 < 0.0 && v < 0.8 * peak) s80 = s;
+    if (v < 0.2 * peak) {
+      s20 = s;
+      break;
+    }
+  }
+  const double h80 = height_at(g, cu + s80 * std::cos(a), cv + s80 * std::sin(a));
+  const double h20 = height_at(g, cu + s20 * std::cos(a), cv + s20 * std::sin(a));
+  return std::atan((h80 - h20) / ((s20 - s80) * cell_m)) / kDeg;
+}
+
+// A column of sand (radius 15 cells, 0.4 m tall) on a bare floor.
+std::vector<float> column(int n, double radius_cells, float height_m) {
+  std::vector<float> h(std::size_t(n) * n, 0.0f);
+  const double c = 0.5 * (n - 1);
+  for (int r = 0; r < n; ++r)
+    for (int k = 0; k < n; ++k)
+      if ((k - c) * (k - c) + (r - c) * (r - c) <= radius_cells * radius_cells)
+        h[std::size_t(r) * n + k] = height_m;
+  return h;
+}
+
+TEST(SoilFlow, AColumnCollapsesIntoARoundConeAtTheReposeAngle) {
+  for (const double repose : {34.0, 45.0}) {
+    const int n = 161;
+    const double cell = 0.01;
+    HeightGrid g(square_grid(n, cell), column(n, 15.0, 0.4f));
+    const double before = sum_heights(g);
+    SoilFlow f(flow(repose), g);
+    EXPECT_GT(f.active_cells(), 0);  // the column's walls are too steep
+    settle(f, g);
+    ASSERT_EQ(f.active_cells(), 0) << "did not settle";
+    // Every direction, not only the grid's axes and diagonals: within the
+    // 8-neighbour stencil's anisotropy (about 1.3 degrees at 22.5 degrees
+    // off the axes at 34) plus the tolerance (2 % of tan, 0.5 degree) and
+    // the interpolation over cells.
+    for (double dir = 0.0; dir < 360.0; dir += 22.5) {
+      const double angle = flank_angle_deg(g, 0.5 * n, 0.5 * n, dir, cell);
+      EXPECT_NEAR(angle, repose, 2.0) << "repose " << repose << ", direction " << dir;
+    }
+    // Nothing is steeper than the repose angle (plus the tolerance) anywhere.
+    const double limit = std::tan(repose * kDeg) * cell * 1.02 + 1e-6;
+    for (int r = 0; r + 1 < n; ++r)
+      for (int c = 0; c + 1 < n; ++c) {
+        EXPECT_LE(std::abs(g.height(c, r) - g.height(c + 1, r)), limit) << c << "," << r;
+        EXPECT_LE(std::abs(g.height(c, r) - g.height(c, r + 1)), limit) << c << "," << r;
+      }
+    // The volume is conserved to float rounding.
+    EXPECT_NEAR(sum_heights(g), before, 1e-6 * before);
+    for (std::int64_t i = 0; i < g.spec().sample_count(); ++i) EXPECT_GE(g.heights()[i], 0.0f);
+  }
+}
+
+TEST(SoilFlow, ASlopeBelowTheReposeAngleNeverMoves) {
+  // A ramp at 30 degrees along X, and one at 30 degrees along the diagonal,
+  // with a repose angle of 34: nothing is active, nothing changes.
+  const int n = 40;
+  const double cell = 0.02;
+  for (const bool diagonal : {false, true}) {
+    std::vector<float> h(std::size_t(n) * n);
+    const double slope = std::tan(30.0 * kDeg);
+    for (int r = 0; r < n; ++r)
+      for (int c = 0; c < n; ++c) {
+        const double along = diagonal ? (c + r) * cell / std::sqrt(2.0) : c * cell;
+        h[std::size_t(r) * n + c] = float(0.05 + slope * along);
+      }
+    HeightGrid g(square_grid(n, cell), h);
+    SoilFlow f(flow(34.0), g);
+    EXPECT_EQ(f.active_cells(), 0) << diagonal;
+    const SoilStepResult r = f.relax(g);
+    EXPECT_EQ(r.moved_pairs, 0);
+    for (std::size_t i = 0; i < h.size(); ++i) EXPECT_EQ(g.heights()[i], h[i]);
+  }
+}
+
+TEST(SoilFlow, DeterministicAndMirrorSymmetric) {
+  // An uneven heap: two columns of different heights, off centre.
+  const int n = 61;
+  std::vector<float> h(std::size_t(n) * n, 0.02f);
+  for (int r = 10; r < 25; ++r)
+    for (int c = 8; c < 20; ++c) h[std::size_t(r) * n + c] = 0.3f;
+  for (int r = 30; r < 36; ++r)
+    for (int c = 20; c < 45; ++c) h[std::size_t(r) * n + c] = 0.18f;
+  std::vector<float> mirrored(h.size());
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) mirrored[std::size_t(r) * n + c] = h[std::size_t(r) * n + (n - 1 - c)];
+
+  HeightGrid a(square_grid(n, 0.01), h), b(square_grid(n, 0.01), h), m(square_grid(n, 0.01), mirrored);
+  SoilFlow fa(flow(34.0), a), fb(flow(34.0), b), fm(flow(34.0), m);
+  settle(fa, a);
+  settle(fb, b);
+  settle(fm, m);
+  EXPECT_EQ(a.state_hash(), b.state_hash());  // the same inputs, the same bits
+  double worst = 0.0;
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c)
+      worst = std::max(worst, std::abs(double(a.height(c, r)) - double(m.height(n - 1 - c, r))));
+  // The mirror differs only by float rounding (the order of additions).
+  EXPECT_LT(worst, 1e-5);
+}
+
+TEST(SoilFlow, WorkPerStepIsCappedAndTheBacklogCarriedOver) {
+  // A collapsing 100 x 100-cell block: more work than one step may do.
+  const int n = 200;
+  std::vector<float> h(std::size_t(n) * n, 0.0f);
+  for (int r = 50; r < 150; ++r)
+    for (int c = 50; c < 150; ++c) h[std::size_t(r) * n + c] = 0.5f;
+  HeightGrid g(square_grid(n, 0.01), h);
+  const std::int64_t cap = 20000;
+  SoilFlow f(flow(34.0, cap), g);
+  const double before = sum_heights(g);
+  int steps = 0;
+  std::int64_t max_backlog = 0;
+  while (f.active_cells() > 0 && steps < 200000) {
+    const SoilStepResult r = f.relax(g);
+    // Whole passes until the cap is reached: at most one pass beyond it,
+    // and a pass checks 8 pairs per active cell (at most the whole grid).
+    EXPECT_LE(r.pair_checks, cap + 8 * std::int64_t(n) * n);
+    EXPECT_EQ(r.backlog_cells, f.active_cells());
+    max_backlog = std::max(max_backlog, r.backlog_cells);
+    ++steps;
+  }
+  EXPECT_EQ(f.active_cells(), 0);
+  EXPECT_GT(steps, 10);  // the collapse was spread over many steps
+  EXPECT_GT(max_backlog, 100);
+  EXPECT_NEAR(sum_heights(g), before, 1e-6 * before);
+}
+
+TEST(SoilFlow, RefusesBadParameters) {
+  HeightGrid g(square_grid(4, 0.1), std::vector<float>(16, 0.1f));
+  SoilFlowParams p = flow(0.0);
+  EXPECT_NE(validate(p).find("soil.repose_deg"), std::string::npos);
+  EXPECT_THROW(SoilFlow(p, g), InputError);
+  p = flow(81.0);
+  EXPECT_NE(validate(p).find("(0, 80]"), std::string::npos);
+  p = flow(34.0, 10);
+  EXPECT_NE(validate(p).find("soil.max_pair_checks_per_step"), std::string::npos);
+  EXPECT_EQ(parse_soil_model("flow"), SoilModel::kFlow);
+  EXPECT_EQ(parse_soil_model("vanish"), SoilModel::kVanish);
+  EXPECT_FALSE(parse_soil_model("mud"));
+}
+
+// A blade 1 m wide cutting d = 5 cm into a 20 cm layer of sand (repose 34)
+// on a 1 cm grid, pushed 0.6 m along +Z at 0.6 mm per step.
+struct Dozing {
+  SimParams params;
+  double layer_m = 0.2, depth_m = 0.05, push_m = 0.6, start_z_m = 0.4;
+  std::unique_ptr<Simulation> sim;
+
+  explicit Dozing(SoilModel model) {
+    params.grid.cols = 200;
+    params.grid.rows = 200;
+    params.grid.size_x_m = 2.0;
+    params.grid.size_z_m = 2.0;
+    params.grid.full_scale_m = 1.0;
+    params.blade.length_m = 1.0;
+    params.soil = flow(34.0, 400000);
+    params.soil.model = model;
+    sim = std::make_unique<Simulation>(
+        params, std::vector<float>(std::size_t(200) * 200, float(layer_m)));
+    const int steps = int(std::lround(push_m / 0.0006));
+    for (int i = 0; i <= steps; ++i) {
+      const double z = start_z_m + push_m * i / steps;
+      sim->step({{1.0, layer_m - depth_m, z}, Quat{}});
+    }
+  }
+  double edge_y() const { return layer_m - depth_m; }
+  double blade_z() const { return start_z_m + push_m; }
+};
+
+TEST(SoilDisplacement, VanishIsThePapersModel) {
+  Dozing v(SoilModel::kVanish);
+  EXPECT_EQ(v.sim->soil(), nullptr);
+  // The cut soil is gone: 1 m x 5 cm x (the pushed length, to a cell).
+  const HeightGrid& g = v.sim->grid();
+  const double initial = 200 * 200 * 0.01 * 0.01 * v.layer_m;
+  EXPECT_NEAR(initial - g.volume_m3(), 1.0 * v.depth_m * v.push_m, 1.0 * v.depth_m * 0.02);
+}
+
+TEST(SoilDisplacement, TheBladePushesAPileThatFollowsTheMassBalance) {
+  Dozing d(SoilModel::kFlow);
+  const HeightGrid& g = d.sim->grid();
+  const double cell = 0.01;
+  // Nothing vanished.
+  const double initial = 200 * 200 * cell * cell * d.layer_m;
+  EXPECT_NEAR(g.volume_m3(), initial, 1e-6 * initial);
+  // The cut behind the blade stays open at the edge's height (the blade is
+  // a wall): along the centre line, from 5 cm after the start to 5 cm
+  // behind the blade, within the float step.
+  for (double z = d.start_z_m + 0.05; z < d.blade_z() - 0.05; z += 0.01) {
+    const int r = int(z / cell);
+    EXPECT_NEAR(g.height(100, r), d.edge_y(), 1e-4) << "z = " << z;
+  }
+  // The pile ahead of the blade holds the pushed volume w d x, less what
+  // spilled round the blade's ends into windrows (which partly slide back
+  // into the cut): for a 1 m blade pushing 60 cm, most of it.
+  double above = 0.0, ahead = 0.0, peak = 0.0;
+  for (int r = 0; r < 200; ++r)
+    for (int c = 0; c < 200; ++c) {
+      const double excess = std::max(0.0, double(g.height(c, r)) - d.layer_m) * cell * cell;
+      above += excess;
+      if (std::abs((c + 0.5) * cell - 1.0) < 0.5 && (r + 0.5) * cell > d.blade_z()) {
+        ahead += excess;
+        peak = std::max(peak, double(g.height(c, r)) - d.layer_m);
+      }
+    }
+  const double pushed = 1.0 * d.depth_m * d.push_m;
+  EXPECT_GT(ahead, 0.75 * pushed);
+  EXPECT_LT(ahead, pushed);
+  EXPECT_GT(above, ahead);  // the windrows beside it
+  // The pile's height, against the 2-D balance of a wedge at the repose
+  // angle (h = sqrt(2 d x tan(theta))): the spill at the ends lowers it a
+  // little; within 15 % (about two cells of the pile's slope).
+  const double wedge = std::sqrt(2.0 * d.depth_m * d.push_m * std::tan(34.0 * kDeg));
+  EXPECT_NEAR(peak, wedge, 0.15 * wedge);
+  // Soil never stands above the blade's edge between the blade and the cut.
+  for (std::int64_t i = 0; i < g.spec().sample_count(); ++i) EXPECT_GE(g.heights()[i], 0.0f);
+}
+
+TEST(SoilDisplacement, SoilLayersKeepTheirIdentity) {
+  // removed = initial - height per sample, now signed: < 0 where the blade
+  // put soil down.
+  Dozing d(SoilModel::kFlow);
+  const HeightGrid& g = d.sim->grid();
+  EXPECT_LT(g.conservation_error_m(), 1e-6);
+  int deposited = 0;
+  for (std::int64_t i = 0; i < g.spec().sample_count(); ++i)
+    if (g.removed()[i] < 0.0f) ++deposited;
+  EXPECT_GT(deposited, 100);
+}
+
+}  // namespace
+}  // namespace terracut
