@@ -15,6 +15,7 @@
 
 #include "subprocess.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 #include "terracut/haptics/device_option.hpp"
 #include "terracut/io/files.hpp"
 #include "terracut/session/haptic.hpp"
@@ -170,11 +171,9 @@ Command add_haptics_command(CLI::App& app) {
           std::to_string(session.udp_port()) +
           " (the session clock runs from now; until poses arrive the force is zero and the "
           "watchdog counts the silence)");
-    char what[160];
-    std::snprintf(what, sizeof what, "running the %s device for %g s (%s clock)",
-                  std::string(to_string(session.device_kind())).c_str(), session.duration_s(),
-                  session.clock() == session::ClockMode::kFake ? "fake" : "real");
-    say(what);
+    say("running the " + std::string(to_string(session.device_kind())) + " device for " +
+        format_number(session.duration_s()) + " s (" +
+        (session.clock() == session::ClockMode::kFake ? "fake" : "real") + " clock)");
 
     g_interrupt.store(false);
     struct sigaction action {};

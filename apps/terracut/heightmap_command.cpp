@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 #include "terracut/core/generators.hpp"
 #include "terracut/io/image.hpp"
 #include "terracut/io/scenario.hpp"
@@ -106,7 +107,7 @@ Command add_heightmap_command(CLI::App& app) {
     if (!(opt->size[0] > 0.0) || !(opt->size[1] > 0.0))
       throw InputError("--size: both extents must be > 0");
     if (!std::isfinite(opt->full_scale) || !(opt->full_scale > 0.0))
-      throw InputError("--full-scale: must be a finite number > 0");
+      throw InputError("--full-scale: " + must_be("a finite number > 0", opt->full_scale));
 
     GridSpec spec;
     spec.cols = res.cols;

@@ -3,6 +3,7 @@
 #include <charconv>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 
 namespace terracut::bullet {
 
@@ -48,7 +49,7 @@ void append_rows(const TerrainWorld& world, double t_s, std::string& out) {
 BodiesCsvWriter::BodiesCsvWriter(const std::filesystem::path& path, int every_n_steps)
     : path_(path), every_n_(every_n_steps) {
   if (every_n_steps < 1)
-    throw InputError("bodies.csv: every_n_steps must be >= 1, got " + std::to_string(every_n_steps));
+    throw InputError(must_be("bodies.csv: every_n_steps", ">= 1", every_n_steps));
   file_ = std::fopen(path.c_str(), "wb");
   if (!file_) throw InputError(path.string() + ": cannot open for writing");
   buffer_.reserve(2 * kFlushBytes);

@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <sstream>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 
 namespace terracut::bullet {
 
@@ -45,27 +45,25 @@ const TerrainWorldParams& checked(const TerrainWorldParams& params) {
 }  // namespace
 
 std::string validate(const TerrainWorldParams& p) {
-  std::ostringstream msg;
-  if (!in_range(p.gravity_m_s2, 0.0, 1000.0)) {
-    msg << "gravity_m_s2 must be in [0, 1000], got " << p.gravity_m_s2;
-  } else if (!(std::isfinite(p.max_height_m) && p.max_height_m >= 0.0)) {
-    msg << "max_height_m must be finite and >= 0 (0 = automatic), got " << p.max_height_m;
-  } else if (!in_range(p.terrain_friction, 0.0, 10.0)) {
-    msg << "terrain_friction must be in [0, 10], got " << p.terrain_friction;
-  } else if (!in_range(p.terrain_restitution, 0.0, 1.0)) {
-    msg << "terrain_restitution must be in [0, 1], got " << p.terrain_restitution;
-  } else if (!in_range(p.convex_margin_m, 0.0, 0.1)) {
-    msg << "convex_margin_m must be in [0, 0.1], got " << p.convex_margin_m;
-  } else if (p.solver_iterations < 1 || p.solver_iterations > 1000) {
-    msg << "solver_iterations must be in [1, 1000], got " << p.solver_iterations;
-  } else if (p.tool.enabled && !(p.tool.height_m > 0.0 && p.tool.height_m <= 100.0)) {
-    msg << "tool.height_m must be in (0, 100], got " << p.tool.height_m;
-  } else if (p.tool.enabled && !(p.tool.thickness_m > 0.0 && p.tool.thickness_m <= 100.0)) {
-    msg << "tool.thickness_m must be in (0, 100], got " << p.tool.thickness_m;
-  } else if (p.tool.enabled && !in_range(p.tool.friction, 0.0, 10.0)) {
-    msg << "tool.friction must be in [0, 10], got " << p.tool.friction;
-  }
-  return msg.str();
+  if (!in_range(p.gravity_m_s2, 0.0, 1000.0))
+    return must_be("gravity_m_s2", "in [0, 1000]", p.gravity_m_s2);
+  if (!(std::isfinite(p.max_height_m) && p.max_height_m >= 0.0))
+    return must_be("max_height_m", "finite and >= 0 (0 = automatic)", p.max_height_m);
+  if (!in_range(p.terrain_friction, 0.0, 10.0))
+    return must_be("terrain_friction", "in [0, 10]", p.terrain_friction);
+  if (!in_range(p.terrain_restitution, 0.0, 1.0))
+    return must_be("terrain_restitution", "in [0, 1]", p.terrain_restitution);
+  if (!in_range(p.convex_margin_m, 0.0, 0.1))
+    return must_be("convex_margin_m", "in [0, 0.1]", p.convex_margin_m);
+  if (p.solver_iterations < 1 || p.solver_iterations > 1000)
+    return must_be("solver_iterations", "in [1, 1000]", p.solver_iterations);
+  if (p.tool.enabled && !(p.tool.height_m > 0.0 && p.tool.height_m <= 100.0))
+    return must_be("tool.height_m", "in (0, 100]", p.tool.height_m);
+  if (p.tool.enabled && !(p.tool.thickness_m > 0.0 && p.tool.thickness_m <= 100.0))
+    return must_be("tool.thickness_m", "in (0, 100]", p.tool.thickness_m);
+  if (p.tool.enabled && !in_range(p.tool.friction, 0.0, 10.0))
+    return must_be("tool.friction", "in [0, 10]", p.tool.friction);
+  return {};
 }
 
 // Bullet objects, in construction order (members are destroyed in reverse:
@@ -104,19 +102,13 @@ TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& bl
                            std::vector<BodySpec> bodies, const TerrainWorldParams& params)
     : grid_(grid), params_(checked(params)), blade_(blade), specs_(std::move(bodies)) {
   // Settings: everything is checked here so the step can trust it.
-  if (!(std::isfinite(rate_hz) && rate_hz > 0.0 && rate_hz <= 1e6)) {
-    std::ostringstream msg;
-    msg << "rate_hz must be in (0, 1e6], got " << rate_hz;
-    throw InputError(msg.str());
-  }
+  if (!(std::isfinite(rate_hz) && rate_hz > 0.0 && rate_hz <= 1e6))
+    throw InputError(must_be("rate_hz", "in (0, 1e6]", rate_hz));
   if (params_.tool.enabled && !(std::isfinite(blade.length_m) && blade.length_m > 0.0))
     throw InputError("blade.length_m must be finite and > 0 for the tool plate");
-  if (grid.cols() < 2 || grid.rows() < 2) {
-    std::ostringstream msg;
-    msg << "the Bullet heightfield needs at least 2 x 2 samples, the grid has " << grid.cols()
-        << " x " << grid.rows();
-    throw InputError(msg.str());
-  }
+  if (grid.cols() < 2 || grid.rows() < 2)
+    throw InputError("the Bullet heightfield needs at least 2 x 2 samples, the grid has " +
+                     format_number(grid.cols()) + " x " + format_number(grid.rows()));
   if (std::string e = validate(specs_); !e.empty()) throw InputError(e);
   dt_s_ = 1.0 / rate_hz;
 
@@ -127,9 +119,8 @@ TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& bl
   if (max_h == 0.0) {
     max_h = std::max(2.0 * spec.full_scale_m, top + spec.full_scale_m);
   } else if (max_h < top) {
-    std::ostringstream msg;
-    msg << "max_height_m (" << max_h << ") is below the highest initial height (" << top << ")";
-    throw InputError(msg.str());
+    throw InputError(must_be(
+        "max_height_m", "0 or at least the highest initial height " + format_number(top), max_h));
   }
   bounds_.min_height_m = 0.0;
   bounds_.max_height_m = double(btScalar(max_h));

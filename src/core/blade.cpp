@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+
+#include "terracut/core/format.hpp"
 
 namespace terracut {
 
@@ -26,26 +27,23 @@ BladePose Motion::sample(double t_s) const {
 }
 
 std::string validate(const Motion& motion) {
-  std::ostringstream msg;
-  if (motion.keyframes.empty()) {
-    msg << "motion '" << motion.name << "' has no keyframes";
-    return msg.str();
-  }
+  const std::string name = "motion '" + motion.name + "'";
+  if (motion.keyframes.empty()) return name + " has no keyframes";
   for (size_t i = 0; i < motion.keyframes.size(); ++i) {
     const Keyframe& k = motion.keyframes[i];
-    if (!std::isfinite(k.t_s) || k.t_s < 0.0) {
-      msg << "motion '" << motion.name << "' keyframe " << i << ": t_s must be finite and >= 0";
-    } else if (i > 0 && !(k.t_s > motion.keyframes[i - 1].t_s)) {
-      msg << "motion '" << motion.name << "' keyframe " << i << ": t_s (" << k.t_s
-          << ") must be greater than the previous keyframe's (" << motion.keyframes[i - 1].t_s << ")";
-    } else if (!is_finite(k.pose.position_m)) {
-      msg << "motion '" << motion.name << "' keyframe " << i << ": position is not finite";
-    } else if (!is_finite(k.pose.orientation) ||
-               !(std::abs(k.pose.orientation.w) + std::abs(k.pose.orientation.x) +
-                     std::abs(k.pose.orientation.y) + std::abs(k.pose.orientation.z) > 0.0)) {
-      msg << "motion '" << motion.name << "' keyframe " << i << ": rotation is not a valid rotation";
-    }
-    if (!msg.str().empty()) return msg.str();
+    const std::string at = name + " keyframe " + format_number(i) + ": ";
+    if (!std::isfinite(k.t_s) || k.t_s < 0.0) return must_be(at + "t_s", "finite and >= 0", k.t_s);
+    if (i > 0 && !(k.t_s > motion.keyframes[i - 1].t_s))
+      return must_be(at + "t_s",
+                     "greater than the previous keyframe's " +
+                         format_number(motion.keyframes[i - 1].t_s),
+                     k.t_s);
+    if (!is_finite(k.pose.position_m)) return at + "position is not finite";
+    if (!is_finite(k.pose.orientation) ||
+        !(std::abs(k.pose.orientation.w) + std::abs(k.pose.orientation.x) +
+              std::abs(k.pose.orientation.y) + std::abs(k.pose.orientation.z) >
+          0.0))
+      return at + "rotation is not a valid rotation";
   }
   return {};
 }

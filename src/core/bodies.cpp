@@ -2,7 +2,8 @@
 
 #include <cctype>
 #include <cmath>
-#include <sstream>
+
+#include "terracut/core/format.hpp"
 
 namespace terracut {
 
@@ -36,52 +37,46 @@ bool valid_name(const std::string& name) {
   return true;
 }
 
-// Appends "FIELD must be in (0, max], got V" to msg when v is not a valid dimension.
-bool check_dimension(std::ostringstream& msg, const char* field, double v) {
-  if (std::isfinite(v) && v > 0.0 && v <= kMaxBodyDimensionM) return true;
-  msg << field << " must be in (0, " << kMaxBodyDimensionM << "] metres, got " << v;
-  return false;
+// "FIELD must be in (0, max] metres, got V" when v is not a valid dimension, else "".
+std::string check_dimension(const char* field, double v) {
+  if (std::isfinite(v) && v > 0.0 && v <= kMaxBodyDimensionM) return {};
+  return must_be(field, "in (0, " + format_number(kMaxBodyDimensionM) + "] metres", v);
 }
 
 }  // namespace
 
 std::string validate(const BodySpec& spec) {
-  std::ostringstream msg;
-  if (!valid_name(spec.name)) {
-    msg << "name '" << spec.name << "' must be 1 to " << kMaxBodyNameLength
-        << " characters among letters, digits, '_', '-' and '.'";
-    return msg.str();
-  }
+  if (!valid_name(spec.name))
+    return "name '" + spec.name + "' must be 1 to " + format_number(kMaxBodyNameLength) +
+           " characters among letters, digits, '_', '-' and '.'";
+  std::string m;
   switch (spec.shape) {
     case BodyShape::kBox:
-      if (!check_dimension(msg, "size_m[0]", spec.size_m.x) ||
-          !check_dimension(msg, "size_m[1]", spec.size_m.y) ||
-          !check_dimension(msg, "size_m[2]", spec.size_m.z))
-        return msg.str();
+      if (!(m = check_dimension("size_m[0]", spec.size_m.x)).empty() ||
+          !(m = check_dimension("size_m[1]", spec.size_m.y)).empty() ||
+          !(m = check_dimension("size_m[2]", spec.size_m.z)).empty())
+        return m;
       break;
     case BodyShape::kSphere:
-      if (!check_dimension(msg, "radius_m", spec.radius_m)) return msg.str();
+      if (!(m = check_dimension("radius_m", spec.radius_m)).empty()) return m;
       break;
     case BodyShape::kCylinder:
-      if (!check_dimension(msg, "radius_m", spec.radius_m) ||
-          !check_dimension(msg, "height_m", spec.height_m))
-        return msg.str();
+      if (!(m = check_dimension("radius_m", spec.radius_m)).empty() ||
+          !(m = check_dimension("height_m", spec.height_m)).empty())
+        return m;
       break;
     default:
       return "shape must be box, sphere or cylinder";
   }
-  if (!(std::isfinite(spec.mass_kg) && spec.mass_kg >= 0.0)) {
-    msg << "mass_kg must be finite and >= 0 (0 = static), got " << spec.mass_kg;
-  } else if (!is_finite(spec.position_m)) {
-    msg << "position_m must be finite";
-  } else if (!is_finite(spec.rotation_deg)) {
-    msg << "rotation_deg must be finite";
-  } else if (!(spec.friction >= 0.0 && spec.friction <= 10.0)) {
-    msg << "friction must be in [0, 10], got " << spec.friction;
-  } else if (!(spec.restitution >= 0.0 && spec.restitution <= 1.0)) {
-    msg << "restitution must be in [0, 1], got " << spec.restitution;
-  }
-  return msg.str();
+  if (!(std::isfinite(spec.mass_kg) && spec.mass_kg >= 0.0))
+    return must_be("mass_kg", "finite and >= 0 (0 = static)", spec.mass_kg);
+  if (!is_finite(spec.position_m)) return "position_m must be finite";
+  if (!is_finite(spec.rotation_deg)) return "rotation_deg must be finite";
+  if (!(spec.friction >= 0.0 && spec.friction <= 10.0))
+    return must_be("friction", "in [0, 10]", spec.friction);
+  if (!(spec.restitution >= 0.0 && spec.restitution <= 1.0))
+    return must_be("restitution", "in [0, 1]", spec.restitution);
+  return {};
 }
 
 std::string validate(const std::vector<BodySpec>& bodies) {
@@ -90,13 +85,13 @@ std::string validate(const std::vector<BodySpec>& bodies) {
     if (problem.empty()) {
       for (std::size_t j = 0; j < i; ++j) {
         if (bodies[j].name == bodies[i].name) {
-          problem = "duplicate name (also bodies[" + std::to_string(j) + "])";
+          problem = "duplicate name (also bodies[" + format_number(j) + "])";
           break;
         }
       }
     }
     if (!problem.empty())
-      return "bodies[" + std::to_string(i) + "] (" + bodies[i].name + "): " + problem;
+      return "bodies[" + format_number(i) + "] (" + bodies[i].name + "): " + problem;
   }
   return {};
 }

@@ -5,11 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numbers>
 
 #include "geometry.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 
 namespace terracut {
 
@@ -18,29 +18,23 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
 
-// A number in messages: shortest round-trip-ish form ("0.02", "3000", "1e+06").
-std::string num(double value) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.6g", value);
-  return buffer;
-}
-
-// "field must be ... (got value)" checks, returning the message or "".
+// "FIELD must be ..., got VALUE" checks, returning the message or "".
 std::string check_nonnegative(const std::string& field, double value) {
   if (std::isfinite(value) && value >= 0.0) return {};
-  return field + " must be finite and >= 0 (got " + num(value) + ")";
+  return must_be(field, "finite and >= 0", value);
 }
 std::string check_positive(const std::string& field, double value) {
   if (std::isfinite(value) && value > 0.0) return {};
-  return field + " must be finite and > 0 (got " + num(value) + ")";
+  return must_be(field, "finite and > 0", value);
 }
 std::string check_angle(const std::string& field, double value_rad, double hi_rad,
                         bool include_zero) {
   bool ok = std::isfinite(value_rad) && (include_zero ? value_rad >= 0.0 : value_rad > 0.0) &&
             value_rad < hi_rad;
   if (ok) return {};
-  return field + " must be in " + (include_zero ? "[0, " : "(0, ") + num(hi_rad) + ") rad (got " +
-         num(value_rad) + " rad = " + num(value_rad / kDeg) + " deg)";
+  return must_be(field, (include_zero ? "in [0, " : "in (0, ") + format_number(hi_rad) + ") rad",
+                 value_rad) +
+         " rad = " + format_number(value_rad / kDeg) + " deg";
 }
 
 // Prefixes a sub-structure's message with its field name.
@@ -192,9 +186,9 @@ std::string validate(const EarthmovingParams& params) {
   double room = kPi - params.rake_angle_rad - params.soil.soil_tool_friction_rad -
                 params.soil.internal_friction_rad;
   if (!(room >= 1.0 * kDeg)) {
-    return "rake_angle_rad + soil.soil_tool_friction_rad + soil.internal_friction_rad must be "
-           "below 179 deg (got " +
-           num((kPi - room) / kDeg) + " deg): no planar failure wedge exists";
+    return must_be("rake_angle_rad + soil.soil_tool_friction_rad + soil.internal_friction_rad",
+                   "below 179 deg", (kPi - room) / kDeg) +
+           " deg: no planar failure wedge exists";
   }
   return {};
 }
@@ -391,7 +385,7 @@ std::string validate(const ForceModelParams& params) {
     return m;
   if (!(std::isfinite(params.loop_rate_hz) && params.loop_rate_hz > 0.0 &&
         params.loop_rate_hz <= 1e6)) {
-    return "loop_rate_hz must be in (0, 1e6] (got " + num(params.loop_rate_hz) + ")";
+    return must_be("loop_rate_hz", "in (0, 1e6]", params.loop_rate_hz);
   }
   return nested("device", validate(params.device));
 }
@@ -402,8 +396,8 @@ ForceModel::ForceModel(const ForceModelParams& params) : requested_(params), par
   const DeviceLimits& dev = params.device;
   // World N/m (or N s/m) -> device N/m (or N s/m).
   const double gain = params.force_scale * params.workspace_scale;
-  const std::string scaling = " (x force_scale " + num(params.force_scale) + " x workspace_scale " +
-                              num(params.workspace_scale) + ")";
+  const std::string scaling = " (x force_scale " + format_number(params.force_scale) +
+                              " x workspace_scale " + format_number(params.workspace_scale) + ")";
 
   // Surface: damping within the device's figure, then stiffness within both
   // the device's figure and Colgate & Brown's passivity bound for that damping.
@@ -411,10 +405,11 @@ ForceModel::ForceModel(const ForceModelParams& params) : requested_(params), par
     double damping = params.surface.damping_n_s_per_m * gain;
     if (damping > dev.max_damping_n_s_per_m) {
       if (refuse) {
-        throw InputError(
-            "surface.damping_n_s_per_m = " + num(params.surface.damping_n_s_per_m) +
-            " N s/m (world) is " + num(damping) + " N s/m on the device" + scaling +
-            ", above device.max_damping_n_s_per_m = " + num(dev.max_damping_n_s_per_m));
+        throw InputError("surface.damping_n_s_per_m = " +
+                         format_number(params.surface.damping_n_s_per_m) + " N s/m (world) is " +
+                         format_number(damping) + " N s/m on the device" + scaling +
+                         ", above device.max_damping_n_s_per_m = " +
+                         format_number(dev.max_damping_n_s_per_m));
       }
       damping = dev.max_damping_n_s_per_m;
       params_.surface.damping_n_s_per_m = damping / gain;
@@ -429,23 +424,26 @@ ForceModel::ForceModel(const ForceModelParams& params) : requested_(params), par
     double passive = passive_stiffness_limit_n_per_m(dev.inherent_damping_n_s_per_m, damping,
                                                      params.loop_rate_hz);
     if (!(passive > 0.0)) {
-      throw InputError(
-          "surface.damping_n_s_per_m = " + num(params_.surface.damping_n_s_per_m) +
-          " N s/m (world) is " + num(damping) + " N s/m on the device" + scaling +
-          ", not below device.inherent_damping_n_s_per_m = " + num(dev.inherent_damping_n_s_per_m) +
-          ": no stiffness is passive (Colgate & Brown: b > K T / 2 + |B|)");
+      throw InputError("surface.damping_n_s_per_m = " +
+                       format_number(params_.surface.damping_n_s_per_m) + " N s/m (world) is " +
+                       format_number(damping) + " N s/m on the device" + scaling +
+                       ", not below device.inherent_damping_n_s_per_m = " +
+                       format_number(dev.inherent_damping_n_s_per_m) +
+                       ": no stiffness is passive (Colgate & Brown: b > K T / 2 + |B|)");
     }
     double limit = std::min(dev.max_stiffness_n_per_m, passive);
     double stiffness = params.surface.stiffness_n_per_m * gain;
     if (stiffness > limit) {
       if (refuse) {
         throw InputError(
-            "surface.stiffness_n_per_m = " + num(params.surface.stiffness_n_per_m) +
-            " N/m (world) is " + num(stiffness) + " N/m on the device" + scaling +
-            ", above the limit " + num(limit) + " N/m = min(device.max_stiffness_n_per_m = " +
-            num(dev.max_stiffness_n_per_m) + ", passivity 2 (b - |B|) / T = 2 (" +
-            num(dev.inherent_damping_n_s_per_m) + " - " + num(damping) + ") * " +
-            num(params.loop_rate_hz) + " Hz = " + num(passive) + ") (Colgate & Brown 1994)");
+            "surface.stiffness_n_per_m = " + format_number(params.surface.stiffness_n_per_m) +
+            " N/m (world) is " + format_number(stiffness) + " N/m on the device" + scaling +
+            ", above the limit " + format_number(limit) +
+            " N/m = min(device.max_stiffness_n_per_m = " +
+            format_number(dev.max_stiffness_n_per_m) + ", passivity 2 (b - |B|) / T = 2 (" +
+            format_number(dev.inherent_damping_n_s_per_m) + " - " + format_number(damping) +
+            ") * " + format_number(params.loop_rate_hz) + " Hz = " + format_number(passive) +
+            ") (Colgate & Brown 1994)");
       }
       stiffness = limit;
       params_.surface.stiffness_n_per_m = limit / gain;
@@ -466,13 +464,13 @@ ForceModel::ForceModel(const ForceModelParams& params) : requested_(params), par
     if (damping > dev.max_damping_n_s_per_m) {
       if (refuse) {
         throw InputError(
-            "low_speed_damping_n_s_per_m = " + num(params.low_speed_damping_n_s_per_m) +
+            "low_speed_damping_n_s_per_m = " + format_number(params.low_speed_damping_n_s_per_m) +
             " N s/m (world)" +
-            (viscous > 0.0
-                 ? " + contact_drag.viscous_n_s_per_m2 * max_contact_length_m = " + num(viscous)
-                 : std::string()) +
-            " is " + num(damping) + " N s/m on the device" + scaling +
-            ", above device.max_damping_n_s_per_m = " + num(dev.max_damping_n_s_per_m));
+            (viscous > 0.0 ? " + contact_drag.viscous_n_s_per_m2 * max_contact_length_m = " +
+                                 format_number(viscous)
+                           : std::string()) +
+            " is " + format_number(damping) + " N s/m on the device" + scaling +
+            ", above device.max_damping_n_s_per_m = " + format_number(dev.max_damping_n_s_per_m));
       }
       double factor = dev.max_damping_n_s_per_m / damping;
       params_.low_speed_damping_n_s_per_m *= factor;

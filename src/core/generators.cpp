@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "terracut/core/format.hpp"
+
 namespace terracut {
 
 std::string_view to_string(GeneratorKind kind) {
@@ -48,9 +50,9 @@ std::string validate(const Generator& g) {
       if (!finite(g.mound.centre_x_m) || !finite(g.mound.centre_z_m))
         return "mound.centre_m must be finite";
       if (!finite(g.mound.radius_m) || !(g.mound.radius_m > 0.0))
-        return "mound.radius_m must be finite and > 0";
+        return must_be("mound.radius_m", "finite and > 0", g.mound.radius_m);
       if (!finite(g.mound.height_m) || !(g.mound.height_m > 0.0))
-        return "mound.height_m must be finite and > 0";
+        return must_be("mound.height_m", "finite and > 0", g.mound.height_m);
       return {};
     case GeneratorKind::kBox:
       if (!finite(g.box.min_x_m) || !finite(g.box.min_z_m) || !finite(g.box.max_x_m) ||
@@ -59,11 +61,11 @@ std::string validate(const Generator& g) {
       if (!(g.box.min_x_m <= g.box.max_x_m) || !(g.box.min_z_m <= g.box.max_z_m))
         return "box.min_m must be <= box.max_m in X and in Z";
       if (!finite(g.box.height_m) || !(g.box.height_m >= 0.0))
-        return "box.height_m must be finite and >= 0";
+        return must_be("box.height_m", "finite and >= 0", g.box.height_m);
       return {};
     case GeneratorKind::kPlane:
       if (!finite(g.plane.height_m) || !(g.plane.height_m >= 0.0))
-        return "plane.height_m must be finite and >= 0";
+        return must_be("plane.height_m", "finite and >= 0", g.plane.height_m);
       return {};
   }
   return "unknown generator kind";

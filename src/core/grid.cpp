@@ -3,30 +3,27 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <sstream>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 
 namespace terracut {
 
 std::string validate(const GridSpec& spec) {
-  std::ostringstream msg;
-  if (spec.cols < 1 || spec.cols > kMaxGridSide) {
-    msg << "grid.cols must be in [1, " << kMaxGridSide << "], got " << spec.cols;
-  } else if (spec.rows < 1 || spec.rows > kMaxGridSide) {
-    msg << "grid.rows must be in [1, " << kMaxGridSide << "], got " << spec.rows;
-  } else if (spec.sample_count() > kMaxGridSamples) {
-    msg << "grid has " << spec.sample_count() << " samples, more than the limit " << kMaxGridSamples;
-  } else if (!(std::isfinite(spec.size_x_m) && spec.size_x_m > 0.0)) {
-    msg << "grid.size_x_m must be finite and > 0, got " << spec.size_x_m;
-  } else if (!(std::isfinite(spec.size_z_m) && spec.size_z_m > 0.0)) {
-    msg << "grid.size_z_m must be finite and > 0, got " << spec.size_z_m;
-  } else if (!is_finite(spec.origin_m)) {
-    msg << "grid.origin_m must be finite";
-  } else if (!(std::isfinite(spec.full_scale_m) && spec.full_scale_m > 0.0)) {
-    msg << "grid.full_scale_m must be finite and > 0, got " << spec.full_scale_m;
-  }
-  return msg.str();
+  const std::string sides = "in [1, " + format_number(kMaxGridSide) + "]";
+  if (spec.cols < 1 || spec.cols > kMaxGridSide) return must_be("grid.cols", sides, spec.cols);
+  if (spec.rows < 1 || spec.rows > kMaxGridSide) return must_be("grid.rows", sides, spec.rows);
+  if (spec.sample_count() > kMaxGridSamples)
+    return "grid has " + format_number(spec.sample_count()) + " samples, more than the limit " +
+           format_number(kMaxGridSamples);
+  if (!(std::isfinite(spec.size_x_m) && spec.size_x_m > 0.0))
+    return must_be("grid.size_x_m", "finite and > 0", spec.size_x_m);
+  if (!(std::isfinite(spec.size_z_m) && spec.size_z_m > 0.0))
+    return must_be("grid.size_z_m", "finite and > 0", spec.size_z_m);
+  if (!is_finite(spec.origin_m)) return "grid.origin_m must be finite";
+  if (!(std::isfinite(spec.full_scale_m) && spec.full_scale_m > 0.0))
+    return must_be("grid.full_scale_m", "finite and > 0", spec.full_scale_m);
+  return {};
 }
 
 void Rect::include(int c, int r) {
@@ -55,18 +52,16 @@ void Rect::include(const Rect& other) {
 HeightGrid::HeightGrid(const GridSpec& spec, std::vector<float> initial_heights_m) : spec_(spec) {
   if (std::string error = validate(spec); !error.empty()) throw InputError(error);
   if (std::int64_t(initial_heights_m.size()) != spec.sample_count()) {
-    std::ostringstream msg;
-    msg << "initial heights have " << initial_heights_m.size() << " values, expected cols x rows = "
-        << spec.cols << " x " << spec.rows << " = " << spec.sample_count();
-    throw InputError(msg.str());
+    throw InputError("initial heights have " + format_number(initial_heights_m.size()) +
+                     " values, expected cols x rows = " + format_number(spec.cols) + " x " +
+                     format_number(spec.rows) + " = " + format_number(spec.sample_count()));
   }
   for (std::int64_t i = 0; i < spec.sample_count(); ++i) {
     float h = initial_heights_m[size_t(i)];
     if (!std::isfinite(h) || h < 0.0f) {
-      std::ostringstream msg;
-      msg << "initial height at sample (col " << i % spec.cols << ", row " << i / spec.cols
-          << ") must be finite and >= 0, got " << h;
-      throw InputError(msg.str());
+      throw InputError(must_be("initial height at sample (col " + format_number(i % spec.cols) +
+                                   ", row " + format_number(i / spec.cols) + ")",
+                               "finite and >= 0", h));
     }
   }
   initial_ = std::move(initial_heights_m);

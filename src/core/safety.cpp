@@ -4,24 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 
 namespace terracut {
 
 namespace {
 
-std::string num(double value) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.6g", value);
-  return buffer;
-}
-
 std::string check(const char* field, double value, bool allow_zero) {
   if (std::isfinite(value) && (allow_zero ? value >= 0.0 : value > 0.0)) return {};
-  return std::string(field) + " must be finite and " + (allow_zero ? ">= 0" : "> 0") + " (got " +
-         num(value) + ")";
+  return must_be(field, allow_zero ? "finite and >= 0" : "finite and > 0", value);
 }
 
 // The point of `target` reachable from `previous` in one sample: anything

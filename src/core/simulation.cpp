@@ -4,10 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
-#include <sstream>
 #include <stdexcept>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 
 namespace terracut {
 
@@ -25,20 +25,16 @@ constexpr int kMaxSubsteps = 64;
 
 std::string validate(const SimParams& params) {
   if (std::string e = validate(params.grid); !e.empty()) return e;
-  std::ostringstream msg;
-  if (!(std::isfinite(params.rate_hz) && params.rate_hz > 0.0 && params.rate_hz <= 1e6)) {
-    msg << "rate_hz must be in (0, 1e6], got " << params.rate_hz;
-  } else if (!(std::isfinite(params.blade.length_m) && params.blade.length_m > 0.0)) {
-    msg << "blade.length_m must be finite and > 0, got " << params.blade.length_m;
-  } else if (!(params.max_arc_error_cells > 0.0 && params.max_arc_error_cells <= 1.0)) {
-    msg << "max_arc_error_cells must be in (0, 1], got " << params.max_arc_error_cells;
-  } else if (params.representation != Representation::kColumns &&
-             params.representation != Representation::kSurface) {
-    msg << "representation must be columns or surface";
-  } else if (std::string soil = validate(params.soil); !soil.empty()) {
-    msg << soil;
-  }
-  return msg.str();
+  if (!(std::isfinite(params.rate_hz) && params.rate_hz > 0.0 && params.rate_hz <= 1e6))
+    return must_be("rate_hz", "in (0, 1e6]", params.rate_hz);
+  if (!(std::isfinite(params.blade.length_m) && params.blade.length_m > 0.0))
+    return must_be("blade.length_m", "finite and > 0", params.blade.length_m);
+  if (!(params.max_arc_error_cells > 0.0 && params.max_arc_error_cells <= 1.0))
+    return must_be("max_arc_error_cells", "in (0, 1]", params.max_arc_error_cells);
+  if (params.representation != Representation::kColumns &&
+      params.representation != Representation::kSurface)
+    return "representation must be columns or surface";
+  return validate(params.soil);
 }
 
 static const SimParams& checked(const SimParams& params) {

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 
 namespace terracut {
 namespace {
@@ -55,10 +56,10 @@ std::string validate(const SoilFlowParams& p) {
   if (p.model != SoilModel::kVanish && p.model != SoilModel::kFlow)
     return "soil.model must be vanish or flow";
   if (!(std::isfinite(p.repose_deg) && p.repose_deg > 0.0 && p.repose_deg <= 80.0))
-    return "soil.repose_deg must be in (0, 80] degrees, got " + std::to_string(p.repose_deg);
+    return must_be("soil.repose_deg", "in (0, 80] degrees", p.repose_deg);
   if (!(p.max_pair_checks_per_step >= 1000 && p.max_pair_checks_per_step <= 1000000000))
-    return "soil.max_pair_checks_per_step must be in [1000, 1e9], got " +
-           std::to_string(p.max_pair_checks_per_step);
+    return must_be("soil.max_pair_checks_per_step", "in [1000, 1e9]",
+                   p.max_pair_checks_per_step);
   return {};
 }
 

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 #include "terracut/haptics/cut_depth.hpp"
 #include "terracut/haptics/pacer.hpp"
 
@@ -45,8 +46,8 @@ HapticLoop::HapticLoop(const LoopParams& params, Simulation& sim, Quat default_o
   const HapticSettings& settings = params_.settings();
   if (options_.ticks < 1) throw InputError("haptics: the loop needs at least one tick");
   if (sim_.params().rate_hz != params_.rate_hz())
-    throw InputError("haptics: the simulation steps at " + std::to_string(sim_.params().rate_hz) +
-                     " Hz, the loop runs at haptics.rate_hz " + std::to_string(params_.rate_hz()) +
+    throw InputError("haptics: the simulation steps at " + format_number(sim_.params().rate_hz) +
+                     " Hz, the loop runs at haptics.rate_hz " + format_number(params_.rate_hz()) +
                      " Hz: build the simulation at the loop's rate");
   if (settings.tool_rotation_deg) {
     fixed_orientation_ = quat_from_euler_deg(*settings.tool_rotation_deg);

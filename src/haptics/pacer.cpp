@@ -5,7 +5,6 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <sstream>
 #include <thread>
 
 #if defined(__unix__) || defined(__APPLE__)
@@ -16,6 +15,7 @@
 #endif
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 
 namespace terracut::haptics {
 
@@ -68,15 +68,15 @@ std::shared_ptr<PacerClock> steady_pacer_clock() {
 }
 
 std::string validate(const PacerSettings& settings) {
-  std::ostringstream msg;
-  if (!(std::isfinite(settings.rate_hz) && settings.rate_hz > 0.0 && settings.rate_hz <= 1e6)) {
-    msg << "pacer.rate_hz must be in (0, 1e6], got " << settings.rate_hz;
-  } else if (!(std::isfinite(settings.spin_s) && settings.spin_s >= 0.0 &&
-               settings.spin_s <= 1.0 / settings.rate_hz)) {
-    msg << "pacer.spin_s must be in [0, 1 / rate_hz] = [0, " << 1.0 / settings.rate_hz
-        << "] seconds, got " << settings.spin_s;
-  }
-  return msg.str();
+  if (!(std::isfinite(settings.rate_hz) && settings.rate_hz > 0.0 && settings.rate_hz <= 1e6))
+    return must_be("pacer.rate_hz", "in (0, 1e6]", settings.rate_hz);
+  if (!(std::isfinite(settings.spin_s) && settings.spin_s >= 0.0 &&
+        settings.spin_s <= 1.0 / settings.rate_hz))
+    return must_be("pacer.spin_s",
+                   "in [0, 1 / rate_hz] = [0, " + format_number(1.0 / settings.rate_hz) +
+                       "] seconds",
+                   settings.spin_s);
+  return {};
 }
 
 // ---------------------------------------------------------------------------

@@ -2,7 +2,8 @@
 #include "terracut/haptics/settings.hpp"
 
 #include <cmath>
-#include <cstdio>
+
+#include "terracut/core/format.hpp"
 
 namespace terracut::haptics {
 
@@ -46,15 +47,11 @@ std::optional<CutDepthMeasure> parse_cut_depth_measure(std::string_view name) {
 }
 
 namespace {
-std::string haptic_num(double value) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.6g", value);
-  return buffer;
-}
-// "FIELD must be WHAT (got VALUE)" when ok is false, else "".
-std::string haptic_check(bool ok, const char* field, const char* what, double value) {
+// "FIELD must be WHAT, got VALUE" when ok is false, else "".
+template <MessageNumber T>
+std::string haptic_check(bool ok, const char* field, const char* what, T value) {
   if (ok) return {};
-  return std::string(field) + " must be " + what + " (got " + haptic_num(value) + ")";
+  return must_be(field, what, value);
 }
 }  // namespace
 
@@ -102,9 +99,9 @@ std::string validate(const HapticSettings& s) {
   if (std::string f = validate(s.forces); !f.empty()) return "forces." + f;
   if (std::string f = validate(s.safety); !f.empty()) return "safety." + f;
   if (s.safety.max_force_n > s.forces.device.max_force_n)
-    return "safety.max_force_n must not exceed forces.device.max_force_n (" +
-           haptic_num(s.safety.max_force_n) + " > " +
-           haptic_num(s.forces.device.max_force_n) + ")";
+    return "safety.max_force_n must not exceed forces.device.max_force_n = " +
+           format_number(s.forces.device.max_force_n) + ", got " +
+           format_number(s.safety.max_force_n);
   const SimHandParams& h = s.hand;
   if (!(m = haptic_check(finite(h.mass_kg) && h.mass_kg > 0.0, "hand.mass_kg", "finite and > 0",
                          h.mass_kg))

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 
 namespace terracut::haptics {
 namespace {
@@ -83,7 +84,7 @@ struct UdpDevice::Impl {
 
 UdpDevice::UdpDevice(const std::string& address, int port) : impl_(std::make_unique<Impl>()) {
   if (port < 0 || port > 65535)
-    throw InputError("udp.port: " + std::to_string(port) + " is not in [0, 65535]");
+    throw InputError(must_be("udp.port", "in [0, 65535]", port));
   const asio::ip::address ip = parse_address(address, "udp.address");
   const asio::ip::udp::endpoint local(ip, static_cast<unsigned short>(port));
   asio::error_code ec;
@@ -182,7 +183,7 @@ struct BridgeClient::Impl {
 BridgeClient::BridgeClient(const std::string& address, int port, std::uint32_t session)
     : impl_(std::make_unique<Impl>()), session_(session) {
   if (port < 1 || port > 65535)
-    throw InputError("port: " + std::to_string(port) + " is not in [1, 65535]");
+    throw InputError(must_be("port", "in [1, 65535]", port));
   const asio::ip::address ip = parse_address(address, "address");
   impl_->server = asio::ip::udp::endpoint(ip, static_cast<unsigned short>(port));
   asio::error_code ec;

@@ -28,6 +28,7 @@
 #include <system_error>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 
 namespace terracut::io {
 namespace {
@@ -528,8 +529,8 @@ void write_png16(const std::filesystem::path& path, const float* values, int col
   }
   if (values == nullptr) throw InputError("cannot write PNG file " + name + ": no values given");
   if (!std::isfinite(full_scale) || full_scale <= 0.0) {
-    throw InputError("cannot write PNG file " + name + ": full_scale must be finite and > 0, got " +
-                     std::to_string(full_scale));
+    throw InputError("cannot write PNG file " + name + ": " +
+                     must_be("full_scale", "finite and > 0", full_scale));
   }
   FilePtr file(std::fopen(path.c_str(), "wb"));
   if (!file) throw InputError("cannot open PNG file " + name + " for writing: " + std::strerror(errno));

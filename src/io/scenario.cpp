@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 #include "terracut/io/yaml_reader.hpp"
 
 namespace terracut::io {
@@ -21,7 +22,6 @@ namespace {
 using yaml::child_path;
 using yaml::Context;
 using yaml::Field;
-using yaml::format_number;
 using yaml::join;
 using yaml::Map;
 
@@ -261,7 +261,7 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
         f->choice({Representation::kSurface, Representation::kColumns}, "representation");
   if (const auto f = top.get("rate_hz")) {
     sc.rate_hz = f->positive();
-    if (sc.rate_hz > kMaxRateHz) f->fail("rate_hz above 1e6 is absurd, got " + format_number(sc.rate_hz));
+    if (sc.rate_hz > kMaxRateHz) f->fail(must_be("in (0, 1e6]", sc.rate_hz));
   }
 
   const Map blade(top.require("blade"), {"length_m"});

@@ -33,15 +33,6 @@ bool read_if_given(const Map& map, std::string_view key, T& out, Read read) {
 
 }  // namespace
 
-std::string format_number(double value) {
-  // Shortest round-trip: exact (the message shows the value that was
-  // compared) and short ("0.1", not "0.10000000000000001"). 32 characters
-  // hold any double.
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  return std::string(buffer, result.ptr);
-}
-
 std::string describe(const YAML::Node& node) {
   switch (node.Type()) {
     case YAML::NodeType::Null:
@@ -181,13 +172,13 @@ double Field::number() const {
 
 double Field::positive() const {
   const double v = number();
-  if (!(v > 0.0)) fail("must be > 0, got " + format_number(v));
+  if (!(v > 0.0)) fail(must_be("> 0", v));
   return v;
 }
 
 double Field::non_negative() const {
   const double v = number();
-  if (!(v >= 0.0)) fail("must be >= 0, got " + format_number(v));
+  if (!(v >= 0.0)) fail(must_be(">= 0", v));
   return v;
 }
 
@@ -196,8 +187,7 @@ double Field::in_range(double lo, double hi, Ends ends) const {
   const bool above_low = (ends == Ends::kOpenLow || ends == Ends::kOpen) ? v > lo : v >= lo;
   const bool below_high = (ends == Ends::kOpenHigh || ends == Ends::kOpen) ? v < hi : v <= hi;
   if (!above_low || !below_high)
-    fail("must be in " + range_text(format_number(lo), format_number(hi), ends) + ", got " +
-         format_number(v));
+    fail(must_be("in " + range_text(format_number(lo), format_number(hi), ends), v));
   return v;
 }
 
@@ -221,8 +211,7 @@ long long Field::integer() const {
 long long Field::integer_in(long long lo, long long hi) const {
   const long long v = integer();
   if (v < lo || v > hi)
-    fail("must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
-         std::to_string(v));
+    fail(must_be("in [" + format_number(lo) + ", " + format_number(hi) + "]", v));
   return v;
 }
 

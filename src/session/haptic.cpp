@@ -12,6 +12,7 @@
 
 #include "bodies_json.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 #include "terracut/haptics/haptics_csv.hpp"
 #include "terracut/haptics/script_device.hpp"
 #include "terracut/haptics/sim_hand.hpp"
@@ -23,12 +24,6 @@ using namespace terracut::haptics;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string fmt(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, value);
-  return buffer;
-}
 
 // The cut the script and sim devices follow: the one named in
 // haptics.cut, else the first cut of the scenario's sequence; nullptr when
@@ -62,9 +57,13 @@ std::string json_string(const std::string& text) {
   return out + "\"";
 }
 
-// JSON text of a number; null for NaN or infinity (JSON has neither).
+// JSON text of a number (an output, so its own fixed format, not
+// format_number's); null for NaN or infinity (JSON has neither).
 std::string json_number(double value) {
-  return std::isfinite(value) ? fmt("%.9g", value) : std::string("null");
+  if (!std::isfinite(value)) return "null";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.9g", value);
+  return buffer;
 }
 
 // {"p50", "p99", "max", "mean"} in microseconds.
@@ -106,18 +105,18 @@ std::vector<std::string> HapticRig::rendering_changes() const {
   const ForceModelParams& used = loop_->force_model().params();
   if (rc.surface_stiffness_limited)
     out.push_back("forces.surface.stiffness_n_per_m lowered to " +
-                  fmt("%.6g", used.surface.stiffness_n_per_m) + " N/m (world; " +
-                  fmt("%.6g", rc.surface_stiffness_n_per_m) +
+                  format_number(used.surface.stiffness_n_per_m) + " N/m (world; " +
+                  format_number(rc.surface_stiffness_n_per_m) +
                   " N/m on the device) to stay passive and within the device");
   if (rc.surface_damping_limited)
     out.push_back("forces.surface.damping_n_s_per_m lowered to " +
-                  fmt("%.6g", used.surface.damping_n_s_per_m) + " N s/m (world; " +
-                  fmt("%.6g", rc.surface_damping_n_s_per_m) + " N s/m on the device)");
+                  format_number(used.surface.damping_n_s_per_m) + " N s/m (world; " +
+                  format_number(rc.surface_damping_n_s_per_m) + " N s/m on the device)");
   if (rc.cutting_damping_limited)
     out.push_back("forces.low_speed_damping_n_s_per_m lowered to " +
-                  fmt("%.6g", used.low_speed_damping_n_s_per_m) +
-                  " N s/m (world; cutting damping " + fmt("%.6g", rc.cutting_damping_n_s_per_m) +
-                  " N s/m on the device, its limit)");
+                  format_number(used.low_speed_damping_n_s_per_m) +
+                  " N s/m (world; cutting damping " +
+                  format_number(rc.cutting_damping_n_s_per_m) + " N s/m on the device, its limit)");
   return out;
 }
 
@@ -131,8 +130,7 @@ HapticSession::HapticSession(const Scenario& input, const SessionOptions& option
   if (options.duration_s) {
     if (!(std::isfinite(*options.duration_s) && *options.duration_s > 0.0 &&
           *options.duration_s <= 86400.0))
-      throw InputError("--duration must be in (0, 86400] seconds, got " +
-                       fmt("%g", *options.duration_s));
+      throw InputError(must_be("--duration", "in (0, 86400] seconds", *options.duration_s));
     settings.duration_s = *options.duration_s;
   }
   kind_ = settings.device;

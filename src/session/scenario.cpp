@@ -3,6 +3,7 @@
 
 #include "terracut/bullet/bodies_yaml.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 #include "terracut/haptics/settings_yaml.hpp"
 #include "terracut/io/image.hpp"
 
@@ -39,8 +40,8 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& so
 
 Scenario heightmap_scenario(const std::filesystem::path& png, double extent_m,
                             double full_scale_m) {
-  if (!(extent_m > 0.0) || !(full_scale_m > 0.0))
-    throw InputError("--extent and --full-scale must be > 0");
+  if (!(extent_m > 0.0)) throw InputError(must_be("--extent", "> 0", extent_m));
+  if (!(full_scale_m > 0.0)) throw InputError(must_be("--full-scale", "> 0", full_scale_m));
   Scenario out;
   io::Scenario& sc = out.base;
   sc.source_path = png;

@@ -9,7 +9,7 @@
 //
 // (LINE 1-based; "FILE: ..." when the place has no line, and no "field.path: "
 // for errors about the document as a whole). Numbers in messages are written
-// by format_number.
+// by core's format_number, range errors by its must_be (terracut/core/format.hpp).
 //
 //   const yaml::Context ctx("scene.yaml");
 //   const yaml::Field root(ctx, document, "", YAML::Mark());
@@ -30,6 +30,7 @@
 #include <string_view>
 #include <vector>
 
+#include "terracut/core/format.hpp"
 #include "terracut/core/math.hpp"
 
 namespace terracut::io::yaml {
@@ -39,11 +40,6 @@ namespace terracut::io::yaml {
 /// and larger values would overflow float heights or volumes. It also keeps
 /// every whole number inside an int.
 inline constexpr double kMaxMagnitude = 1e9;
-
-/// The one way numbers are written in messages: the shortest text that reads
-/// back as the same double (std::to_chars), e.g. "0.5", "-0.2", "250",
-/// "1e+10", "1e-07"; "nan", "inf" and "-inf" for the non-finite.
-std::string format_number(double value);
 
 /// A node for messages: "'text'" for a scalar, "a list", "a mapping",
 /// "nothing" for null, "an undefined value" otherwise.

@@ -37,7 +37,7 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& so
 /// A bare heightmap as a scenario (the viewer's PNG input): the image at its
 /// own resolution over extent_m x extent_m, a white pixel full_scale_m high,
 /// a blade half the extent long, no cuts, default haptic settings. Throws
-/// InputError naming the file, or "--extent and --full-scale must be > 0".
+/// InputError naming the file, or e.g. "--extent must be > 0, got 0".
 Scenario heightmap_scenario(const std::filesystem::path& png, double extent_m,
                             double full_scale_m);
 
