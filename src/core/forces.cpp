@@ -508,7 +508,14 @@ ForceOutput ForceModel::compute(const ForceInput& input) const noexcept {
         width *= length(cross(e, u));
       }
       out.engaged_width_m = width;
-      out.earthmoving = earthmoving_force(params_.earthmoving, width, input.cut_depth_m);
+      if (input.surcharge_pa > 0.0) {
+        // A pile ahead of the blade adds its weight on the wedge (N_q).
+        EarthmovingParams piled = params_.earthmoving;
+        piled.soil.surcharge_pa += input.surcharge_pa;
+        out.earthmoving = earthmoving_force(piled, width, input.cut_depth_m);
+      } else {
+        out.earthmoving = earthmoving_force(params_.earthmoving, width, input.cut_depth_m);
+      }
       out.cutting_n =
           earthmoving_world_force(out.earthmoving, v, params_.low_speed_damping_n_s_per_m);
       break;

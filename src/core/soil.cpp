@@ -320,7 +320,12 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   float* h = layers.height_m;
   const float tol = tolerance_m_;
   const bool blade = blade_.present;
-  while (!active_.empty() && out.pair_checks < params_.max_pair_checks_per_step) {
+  while (!active_.empty()) {
+    // A pass is run whole or not at all (its fluxes come from one frozen
+    // state); it starts only when it fits in what is left of the cap, except
+    // the step's first pass, which always runs.
+    const std::int64_t pass_checks = 8 * std::int64_t(active_.size());
+    if (out.passes > 0 && out.pair_checks + pass_checks > params_.max_pair_checks_per_step) break;
     ++out.passes;
     // Each active cell sheds half of its steepest excess, shared among its
     // lower neighbours in proportion to their excess (from the heights

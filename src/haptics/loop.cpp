@@ -165,8 +165,9 @@ const LoopRecord& HapticLoop::step2(double period_s, double compute_s,
   // Cut (and the simulation's listeners: e.g. the rigid bodies), then the
   // force in the world from the contact, the motion and the listeners.
   const StepOutput& out = stepped_ ? sim_.finish_step() : not_stepped_;
-  const double depth_m = stepped_ ? cut_depth(out) : 0.0;
-  const ForceOutput force = stepped_ ? world_force(out, depth_m) : ForceOutput{};
+  const CutLoad load = stepped_ ? cut_load(out) : CutLoad{};
+  const double depth_m = load.depth_m;
+  const ForceOutput force = stepped_ ? world_force(out, load) : ForceOutput{};
 
   // Safety: a bad sample or no sample yet asks for zero force (shrinking to
   // zero is immediate); the watchdog looks at the last good sample's time.
@@ -191,12 +192,13 @@ const LoopRecord& HapticLoop::step2(double period_s, double compute_s,
 
 // The force models' world force plus the listeners' (e.g. rigid bodies
 // pushing the blade's plate), both scaled to the device the same way.
-ForceOutput HapticLoop::world_force(const StepOutput& out, double cut_depth_m) const noexcept {
+ForceOutput HapticLoop::world_force(const StepOutput& out, const CutLoad& load) const noexcept {
   const HapticSettings& settings = params_.settings();
   ForceInput in;
   in.velocity_m_per_s = velocity_m_per_s_;
   in.contact_length_m = out.contact.length_m;
-  in.cut_depth_m = cut_depth_m;
+  in.cut_depth_m = load.depth_m;
+  in.surcharge_pa = load.surcharge_pa;
   in.edge_direction = out.edge.b - out.edge.a;
   in.device_point_m = out.pose.position_m;
   in.surface_y_m = settings.surface_reference == SurfaceReference::kGround
@@ -261,12 +263,20 @@ void HapticLoop::publish_frame(const StepOutput& out, const ForceOutput& force,
   x.publish(sim_.grid());
 }
 
-double HapticLoop::cut_depth(const StepOutput& out) const noexcept {
-  if (out.contact.length_m <= 0.0) return 0.0;
+HapticLoop::CutLoad HapticLoop::cut_load(const StepOutput& out) const noexcept {
+  if (out.contact.length_m <= 0.0) return {};
   if (params_.settings().cut_depth == CutDepthMeasure::kSection)
-    return out.contact.section_area_m2 / out.contact.length_m;
-  return depth_ahead_m(sim_.grid(), sim_.params().representation, out.edge, velocity_m_per_s_,
-                       lookahead_m_);
+    return {out.contact.section_area_m2 / out.contact.length_m, 0.0};
+  if (sim_.params().soil.model != SoilModel::kFlow)
+    return {depth_ahead_m(sim_.grid(), sim_.params().representation, out.edge, velocity_m_per_s_,
+                          lookahead_m_),
+            0.0};
+  // Soil that flows: the pile the blade pushes is not depth of cut but a
+  // surcharge on the failure wedge (q = unit weight x pile height).
+  const SoilAhead ahead = soil_ahead(sim_.grid(), sim_.params().representation, out.edge,
+                                     velocity_m_per_s_, lookahead_m_);
+  const double unit_weight = params_.force_model().params().earthmoving.soil.unit_weight_n_per_m3;
+  return {ahead.depth_m, unit_weight * ahead.pile_m};
 }
 
 void HapticLoop::record(const LoopRecord& r) noexcept {

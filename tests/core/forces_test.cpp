@@ -330,6 +330,48 @@ TEST(Earthmoving, ScalesWithWidthAndDepth) {
   EXPECT_EQ(earthmoving_force(p, 0.5, -0.1).horizontal_n, 0.0);
 }
 
+TEST(Earthmoving, SurchargeRatioIsExactForACohesionlessSoil) {
+  // McKyes: N_q = 2 N_gamma at the same failure angle, so with c = c_a = 0
+  // P(q) / P(0) = (gamma d^2 / 2 + q d) / (gamma d^2 / 2) = 1 + 2 q / (gamma d),
+  // and the minimising beta does not depend on q. A pile of height h on the
+  // wedge gives q = gamma h.
+  EarthmovingParams p = fee(90, 20, 35, 16e3, 0.0, 0.0, 0.0);
+  const double d = 0.05, w = 1.0;
+  const EarthmovingResult bare = earthmoving_force(p, w, d);
+  for (const double pile_m : {0.05, 0.2, 0.5}) {
+    EarthmovingParams piled = p;
+    piled.soil.surcharge_pa = p.soil.unit_weight_n_per_m3 * pile_m;
+    const EarthmovingResult r = earthmoving_force(piled, w, d);
+    const double ratio = 1.0 + 2.0 * piled.soil.surcharge_pa / (p.soil.unit_weight_n_per_m3 * d);
+    expect_rel(r.total_n, ratio * bare.total_n, 1e-9, "P(q) / P(0)");
+    expect_rel(r.horizontal_n, ratio * bare.horizontal_n, 1e-9, "H(q) / H(0)");
+    EXPECT_NEAR(r.beta_rad, bare.beta_rad, 1e-7) << pile_m;
+  }
+}
+
+TEST(ForceModel, APileAheadIsASurchargeOnTheWedge) {
+  // ForceInput::surcharge_pa (a pile the blade pushes) acts as the soil's
+  // own surcharge_pa does, added to it.
+  ForceModelParams p;
+  p.cutting = CuttingModel::kEarthmoving;
+  p.surface_enabled = false;
+  ForceInput in;
+  in.velocity_m_per_s = {0.0, 0.0, 1.0};
+  in.contact_length_m = 0.5;
+  in.cut_depth_m = 0.05;
+  in.edge_direction = {1.0, 0.0, 0.0};
+  const ForceOutput bare = ForceModel(p).compute(in);
+  in.surcharge_pa = 3000.0;
+  const ForceOutput piled = ForceModel(p).compute(in);
+  ForceModelParams q = p;
+  q.earthmoving.soil.surcharge_pa += 3000.0;
+  in.surcharge_pa = 0.0;
+  const ForceOutput same = ForceModel(q).compute(in);
+  EXPECT_GT(length(piled.cutting_n), length(bare.cutting_n));
+  EXPECT_EQ(piled.cutting_n.z, same.cutting_n.z);
+  EXPECT_EQ(piled.earthmoving.total_n, same.earthmoving.total_n);
+}
+
 TEST(Earthmoving, WorldForceOpposesHorizontalMotion) {
   EarthmovingParams p;
   p.soil = soil_preset(SoilPreset::kDrySand);

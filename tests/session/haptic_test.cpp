@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -180,6 +181,45 @@ TEST(Session, SimSessionReportsTheHand) {
   EXPECT_EQ(j["device"], "sim");
   EXPECT_LT(j["device_stats"]["hand_rendered_work_j"].get<double>(), 0.0);  // the soil took energy
   EXPECT_GT(j["device_stats"]["hand_max_tracking_error_m"].get<double>(), 0.0);
+}
+
+// The world force's magnitude in the horizontal plane, averaged over the
+// records with t in [t0, t1).
+double mean_push_force(const std::vector<haptics::LoopRecord>& records, double t0, double t1) {
+  double sum = 0.0;
+  int n = 0;
+  for (const haptics::LoopRecord& r : records)
+    if (r.t_s >= t0 && r.t_s < t1) {
+      sum += std::hypot(r.force_world_n.x, r.force_world_n.z);
+      ++n;
+    }
+  return n > 0 ? sum / n : 0.0;
+}
+
+TEST(Session, TheForceGrowsWithThePileTheBladePushes) {
+  // scenarios/push_pile.yaml: a blade pushes a 5 cm cut 1 m through dry sand
+  // that flows. The pile ahead weighs on the failure wedge (a surcharge), so
+  // the force at the end of the push exceeds the force at its start; with
+  // the soil vanishing (the paper's model) it stays as it was.
+  const Scenario flow = load_scenario(fs::path(TERRACUT_SOURCE_DIR) / "scenarios/push_pile.yaml");
+  ASSERT_EQ(flow.base.soil.model, SoilModel::kFlow);
+  Scenario vanish = flow;
+  vanish.base.soil.model = SoilModel::kVanish;
+  SessionOptions o;
+  o.clock = ClockMode::kFake;
+  HapticSession a(flow, o), b(vanish, o);
+  a.run();
+  b.run();
+  // The push runs from t = 1.4 s to 3.4 s at constant depth and speed.
+  const std::vector<haptics::LoopRecord> ra = a.loop().records(), rb = b.loop().records();
+  const double flow_start = mean_push_force(ra, 1.6, 2.0), flow_end = mean_push_force(ra, 3.0, 3.4);
+  const double vanish_start = mean_push_force(rb, 1.6, 2.0), vanish_end = mean_push_force(rb, 3.0, 3.4);
+  EXPECT_GT(flow_start, 0.0);
+  EXPECT_GT(flow_end, 1.1 * flow_start);
+  EXPECT_NEAR(vanish_end, vanish_start, 0.02 * vanish_start);
+  EXPECT_GT(flow_end, 1.1 * vanish_end);
+  // Nothing vanished in the flowing run.
+  EXPECT_NEAR(a.loop().simulation().grid().volume_m3(), 2.0 * 2.0 * 0.3, 1e-5);
 }
 
 }  // namespace

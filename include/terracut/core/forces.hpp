@@ -329,6 +329,10 @@ struct ForceInput {
   double contact_length_m = 0.0;  ///< blade length in material (ContactResult::length_m), m
   /// Material depth ahead of the edge, m (e.g. section_area_m2 / length_m).
   double cut_depth_m = 0.0;
+  /// Surcharge on the soil ahead of the blade from soil piled on it (a pile
+  /// the blade pushes: unit weight x the pile's height over the failure
+  /// wedge), Pa, finite, >= 0; added to the soil's own surcharge_pa.
+  double surcharge_pa = 0.0;
   /// Direction of the cutting edge (any length; zero = unknown, no projection).
   Vec3 edge_direction{};
   Vec3 device_point_m{};     ///< point held on the surface by the proxy, world metres

@@ -38,10 +38,9 @@
 // construction, every cell steeper than the repose angle) are examined, and
 // a pass examines each active cell's 8 pairs; a cell that changed, and the
 // neighbours of one that fell, are examined in the next pass. A step runs
-// whole passes while
-// it has done fewer than max_pair_checks_per_step pair checks; what is left
-// active is carried to the next step (the backlog), so a large collapse is
-// spread over ticks and the 1 kHz loop keeps its millisecond.
+// whole passes as long as the next fits in max_pair_checks_per_step; what is
+// left active is carried to the next step (the backlog), so a large
+// collapse is spread over ticks and the 1 kHz loop keeps its millisecond.
 //
 // The rigid floor stays: heights never go below 0 (a flux moves at most an
 // eighth of a height difference). The grid's edge is a wall: no soil leaves.
@@ -76,8 +75,11 @@ struct SoilFlowParams {
   /// (Al-Hashemi & Al-Amoudi, Powder Technology 330 (2018) 397).
   double repose_deg = 34.0;
   /// Work cap of one step's relaxation: pair checks, in [1000, 1e9]. A pass
-  /// checks 8 pairs per active cell; passes stop once this many were done.
-  std::int64_t max_pair_checks_per_step = 200000;
+  /// checks 8 pairs per active cell; a pass runs only when it fits in what
+  /// is left of the cap (the step's first pass always runs).
+  /// The default, about 0.45 ms on a 2-core 2020s server, leaves a 1 kHz
+  /// loop half its millisecond.
+  std::int64_t max_pair_checks_per_step = 100000;
 };
 
 /// Returns an empty string when params are valid, else a message naming the field.
@@ -85,7 +87,7 @@ std::string validate(const SoilFlowParams& params);
 
 /// What the soil phase did in one step.
 struct SoilStepResult {
-  double displaced_volume_m3 = 0.0;  ///< cut soil put down ahead of the blade, m^3
+  double displaced_volume_m3 = 0.0;  ///< cut soil put down ahead of the blade (soil pushed again counts again), m^3
   int passes = 0;                    ///< relaxation passes run
   std::int64_t pair_checks = 0;      ///< neighbour pairs examined
   std::int64_t moved_pairs = 0;      ///< pairs that exchanged soil

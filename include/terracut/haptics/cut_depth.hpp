@@ -34,4 +34,30 @@ double depth_lookahead_m(const GridSpec& spec);
 double depth_ahead_m(const HeightGrid& grid, Representation representation, const Segment& edge,
                      Vec3 velocity_m_per_s, double lookahead_m) noexcept;
 
+/// The soil ahead of the edge when soil flows (SoilModel::kFlow), where the
+/// surface ahead may be a pile the blade pushes.
+struct SoilAhead {
+  /// Depth of the undisturbed soil ahead, metres (>= 0): depth_ahead_m's
+  /// reading taken against the lower of the current and the initial
+  /// surface, so a pile does not count as depth of cut.
+  double depth_m = 0.0;
+  /// Mean height of soil piled above the initial surface over the failure
+  /// wedge ahead (from the lookahead on, over wedge_per_depth x the local
+  /// depth), metres (>= 0).
+  double pile_m = 0.0;
+};
+
+/// The failure wedge's length ahead of the blade per metre of cut depth:
+/// cot(45 deg - phi / 2), the passive (Rankine) failure plane, about 2 for
+/// a sand's phi of 35 degrees.
+inline constexpr double kWedgeLengthPerDepth = 2.0;
+
+/// The depth and the pile ahead of the edge (see SoilAhead), sampled as
+/// depth_ahead_m samples it; at each part of the edge the pile is averaged
+/// over up to 64 points along the motion from the lookahead to
+/// wedge_per_depth x that part's depth beyond it. Allocates nothing.
+SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, const Segment& edge,
+                     Vec3 velocity_m_per_s, double lookahead_m,
+                     double wedge_per_depth = kWedgeLengthPerDepth) noexcept;
+
 }  // namespace terracut::haptics

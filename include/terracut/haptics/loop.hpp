@@ -225,14 +225,20 @@ class HapticLoop {
   BladePose tool_pose() const noexcept;
   void estimate_velocity(const BladePose& pose, double t_s) noexcept;
   // step2's phases.
-  ForceOutput world_force(const StepOutput& out, double cut_depth_m) const noexcept;
+  /// What the earthmoving model is given: the depth of cut, m, and the
+  /// surcharge of a pile ahead, Pa (soil flow only; 0 otherwise).
+  struct CutLoad {
+    double depth_m = 0.0;
+    double surcharge_pa = 0.0;
+  };
+  CutLoad cut_load(const StepOutput& out) const noexcept;
+  ForceOutput world_force(const StepOutput& out, const CutLoad& load) const noexcept;
   LoopRecord& write_record(const StepOutput& out, const ForceOutput& force, double cut_depth_m,
                            const DeviceCommand& command, double period_s,
                            double compute_s) noexcept;
   void publish_frame(const StepOutput& out, const ForceOutput& force,
                      const DeviceCommand& command, double period_s,
                      double compute_s) noexcept;
-  double cut_depth(const StepOutput& out) const noexcept;
   TimePercentiles percentiles(double LoopRecord::*field, bool deviation) const;
 
   LoopParams params_;
