@@ -166,22 +166,32 @@ void SoilFlow::clear_blade() {
   blade_.present = false;
 }
 
-bool SoilFlow::blade_separates(std::uint32_t a, std::uint32_t b, float top_m) const {
+bool SoilFlow::blade_blocks(std::uint32_t high, std::uint32_t low, float top_m) const {
   // Cell centres relative to the edge's first end, in plan.
   const auto centre = [&](std::uint32_t i, double& x, double& z) {
     x = (double(i % std::uint32_t(cols_)) + 0.5) * dx_ + origin_x_ - blade_.ax;
     z = (double(i / std::uint32_t(cols_)) + 0.5) * dz_ + origin_z_ - blade_.az;
   };
   double xa, za, xb, zb;
-  centre(a, xa, za);
-  centre(b, xb, zb);
-  const double sa = blade_.dx * za - blade_.dz * xa;
-  const double sb = blade_.dx * zb - blade_.dz * xb;
-  if ((sa > 0.0) == (sb > 0.0)) return false;  // same side of the edge's line
-  // Where the pair's segment meets the line, as a fraction of the edge.
-  const double w = sa / (sa - sb);
-  const double px = xa + (xb - xa) * w, pz = za + (zb - za) * w;
+  centre(high, xa, za);
+  centre(low, xb, zb);
   const double len2 = blade_.dx * blade_.dx + blade_.dz * blade_.dz;
+  const double len = std::sqrt(len2);
+  // Signed distances to the edge's line, and the half width of a cell
+  // across it: a cell closer than that is inside the blade.
+  const double da = (blade_.dx * za - blade_.dz * xa) / len;
+  const double db = (blade_.dx * zb - blade_.dz * xb) / len;
+  const double half = 0.5 * (std::abs(blade_.dz) * dx_ + std::abs(blade_.dx) * dz_) / len;
+  const bool low_inside = std::abs(db) < half;
+  if (!low_inside && (da > 0.0) == (db > 0.0)) return false;  // one side, outside the blade
+  // Where along the edge: at the low cell when it is inside the blade, else
+  // where the pair's segment meets the line.
+  double px = xb, pz = zb;
+  if (!low_inside) {
+    const double w = da / (da - db);
+    px = xa + (xb - xa) * w;
+    pz = za + (zb - za) * w;
+  }
   const double t = (px * blade_.dx + pz * blade_.dz) / len2;
   if (t < 0.0 || t > 1.0) return false;  // around an end of the blade
   // The blade stops soil whose surface there is above its edge.
@@ -344,8 +354,9 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
         const std::uint32_t b = std::uint32_t(std::int64_t(rb) * cols_ + cb);
         const float e = ha - h[b] - float(limit_[nb.kind]);
         if (!(e > tol)) continue;
-        // The blade is a wall between the cells on its two sides.
-        if (blade && near_blade_[a] && near_blade_[b] && blade_separates(a, b, ha)) continue;
+        // The blade is a wall between the cells on its two sides, and soil
+        // does not flow into the cells it passes through.
+        if (blade && near_blade_[a] && near_blade_[b] && blade_blocks(a, b, ha)) continue;
         lower[n] = b;
         excess[n] = e;
         ++n;

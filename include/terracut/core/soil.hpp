@@ -13,10 +13,11 @@
 // Displacement. Each sample the cut lowered gives its lost height to the
 // cell straight ahead of the blade: along the edge's horizontal normal, on
 // the side the edge moved to, one and a half cells beyond the edge's current
-// line. The blade is a wall for the flowing soil: no soil moves between two
-// cells whose centres lie on the two sides of the edge (in plan, within its
-// length) where the soil there stands above the edge, so soil never flows
-// through or under the blade into the cut behind it; the pile in front grows
+// line. The blade is a wall for the flowing soil: where the soil stands above
+// the edge, no soil moves between two cells whose centres lie on the two
+// sides of the edge (in plan, within its length), nor into a cell the edge
+// passes through (its centre within half a cell of the edge's line), so
+// soil never flows through or under the blade into the cut behind it; the pile in front grows
 // as the blade pushes, and spills around the blade's ends and to the sides
 // as it relaxes (windrows). The blade's face is taken as tall as the pile.
 //
@@ -125,7 +126,7 @@ class SoilFlow {
   void activate(std::uint32_t cell);
   void mark_blade(const HeightGrid& grid, const Segment& edge);
   void clear_blade();
-  bool blade_separates(std::uint32_t a, std::uint32_t b, float top_m) const;
+  bool blade_blocks(std::uint32_t high, std::uint32_t low, float top_m) const;
   void displace(HeightGrid& grid, const Segment& from, const Segment& to, SoilStepResult& out);
   void run_passes(HeightGrid& grid, SoilStepResult& out);
 
