@@ -198,7 +198,9 @@ TEST(SoilFlow, WorkPerStepIsCappedAndTheBacklogCarriedOver) {
     const SoilStepResult r = f.relax(g);
     // Whole passes while the next fits in the cap; only a step's first
     // pass may exceed it alone (8 pairs per active cell, at most the grid).
-    if (r.passes > 1) EXPECT_LE(r.pair_checks, cap);
+    if (r.passes > 1) {
+      EXPECT_LE(r.pair_checks, cap);
+    }
     EXPECT_LE(r.pair_checks, std::max(cap, 8 * std::int64_t(n) * n));
     EXPECT_EQ(r.backlog_cells, f.active_cells());
     max_backlog = std::max(max_backlog, r.backlog_cells);
