@@ -49,6 +49,17 @@ struct LoopRig {
   HapticLoop& operator*() const { return *loop; }
 };
 
+/// Options of a synchronous test loop: `ticks` ticks, every record kept,
+/// no real-time request, an optional snapshot exchange.
+inline LoopOptions test_loop_options(std::int64_t ticks, SnapshotExchange* snapshot = nullptr) {
+  LoopOptions o;
+  o.ticks = ticks;
+  o.record_capacity = std::size_t(ticks);
+  o.realtime = false;
+  o.snapshot = snapshot;
+  return o;
+}
+
 /// A loop over a fresh simulation of sc at the loop's rate, with the given
 /// step listeners added to the simulation first. Throws as LoopParams and
 /// HapticLoop do.

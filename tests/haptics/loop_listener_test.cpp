@@ -91,12 +91,8 @@ std::int64_t ticks_of(const HapticSettings& s) {
 EngineLoop make_loop(Device& device, std::int64_t ticks, TestEngine* engine,
                      SnapshotExchange* snapshot = nullptr) {
   const io::Scenario& sc = trench().scenario;
-  LoopOptions o;
-  o.ticks = ticks;
-  o.record_capacity = std::size_t(ticks);
-  o.realtime = false;
+  LoopOptions o = test::test_loop_options(ticks, snapshot);
   o.bodies = engine;
-  o.snapshot = snapshot;
   auto r = std::make_unique<EngineRig>();
   r->rig = test::make_loop_rig(trench().haptics, sc, trench_cut().keyframes[0].pose.orientation,
                                device, o);

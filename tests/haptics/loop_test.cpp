@@ -26,12 +26,8 @@ using test::trench;
 test::LoopRig trench_loop(const HapticSettings& settings, Device& device, std::int64_t ticks,
                           SnapshotExchange* snapshot = nullptr) {
   const io::Scenario& sc = trench().scenario;
-  LoopOptions o;
-  o.ticks = ticks;
-  o.record_capacity = std::size_t(ticks);
-  o.realtime = false;
-  o.snapshot = snapshot;
-  return test::make_loop_rig(settings, sc, sc.cuts[0].keyframes[0].pose.orientation, device, o);
+  return test::make_loop_rig(settings, sc, sc.cuts[0].keyframes[0].pose.orientation, device,
+                             test::test_loop_options(ticks, snapshot));
 }
 
 const Motion& trench_cut() { return trench().scenario.cuts[0]; }

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 
+#include "../support/scenario_text.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/io/image.hpp"
 
@@ -40,23 +41,8 @@ class ScenarioTest : public ::testing::Test {
   fs::path dir_;
 };
 
-// 1-based line of the first line containing needle.
-int line_of(const std::string& text, const std::string& needle) {
-  const std::size_t pos = text.find(needle);
-  EXPECT_NE(pos, std::string::npos) << needle;
-  int line = 1;
-  for (std::size_t i = 0; i < pos; ++i)
-    if (text[i] == '\n') ++line;
-  return line;
-}
-
-// Replaces the first occurrence of from by to.
-std::string replace(std::string text, const std::string& from, const std::string& to) {
-  const std::size_t pos = text.find(from);
-  EXPECT_NE(pos, std::string::npos) << from;
-  if (pos != std::string::npos) text.replace(pos, from.size(), to);
-  return text;
-}
+using test::line_of;
+using test::replace;
 
 // The error of parsing text as "bad.yaml", or "" when it parses.
 std::string parse_error(const std::string& text) {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 
+#include "../support/scenario_text.hpp"
 #include "terracut/core/error.hpp"
 
 namespace terracut::session {
@@ -15,23 +16,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// 1-based line of the first line containing needle.
-int line_of(const std::string& text, const std::string& needle) {
-  const std::size_t pos = text.find(needle);
-  EXPECT_NE(pos, std::string::npos) << needle;
-  int line = 1;
-  for (std::size_t i = 0; i < pos; ++i)
-    if (text[i] == '\n') ++line;
-  return line;
-}
-
-// Replaces the first occurrence of from by to.
-std::string replace(std::string text, const std::string& from, const std::string& to) {
-  const std::size_t pos = text.find(from);
-  EXPECT_NE(pos, std::string::npos) << from;
-  if (pos != std::string::npos) text.replace(pos, from.size(), to);
-  return text;
-}
+using test::line_of;
+using test::replace;
 
 // Expects an InputError naming the file, the line and the field, with a fragment.
 void expect_error(const std::string& text, int line, const std::string& field,
