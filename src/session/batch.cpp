@@ -131,6 +131,7 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
                    {"step_us", timing_json(r.step_timing)},
                    {"wall_s", r.wall_s}};
   if (r.soil) out["timing"]["soil_us"] = timing_json(r.soil->soil_timing);
+  if (r.listeners_timing) out["timing"]["listeners_us"] = timing_json(*r.listeners_timing);
   return out;
 }
 
@@ -197,8 +198,10 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
   if (options.keep_records) result.records.reserve(std::size_t(total_steps));
   const bool flow = sim.params().soil.model == SoilModel::kFlow;
   SoilRunStats soil;
-  std::vector<double> contact_s, cut_s, step_s, soil_s;
+  const bool listening = !sim.listeners().empty();
+  std::vector<double> contact_s, cut_s, step_s, soil_s, listeners_s;
   if (flow) soil_s.reserve(std::size_t(total_steps));
+  if (listening) listeners_s.reserve(std::size_t(total_steps));
   contact_s.reserve(std::size_t(total_steps));
   cut_s.reserve(std::size_t(total_steps));
   step_s.reserve(std::size_t(total_steps));
@@ -248,6 +251,7 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
       contact_s.push_back(out.timers.contact_s);
       cut_s.push_back(out.timers.cut_s);
       step_s.push_back(out.timers.total_s);
+      if (listening) listeners_s.push_back(out.timers.listeners_s);
       if (flow) {
         soil.displaced_volume_m3 += out.soil.displaced_volume_m3;
         soil.passes += out.soil.passes;
@@ -278,6 +282,7 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
   result.contact_timing = timing_stats(contact_s);
   result.cut_timing = timing_stats(cut_s);
   result.step_timing = timing_stats(step_s);
+  if (listening) result.listeners_timing = timing_stats(listeners_s);
   if (pacer) result.realtime = pacer->stats();
   if (flow) {
     soil.final_backlog_cells = sim.soil()->active_cells();

@@ -98,6 +98,9 @@ struct RunResult {
   TimingStats contact_timing{};      ///< StepTimers::contact_s
   TimingStats cut_timing{};          ///< StepTimers::cut_s
   TimingStats step_timing{};         ///< StepTimers::total_s
+  /// StepTimers::listeners_s (e.g. the Bullet world's step), when the world
+  /// has step listeners.
+  std::optional<TimingStats> listeners_timing;
   /// The soil phase's figures, with SoilModel::kFlow.
   std::optional<SoilRunStats> soil;
   /// The pacer's figures, with RunOptions::realtime.
