@@ -232,12 +232,24 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
 
   const HeightGrid::EditLayers layers = grid.edit_layers();
   const Rect& r = before_rect_;
+  // What the cut took (exact in double: a difference of two floats) and
+  // what the displacement put down, measured as it writes, so that the
+  // rounding of the writes is given back at the end.
+  double taken = 0.0, put = 0.0;
+  std::int64_t last_put = -1;
+  const auto write = [&](std::int64_t cell, float value) {
+    put += double(value) - double(layers.height_m[cell]);
+    layers.height_m[cell] = value;
+    layers.removed_m[cell] = layers.initial_m[cell] - value;
+    last_put = cell;
+  };
   std::size_t k = 0;
   for (int row = r.r0; row < r.r1; ++row)
     for (int c = r.c0; c < r.c1; ++c, ++k) {
       const std::int64_t i = std::int64_t(row) * cols_ + c;
       const float lost = before_[k] - layers.height_m[i];
       if (!(lost > 0.0f)) continue;
+      taken += double(before_[k]) - double(layers.height_m[i]);
       activate(std::uint32_t(i));  // its walls may now be too steep
       // Straight ahead of the edge: the cell centre's distance to the edge's
       // line along the normal, plus kDepositAheadCells. At rest, away from
@@ -277,8 +289,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
         for (int j = 0; j < length; ++j) {
           const std::int64_t cell_j = ray[j];
           const float old = layers.height_m[cell_j];
-          layers.height_m[cell_j] = previous;
-          layers.removed_m[cell_j] = layers.initial_m[cell_j] - previous;
+          write(cell_j, previous);
           out.changed.include(int(cell_j % cols_), int(cell_j / cols_));
           activate(std::uint32_t(cell_j));
           previous = old;
@@ -307,22 +318,26 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           continue;
         }
         const float add = std::min(rest, room);
-        layers.height_m[u] += add;
+        write(u, layers.height_m[u] + add);
         rest -= add;
         level = layers.height_m[u];
-        layers.removed_m[u] = layers.initial_m[u] - layers.height_m[u];
         out.changed.include(int(u % cols_), int(u / cols_));
         activate(std::uint32_t(u));
       }
       // What did not fit (or, by rounding, came out negative) is settled on
       // the last cell reached, keeping the volume.
       if (rest != 0.0f) {
-        layers.height_m[t] = std::max(0.0f, layers.height_m[t] + rest);
-        layers.removed_m[t] = layers.initial_m[t] - layers.height_m[t];
+        write(t, std::max(0.0f, layers.height_m[t] + rest));
         out.changed.include(int(t % cols_), int(t / cols_));
         activate(std::uint32_t(t));
       }
     }
+  // Give back the rounding of the writes on the last cell written.
+  if (last_put >= 0 && put != taken) {
+    const float corrected = float(std::max(0.0, double(layers.height_m[last_put]) + (taken - put)));
+    layers.height_m[last_put] = corrected;
+    layers.removed_m[last_put] = layers.initial_m[last_put] - corrected;
+  }
 }
 
 void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
@@ -379,11 +394,23 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
     // Apply the pass. A cell that rose may now be too steep toward its
     // lower neighbours; one that fell may have made its higher neighbours
     // too steep toward it: they are examined in the next pass.
+    // The fluxes cancel exactly; the float heights do not quite: what the
+    // pass gained or lost by rounding is measured in double and given back
+    // to the highest cell it changed, so no bias builds up over a run.
+    double gained = 0.0;
+    std::uint32_t highest = 0;
+    float highest_h = -1.0f;
     for (std::uint32_t t : touched_) {
       const float d = delta_[t];
       delta_[t] = 0.0f;
       if (d == 0.0f) continue;  // fluxes that cancelled
+      const float old = h[t];
       h[t] = std::max(0.0f, h[t] + d);
+      gained += double(h[t]) - double(old);
+      if (h[t] > highest_h) {
+        highest_h = h[t];
+        highest = t;
+      }
       layers.removed_m[t] = layers.initial_m[t] - h[t];
       const int ct = int(t % std::uint32_t(cols_)), rt = int(t / std::uint32_t(cols_));
       out.changed.include(ct, rt);
@@ -394,6 +421,10 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
           if (c >= 0 && r >= 0 && c < cols_ && r < rows_)
             activate(std::uint32_t(std::int64_t(r) * cols_ + c));
         }
+    }
+    if (gained != 0.0 && highest_h > 0.0f) {
+      h[highest] = float(std::max(0.0, double(h[highest]) - gained));
+      layers.removed_m[highest] = layers.initial_m[highest] - h[highest];
     }
     touched_.clear();
   }
