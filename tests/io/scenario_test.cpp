@@ -4,6 +4,7 @@
 #include "terracut/io/scenario.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -455,6 +456,147 @@ TEST(ScenarioErrors, AbsurdMagnitudesAreRefused) {
   expect_error(size, line_of(size, "1e300"), "terrain.size_m[0]", "1e9");
   const std::string scale = replace(kGood, "full_scale_m: 0.3", "full_scale_m: 2e9");
   expect_error(scale, line_of(scale, "2e9"), "terrain.full_scale_m", "1e9");
+}
+
+// ---- Bounded parsing: keyframe caps, nesting depth, top-level keys --------
+
+// A scenario whose cuts hold the given numbers of keyframes, each written as
+// `element` (the scan counts list elements, whatever they are), followed by
+// `tail`.
+std::string scenario_with_keyframes(const std::vector<std::size_t>& counts, const std::string& element,
+                                    const std::string& tail = "") {
+  std::string text = "terrain: {generator: plane, resolution: 4, size_m: [1, 1], full_scale_m: 1}\n"
+                     "blade: {length_m: 0.5}\ncuts:\n";
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    text += "  - name: c" + std::to_string(i) + "\n    keyframes:\n";
+    for (std::size_t k = 0; k < counts[i]; ++k) text += "      - " + element + "\n";
+  }
+  return text + tail;
+}
+
+// Peak resident memory of this process so far, bytes (Linux reports KiB).
+std::int64_t peak_rss_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return std::int64_t{usage.ru_maxrss} * 1024;
+}
+
+// One keyframe over the cap is refused while the text is scanned, naming the
+// cut's keyframes and the cap: before the document is built (a malformed
+// line after the keyframes is never reached) and with little memory
+// (building 100000 keyframes in yaml-cpp takes about 640 MB).
+TEST(ScenarioErrors, KeyframeCapPerCutRefusesWhileScanning) {
+  const std::string cap = std::to_string(kMaxKeyframesPerCut);
+  const std::string text = scenario_with_keyframes({2, kMaxKeyframesPerCut + 1},
+                                                   "{t_s: 0, position_m: [0.5, 0.1, 0.5]}", "broken: [\n");
+  const std::int64_t before = peak_rss_bytes();
+  const std::string m = parse_error(text);
+  EXPECT_LT(peak_rss_bytes() - before, std::int64_t{64} << 20);
+  const int line = line_of(text, "  - name: c1") + 1;  // the line of its key
+  EXPECT_EQ(m.rfind("/some/folder/bad.yaml:" + std::to_string(line) + ": cuts[1].keyframes: ", 0), 0u) << m;
+  EXPECT_NE(m.find("more than " + cap + " keyframes; a cut may have at most " + cap), std::string::npos) << m;
+  // At the cap the scan lets it through (these elements then fail as keyframes).
+  const std::string at_cap = parse_error(scenario_with_keyframes({kMaxKeyframesPerCut}, "0"));
+  EXPECT_NE(at_cap.find("cuts[0].keyframes[0]: expected a mapping"), std::string::npos) << at_cap;
+}
+
+// The cap on all cuts together, and the same caps for lists given by alias
+// (which the scan does not expand; they are counted before any keyframe is read).
+TEST(ScenarioErrors, KeyframeCapInAllCutsIsRefused) {
+  const std::string all = std::to_string(kMaxKeyframes);
+  const std::size_t third = kMaxKeyframes / 3 + 1;
+  const std::string text = scenario_with_keyframes({third, third, third}, "0", "broken: [\n");
+  ASSERT_GT(3 * third, kMaxKeyframes);
+  ASSERT_LE(2 * third, kMaxKeyframes);
+  const std::string m = parse_error(text);
+  EXPECT_EQ(m.rfind("/some/folder/bad.yaml:" + std::to_string(line_of(text, "  - name: c2") + 1) +
+                        ": cuts[2].keyframes: ", 0), 0u) << m;
+  EXPECT_NE(m.find("the cuts have more than " + all + " keyframes in all; a scenario may have at most " + all),
+            std::string::npos) << m;
+
+  std::string list;
+  for (std::size_t k = 0; k < kMaxKeyframesPerCut; ++k) list += k ? ", 0" : "0";
+  const std::string aliased = "terrain: {generator: plane, resolution: 4, size_m: [1, 1], full_scale_m: 1}\n"
+                              "blade: {length_m: 0.5}\ncuts:\n"
+                              "  - {name: a, keyframes: &k [" + list + "]}\n"
+                              "  - {name: b, keyframes: *k}\n"
+                              "  - {name: c, keyframes: *k}\n";
+  const std::string m2 = parse_error(aliased);
+  EXPECT_EQ(m2.rfind("/some/folder/bad.yaml:6: cuts[2].keyframes: the cuts have more than " + all, 0), 0u) << m2;
+}
+
+// Lists and mappings nested absurdly deep: the message says so and where,
+// instead of yaml-cpp's "bad file".
+TEST(ScenarioErrors, DeepNestingSaysSoAndWhere) {
+  const std::string deep = std::string(1000, '[') + std::string(1000, ']');
+  const std::string text = replace(kGood, "representation: columns", "representation:\n  - " + deep);
+  const std::string m = parse_error(text);
+  EXPECT_EQ(m.rfind("/some/folder/bad.yaml:" + std::to_string(line_of(text, "  - [[")) + ": representation[0][0]", 0),
+            0u) << m;
+  EXPECT_NE(m.find("nested more than " + std::to_string(kMaxScenarioDepth) + " levels deep"), std::string::npos) << m;
+  EXPECT_EQ(m.find("bad file"), std::string::npos) << m;
+  // Just within the limit, the scan passes it on (and the field is then refused as a list).
+  const int within = kMaxScenarioDepth - 1;
+  const std::string ok = replace(kGood, "representation: columns",
+                                 "representation: " + std::string(within, '[') + std::string(within, ']'));
+  EXPECT_NE(parse_error(ok).find("representation: expected a text value, got a list"), std::string::npos)
+      << parse_error(ok);
+}
+
+// An unknown top-level key is refused while scanning (a malformed line after
+// it is never reached), with the message the document's check gives, and so
+// is a top-level key given twice.
+TEST(ScenarioErrors, TopLevelKeysAreCheckedWhileScanning) {
+  const std::string text = kGood + "bad_key: 1\nbroken: [\n";
+  expect_error(text, line_of(text, "bad_key"), "bad_key",
+               "unknown key 'bad_key'; allowed keys here: name, description, terrain, representation, "
+               "rate_hz, blade, cuts, sequence, reference, soil");
+  const std::string twice = kGood + "rate_hz: 100\n";
+  expect_error(twice, line_of(twice, "rate_hz: 100"), "rate_hz",
+               "key given twice (first at line " + std::to_string(line_of(kGood, "rate_hz")) + ")");
+  // Malformed YAML before any such key is still reported as malformed.
+  EXPECT_NE(parse_error("name: [x\nbad_key: 1\n").find("malformed YAML"), std::string::npos);
+}
+
+// A scenario path that is a symbolic link loop says so, rather than "not
+// found"; a dangling link says where it points; the same for the image.
+TEST_F(ScenarioTest, SymlinkLoopAndDanglingLinkAreNamed) {
+  fs::create_symlink(dir_ / "b.yaml", dir_ / "a.yaml");
+  fs::create_symlink(dir_ / "a.yaml", dir_ / "b.yaml");
+  try {
+    load_scenario(dir_ / "a.yaml");
+    FAIL() << "a symlink loop was loaded";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind((dir_ / "a.yaml").string() + ": cannot be resolved: it is a symbolic link loop", 0), 0u) << m;
+    EXPECT_EQ(m.find("not found"), std::string::npos) << m;
+  }
+  fs::create_symlink(dir_ / "gone.yaml", dir_ / "dangling.yaml");
+  try {
+    load_scenario(dir_ / "dangling.yaml");
+    FAIL() << "a dangling link was loaded";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("scenario file not found (a symbolic link to '" + (dir_ / "gone.yaml").string() +
+                     "', which does not exist)"), std::string::npos) << m;
+  }
+  fs::create_symlink(dir_ / "y.png", dir_ / "x.png");
+  fs::create_symlink(dir_ / "x.png", dir_ / "y.png");
+  const fs::path path = write("image.yaml", R"(terrain:
+  image: x.png
+  size_m: [1, 1]
+  full_scale_m: 1
+blade: {length_m: 1}
+cuts: [{name: a, keyframes: [{t_s: 0, position_m: [0, 0, 0]}]}]
+)");
+  try {
+    load_scenario(path);
+    FAIL() << "an image behind a symlink loop was read";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(path.string() + ":2: terrain.image: image file '" + (dir_ / "x.png").string() +
+                          "' cannot be resolved: it is a symbolic link loop", 0), 0u) << m;
+  }
 }
 
 TEST_F(ScenarioTest, MissingScenarioFileIsNamed) {
