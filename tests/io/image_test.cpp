@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 #include <png.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -28,6 +27,8 @@
 #include <vector>
 
 #include "terracut/core/error.hpp"
+
+#include "../support/peak_memory.hpp"
 
 namespace terracut::io {
 namespace {
@@ -667,12 +668,8 @@ TEST_F(ImageTest, TooLittleImageData) {
   expect_input_error(file("too_little.png"));
 }
 
-// Peak resident memory of this process so far, bytes (Linux reports KiB).
-std::int64_t peak_rss_bytes() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return std::int64_t{usage.ru_maxrss} * 1024;
-}
+using test::peak_rss_bytes;
+using test::small_growth;
 
 // A header claiming far more pixels than its few bytes of data can hold
 // (the review's 69-byte file claiming 65536 x 16384, and a 16-bit
@@ -702,14 +699,14 @@ TEST_F(ImageTest, LyingHeaderRefusedBeforeAllocating) {
               std::string::npos) << message;
     EXPECT_NE(message.find("only " + std::to_string(bytes.size()) + " bytes"), std::string::npos) << message;
     EXPECT_NE(message.find("at most 1032"), std::string::npos) << message;
-    EXPECT_LT(grew, std::int64_t{16} << 20) << "peak memory grew by " << grew << " bytes";
+    EXPECT_LT(grew, small_growth(16)) << "peak memory grew by " << grew << " bytes";
   }
   // 2^31 pixels: refused by the size limit, before reading on.
   write_bytes(file("huge.png"), png_with_size(65536, 32768));
   const std::int64_t before = peak_rss_bytes();
   const std::string message = expect_input_error(file("huge.png"));
   EXPECT_NE(message.find("2^30 pixels"), std::string::npos) << message;
-  EXPECT_LT(peak_rss_bytes() - before, std::int64_t{16} << 20);
+  EXPECT_LT(peak_rss_bytes() - before, small_growth(16));
 }
 
 // Through a pipe the file size is not known in advance, so the claim cannot
@@ -736,7 +733,7 @@ TEST_F(ImageTest, LyingHeaderThroughAPipeCommitsOnlyWhatIsDecoded) {
     writer.join();
     const std::int64_t grew = peak_rss_bytes() - before;
     EXPECT_NE(message.find("image data"), std::string::npos) << message;
-    EXPECT_LT(grew, std::int64_t{64} << 20) << "peak memory grew by " << grew << " bytes";
+    EXPECT_LT(grew, small_growth(64)) << "peak memory grew by " << grew << " bytes";
   }
 }
 
