@@ -4,6 +4,7 @@
 // baseline in benchmarks.
 #include "terracut/core/brute_force.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "geometry.hpp"
@@ -11,6 +12,21 @@
 namespace terracut {
 
 using detail::GridFrame;
+
+namespace {
+
+/// Clips the parameter range [s0, s1] of p(s) = p0 + s * dp to the cell
+/// lo <= p < hi, or lo <= p <= hi for the grid's last cell (last): half-open
+/// cells, so that each point of the edge belongs to one cell and an edge
+/// lying on a cell wall is counted once. The closed range otherwise, since
+/// its ends only matter for an edge along the axis (dp = 0), which lies in
+/// the cell only when its p0 does.
+bool clip_cell(double p0, double dp, double lo, double hi, bool last, double& s0, double& s1) {
+  if (dp == 0.0) return p0 >= lo && (last ? p0 <= hi : p0 < hi);
+  return detail::clip_axis(p0, dp, lo, hi, s0, s1);
+}
+
+}  // namespace
 
 ContactResult measure_contact_brute_force(const HeightGrid& grid, Representation representation,
                                           const Segment& edge) {
@@ -20,6 +36,7 @@ ContactResult measure_contact_brute_force(const HeightGrid& grid, Representation
   Vec3 d = edge.b - edge.a;
   double seg_len = length(d);
   const float* h = grid.heights();
+  const double min_piece = detail::min_depth_piece(std::max(std::abs(d.x * f.inv_cx), std::abs(d.z * f.inv_cz)));
   if (representation == Representation::kColumns) {
     // Slab method against every box: the x and z slabs give the parameter
     // range over the column's footprint, the y range is clipped per piece.
@@ -27,11 +44,11 @@ ContactResult measure_contact_brute_force(const HeightGrid& grid, Representation
       for (int c = 0; c < f.cols; ++c) {
         ++out.cells_visited;
         double s0 = 0.0, s1 = 1.0;
-        if (!detail::clip_axis(edge.a.x, d.x, f.x0 + c * f.cx, f.x0 + (c + 1) * f.cx, s0, s1)) continue;
-        if (!detail::clip_axis(edge.a.z, d.z, f.z0 + r * f.cz, f.z0 + (r + 1) * f.cz, s0, s1)) continue;
+        if (!clip_cell(edge.a.x, d.x, f.x0 + c * f.cx, f.x0 + (c + 1) * f.cx, c == f.cols - 1, s0, s1)) continue;
+        if (!clip_cell(edge.a.z, d.z, f.z0 + r * f.cz, f.z0 + (r + 1) * f.cz, r == f.rows - 1, s0, s1)) continue;
         double top = f.ground_y + h[std::int64_t(r) * f.cols + c];
         detail::accumulate_piece(s0, s1, top, top, edge.a.y + s0 * d.y, edge.a.y + s1 * d.y, f,
-                                 f.min_contact_depth_m(representation), seg_len, out);
+                                 f.min_contact_depth_m(representation), seg_len, min_piece, out);
       }
     }
     return out;
@@ -49,12 +66,16 @@ ContactResult measure_contact_brute_force(const HeightGrid& grid, Representation
       double h11 = detail::clamped_height(h, f.cols, f.rows, i + 1, j + 1);
       for (int lower = 1; lower >= 0; --lower) {
         double s0 = 0.0, s1 = 1.0;
-        // The domain and the square.
-        if (!detail::clip_axis(u0, du, std::max(-0.5, double(i)), std::min(f.cols - 0.5, i + 1.0), s0, s1)) break;
-        if (!detail::clip_axis(v0, dv, std::max(-0.5, double(j)), std::min(f.rows - 0.5, j + 1.0), s0, s1)) break;
-        // The triangle: a + b <= 1 (lower) or a + b >= 1 (upper).
+        // The domain and the square (half-open, the last one closed).
+        if (!clip_cell(u0, du, std::max(-0.5, double(i)), std::min(f.cols - 0.5, i + 1.0), i == f.cols - 1, s0, s1))
+          break;
+        if (!clip_cell(v0, dv, std::max(-0.5, double(j)), std::min(f.rows - 0.5, j + 1.0), j == f.rows - 1, s0, s1))
+          break;
+        // The triangle: a + b <= 1 (lower) or a + b > 1 (upper).
         double w0 = (u0 - i) + (v0 - j) - 1.0, dw = du + dv;
-        if (lower) {
+        if (dw == 0.0) {
+          if (lower ? !(w0 <= 0.0) : !(w0 > 0.0)) continue;
+        } else if (lower) {
           if (!detail::clip_axis(w0, dw, -INFINITY, 0.0, s0, s1)) continue;
         } else {
           if (!detail::clip_axis(w0, dw, 0.0, INFINITY, s0, s1)) continue;
@@ -65,7 +86,7 @@ ContactResult measure_contact_brute_force(const HeightGrid& grid, Representation
         double top1 = f.ground_y + detail::surface_in_square(h00, h10, h01, h11, u0 + s1 * du - i,
                                                             v0 + s1 * dv - j, lower);
         detail::accumulate_piece(s0, s1, top0, top1, edge.a.y + s0 * d.y, edge.a.y + s1 * d.y, f,
-                                 f.min_contact_depth_m(representation), seg_len, out);
+                                 f.min_contact_depth_m(representation), seg_len, min_piece, out);
       }
     }
   }

@@ -97,8 +97,8 @@ TEST(PerfTraversal, LongEdgesEqualBruteForce) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (const Direction& d : directions) {
     for (int k = 0; k < 6; ++k) {
-      // Centres at generic positions (the brute force counts an edge lying
-      // exactly on a cell wall or a triangle edge on both sides).
+      // Centres at generic positions (edges exactly on cell walls and node
+      // lines are brute_force_test.cpp's).
       double cu = 120.0123 + unit(rng) * 10.0 - 5.0;
       double cv = 90.0371 + unit(rng) * 10.0 - 5.0;
       double y0 = 0.1 + 0.6 * unit(rng), y1 = k % 3 == 0 ? y0 : 0.1 + 0.6 * unit(rng);
