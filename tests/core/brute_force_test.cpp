@@ -1,15 +1,24 @@
-// The boundary rules, where the fast paths and the brute-force oracle must
-// decide alike: edges lying on cell walls and node lines (contact), in both
+// The boundary rules (docs/model.md, "Boundaries"), where the fast paths and
+// the brute-force oracle must decide alike: edges lying on cell walls and
+// node lines (contact), blades at rest with their ends on samples, sweeps
+// whose edges pass through cell corners and along cell walls (cut), in both
 // representations.
 //
 // The grid is 32 x 16 cells of exactly 1/8 m, so positions given in cell
-// units are exact in binary floating point and a tie is a real tie.
+// units are exact in binary floating point and a tie is a real tie. The
+// oracle's closed regions are checked against an exact integer reference
+// on a lattice of points 1/den of a cell apart; the fast paths against the
+// oracle wherever every edge of the swept triangles has a dx/dz that binary
+// floating point represents (along a row or column, diagonal, 2:1, 3:4, ...;
+// see docs/model.md for the general case).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -158,6 +167,215 @@ TEST(BruteForceTies, LatticeContactEqualsOracle) {
       for (Representation rep : kBoth) expect_same_contact(grid, rep, e, "lattice edge " + std::to_string(k));
     }
   }
+}
+
+// ---------------------------------------------------------------------------
+// Cut: the closed rule, against an exact integer reference.
+
+/// A point of the lattice in units of 1/den of a cell.
+struct LatticePoint {
+  std::int64_t x, z;
+};
+
+std::int64_t orient(LatticePoint a, LatticePoint b, LatticePoint p) {
+  return (b.x - a.x) * (p.z - a.z) - (b.z - a.z) * (p.x - a.x);
+}
+
+/// Whether the closed triangle t (possibly with no area) meets the closed
+/// box [x0, x1] x [z0, z1]: separating axes (the box's, then each edge's).
+bool touches(const LatticePoint (&t)[3], std::int64_t x0, std::int64_t x1, std::int64_t z0, std::int64_t z1) {
+  auto [mnx, mxx] = std::minmax({t[0].x, t[1].x, t[2].x});
+  auto [mnz, mxz] = std::minmax({t[0].z, t[1].z, t[2].z});
+  if (mxx < x0 || mnx > x1 || mxz < z0 || mnz > z1) return false;
+  const LatticePoint box[4] = {{x0, z0}, {x1, z0}, {x1, z1}, {x0, z1}};
+  for (int e = 0; e < 3; ++e) {
+    const LatticePoint a = t[e], b = t[(e + 1) % 3];
+    if (a.x == b.x && a.z == b.z) continue;
+    std::int64_t side = 0;  // the triangle's side of the edge (0: it has no area)
+    for (const LatticePoint& p : t)
+      if (std::int64_t o = orient(a, b, p); o != 0) side = o;
+    int pos = 0, neg = 0;
+    for (const LatticePoint& p : box) {
+      const std::int64_t o = orient(a, b, p);
+      pos += o > 0;
+      neg += o < 0;
+    }
+    if (side == 0 ? (pos == 4 || neg == 4) : (side > 0 ? neg == 4 : pos == 4)) return false;
+  }
+  return true;
+}
+
+/// Whether the closed triangle t (possibly with no area) holds point p.
+bool holds(const LatticePoint (&t)[3], LatticePoint p) {
+  auto [mnx, mxx] = std::minmax({t[0].x, t[1].x, t[2].x});
+  auto [mnz, mxz] = std::minmax({t[0].z, t[1].z, t[2].z});
+  if (p.x < mnx || p.x > mxx || p.z < mnz || p.z > mxz) return false;
+  const std::int64_t area = orient(t[0], t[1], t[2]);
+  for (int e = 0; e < 3; ++e) {
+    const LatticePoint a = t[e], b = t[(e + 1) % 3];
+    const std::int64_t o = orient(a, b, p);
+    if (area != 0 && (area > 0 ? o < 0 : o > 0)) return false;
+    if (area == 0 && o == 0 && p.x >= std::min(a.x, b.x) && p.x <= std::max(a.x, b.x) &&
+        p.z >= std::min(a.z, b.z) && p.z <= std::max(a.z, b.z))
+      return true;
+  }
+  return area != 0;
+}
+
+/// Whether dx/dz of the segment is exact in binary floating point.
+bool representable_slope(LatticePoint a, LatticePoint b) {
+  const std::int64_t dx = std::abs(b.x - a.x), dz = std::abs(b.z - a.z);
+  if (dx == 0 || dz == 0) return true;
+  const std::int64_t q = dz / std::gcd(dx, dz);
+  return (q & (q - 1)) == 0;
+}
+
+/// A sweep between lattice points (units of 1/den cell), heights in metres.
+struct LatticeSweep {
+  LatticePoint from_a, from_b, to_a, to_b;
+  double y_a, y_b;  // at the blade's two ends, the same at both poses
+};
+
+/// Cuts the sweep with the fast path and the oracle on a terrain at 0.9 m
+/// (above every blade height used, so a sample is lowered exactly when the
+/// region covers it), checks the oracle's lowered set against the exact
+/// reference and, when check_fast, the fast path against the oracle. Returns
+/// whether the fast path was checked.
+bool expect_closed_cut(const LatticeSweep& w, int den, bool check_fast, const std::string& what) {
+  const GridSpec s = tie_spec();
+  auto world = [&](LatticePoint p, double y) { return at(s, double(p.x) / den, double(p.z) / den, y); };
+  const Segment from{world(w.from_a, w.y_a), world(w.from_b, w.y_b)};
+  const Segment to{world(w.to_a, w.y_a), world(w.to_b, w.y_b)};
+  const LatticePoint tri[2][3] = {{w.from_a, w.from_b, w.to_b}, {w.from_a, w.to_b, w.to_a}};
+  for (Representation rep : kBoth) {
+    const std::vector<float> initial(std::size_t(s.sample_count()), 0.9f);
+    HeightGrid fast(s, initial), slow(s, initial);
+    const CutResult a = cut_sweep(fast, rep, from, to);
+    const CutResult b = cut_sweep_brute_force(slow, rep, from, to);
+    int wrong_oracle = 0, wrong_fast = 0;
+    for (int r = 0; r < s.rows; ++r) {
+      for (int c = 0; c < s.cols; ++c) {
+        bool covered = false;
+        for (const auto& t : tri) {
+          if (rep == Representation::kColumns) {
+            covered |= touches(t, std::int64_t(c) * den, std::int64_t(c + 1) * den, std::int64_t(r) * den,
+                               std::int64_t(r + 1) * den);
+          } else {
+            // Sample centres at half cells: the lattice doubled.
+            const LatticePoint t2[3] = {{2 * t[0].x, 2 * t[0].z}, {2 * t[1].x, 2 * t[1].z}, {2 * t[2].x, 2 * t[2].z}};
+            covered |= holds(t2, {std::int64_t(2 * c + 1) * den, std::int64_t(2 * r + 1) * den});
+          }
+        }
+        const float h_slow = slow.height(c, r), h_fast = fast.height(c, r);
+        wrong_oracle += (h_slow < 0.9f) != covered;
+        if (check_fast) wrong_fast += !(std::abs(h_fast - h_slow) <= 1e-6f);
+      }
+    }
+    EXPECT_EQ(wrong_oracle, 0) << name_of(rep, what);
+    if (check_fast) {
+      EXPECT_EQ(wrong_fast, 0) << name_of(rep, what);
+      EXPECT_NEAR(a.removed_volume_m3, b.removed_volume_m3, 1e-9 + 1e-7 * b.removed_volume_m3) << name_of(rep, what);
+      if (!b.changed.empty()) {
+        EXPECT_EQ(a.changed, b.changed) << name_of(rep, what);
+      }
+    }
+  }
+  return check_fast;
+}
+
+// The ties the review found and their kin, each with both representations:
+// a blade at rest whose end is exactly on a sample (the fast path lowered
+// the sample, the oracle did not), at rest through samples and along a row
+// of them, at rest on a cell wall (both rows of columns are lowered), sweeps
+// whose edges pass through cell corners (a column touched only at its
+// corner is lowered), plunges onto samples. Coordinates in cells (den 2:
+// half cells, so sample centres are lattice points).
+TEST(BruteForceTies, NamedTiesFollowTheClosedRule) {
+  auto p = [](double u, double v) { return LatticePoint{std::int64_t(2 * u), std::int64_t(2 * v)}; };
+  const struct {
+    LatticePoint fa, fb, ta, tb;
+    double ya, yb;
+    const char* what;
+  } cases[] = {
+      {p(3.5, 5.5), p(9, 8), p(3.5, 5.5), p(9, 8), 0.2, 0.2, "at rest, an end on sample (3, 5)"},
+      {p(3.5, 5.5), p(9.5, 11.5), p(3.5, 5.5), p(9.5, 11.5), 0.2, 0.5, "at rest, diagonally through samples"},
+      {p(3, 5.5), p(20.5, 5.5), p(3, 5.5), p(20.5, 5.5), 0.2, 0.2, "at rest along sample row 5"},
+      {p(3, 5), p(20.5, 5), p(3, 5), p(20.5, 5), 0.2, 0.3, "at rest on the row wall v = 5"},
+      {p(4, 2), p(12, 10), p(4, 2), p(12, 10), 0.2, 0.2, "at rest through cell corners"},
+      {p(4, 2), p(20, 10), p(4, 2), p(20, 10), 0.2, 0.2, "at rest, 2:1 through cell corners"},
+      {p(4, 2), p(9, 7.5), p(4, 2), p(9, 7.5), 0.2, 0.2, "at rest, an end on a cell corner"},
+      {p(3.5, 5.5), p(20.5, 5.5), p(3.5, 8.5), p(20.5, 8.5), 0.2, 0.2, "3 rows, ends on samples"},
+      {p(3, 5), p(20.5, 5), p(3, 6), p(20.5, 6), 0.2, 0.2, "from one row wall to the next"},
+      {p(4, 2), p(12, 10), p(6, 2), p(14, 10), 0.2, 0.2, "along x, edges through cell corners"},
+      {p(4.5, 2.5), p(12.5, 10.5), p(6.5, 2.5), p(14.5, 10.5), 0.2, 0.2, "along x, edges through samples"},
+      {p(4, 2), p(12, 10), p(5, 1), p(13, 9), 0.2, 0.2, "diagonal step, corners"},
+      {p(4, 2), p(8, 6), p(4, 2), p(8.5, 3), 0.2, 0.2, "rotation about a corner, touching corners"},
+      {p(4, 2), p(12, 2), p(4, 2), p(12, 6), 0.2, 0.2, "rotation about a corner on a wall"},
+      {p(3.5, 5.5), p(9.5, 5.5), p(3.5, 5.5), p(9.5, 5.5), 0.1, 0.1, "at rest on samples, low"},
+      {p(0, 0), p(32, 16), p(0, 0), p(32, 16), 0.2, 0.2, "at rest corner to corner of the terrain"},
+      {p(0, 16), p(32, 16), p(0, 15), p(32, 15), 0.2, 0.2, "along the far edge"},
+  };
+  for (const auto& c : cases) expect_closed_cut({c.fa, c.fb, c.ta, c.tb, c.ya, c.yb}, 2, true, c.what);
+  // A plunge straight down onto a row of samples: the region stands on edge.
+  const GridSpec s = tie_spec();
+  for (Representation rep : kBoth) {
+    HeightGrid fast(s, tie_heights(s)), slow(s, tie_heights(s));
+    const Segment high = edge(s, 3.5, 5.5, 9.5, 5.5, 0.6, 0.6), low = edge(s, 3.5, 5.5, 9.5, 5.5, 0.1, 0.1);
+    cut_sweep(fast, rep, high, low);
+    cut_sweep_brute_force(slow, rep, high, low);
+    for (int c = 0; c < s.cols; ++c) {
+      for (int r = 0; r < s.rows; ++r) {
+        EXPECT_EQ(fast.height(c, r), slow.height(c, r)) << name_of(rep, "plunge") << " c=" << c << " r=" << r;
+      }
+    }
+    if (rep == Representation::kSurface) {
+      for (int c = 3; c <= 9; ++c) EXPECT_NEAR(slow.height(c, 5), 0.1, 1e-6) << "plunge onto sample " << c;
+    }
+  }
+}
+
+// Random sweeps between lattice points (general, at rest, translations),
+// dense in ties: the oracle's lowered set is exactly the closed rule's, and
+// the fast path equals the oracle wherever the swept edges' slopes are
+// representable.
+TEST(BruteForceTies, LatticeSweepsFollowTheClosedRule) {
+  std::mt19937 rng(17);
+  int fast_checked = 0;
+  for (int den : {1, 2, 4}) {
+    std::uniform_int_distribution<int> u(2 * den, 30 * den), v(1 * den, 15 * den), y(1, 12);
+    for (int mode = 0; mode < 3; ++mode) {
+      for (int k = 0; k < 400; ++k) {
+        LatticeSweep w;
+        w.from_a = {u(rng), v(rng)};
+        w.from_b = {u(rng), v(rng)};
+        if (mode == 0) {
+          w.to_a = {u(rng), v(rng)};
+          w.to_b = {u(rng), v(rng)};
+        } else if (mode == 1) {
+          w.to_a = w.from_a;
+          w.to_b = w.from_b;
+        } else {
+          const LatticePoint d{u(rng) / 4, v(rng) / 4};
+          w.to_a = {w.from_a.x + d.x, w.from_a.z + d.z};
+          w.to_b = {w.from_b.x + d.x, w.from_b.z + d.z};
+        }
+        w.y_a = y(rng) / 16.0;
+        w.y_b = y(rng) / 16.0;
+        const LatticePoint tri[2][3] = {{w.from_a, w.from_b, w.to_b}, {w.from_a, w.to_b, w.to_a}};
+        bool representable = true;
+        for (const auto& t : tri)
+          for (int e = 0; e < 3; ++e) representable = representable && representable_slope(t[e], t[(e + 1) % 3]);
+        std::ostringstream what;
+        what << "den " << den << " mode " << mode << " sweep " << k << ": ";
+        for (const LatticePoint& p : {w.from_a, w.from_b, w.to_a, w.to_b}) {
+          what << "(" << double(p.x) / den << ", " << double(p.z) / den << ") ";
+        }
+        what << "y " << w.y_a << " to " << w.y_b;
+        fast_checked += expect_closed_cut(w, den, representable, what.str());
+      }
+    }
+  }
+  EXPECT_GT(fast_checked, 500);  // the fast path was compared on many of them
 }
 
 }  // namespace
