@@ -55,6 +55,7 @@ struct ContactSums {
   double length = 0.0;
   double area2 = 0.0;
   double max_depth = 0.0;
+  double min_piece = 0.0;  // shortest piece (edge parameter) whose depth counts for max_depth
 };
 
 /// Adds a piece [s0, s1] of the edge over which the depth below the material
@@ -67,7 +68,7 @@ inline void add_piece(double s0, double s1, double d0, double d1, double eps, Co
     if (ds > 0.0) {
       sums.length += ds;
       sums.area2 += ds * (d0 + d1);
-      sums.max_depth = max_d(sums.max_depth, max_d(d0, d1));
+      if (ds >= sums.min_piece) sums.max_depth = max_d(sums.max_depth, max_d(d0, d1));
     }
     return;
   }
@@ -86,7 +87,7 @@ inline void add_piece(double s0, double s1, double d0, double d1, double eps, Co
   double len = (t1 - t0) * ds;
   sums.length += len;
   sums.area2 += len * (e0 + e1);
-  sums.max_depth = max_d(sums.max_depth, max_d(e0, e1));
+  if (len >= sums.min_piece) sums.max_depth = max_d(sums.max_depth, max_d(e0, e1));
 }
 
 /// The edge in grid coordinates, oriented along its major axis: p is the
@@ -296,7 +297,10 @@ std::int64_t columns_full(const float* h, const Line& l, int p_first, int p_end,
         if (d_min > eps && a_c > 0.0 && a_c < 1.0) {
           ++columns;
           area2 += a_c * (d0 + d1) + (1.0 - a_c) * (d2 + d3);
-          max_depth = max_d(max_depth, max_d(max_d(d0, d1), max_d(d2, d3)));
+          // A sliver cell at a corner crossing adds no depth (kMinDepthPieceCells).
+          double m01 = a_c >= detail::kMinDepthPieceCells ? max_d(d0, d1) : 0.0;
+          double m23 = 1.0 - a_c >= detail::kMinDepthPieceCells ? max_d(d2, d3) : 0.0;
+          max_depth = max_d(max_depth, max_d(m01, m23));
         } else {
           double s_in = (P - l.p0) * inv_dp, s_c = s_in + a_c * inv_dp, s_out = s_in + inv_dp;
           pending[n++] = {s_in, s_c, d0, d1};
@@ -355,6 +359,7 @@ ContactResult contact_columns(const HeightGrid& grid, const Segment& edge) {
   const float* h = grid.heights();
   const double eps = f.min_contact_depth_m(Representation::kColumns);
   ContactSums sums;
+  sums.min_piece = detail::min_depth_piece(l.dp);
   std::int64_t visited = 0;
   // Full columns take the fast walk, the partial first and last the general one.
   int p_first = 0, p_end = 0;
@@ -458,6 +463,11 @@ std::int64_t surface_columns(const float* h, const Line& l, int p_first, int p_e
   double y = l.y0 + s_first * l.dy;
   const float* base = h + p_first * sp + std::int64_t(Q) * sq;  // node (P, Q)
   double d_in = (base[0] + b * (double(base[sq]) - base[0])) - y;
+  // The depth where the walk starts: the two-column path takes each column's
+  // largest depth from its later points, and an edge that starts exactly on
+  // the first column's line has no piece before it that would hold this one
+  // (in material here means in material just after: the surface is continuous).
+  if (d_in > eps) sums.max_depth = max_d(sums.max_depth, d_in);
   // Columns wholly in material are summed in a-units (each is 1 / dp long).
   Pending pending[kMaxPending];
   std::int64_t visited = 0;
@@ -626,6 +636,7 @@ ContactResult contact_surface(const HeightGrid& grid, const Segment& edge) {
   const float* h = grid.heights();
   const double eps = f.min_contact_depth_m(Representation::kSurface);
   ContactSums sums;
+  sums.min_piece = detail::min_depth_piece(l.dp);
   std::int64_t visited = 0;
   // The interior part, where every node of the squares crossed exists: p in
   // [0, np - 1] and q in [0, nq - 1]. Its full columns take the fast walk;

@@ -266,15 +266,17 @@ struct Scanline {
 
   Scanline(const Point& p0, const Point& p1, const Point& p2) : a(p0), b(p1), c(p2) {
     sort_by_z(a, b, c);
-    double inv_ac = c.z > a.z ? 1.0 / (c.z - a.z) : 0.0;
-    ac_kx = (c.x - a.x) * inv_ac;
-    ac_ky = (c.y - a.y) * inv_ac;
-    double inv_ab = b.z > a.z ? 1.0 / (b.z - a.z) : 0.0;
-    ab_kx = (b.x - a.x) * inv_ab;
-    ab_ky = (b.y - a.y) * inv_ab;
-    double inv_bc = c.z > b.z ? 1.0 / (c.z - b.z) : 0.0;
-    bc_kx = (c.x - b.x) * inv_bc;
-    bc_ky = (c.y - b.y) * inv_bc;
+    // Divisions, not products with a reciprocal: an edge whose dx/dz is
+    // representable (along a row or column, diagonal, 2:1, ...) then puts
+    // its crossings exactly, so a sample or cell corner exactly on it is
+    // found on it (the boundary is closed, docs/model.md).
+    auto slope = [](double d, double dz) { return dz > 0.0 ? d / dz : 0.0; };
+    ac_kx = slope(c.x - a.x, c.z - a.z);
+    ac_ky = slope(c.y - a.y, c.z - a.z);
+    ab_kx = slope(b.x - a.x, b.z - a.z);
+    ab_ky = slope(b.y - a.y, b.z - a.z);
+    bc_kx = slope(c.x - b.x, c.z - b.z);
+    bc_ky = slope(c.y - b.y, c.z - b.z);
   }
 
   /// The point of the long edge at z (a.z <= z <= c.z).
@@ -361,30 +363,47 @@ struct SurfaceTriangle {
   }
 };
 
-/// A flat triangle (all three vertices on the plane z = zmax): it cuts only
-/// when that plane is a sample row's, along the triangle's extent in x, from
-/// its lowest point at the smallest x to its lowest point at the largest x.
+/// A flat triangle (all three vertices on the plane z = zmax, as when a
+/// blade along X slides along its own line): it cuts only when that plane is
+/// a sample row's, along the triangle's extent in x, down to its lowest
+/// point over each sample. The triangle is then a vertical figure whose
+/// lowest points are on its edges, so a sample's target is the lowest of the
+/// edges over it (their x ranges together cover the extent; one pass).
 void cut_flat_points(HeightGrid& grid, const GridFrame& f, const SurfaceTriangle& t, CutBook& book) {
   const Point* q = t.q;
-  int lo = 0, hi = 0;
-  for (int k = 1; k < 3; ++k) {
-    if (q[k].x < q[lo].x || (q[k].x == q[lo].x && q[k].y < q[lo].y)) lo = k;
-    if (q[k].x > q[hi].x || (q[k].x == q[hi].x && q[k].y < q[hi].y)) hi = k;
-  }
   for (int r = t.r_lo; r <= t.r_hi; ++r) {
     if (f.z0 + (r + 0.5) * f.cz != q[0].z) continue;
-    int c_lo = ceil_clamped((q[lo].x - f.x0) * f.inv_cx - 0.5, 0, f.cols);
-    int c_hi = floor_clamped((q[hi].x - f.x0) * f.inv_cx - 0.5, -1, f.cols - 1);
-    if (c_lo > c_hi) continue;
-    double span = q[hi].x - q[lo].x;
-    if (!(span > 1e-12 * f.cx)) {
-      double y = std::min({q[0].y, q[1].y, q[2].y});
-      book.add(r, lower_row(grid, r, c_lo, c_hi, linear_targets(y, 0.0)));
-    } else {
-      double slope = (q[hi].y - q[lo].y) / span;
-      double base = q[lo].y + (f.x0 + 0.5 * f.cx - q[lo].x) * slope, step = f.cx * slope;
-      book.add(r, lower_row(grid, r, c_lo, c_hi, linear_targets(base, step)));
+    Section edges[3];  // each edge's samples and its height over them
+    int n = 0, c_lo = INT_MAX, c_hi = INT_MIN;
+    for (int k = 0; k < 3; ++k) {
+      const Point& a = q[k].x <= q[(k + 1) % 3].x ? q[k] : q[(k + 1) % 3];
+      const Point& b = q[k].x <= q[(k + 1) % 3].x ? q[(k + 1) % 3] : q[k];
+      Section& e = edges[n];
+      e.c_lo = ceil_clamped((a.x - f.x0) * f.inv_cx - 0.5, 0, f.cols);
+      e.c_hi = floor_clamped((b.x - f.x0) * f.inv_cx - 0.5, -1, f.cols - 1);
+      if (e.c_lo > e.c_hi) continue;
+      double span = b.x - a.x;
+      if (!(span > 1e-12 * f.cx)) {
+        e.base = std::min(a.y, b.y);
+        e.step = 0.0;
+      } else {
+        double slope = (b.y - a.y) / span;
+        e.base = a.y + (f.x0 + 0.5 * f.cx - a.x) * slope;
+        e.step = f.cx * slope;
+      }
+      c_lo = std::min(c_lo, e.c_lo);
+      c_hi = std::max(c_hi, e.c_hi);
+      ++n;
     }
+    if (n == 0) continue;
+    book.add(r, lower_row(grid, r, c_lo, c_hi, [&edges, n](int c0, int count, float* target) {
+      for (int k = 0; k < count; ++k) target[k] = float(kInf);
+      for (int j = 0; j < n; ++j) {
+        const Section& e = edges[j];
+        int k0 = std::max(e.c_lo - c0, 0), k1 = std::min(e.c_hi - c0, count - 1);
+        for (int k = k0; k <= k1; ++k) target[k] = std::min(target[k], float(e.base + double(c0 + k) * e.step));
+      }
+    }));
   }
 }
 

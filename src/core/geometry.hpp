@@ -45,6 +45,19 @@ struct GridFrame {
         depth_epsilon_m(std::ldexp(grid.spec().full_scale_m + std::abs(grid.spec().origin_m.y), -20)) {}
 };
 
+/// Pieces of an edge shorter than this (in cells along the edge's major
+/// axis) add to the contact length and area but not to the largest depth:
+/// where an edge crosses a cell corner, rounding of its parameter can leave
+/// such a sliver in a third cell, and with columns that cell's depth (a
+/// neighbour's top) would be taken as the whole edge's largest depth.
+constexpr double kMinDepthPieceCells = 1e-9;
+
+/// The edge-parameter length of a kMinDepthPieceCells piece, for an edge
+/// spanning major_cells cells along its major axis (0 when it spans none).
+inline double min_depth_piece(double major_cells) {
+  return major_cells > 0.0 ? kMinDepthPieceCells / major_cells : 0.0;
+}
+
 /// Keeps the part of [t0, t1] where the linear function f(t) = fa + (fb - fa) t
 /// is > 0 (strict) or >= 0. Returns false when nothing is left.
 inline bool clip_linear(double fa, double fb, bool strict, double& t0, double& t1) {
@@ -66,10 +79,12 @@ inline bool clip_linear(double fa, double fb, bool strict, double& t0, double& t
 /// Adds the contact of one piece of the edge, [sa, sb] in edge parameter,
 /// over which both the material top and the edge height are linear: inside
 /// material where ground <= y and top - y > min_depth_m (see
-/// GridFrame::min_contact_depth_m). seg_length_m is the edge's 3-D length.
+/// GridFrame::min_contact_depth_m). seg_length_m is the edge's 3-D length;
+/// min_piece (edge parameter) the shortest piece whose depth counts for the
+/// largest depth (min_depth_piece).
 inline void accumulate_piece(double sa, double sb, double top_a, double top_b, double y_a,
                              double y_b, const GridFrame& frame, double min_depth_m,
-                             double seg_length_m, ContactResult& out) {
+                             double seg_length_m, double min_piece, ContactResult& out) {
   if (!(sb > sa)) return;
   double t0 = 0.0, t1 = 1.0;
   double da = top_a - y_a, db = top_b - y_b;
@@ -80,7 +95,7 @@ inline void accumulate_piece(double sa, double sb, double top_a, double top_b, d
   double len = (t1 - t0) * (sb - sa) * seg_length_m;
   out.length_m += len;
   out.section_area_m2 += len * 0.5 * (d0 + d1);
-  out.max_depth_m = std::max(out.max_depth_m, std::max(d0, d1));
+  if ((t1 - t0) * (sb - sa) >= min_piece) out.max_depth_m = std::max(out.max_depth_m, std::max(d0, d1));
 }
 
 /// Clips the parameter range [s0, s1] of p(s) = p0 + s * dp to lo <= p <= hi

@@ -11,6 +11,8 @@
 
 #include <png.h>
 
+#include <sys/stat.h>
+
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
@@ -24,6 +26,7 @@
 #include <cstring>
 #include <memory>
 #include <new>
+#include <optional>
 #include <string>
 #include <system_error>
 
@@ -36,6 +39,20 @@ namespace {
 // Largest accepted image: per side and in total (checked before allocating).
 constexpr std::uint64_t kMaxSide = 65536;
 constexpr std::uint64_t kMaxPixels = std::uint64_t{1} << 30;
+
+// The most bytes zlib's deflate can expand one compressed byte to: a
+// dynamic-Huffman block can code a 258-byte match in 2 bits, so 258 * 8 / 2
+// = 1032 (less in practice, after the block headers). A PNG's image data is
+// deflated, so a file of N bytes holds at most 1032 N bytes of it: a header
+// claiming more pixels than that is refused before any image memory is
+// allocated, whatever it claims.
+constexpr std::uint64_t kMaxDeflateRatio = 1032;
+
+// Rows of a non-interlaced image decoded per growth of the output buffer, so
+// that memory follows the rows actually decoded: a file whose data ends early
+// (or a pipe, whose size is not known in advance) never has the whole image
+// committed.
+constexpr int kRowsPerBlock = 64;
 
 // Rec. 709 luminance weights applied to stored (not linearised) values.
 constexpr double kLumaR = 0.2126;
@@ -50,18 +67,20 @@ std::string quoted(const std::filesystem::path& path) {
   return s;
 }
 
-// Sizes a buffer of n floats for a large image. On Linux a buffer of 8 MiB
-// or more is first advised to use transparent huge pages (before it is
-// touched): where each page fault is expensive, as in virtual machines,
-// faulting in 4 KiB pages costs more than decoding the image (measured:
-// 256 MiB took 0.7-1.0 s with 4 KiB pages, 0.03 s with 2 MiB pages). The
-// advice is only a hint; the result is the same either way.
-void resize_image_buffer(std::vector<float>& buffer, std::size_t n) {
+// Reserves (address space only: nothing is touched, so nothing is committed)
+// a buffer of n floats for a large image. On Linux a buffer of 8 MiB or more
+// is advised to use transparent huge pages before it is touched: where each
+// page fault is expensive, as in virtual machines, faulting in 4 KiB pages
+// costs more than decoding the image (measured: 256 MiB took 0.7-1.0 s with
+// 4 KiB pages, 0.03 s with 2 MiB pages). The advice is only a hint; the
+// result is the same either way.
+void reserve_image_buffer(std::vector<float>& buffer, std::size_t n) {
+  if (buffer.capacity() >= n) return;
+  buffer.reserve(n);
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
   constexpr std::size_t kHugePage = std::size_t{2} << 20U;
   constexpr std::size_t kMinBytes = std::size_t{8} << 20U;
-  if (n * sizeof(float) >= kMinBytes && buffer.capacity() < n) {
-    buffer.reserve(n);
+  if (n * sizeof(float) >= kMinBytes) {
     const auto begin = reinterpret_cast<std::uintptr_t>(buffer.data());
     const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
     const std::uintptr_t last = (begin + n * sizeof(float)) & ~(kHugePage - 1);
@@ -70,6 +89,11 @@ void resize_image_buffer(std::vector<float>& buffer, std::size_t n) {
     }
   }
 #endif
+}
+
+// Sizes a buffer of n floats for a large image (see reserve_image_buffer).
+void resize_image_buffer(std::vector<float>& buffer, std::size_t n) {
+  reserve_image_buffer(buffer, n);
   buffer.resize(n);
 }
 
@@ -254,15 +278,22 @@ void row_to_luminance(const std::uint8_t* row, int cols, const PngLayout& layout
   }
 }
 
-// Non-interlaced: decode one row at a time into `row` and convert it straight
-// away, so memory stays at one row of raw samples. Returns false on a libpng error.
-bool png_read_streaming(png_structp png, png_infop info, const PngLayout& layout, int cols, int rows,
-                        std::uint8_t* row, float* out) {
+// Non-interlaced: decode `rows` rows, one at a time into `row`, converting
+// each straight away into out (rows x cols), so memory stays at one row of
+// raw samples. Returns false on a libpng error.
+bool png_read_rows_into(png_structp png, const PngLayout& layout, int cols, int rows, std::uint8_t* row,
+                        float* out) {
   if (setjmp(png_jmpbuf(png))) return false;
   for (int r = 0; r < rows; ++r) {
     png_read_row(png, row, nullptr);
     row_to_luminance(row, cols, layout, out + static_cast<std::ptrdiff_t>(r) * cols);
   }
+  return true;
+}
+
+// The chunks after the image data. Returns false on a libpng error.
+bool png_read_tail(png_structp png, png_infop info) {
+  if (setjmp(png_jmpbuf(png))) return false;
   png_read_end(png, info);
   return true;
 }
@@ -274,6 +305,30 @@ bool png_read_whole(png_structp png, png_infop info, png_bytepp row_pointers) {
   png_read_end(png, info);
   return true;
 }
+
+// Bits per pixel as stored in the file (before any transformation).
+std::uint64_t stored_bits_per_pixel(const PngHeader& header) {
+  std::uint64_t channels = 1;  // grey, or a palette index
+  if (header.color_type == PNG_COLOR_TYPE_GRAY_ALPHA) channels = 2;
+  if (header.color_type == PNG_COLOR_TYPE_RGB) channels = 3;
+  if (header.color_type == PNG_COLOR_TYPE_RGB_ALPHA) channels = 4;
+  return channels * static_cast<std::uint64_t>(header.bit_depth);
+}
+
+// The size of an open file in bytes; nullopt when it is not a regular file
+// (a pipe, a device) and so has no size known in advance.
+std::optional<std::uint64_t> regular_file_size(std::FILE* file) {
+  struct stat st {};
+  if (fstat(fileno(file), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+  return static_cast<std::uint64_t>(st.st_size);
+}
+
+// An uninitialised byte buffer: unlike std::vector it does not write its
+// bytes, so pages the decoder never reaches are never committed.
+struct RawBuffer {
+  std::unique_ptr<std::uint8_t[]> bytes;
+  explicit RawBuffer(std::size_t n) : bytes(new std::uint8_t[n]) {}
+};
 
 std::string describe_size(std::uint64_t cols, std::uint64_t rows) {
   return std::to_string(cols) + " x " + std::to_string(rows) + " pixels";
@@ -464,23 +519,47 @@ Image read_png(const std::filesystem::path& path) {
                      " bits)");
   }
 
+  // Refuse a header claiming more image data than the file can hold, before
+  // allocating: every pixel is stored (each row of each interlace pass adds
+  // a filter byte on top), deflated at most kMaxDeflateRatio to 1.
+  const std::uint64_t min_data_bytes = cols64 * rows64 * stored_bits_per_pixel(header) / 8;
+  const std::optional<std::uint64_t> file_bytes = regular_file_size(file.get());
+  if (file_bytes && min_data_bytes > *file_bytes * kMaxDeflateRatio) {
+    throw InputError("PNG file " + name + " claims " + describe_size(cols64, rows64) + ", at least " +
+                     std::to_string(min_data_bytes) + " bytes of image data, but the file is only " +
+                     std::to_string(*file_bytes) + " bytes and zlib expands a byte to at most " +
+                     std::to_string(kMaxDeflateRatio) + ": its header is wrong or the file is truncated");
+  }
+
   Image image;
   image.cols = static_cast<int>(cols64);
   image.rows = static_cast<int>(rows64);
   image.bit_depth = header.color_type == PNG_COLOR_TYPE_PALETTE ? 8 : header.bit_depth;
+  const std::size_t pixels = static_cast<std::size_t>(cols64 * rows64);
   try {
-    resize_image_buffer(image.values, static_cast<std::size_t>(cols64 * rows64));
     if (layout.passes == 1) {
+      // The output grows block by block as rows are decoded. With a known
+      // file size (the check above passed) the whole image is reserved up
+      // front, as address space only; from a pipe it grows geometrically.
+      if (file_bytes) reserve_image_buffer(image.values, pixels);
       std::vector<std::uint8_t> row(layout.row_bytes);
-      if (!png_read_streaming(handle.png(), handle.info(), layout, image.cols, image.rows, row.data(),
-                              image.values.data())) {
-        throw fail("image data");
+      for (int r0 = 0; r0 < image.rows; r0 += kRowsPerBlock) {
+        const int n = std::min(kRowsPerBlock, image.rows - r0);
+        const std::size_t offset = static_cast<std::size_t>(r0) * static_cast<std::size_t>(image.cols);
+        image.values.resize(offset + static_cast<std::size_t>(n) * static_cast<std::size_t>(image.cols));
+        if (!png_read_rows_into(handle.png(), layout, image.cols, n, row.data(), image.values.data() + offset)) {
+          throw fail("image data");
+        }
       }
+      if (!png_read_tail(handle.png(), handle.info())) throw fail("image data");
     } else {
-      std::vector<std::uint8_t> raw(layout.row_bytes * static_cast<std::size_t>(rows64));
+      // The raw rows are not initialised, so only the rows the passes reach
+      // are committed; the output is allocated once they are all decoded.
+      RawBuffer raw(layout.row_bytes * static_cast<std::size_t>(rows64));
       std::vector<png_bytep> row_pointers(static_cast<std::size_t>(rows64));
-      for (std::size_t r = 0; r < row_pointers.size(); ++r) row_pointers[r] = raw.data() + r * layout.row_bytes;
+      for (std::size_t r = 0; r < row_pointers.size(); ++r) row_pointers[r] = raw.bytes.get() + r * layout.row_bytes;
       if (!png_read_whole(handle.png(), handle.info(), row_pointers.data())) throw fail("image data");
+      resize_image_buffer(image.values, pixels);
       for (int r = 0; r < image.rows; ++r) {
         row_to_luminance(row_pointers[static_cast<std::size_t>(r)], image.cols, layout,
                          image.values.data() + static_cast<std::ptrdiff_t>(r) * image.cols);

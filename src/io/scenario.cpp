@@ -2,6 +2,7 @@
 // docs/scenario-format.md.
 #include "terracut/io/scenario.hpp"
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -90,6 +91,207 @@ bool valid_cut_name(const std::string& name) {
   return true;
 }
 
+// The caps on keyframes, in the words of both checks (the scan of the text
+// and the check of the parsed document, which also sees aliased lists).
+std::string too_many_keyframes_in_cut() {
+  return "more than " + format_number(kMaxKeyframesPerCut) + " keyframes; a cut may have at most " +
+         format_number(kMaxKeyframesPerCut);
+}
+std::string too_many_keyframes_in_all() {
+  return "the cuts have more than " + format_number(kMaxKeyframes) +
+         " keyframes in all; a scenario may have at most " + format_number(kMaxKeyframes);
+}
+
+// The top-level keys: the scenario's own and those of the section readers.
+std::vector<std::string_view> top_level_keys(std::span<SectionReader* const> sections) {
+  std::vector<std::string_view> keys = {"name",     "description", "terrain",  "representation",
+                                        "rate_hz",  "blade",       "cuts",     "sequence",
+                                        "reference", "soil"};
+  for (const SectionReader* reader : sections) keys.push_back(reader->key());
+  return keys;
+}
+
+// A scan of the scenario text by yaml-cpp's event parser, before the
+// document is built (yaml-cpp's YAML::Load holds the whole document, a few
+// hundred bytes per value): it refuses, while reading and with memory
+// bounded by the nesting depth, what would make the document absurdly large
+// or deep -- more keyframes than kMaxKeyframesPerCut in a cut or
+// kMaxKeyframes in all, nesting deeper than kMaxScenarioDepth -- and an
+// unknown or repeated top-level key, with the messages the document's checks
+// would give. Everything else is left to those checks.
+class ScenarioScan : public YAML::EventHandler {
+ public:
+  ScenarioScan(const Context& ctx, std::vector<std::string_view> top_keys)
+      : ctx_(ctx), top_keys_(std::move(top_keys)) {}
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { leaf(mark, nullptr); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { leaf(mark, nullptr); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string& value) override {
+    leaf(mark, &value);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    open(mark, false);
+  }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    open(mark, true);
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapEnd() override { close(); }
+
+ private:
+  // What a collection is in a scenario, as far as the scan cares.
+  enum class Role { kOther, kTop, kCuts, kCut, kKeyframes };
+  struct Frame {
+    bool map = false;
+    Role role = Role::kOther;
+    bool is_key = false;       // this collection is itself a mapping's key
+    bool expect_key = true;    // (mapping) the next node is a key
+    bool key_plain = false;    // (mapping) the last key was a scalar; its text in key
+    std::string key;
+    YAML::Mark key_mark;
+    std::size_t count = 0;     // (list) elements so far
+    std::string component;     // this node's part of the field path: "key" or "[i]"
+    YAML::Mark mark;           // where it starts; for a mapping's value, its key's mark
+  };
+
+  // The field path of the node about to start in the innermost collection.
+  std::string path_of_next() const {
+    std::string path;
+    for (const Frame& f : stack_) path = child_path(path, f.component);
+    if (!stack_.empty()) path = child_path(path, next_component());
+    return path;
+  }
+  // (called once the node has begun: a list's count includes it)
+  std::string next_component() const {
+    const Frame& parent = stack_.back();
+    if (parent.map) return parent.key_plain ? parent.key : "?";
+    return "[" + std::to_string(parent.count - 1) + "]";
+  }
+
+  // A node begins in the innermost collection: a mapping key, a mapping
+  // value or a list element. Returns whether it is a key.
+  bool begin_node() {
+    if (stack_.empty()) return false;
+    Frame& parent = stack_.back();
+    if (parent.map) return parent.expect_key;
+    ++parent.count;
+    if (parent.role == Role::kKeyframes) {
+      if (parent.count > kMaxKeyframesPerCut) fail_keyframes(parent, too_many_keyframes_in_cut());
+      if (++keyframes_ > kMaxKeyframes) fail_keyframes(parent, too_many_keyframes_in_all());
+    }
+    return false;
+  }
+  // A node ended in the innermost collection.
+  void end_node() {
+    if (stack_.empty()) return;
+    Frame& parent = stack_.back();
+    if (parent.map) parent.expect_key = !parent.expect_key;
+  }
+
+  void leaf(const YAML::Mark& mark, const std::string* scalar) {
+    if (begin_node()) {
+      Frame& parent = stack_.back();
+      parent.key_plain = scalar != nullptr;
+      parent.key = scalar != nullptr ? *scalar : std::string();
+      parent.key_mark = mark;
+      if (parent.role == Role::kTop) check_top_key(scalar, mark);
+    }
+    end_node();
+  }
+
+  void open(const YAML::Mark& mark, bool map) {
+    Frame frame;
+    frame.map = map;
+    frame.mark = mark;
+    if (stack_.empty()) {
+      frame.role = map ? Role::kTop : Role::kOther;
+    } else {
+      const bool is_key = begin_node();
+      Frame& parent = stack_.back();
+      frame.is_key = is_key || parent.is_key;
+      frame.component = next_component();
+      if (parent.map && !is_key) frame.mark = parent.key_mark;
+      if (is_key) {
+        // A collection as a key: not a plain name (the document's check says so).
+        parent.key_plain = false;
+        parent.key.clear();
+        if (parent.role == Role::kTop) top_checked_ = true;
+      } else if (!frame.is_key && parent.key_plain) {
+        if (parent.role == Role::kTop && !map && parent.key == "cuts") frame.role = Role::kCuts;
+        if (parent.role == Role::kCut && !map && parent.key == "keyframes") frame.role = Role::kKeyframes;
+      }
+      if (parent.role == Role::kCuts && !frame.is_key && map) frame.role = Role::kCut;
+    }
+    if (int(stack_.size()) + 1 > kMaxScenarioDepth) {
+      std::string path = path_of_next();
+      if (path.size() > 120) path = path.substr(0, 120) + "...";
+      ctx_.fail(mark, path, "lists and mappings are nested more than " + std::to_string(kMaxScenarioDepth) +
+                                " levels deep (a scenario needs a handful)");
+    }
+    stack_.push_back(std::move(frame));
+  }
+
+  void close() {
+    stack_.pop_back();
+    end_node();
+  }
+
+  // An unknown or repeated top-level key, as the document's Map would say it.
+  void check_top_key(const std::string* name, const YAML::Mark& mark) {
+    if (top_checked_) return;
+    if (name == nullptr) {  // not a plain name: left to the document's check
+      top_checked_ = true;
+      return;
+    }
+    if (std::find(top_keys_.begin(), top_keys_.end(), *name) == top_keys_.end()) {
+      std::vector<std::string> allowed(top_keys_.begin(), top_keys_.end());
+      ctx_.fail(mark, *name, "unknown key '" + *name + "'; allowed keys here: " + join(allowed));
+    }
+    for (const auto& [seen, seen_mark] : seen_top_keys_)
+      if (seen == *name)
+        ctx_.fail(mark, *name, "key given twice (first at line " + std::to_string(seen_mark.line + 1) + ")");
+    seen_top_keys_.emplace_back(*name, mark);
+  }
+
+  [[noreturn]] void fail_keyframes(const Frame& keyframes, const std::string& what) const {
+    std::string path;
+    for (const Frame& f : stack_) path = child_path(path, f.component);
+    ctx_.fail(keyframes.mark, path, what);
+  }
+
+  const Context& ctx_;
+  std::vector<std::string_view> top_keys_;
+  std::vector<Frame> stack_;
+  std::size_t keyframes_ = 0;
+  bool top_checked_ = false;
+  std::vector<std::pair<std::string, YAML::Mark>> seen_top_keys_;
+};
+
+// Reads a string in place (std::istringstream would copy it).
+class StringViewBuf : public std::streambuf {
+ public:
+  explicit StringViewBuf(const std::string& text) {
+    char* begin = const_cast<char*>(text.data());  // only read: the get area
+    setg(begin, begin, begin + text.size());
+  }
+};
+
+// Runs the scan over the text; malformed YAML gets parse_text's message.
+void scan_scenario(const Context& ctx, const std::string& text, std::span<SectionReader* const> sections) {
+  ScenarioScan scan(ctx, top_level_keys(sections));
+  StringViewBuf buffer(text);
+  std::istream in(&buffer);
+  try {
+    YAML::Parser parser(in);
+    parser.HandleNextDocument(scan);
+  } catch (const YAML::Exception&) {
+    // Malformed text: reported by parse_text, which meets the same error.
+  }
+}
+
 // An image terrain whose file is read once the rest of the document is
 // checked (a mistake anywhere is reported before a large image is decoded).
 struct PendingImage {
@@ -167,6 +369,25 @@ std::optional<PendingImage> parse_terrain(const Context& ctx, const Field& field
   return PendingImage{*image, resolution};
 }
 
+// Why a path's status cannot be read (exists() failed with ec): a
+// symbolic link loop, or the system's reason.
+std::string unresolvable(const std::error_code& ec) {
+  if (ec == std::errc::too_many_symbolic_link_levels)
+    return "cannot be resolved: it is a symbolic link loop (or a chain of more links than the system "
+           "follows)";
+  return "cannot be resolved: " + ec.message();
+}
+
+// For a path that does not exist: ", a symbolic link to 'TARGET', which does
+// not exist" when it is a dangling link, else nothing.
+std::string dangling_link(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_symlink(path, ec)) return {};
+  const std::filesystem::path target = std::filesystem::read_symlink(path, ec);
+  if (ec) return {};
+  return " (a symbolic link to '" + target.string() + "', which does not exist)";
+}
+
 // Image terrain: the path is relative to the scenario's folder.
 void read_terrain_image(const PendingImage& pending, const std::filesystem::path& base_dir,
                         Scenario& sc) {
@@ -176,9 +397,11 @@ void read_terrain_image(const PendingImage& pending, const std::filesystem::path
   std::filesystem::path path(relative);
   if (path.is_relative()) path = base_dir / path;
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    image.fail("image file '" + path.string() + "' not found (relative paths are read from the "
-               "scenario file's folder)");
+  if (!std::filesystem::exists(path, ec)) {
+    if (ec) image.fail("image file '" + path.string() + "' " + unresolvable(ec));
+    image.fail("image file '" + path.string() + "' not found" + dangling_link(path) +
+               " (relative paths are read from the scenario file's folder)");
+  }
   if (!std::filesystem::is_regular_file(path, ec))
     image.fail("image '" + path.string() + "' is not a regular file");
   try {
@@ -212,6 +435,8 @@ ParsedCut parse_cut(const Field& field) {
               "' must be non-empty and use only letters, digits, '_', '-' and '.'");
 
   const Field frames = cut.require("keyframes");
+  if (frames.is_sequence() && frames.node().size() > kMaxKeyframesPerCut)
+    frames.context().fail(frames.key_mark(), frames.path(), too_many_keyframes_in_cut());
   const std::vector<Field> items = frames.elements();
   if (items.empty()) frames.fail("a cut needs at least one keyframe");
   std::optional<Field> last_t;
@@ -244,11 +469,7 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
   if (root.IsNull() || !root.IsDefined())
     ctx.fail(YAML::Mark(), "", "the scenario is empty; expected a mapping with 'terrain', "
                                       "'blade' and 'cuts'");
-  std::vector<std::string_view> keys = {"name",     "description", "terrain",  "representation",
-                                        "rate_hz",  "blade",       "cuts",     "sequence",
-                                        "reference", "soil"};
-  for (const SectionReader* reader : sections) keys.push_back(reader->key());
-  const Map top(top_field, std::move(keys));
+  const Map top(top_field, top_level_keys(sections));
 
   if (const auto f = top.get("name")) {
     sc.name = f->text();
@@ -273,6 +494,18 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
   const Field cuts = top.require("cuts");
   const std::vector<Field> cut_fields = cuts.elements();
   if (cut_fields.empty()) cuts.fail("the list of cuts is empty; give at least one cut");
+  // The keyframe caps before any keyframe is read (the scan of the text saw
+  // the lists written out; this also counts lists given by alias).
+  std::size_t keyframes = 0;
+  for (const Field& cf : cut_fields) {
+    const std::optional<Field> frames = cf.lookup("keyframes");
+    if (!frames || !frames->is_sequence()) continue;
+    // At the key's line, as the scan reports it (an aliased list's own line is elsewhere).
+    if (frames->node().size() > kMaxKeyframesPerCut)
+      ctx.fail(frames->key_mark(), frames->path(), too_many_keyframes_in_cut());
+    keyframes += frames->node().size();
+    if (keyframes > kMaxKeyframes) ctx.fail(frames->key_mark(), frames->path(), too_many_keyframes_in_all());
+  }
   std::vector<YAML::Mark> name_marks;
   for (const Field& cf : cut_fields) {
     ParsedCut cut = parse_cut(cf);
@@ -363,6 +596,7 @@ std::vector<std::string> Scenario::sequence_names() const {
 Scenario parse_scenario(const std::string& text, const std::filesystem::path& source_name,
                         std::span<SectionReader* const> sections) {
   const Context ctx(source_name.string());
+  scan_scenario(ctx, text, sections);
   const YAML::Node root = yaml::parse_text(ctx, text);
   try {
     return parse_document(ctx, root, source_name, sections);
@@ -375,8 +609,10 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& so
 Scenario load_scenario(const std::filesystem::path& path,
                        std::span<SectionReader* const> sections) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    throw InputError(path.string() + ": scenario file not found");
+  if (!std::filesystem::exists(path, ec)) {
+    if (ec) throw InputError(path.string() + ": " + unresolvable(ec));
+    throw InputError(path.string() + ": scenario file not found" + dangling_link(path));
+  }
   if (!std::filesystem::is_regular_file(path, ec))
     throw InputError(path.string() + ": not a regular file");
   const std::uintmax_t bytes = std::filesystem::file_size(path, ec);

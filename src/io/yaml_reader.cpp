@@ -1,6 +1,11 @@
 // The YAML section-reader toolkit. See yaml_reader.hpp.
 #include "terracut/io/yaml_reader.hpp"
 
+#if __has_include(<yaml-cpp/depthguard.h>)
+#include <yaml-cpp/depthguard.h>  // YAML::DeepRecursion (yaml-cpp >= 0.7)
+#define TERRACUT_YAML_HAS_DEPTH_GUARD 1
+#endif
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -89,6 +94,12 @@ void Context::fail(const YAML::Mark& mark, std::string_view path, std::string_vi
 YAML::Node parse_text(const Context& ctx, const std::string& text, std::string_view malformed) {
   try {
     return YAML::Load(text);
+#if defined(TERRACUT_YAML_HAS_DEPTH_GUARD)
+  } catch (const YAML::DeepRecursion& e) {
+    // yaml-cpp's own message for this is "bad file".
+    ctx.fail(e.mark, "", std::string(malformed) + ": lists and mappings are nested more than " +
+                             std::to_string(e.depth() - 1) + " levels deep");
+#endif
   } catch (const YAML::Exception& e) {
     ctx.fail(e.mark, "", std::string(malformed) + ": " + e.msg);
   }

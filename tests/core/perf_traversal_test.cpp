@@ -97,8 +97,8 @@ TEST(PerfTraversal, LongEdgesEqualBruteForce) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (const Direction& d : directions) {
     for (int k = 0; k < 6; ++k) {
-      // Centres at generic positions (the brute force counts an edge lying
-      // exactly on a cell wall or a triangle edge on both sides).
+      // Centres at generic positions (edges exactly on cell walls and node
+      // lines are brute_force_test.cpp's).
       double cu = 120.0123 + unit(rng) * 10.0 - 5.0;
       double cv = 90.0371 + unit(rng) * 10.0 - 5.0;
       double y0 = 0.1 + 0.6 * unit(rng), y1 = k % 3 == 0 ? y0 : 0.1 + 0.6 * unit(rng);
@@ -201,7 +201,7 @@ TEST(PerfTraversal, SweepsEqualBruteForce) {
   auto shifted = [](Segment e, Vec3 d) { return Segment{e.a + d, e.b + d}; };
   double cz = s.cell_z_m(), cx = s.cell_x_m();
   // Generic positions: no sample exactly on an edge of the swept region
-  // (where the brute force and the rasteriser may decide either way).
+  // (ties are brute_force_test.cpp's).
   Segment level = at(75.3123, 40.2371, 170, 0, 0.3, 0.3);  // wider than the terrain
   Segment tilted = at(75.3123, 40.2371, 120, 0, 0.1, 0.6);
   Segment yawed = at(75.3123, 55.1371, 140, 80.0173, 0.35, 0.35);

@@ -5,24 +5,30 @@
 
 #include <gtest/gtest.h>
 #include <png.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <csetjmp>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "terracut/core/error.hpp"
+
+#include "../support/peak_memory.hpp"
 
 namespace terracut::io {
 namespace {
@@ -65,6 +71,7 @@ struct RawPng {
   std::vector<std::uint16_t> samples;
   std::vector<png_color> palette;
   std::vector<png_byte> palette_alpha;  // tRNS for palette images
+  int zlib_level = -1;                  // libpng's default when < 0
 };
 
 RawPng raw_png(int width, int height, int bit_depth, int color_type, bool interlaced = false) {
@@ -97,6 +104,7 @@ bool write_png_c(std::FILE* fp, const RawPng* png_desc, png_bytepp rows) {
     return false;
   }
   png_init_io(png, fp);
+  if (png_desc->zlib_level >= 0) png_set_compression_level(png, png_desc->zlib_level);
   png_set_IHDR(png, info, static_cast<png_uint_32>(png_desc->width), static_cast<png_uint_32>(png_desc->height),
                png_desc->bit_depth, png_desc->color_type,
                png_desc->interlaced ? PNG_INTERLACE_ADAM7 : PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
@@ -212,13 +220,15 @@ void add_chunk(std::vector<char>* b, const std::string& type, const std::vector<
   put_be32(b, static_cast<std::uint32_t>(crc32(0L, p, static_cast<uInt>(4 + data.size()))));
 }
 
-// A hand-made PNG with the given IHDR size and a small IDAT.
-std::vector<char> png_with_size(std::uint32_t width, std::uint32_t height) {
+// A hand-made PNG with the given IHDR (size, bit depth, colour type,
+// interlace method) and a small IDAT.
+std::vector<char> png_with_header(std::uint32_t width, std::uint32_t height, char bit_depth, char color_type,
+                                  char interlace) {
   std::vector<char> b = {'\x89', 'P', 'N', 'G', '\r', '\n', '\x1a', '\n'};
   std::vector<char> ihdr;
   put_be32(&ihdr, width);
   put_be32(&ihdr, height);
-  ihdr.insert(ihdr.end(), {8, 0, 0, 0, 0});  // 8-bit grey, deflate, adaptive filters, no interlace
+  ihdr.insert(ihdr.end(), {bit_depth, color_type, 0, 0, interlace});  // deflate, adaptive filters
   add_chunk(&b, "IHDR", ihdr);
   // A valid zlib stream of a few zero bytes.
   std::vector<Bytef> raw(64, 0);
@@ -228,6 +238,11 @@ std::vector<char> png_with_size(std::uint32_t width, std::uint32_t height) {
   add_chunk(&b, "IDAT", std::vector<char>(packed.begin(), packed.begin() + static_cast<std::ptrdiff_t>(packed_size)));
   add_chunk(&b, "IEND", {});
   return b;
+}
+
+// A hand-made PNG with the given IHDR size (8-bit grey, not interlaced) and a small IDAT.
+std::vector<char> png_with_size(std::uint32_t width, std::uint32_t height) {
+  return png_with_header(width, height, 8, 0, 0);
 }
 
 // Expects read_png to throw InputError whose message names the file; returns the message.
@@ -651,6 +666,91 @@ TEST_F(ImageTest, TooLittleImageData) {
   EXPECT_NO_THROW((void)read_png(file("enough.png")));
   write_bytes(file("too_little.png"), png_with_size(16, 16));
   expect_input_error(file("too_little.png"));
+}
+
+using test::peak_rss_bytes;
+using test::small_growth;
+
+// A header claiming far more pixels than its few bytes of data can hold
+// (the review's 69-byte file claiming 65536 x 16384, and a 16-bit
+// interlaced one claiming 32768^2) is refused from its file size alone,
+// before any image memory is committed: the message names the file, the
+// claim and zlib's limit, and the peak memory of the process barely moves.
+TEST_F(ImageTest, LyingHeaderRefusedBeforeAllocating) {
+  const struct {
+    std::uint32_t width, height;
+    char bit_depth, color_type, interlace;
+    const char* name;
+  } cases[] = {
+      {65536, 16384, 8, 0, 0, "grey8_65536x16384.png"},        // 2^30 pixels, 1 GiB of data, 4 GiB of floats
+      {32768, 32768, 16, 0, 1, "grey16_interlaced_32768.png"},  // 2 GiB of data held raw while interlaced
+      {16384, 16384, 16, 6, 0, "rgba16_16384.png"},             // 8 bytes a pixel
+      {32768, 32768, 1, 0, 0, "grey1_32768.png"},               // 1 bit a pixel still needs 128 MiB of data
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::vector<char> bytes = png_with_header(c.width, c.height, c.bit_depth, c.color_type, c.interlace);
+    ASSERT_LT(bytes.size(), 100U);
+    write_bytes(file(c.name), bytes);
+    const std::int64_t before = peak_rss_bytes();
+    const std::string message = expect_input_error(file(c.name));
+    const std::int64_t grew = peak_rss_bytes() - before;
+    EXPECT_NE(message.find("claims " + std::to_string(c.width) + " x " + std::to_string(c.height) + " pixels"),
+              std::string::npos) << message;
+    EXPECT_NE(message.find("only " + std::to_string(bytes.size()) + " bytes"), std::string::npos) << message;
+    EXPECT_NE(message.find("at most 1032"), std::string::npos) << message;
+    EXPECT_LT(grew, small_growth(16)) << "peak memory grew by " << grew << " bytes";
+  }
+  // 2^31 pixels: refused by the size limit, before reading on.
+  write_bytes(file("huge.png"), png_with_size(65536, 32768));
+  const std::int64_t before = peak_rss_bytes();
+  const std::string message = expect_input_error(file("huge.png"));
+  EXPECT_NE(message.find("2^30 pixels"), std::string::npos) << message;
+  EXPECT_LT(peak_rss_bytes() - before, small_growth(16));
+}
+
+// Through a pipe the file size is not known in advance, so the claim cannot
+// be checked against it: memory then follows the rows actually decoded, and
+// the lying file still fails (too little image data) without committing the
+// image it claims.
+TEST_F(ImageTest, LyingHeaderThroughAPipeCommitsOnlyWhatIsDecoded) {
+  const struct {
+    std::uint32_t width, height;
+    char bit_depth, interlace;
+  } cases[] = {{65536, 16384, 8, 0}, {32768, 32768, 16, 1}};
+  for (const auto& c : cases) {
+    const fs::path fifo = file("pipe_" + std::to_string(c.width) + ".png");
+    ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+    const std::vector<char> bytes = png_with_header(c.width, c.height, c.bit_depth, 0, c.interlace);
+    std::thread writer([&] {
+      std::FILE* out = std::fopen(fifo.c_str(), "wb");
+      if (out == nullptr) return;
+      std::fwrite(bytes.data(), 1, bytes.size(), out);
+      std::fclose(out);
+    });
+    const std::int64_t before = peak_rss_bytes();
+    const std::string message = expect_input_error(fifo);
+    writer.join();
+    const std::int64_t grew = peak_rss_bytes() - before;
+    EXPECT_NE(message.find("image data"), std::string::npos) << message;
+    EXPECT_LT(grew, small_growth(64)) << "peak memory grew by " << grew << " bytes";
+  }
+}
+
+// A real file near zlib's best ratio (a constant image at level 9) is not
+// mistaken for a lying one.
+TEST_F(ImageTest, MaximallyCompressedImageIsRead) {
+  const int n = 2048;
+  RawPng p = raw_png(n, n, 8, PNG_COLOR_TYPE_GRAY);
+  p.samples.assign(static_cast<std::size_t>(n) * n, 0);
+  p.zlib_level = 9;
+  write_raw_png(file("zeros.png"), p);
+  const auto bytes = fs::file_size(file("zeros.png"));
+  EXPECT_LT(bytes, static_cast<std::uintmax_t>(n) * n / 500) << "not compressed near zlib's limit";
+  const Image image = read_png(file("zeros.png"));
+  ASSERT_EQ(image.cols, n);
+  ASSERT_EQ(image.rows, n);
+  EXPECT_EQ(*std::max_element(image.values.begin(), image.values.end()), 0.0F);
 }
 
 // ---------------------------------------------------------------------------

@@ -14,6 +14,8 @@
 #include "terracut/core/error.hpp"
 #include "terracut/io/image.hpp"
 
+#include "../support/peak_memory.hpp"
+
 namespace terracut::io {
 namespace {
 
@@ -441,6 +443,140 @@ TEST(ScenarioErrors, AbsurdMagnitudesAreRefused) {
   expect_error(size, line_of(size, "1e300"), "terrain.size_m[0]", "1e9");
   const std::string scale = replace(kGood, "full_scale_m: 0.3", "full_scale_m: 2e9");
   expect_error(scale, line_of(scale, "2e9"), "terrain.full_scale_m", "1e9");
+}
+
+// ---- Bounded parsing: keyframe caps, nesting depth, top-level keys --------
+
+// A scenario whose cuts hold the given numbers of keyframes, each written as
+// `element` (the scan counts list elements, whatever they are), followed by
+// `tail`.
+std::string scenario_with_keyframes(const std::vector<std::size_t>& counts, const std::string& element,
+                                    const std::string& tail = "") {
+  std::string text = "terrain: {generator: plane, resolution: 4, size_m: [1, 1], full_scale_m: 1}\n"
+                     "blade: {length_m: 0.5}\ncuts:\n";
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    text += "  - name: c" + std::to_string(i) + "\n    keyframes:\n";
+    for (std::size_t k = 0; k < counts[i]; ++k) text += "      - " + element + "\n";
+  }
+  return text + tail;
+}
+
+using test::peak_rss_bytes;
+using test::small_growth;
+
+// One keyframe over the cap is refused while the text is scanned, naming the
+// cut's keyframes and the cap: before the document is built (a malformed
+// line after the keyframes is never reached) and with little memory
+// (building 100000 keyframes in yaml-cpp takes about 640 MB).
+TEST(ScenarioErrors, KeyframeCapPerCutRefusesWhileScanning) {
+  const std::string cap = std::to_string(kMaxKeyframesPerCut);
+  const std::string text = scenario_with_keyframes({2, kMaxKeyframesPerCut + 1},
+                                                   "{t_s: 0, position_m: [0.5, 0.1, 0.5]}", "broken: [\n");
+  const std::int64_t before = peak_rss_bytes();
+  const std::string m = parse_error(text);
+  EXPECT_LT(peak_rss_bytes() - before, small_growth(64));
+  const int line = line_of(text, "  - name: c1") + 1;  // the line of its key
+  EXPECT_EQ(m.rfind("/some/folder/bad.yaml:" + std::to_string(line) + ": cuts[1].keyframes: ", 0), 0u) << m;
+  EXPECT_NE(m.find("more than " + cap + " keyframes; a cut may have at most " + cap), std::string::npos) << m;
+  // At the cap the scan lets it through (these elements then fail as keyframes).
+  const std::string at_cap = parse_error(scenario_with_keyframes({kMaxKeyframesPerCut}, "0"));
+  EXPECT_NE(at_cap.find("cuts[0].keyframes[0]: expected a mapping"), std::string::npos) << at_cap;
+}
+
+// The cap on all cuts together, and the same caps for lists given by alias
+// (which the scan does not expand; they are counted before any keyframe is read).
+TEST(ScenarioErrors, KeyframeCapInAllCutsIsRefused) {
+  const std::string all = std::to_string(kMaxKeyframes);
+  const std::size_t third = kMaxKeyframes / 3 + 1;
+  const std::string text = scenario_with_keyframes({third, third, third}, "0", "broken: [\n");
+  ASSERT_GT(3 * third, kMaxKeyframes);
+  ASSERT_LE(2 * third, kMaxKeyframes);
+  const std::string m = parse_error(text);
+  EXPECT_EQ(m.rfind("/some/folder/bad.yaml:" + std::to_string(line_of(text, "  - name: c2") + 1) +
+                        ": cuts[2].keyframes: ", 0), 0u) << m;
+  EXPECT_NE(m.find("the cuts have more than " + all + " keyframes in all; a scenario may have at most " + all),
+            std::string::npos) << m;
+
+  std::string list;
+  for (std::size_t k = 0; k < kMaxKeyframesPerCut; ++k) list += k ? ", 0" : "0";
+  const std::string aliased = "terrain: {generator: plane, resolution: 4, size_m: [1, 1], full_scale_m: 1}\n"
+                              "blade: {length_m: 0.5}\ncuts:\n"
+                              "  - {name: a, keyframes: &k [" + list + "]}\n"
+                              "  - {name: b, keyframes: *k}\n"
+                              "  - {name: c, keyframes: *k}\n";
+  const std::string m2 = parse_error(aliased);
+  EXPECT_EQ(m2.rfind("/some/folder/bad.yaml:6: cuts[2].keyframes: the cuts have more than " + all, 0), 0u) << m2;
+}
+
+// Lists and mappings nested absurdly deep: the message says so and where,
+// instead of yaml-cpp's "bad file".
+TEST(ScenarioErrors, DeepNestingSaysSoAndWhere) {
+  const std::string deep = std::string(1000, '[') + std::string(1000, ']');
+  const std::string text = replace(kGood, "representation: columns", "representation:\n  - " + deep);
+  const std::string m = parse_error(text);
+  EXPECT_EQ(m.rfind("/some/folder/bad.yaml:" + std::to_string(line_of(text, "  - [[")) + ": representation[0][0]", 0),
+            0u) << m;
+  EXPECT_NE(m.find("nested more than " + std::to_string(kMaxScenarioDepth) + " levels deep"), std::string::npos) << m;
+  EXPECT_EQ(m.find("bad file"), std::string::npos) << m;
+  // Just within the limit, the scan passes it on (and the field is then refused as a list).
+  const int within = kMaxScenarioDepth - 1;
+  const std::string ok = replace(kGood, "representation: columns",
+                                 "representation: " + std::string(within, '[') + std::string(within, ']'));
+  EXPECT_NE(parse_error(ok).find("representation: expected a text value, got a list"), std::string::npos)
+      << parse_error(ok);
+}
+
+// An unknown top-level key is refused while scanning (a malformed line after
+// it is never reached), with the message the document's check gives, and so
+// is a top-level key given twice.
+TEST(ScenarioErrors, TopLevelKeysAreCheckedWhileScanning) {
+  const std::string text = kGood + "bad_key: 1\nbroken: [\n";
+  expect_error(text, line_of(text, "bad_key"), "bad_key",
+               "unknown key 'bad_key'; allowed keys here: name, description, terrain, representation, "
+               "rate_hz, blade, cuts, sequence, reference, soil");
+  const std::string twice = kGood + "rate_hz: 100\n";
+  expect_error(twice, line_of(twice, "rate_hz: 100"), "rate_hz",
+               "key given twice (first at line " + std::to_string(line_of(kGood, "rate_hz")) + ")");
+  // Malformed YAML before any such key is still reported as malformed.
+  EXPECT_NE(parse_error("name: [x\nbad_key: 1\n").find("malformed YAML"), std::string::npos);
+}
+
+// The error of loading the scenario file, or "" when it loads.
+std::string load_error(const fs::path& path) {
+  std::string message;
+  try { load_scenario(path); } catch (const InputError& e) { message = e.what(); }
+  return message;
+}
+
+// A scenario path that is a symbolic link loop says so, rather than "not
+// found"; a dangling link says where it points; the same for the image.
+TEST_F(ScenarioTest, SymlinkLoopAndDanglingLinkAreNamed) {
+  fs::create_symlink(dir_ / "b.yaml", dir_ / "a.yaml");
+  fs::create_symlink(dir_ / "a.yaml", dir_ / "b.yaml");
+  const std::string loop = load_error(dir_ / "a.yaml");
+  EXPECT_EQ(loop.rfind((dir_ / "a.yaml").string() + ": cannot be resolved: it is a symbolic link loop", 0), 0u)
+      << loop;
+  EXPECT_EQ(loop.find("not found"), std::string::npos) << loop;
+
+  fs::create_symlink(dir_ / "gone.yaml", dir_ / "dangling.yaml");
+  const std::string dangling = load_error(dir_ / "dangling.yaml");
+  EXPECT_NE(dangling.find("scenario file not found (a symbolic link to '" + (dir_ / "gone.yaml").string() +
+                          "', which does not exist)"),
+            std::string::npos) << dangling;
+
+  fs::create_symlink(dir_ / "y.png", dir_ / "x.png");
+  fs::create_symlink(dir_ / "x.png", dir_ / "y.png");
+  const fs::path path = write("image.yaml", R"(terrain:
+  image: x.png
+  size_m: [1, 1]
+  full_scale_m: 1
+blade: {length_m: 1}
+cuts: [{name: a, keyframes: [{t_s: 0, position_m: [0, 0, 0]}]}]
+)");
+  const std::string image = load_error(path);
+  EXPECT_EQ(image.rfind(path.string() + ":2: terrain.image: image file '" + (dir_ / "x.png").string() +
+                            "' cannot be resolved: it is a symbolic link loop", 0),
+            0u) << image;
 }
 
 TEST_F(ScenarioTest, MissingScenarioFileIsNamed) {

@@ -73,6 +73,14 @@ TEST(YamlReader, MalformedTextNamesTheLine) {
             std::string::npos);
 }
 
+// Nesting deeper than yaml-cpp allows: said so, not yaml-cpp's "bad file".
+TEST(YamlReader, DeepNestingSaysSo) {
+  const std::string m = error_of([] { root_of("a: 1\nb: " + std::string(5000, '[') + std::string(5000, ']') + "\n"); });
+  EXPECT_EQ(m.rfind("doc.yaml:2: malformed YAML: lists and mappings are nested more than ", 0), 0u) << m;
+  EXPECT_NE(m.find(" levels deep"), std::string::npos) << m;
+  EXPECT_EQ(m.find("bad file"), std::string::npos) << m;
+}
+
 TEST(YamlReader, UnknownKeyListsTheAllowedKeys) {
   EXPECT_EQ(error_of([] { Map(root_of("alpha: 1\ngamma: 2\n"), {"alpha", "beta"}); }),
             "doc.yaml:2: gamma: unknown key 'gamma'; allowed keys here: alpha, beta");

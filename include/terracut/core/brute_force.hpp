@@ -1,6 +1,8 @@
 // The paper's algorithm as written: test the blade against every column every
 // step. Kept as the test oracle for the traversal code and as the baseline of
 // the performance work. Cost grows with the whole terrain, not the blade.
+// Boundary cases follow docs/model.md ("Boundaries"), decided exactly: contact
+// half-open (a point of the edge in one cell), cuts closed.
 #pragma once
 
 #include "terracut/core/cut.hpp"

@@ -37,7 +37,10 @@ struct ContactResult {
 };
 
 /// Contact of the segment with the terrain, walking only the cells under the
-/// segment (a 2-D grid traversal of its footprint on the ground plane).
+/// segment (a 2-D grid traversal of its footprint on the ground plane). Each
+/// point of the segment belongs to one cell, [c, c+1) x [r, r+1) (the last
+/// cells holding the grid's far edges), so a segment lying on a cell wall is
+/// counted once (docs/model.md, "Boundaries").
 ContactResult measure_contact(const HeightGrid& grid, Representation representation,
                               const Segment& edge);
 

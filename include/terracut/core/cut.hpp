@@ -7,11 +7,15 @@
 // Simulation), so this approximates the true sweep to a fraction of a cell.
 //
 // - Surface representation: every sample point whose ground position lies
-//   under a swept triangle is lowered to the triangle's height there.
+//   under a swept triangle (its edges included) is lowered to the
+//   triangle's height there.
 // - Columns representation: every column whose cell the swept region crosses
 //   is lowered to the lowest point of the region inside its cell ("until its
 //   top is below the line"). With from == to this is the paper's rule for a
 //   line at rest.
+// The region and the cells are closed: a sample on the region's edge, or a
+// cell the region meets only along a wall or at a corner, is cut
+// (docs/model.md, "Boundaries").
 // Heights never go below 0 (the rigid floor). Cutting only lowers samples, so
 // the final shape after a set of cuts does not depend on their order.
 #pragma once

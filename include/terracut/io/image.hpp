@@ -27,8 +27,12 @@ struct Image {
 /// gamma decoding); alpha and tRNS transparency are ignored. Interlaced files
 /// are read. Throws terracut::InputError naming the file and what is wrong:
 /// missing, empty, not a PNG, truncated, corrupt (CRC or compressed-data
-/// errors, too little image data), zero size, or more than 65536 pixels per
-/// side or 2^30 pixels in all (refused before any image memory is allocated).
+/// errors, too little image data), zero size, more than 65536 pixels per
+/// side or 2^30 pixels in all, or a header claiming more image data than the
+/// file can hold (its size times 1032, zlib's largest expansion) -- these
+/// three refused before any image memory is allocated. Memory otherwise
+/// follows the rows decoded, so a file whose data ends early (or a pipe,
+/// whose size is unknown) never has the whole claimed image committed.
 /// Never prints to stderr. Safe to call from several threads at once.
 Image read_png(const std::filesystem::path& path);
 

@@ -48,6 +48,17 @@ class SectionReader {
 /// float layers); more is refused as absurd.
 inline constexpr std::int64_t kMaxScenarioSamples = std::int64_t(1) << 28;
 
+/// Largest number of keyframes in one cut: a keyframe a millisecond for 100 s.
+/// yaml-cpp holds the whole document in memory, about 6 kB per keyframe, so
+/// the caps bound what a scenario file can make the reader allocate; they
+/// are checked while the text is scanned, before the document is built.
+inline constexpr std::size_t kMaxKeyframesPerCut = 100'000;
+/// Largest number of keyframes in all the cuts of a scenario together.
+inline constexpr std::size_t kMaxKeyframes = 200'000;
+/// Deepest nesting of lists and mappings in a scenario file (a scenario
+/// needs a handful of levels; deeper is refused while the text is scanned).
+inline constexpr int kMaxScenarioDepth = 64;
+
 /// A grid resolution: samples along X (cols) and along Z (rows).
 struct Resolution {
   int cols = 0;  ///< samples along +X, in [1, 65536]
