@@ -21,6 +21,24 @@ double now_s() {
 /// Largest number of sweep sub-steps in one step (bounds the step's cost).
 constexpr int kMaxSubsteps = 64;
 
+/// How far, in cells, each sweep reaches back over the previous one's end.
+constexpr double kSweepOverlapCells = 1e-6;
+
+// The sweep's start, moved back along each end's own motion by `back`
+// metres: consecutive sweeps then overlap by that much, so a sample lying
+// (to rounding) on the line they share is inside at least one of them. The
+// rasterisers decide a sample within about 1e-15 of a cell of a sweep's
+// edge either way, and without the overlap a blade moving by small steps
+// could miss such a row in both sweeps. Cutting twice is cutting once.
+Segment reach_back(const Segment& from, const Segment& to, double back) {
+  const auto moved = [&](const Vec3& p0, const Vec3& p1) {
+    const Vec3 d = p1 - p0;
+    const double len = length(d);
+    return len > 0.0 ? p0 - d * (back / len) : p0;
+  };
+  return {moved(from.a, to.a), moved(from.b, to.b)};
+}
+
 }  // namespace
 
 std::string validate(const SimParams& params) {
@@ -87,6 +105,8 @@ const StepOutput& Simulation::finish_step() {
     double max_angle = 2.0 * std::acos(1.0 - tolerance / half_length);
     substeps = std::clamp(int(std::ceil(angle / max_angle)), 1, kMaxSubsteps);
   }
+  const double overlap_m =
+      kSweepOverlapCells * std::min(params_.grid.cell_x_m(), params_.grid.cell_z_m());
   Segment previous = blade_segment(params_.blade, from);
   const Segment step_from = previous;
   if (soil_) soil_->before_cut(grid_, step_from, out_.edge);
@@ -96,7 +116,8 @@ const StepOutput& Simulation::finish_step() {
                                    : BladePose{lerp(from.position_m, out_.pose.position_m, t),
                                                slerp(from.orientation, out_.pose.orientation, t)};
     Segment next = blade_segment(params_.blade, pose);
-    CutResult part = cut_sweep(grid_, params_.representation, previous, next);
+    CutResult part = cut_sweep(grid_, params_.representation, reach_back(previous, next, overlap_m),
+                               next);
     out_.cut.removed_volume_m3 += part.removed_volume_m3;
     out_.cut.cells_visited += part.cells_visited;
     out_.cut.changed.include(part.changed);
