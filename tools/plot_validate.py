@@ -21,42 +21,25 @@ and the CSV and .npy files it names) and receives:
 Exit codes: 0 done; 2 bad arguments or input folder; 3 numpy or matplotlib missing.
 Needs Debian's python3-numpy and python3-matplotlib.
 """
-import json
 import os
 import sys
 
-from plot_common import import_plotting, make_fail
+from plot_common import FigureFolder, import_plotting, make_fail, parse_folder_args
 
 fail = make_fail("plot_validate.py")
 np, plt = import_plotting(fail)
 from matplotlib.colors import TwoSlopeNorm  # noqa: E402 (after the checked import)
 
-DPI = 110
-QUIET = False
+FILES = FigureFolder(np, plt, fail, "plot_validate.py", "terracut validate", dpi=110)
 WIDTH_COLOURS = {1.0: "tab:blue", 2.0: "tab:red"}
-REPOSE_COLOURS = {34.0: "tab:orange", 45.0: "tab:purple"}
 
 
 def read_csv(out_dir, name):
-    path = os.path.join(out_dir, name)
-    if not os.path.isfile(path):
-        fail(f"{path} not found (run `terracut validate --out {out_dir}` first)")
-    return np.genfromtxt(path, delimiter=",", names=True, dtype=None, encoding="utf-8")
+    return FILES.read_csv(os.path.join(out_dir, name))
 
 
 def read_npy(out_dir, name):
-    path = os.path.join(out_dir, name)
-    if not os.path.isfile(path):
-        fail(f"{path} not found")
-    return np.load(path)
-
-
-def save(fig, out_dir, name):
-    path = os.path.join(out_dir, name)
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
-    if not QUIET:
-        print(f"plot_validate.py: wrote {path}")
+    return FILES.read_npy(os.path.join(out_dir, name))
 
 
 def direction_style(direction):
@@ -144,10 +127,9 @@ def cone(out_dir, meta):
         ax.set_ylabel("Z (m)")
         ax.set_title("from above; dashed: the ideal cone's toe", fontsize=10)
         fig.colorbar(image, ax=ax, label="height (m)", shrink=0.85)
-    fig.suptitle("Check 1: a column of sand (1 cm cells) collapses into a cone at the angle of "
-                 "repose")
-    fig.tight_layout()
-    save(fig, out_dir, "soil_cone.png")
+    FILES.save(fig, out_dir, "soil_cone.png",
+               "Check 1: a column of sand (1 cm cells) collapses into a cone at the angle of "
+               "repose")
 
 
 def slope(out_dir, meta):
@@ -178,10 +160,9 @@ def slope(out_dir, meta):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="upper left")
     axes[0].set_ylabel("height (m)")
-    fig.suptitle(f"Check 2: slopes below and above the repose angle ({s['repose_deg']:g} deg), "
-                 "1 cm cells; the grid's edges are walls")
-    fig.tight_layout()
-    save(fig, out_dir, "soil_slope.png")
+    FILES.save(fig, out_dir, "soil_slope.png",
+               f"Check 2: slopes below and above the repose angle ({s['repose_deg']:g} deg), "
+               "1 cm cells; the grid's edges are walls")
 
 
 def bulldozing(out_dir, meta):
@@ -205,9 +186,9 @@ def bulldozing(out_dir, meta):
         ax_v.plot(p["pushed_m"], p["pile_m3"], "o-", color=colour, ms=4, lw=1.3,
                   label=f"pile ahead of the {w:g} m blade")
         ax_v.plot(p["pushed_m"], p["windrow_m3"], "s:", color=colour, ms=3, lw=1.0,
-                  label=f"windrows beside it")
+                  label="windrows beside it")
         ax_v.plot(p["pushed_m"], p["refill_m3"], "^:", color=colour, ms=3, lw=0.8, alpha=0.7,
-                  label=f"back in the trench")
+                  label="back in the trench")
         # Peak.
         ok = (p["centre_peak_m"] >= p["wedge_min_m"]) & (p["centre_peak_m"] <= p["wedge_max_m"])
         ax_h.plot(p["pushed_m"], p["centre_peak_m"], "-", color=colour, lw=1.0, alpha=0.6)
@@ -296,10 +277,9 @@ def bulldozing(out_dir, meta):
     ax.set_title(f"where the dug-out soil is after {b['push_m']:g} m", fontsize=10)
     ax.grid(alpha=0.3, axis="y")
     ax.legend(fontsize=8, loc="center right")
-    fig.suptitle(f"Check 3: bulldozing, blades cutting d = {d:g} m into a {b['layer_m']:g} m "
-                 f"layer, repose {b['repose_deg']:g} deg, {b['cell_m'] * 100:g} cm cells")
-    fig.tight_layout()
-    save(fig, out_dir, "soil_bulldozing.png")
+    FILES.save(fig, out_dir, "soil_bulldozing.png",
+               f"Check 3: bulldozing, blades cutting d = {d:g} m into a {b['layer_m']:g} m "
+               f"layer, repose {b['repose_deg']:g} deg, {b['cell_m'] * 100:g} cm cells")
 
 
 def conservation(out_dir, meta):
@@ -335,22 +315,12 @@ def conservation(out_dir, meta):
     ax.set_title("Check 4: total volume over a long mixed run on flow soil "
                  f"({', '.join(c['sequence'])})", fontsize=10)
     fig.tight_layout()
-    save(fig, out_dir, "soil_conservation.png")
+    FILES.save(fig, out_dir, "soil_conservation.png")
 
 
 def main(argv):
-    global QUIET
-    args = [a for a in argv[1:] if a != "--quiet"]
-    QUIET = len(args) != len(argv) - 1
-    if len(args) != 1 or args[0] in ("-h", "--help"):
-        print(__doc__)
-        return 0 if args in (["-h"], ["--help"]) else 2
-    out_dir = args[0]
-    meta_path = os.path.join(out_dir, "validate.json")
-    if not os.path.isfile(meta_path):
-        fail(f"{meta_path} not found (run `terracut validate --out {out_dir}` first)")
-    with open(meta_path, encoding="utf-8") as f:
-        meta = json.load(f)
+    out_dir, FILES.quiet = parse_folder_args(argv, __doc__)
+    meta = FILES.read_meta(out_dir, "validate.json")
     cone(out_dir, meta)
     slope(out_dir, meta)
     bulldozing(out_dir, meta)

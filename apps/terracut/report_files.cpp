@@ -13,6 +13,22 @@ namespace terracut::cli {
 
 namespace fs = std::filesystem;
 
+void add_report_options(CLI::App& sub, ReportOptions& o, const std::string& script,
+                        const std::string& no_plots_help) {
+  sub.add_option("--out,-o", o.out, "Output folder; created if missing")
+      ->required()
+      ->type_name("DIR");
+  sub.add_option("--tools-dir", o.tools, "Folder holding " + script)
+      ->capture_default_str()
+      ->type_name("DIR");
+  sub.add_option("--python", o.python,
+                 "Python interpreter used for the figures (needs numpy and matplotlib)")
+      ->capture_default_str()
+      ->type_name("PATH");
+  sub.add_flag("--no-plot,--no-plots", o.no_plots, no_plots_help);
+  sub.add_flag("--quiet,-q", o.quiet, "No progress lines on stderr");
+}
+
 void create_output_folder(const fs::path& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);

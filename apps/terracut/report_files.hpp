@@ -3,12 +3,28 @@
 // script that draws their figures.
 #pragma once
 
+#include <CLI/CLI.hpp>
+
 #include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
 
 namespace terracut::cli {
+
+/// The options of a report-writing subcommand.
+struct ReportOptions {
+  std::string out;                          ///< --out: the output folder
+  std::string tools = TERRACUT_TOOLS_DIR;   ///< --tools-dir: where the plot script is
+  std::string python = "/usr/bin/python3";  ///< --python: the figures' interpreter
+  bool no_plots = false;                    ///< --no-plot(s): tables only
+  bool quiet = false;                       ///< --quiet: no progress lines
+};
+
+/// Adds --out, --tools-dir (the folder holding `script`), --python,
+/// --no-plot/--no-plots (no_plots_help says what then happens) and --quiet.
+void add_report_options(CLI::App& sub, ReportOptions& options, const std::string& script,
+                        const std::string& no_plots_help);
 
 /// Creates the output folder (with parents). Throws InputError naming it
 /// when that fails.

@@ -325,13 +325,8 @@ std::string report_markdown(const ReportInput& in) {
 }  // namespace
 
 Command add_reproduce_command(CLI::App& app) {
-  struct Options {
-    std::string out;
+  struct Options : ReportOptions {
     std::string scenarios = TERRACUT_SCENARIOS_DIR;
-    std::string tools = TERRACUT_TOOLS_DIR;
-    std::string python = "/usr/bin/python3";
-    bool no_plots = false;
-    bool quiet = false;
   };
   auto opt = std::make_shared<Options>();
 
@@ -340,23 +335,12 @@ Command add_reproduce_command(CLI::App& app) {
       "Reproduce the paper's two experiments from the shipped scenario files: run them for\n"
       "both representations, compare the contact length with exact geometry, and write the\n"
       "outputs, a report (report.md) and figures into a folder.");
-  sub->add_option("--out,-o", opt->out, "Output folder; created if missing")
-      ->required()
-      ->type_name("DIR");
+  add_report_options(*sub, *opt, "plot_reproduce.py",
+                     "Do not make figures (report.md then has tables only); exit code 0");
   sub->add_option("--scenarios", opt->scenarios,
                   "Folder holding paper_experiment1.yaml and paper_experiment2.yaml")
       ->capture_default_str()
       ->type_name("DIR");
-  sub->add_option("--tools-dir", opt->tools, "Folder holding plot_reproduce.py")
-      ->capture_default_str()
-      ->type_name("DIR");
-  sub->add_option("--python", opt->python, "Python interpreter used for the figures (needs "
-                                           "numpy and matplotlib)")
-      ->capture_default_str()
-      ->type_name("PATH");
-  sub->add_flag("--no-plots", opt->no_plots,
-                "Do not make figures (report.md then has tables only); exit code 0");
-  sub->add_flag("--quiet,-q", opt->quiet, "No progress lines on stderr");
   sub->footer(
       "Experiment 1 (paper_experiment1.yaml): a mound image, one horizontal cut through it,\n"
       "run at 5x5, 15x15, 25x25, 35x35, 50x50, 100x100 and 200x200 for the 'columns' and\n"

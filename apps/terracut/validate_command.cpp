@@ -25,6 +25,7 @@
 #include "terracut/core/simulation.hpp"
 #include "terracut/core/soil.hpp"
 #include "terracut/core/stats.hpp"
+#include "terracut/core/surface.hpp"
 #include "terracut/io/image.hpp"
 #include "terracut/session/scenario.hpp"
 #include "terracut/session/world.hpp"
@@ -97,17 +98,13 @@ Settled settle(SoilFlow& flow, HeightGrid& grid) {
   return s;
 }
 
-// Bilinear height at continuous cell coordinates (u, v): sample (c, r) is the
-// node at (c + 0.5, r + 0.5); beyond the grid the edge samples continue.
+// The terrain surface at continuous cell coordinates (u, v), metres above the
+// ground: the triangulated surface through the cell centres (surface.hpp),
+// as the surface representation reads the samples.
 double height_at(const HeightGrid& g, double u, double v) {
-  const double x = u - 0.5, z = v - 0.5;
-  const int c = int(std::floor(x)), r = int(std::floor(z));
-  const double fx = x - c, fz = z - r;
-  const auto h = [&](int cc, int rr) {
-    return double(g.height(std::clamp(cc, 0, g.cols() - 1), std::clamp(rr, 0, g.rows() - 1)));
-  };
-  return h(c, r) * (1 - fx) * (1 - fz) + h(c + 1, r) * fx * (1 - fz) +
-         h(c, r + 1) * (1 - fx) * fz + h(c + 1, r + 1) * fx * fz;
+  const GridSpec& spec = g.spec();
+  return surface_height_m(g, Representation::kSurface, spec.origin_m.x + u * spec.cell_x_m(),
+                          spec.origin_m.z + v * spec.cell_z_m());
 }
 
 // Least-squares slope dy/dx through the points.
@@ -798,7 +795,7 @@ std::string report_markdown(const Report& r) {
      << " grid of " << fmt("%g", kConeCell_m * 100) << " cm cells is relaxed "
      << "(`SoilFlow::relax`, the default work cap) until no cell is active. The flank angle "
      << "along each of " << kConeDirections << " directions is the least-squares slope of "
-     << "the bilinear profile between " << fmt("%g", kFlankTop * 100) << " % and "
+     << "the profile of the triangulated surface through the cell centres between " << fmt("%g", kFlankTop * 100) << " % and "
      << fmt("%g", kFlankToe * 100) << " % of the peak height. The 8-neighbour stencil holds "
      << "the repose slope along the axes and the diagonals; 22.5 degrees off them a plane can "
      << "stand up to tan / cos(22.5) and a facet reads tan x cos(22.5), so the band there is "
@@ -1058,34 +1055,15 @@ void write_outputs(const fs::path& out, const Report& r) {
 }  // namespace
 
 Command add_validate_command(CLI::App& app) {
-  struct Options {
-    std::string out;
-    std::string tools = TERRACUT_TOOLS_DIR;
-    std::string python = "/usr/bin/python3";
-    bool no_plot = false;
-    bool quiet = false;
-  };
-  auto opt = std::make_shared<Options>();
-
+  auto opt = std::make_shared<ReportOptions>();
   CLI::App* sub = app.add_subcommand(
       "validate",
       "Check the soil that flows (soil: {model: flow}) against physics: a column collapsing\n"
       "into a cone at the angle of repose, slopes that stand or relax, a blade bulldozing a\n"
       "pile (mass balance and wedge), and conservation over a long mixed run. Writes CSV\n"
       "files, a report (report.md) with PASS/FAIL per check, and figures into a folder.");
-  sub->add_option("--out,-o", opt->out, "Output folder; created if missing")
-      ->required()
-      ->type_name("DIR");
-  sub->add_option("--tools-dir", opt->tools, "Folder holding plot_validate.py")
-      ->capture_default_str()
-      ->type_name("DIR");
-  sub->add_option("--python", opt->python,
-                  "Python interpreter used for the figures (needs numpy and matplotlib)")
-      ->capture_default_str()
-      ->type_name("PATH");
-  sub->add_flag("--no-plot,--no-plots", opt->no_plot,
-                "Do not make figures (report.md then has tables only)");
-  sub->add_flag("--quiet,-q", opt->quiet, "No progress lines on stderr");
+  add_report_options(*sub, *opt, "plot_validate.py",
+                     "Do not make figures (report.md then has tables only)");
   sub->footer(
       "Checks (1 cm cells unless said; tolerances from the cell size, the relaxation's stated\n"
       "tolerance of 2 % of tan(repose), or float rounding; docs/validation.md explains each):\n"
@@ -1182,7 +1160,7 @@ Command add_validate_command(CLI::App& app) {
     write_outputs(out, report);
     write_file(out / "report.md", report_markdown(report));
     const int checks_code = all_pass ? kExitOk : kExitError;
-    if (opt->no_plot) {
+    if (opt->no_plots) {
       say("figures skipped (--no-plot); report: " + (out / "report.md").string());
       return checks_code;
     }
