@@ -21,7 +21,6 @@
 
 #include "commands.hpp"
 #include "report_files.hpp"
-#include "terracut/core/error.hpp"
 #include "terracut/core/simulation.hpp"
 #include "terracut/core/soil.hpp"
 #include "terracut/core/stats.hpp"
