@@ -55,3 +55,59 @@ def parse_dir_args(argv, doc, default_png, fail, script):
     if folder is None:
         fail(f"no output folder given (usage: {script} DIR [--out FILE.png])")
     return folder, out or os.path.join(folder, default_png), quiet
+
+
+def parse_folder_args(argv, doc):
+    """(folder, quiet) from `SCRIPT DIR [--quiet]`, for the scripts that draw a
+    report folder's figures into it; --help prints doc and exits 0, any other
+    command line prints it and exits 2."""
+    args = [a for a in argv[1:] if a != "--quiet"]
+    quiet = len(args) != len(argv) - 1
+    if len(args) != 1 or args[0] in ("-h", "--help"):
+        print(doc)
+        sys.exit(0 if args in (["-h"], ["--help"]) else 2)
+    return args[0], quiet
+
+
+class FigureFolder:
+    """The data files and figures of a report folder written by `command`
+    (e.g. "terracut reproduce"): CSV and .npy files read with numpy (a missing
+    one is fail()ed, naming the command that writes it) and figures saved at
+    one DPI, each saying where it went unless quiet."""
+
+    def __init__(self, np, plt, fail, script, command, dpi):
+        self.np, self.plt, self.fail = np, plt, fail
+        self.script, self.command, self.dpi = script, command, dpi
+        self.quiet = False
+
+    def read_meta(self, folder, name):
+        """The JSON file `name` the command wrote into folder."""
+        import json
+
+        path = os.path.join(folder, name)
+        if not os.path.isfile(path):
+            self.fail(f"{path} not found (run `{self.command} --out {folder}` first)")
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+
+    def read_csv(self, path):
+        """A CSV file with a header row, as a numpy structured array."""
+        if not os.path.isfile(path):
+            self.fail(f"{path} not found (run `{self.command} --out DIR` first)")
+        return self.np.genfromtxt(path, delimiter=",", names=True, dtype=None, encoding="utf-8")
+
+    def read_npy(self, path):
+        if not os.path.isfile(path):
+            self.fail(f"{path} not found")
+        return self.np.load(path)
+
+    def save(self, fig, folder, name, title=None):
+        """Writes fig to folder/name; with a title, as its suptitle, laid out first."""
+        if title is not None:
+            fig.suptitle(title)
+            fig.tight_layout()
+        path = os.path.join(folder, name)
+        fig.savefig(path, dpi=self.dpi)
+        self.plt.close(fig)
+        if not self.quiet:
+            print(f"{self.script}: wrote {path}")

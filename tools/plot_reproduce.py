@@ -19,66 +19,31 @@ DIR/exp1/errors.csv) and receives:
 Exit codes: 0 done; 2 bad input folder; 3 numpy or matplotlib missing.
 Needs Debian's python3-numpy and python3-matplotlib.
 """
-import json
 import os
 import sys
 
+from plot_common import FigureFolder, import_plotting, make_fail, parse_folder_args
 
-def fail(message, code=2):
-    print(f"plot_reproduce.py: error: {message}", file=sys.stderr)
-    sys.exit(code)
-
-
-try:
-    import numpy as np
-except ImportError:
-    fail("missing Python module 'numpy' (Debian: apt-get install python3-numpy)", 3)
-try:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-except ImportError:
-    fail("missing Python module 'matplotlib' (Debian: apt-get install python3-matplotlib)", 3)
+fail = make_fail("plot_reproduce.py")
+np, plt = import_plotting(fail)
 
 CUT_COLOURS = {"A": "tab:blue", "B": "tab:orange", "C": "tab:green"}
 RES_COLOURS = ["tab:red", "tab:orange", "tab:green", "tab:blue", "tab:purple", "tab:brown",
                "tab:pink"]
 REP_STYLE = {"columns": dict(color="tab:red", marker="s"),
              "surface": dict(color="tab:blue", marker="o")}
-DPI = 110
-QUIET = False
-
-
-def read_csv(path):
-    if not os.path.isfile(path):
-        fail(f"{path} not found (run `terracut reproduce --out DIR` first)")
-    return np.genfromtxt(path, delimiter=",", names=True, dtype=None, encoding="utf-8")
-
-
-def read_npy(path):
-    if not os.path.isfile(path):
-        fail(f"{path} not found")
-    return np.load(path)
-
-
-def save(fig, out_dir, name):
-    path = os.path.join(out_dir, name)
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
-    if not QUIET:
-        print(f"plot_reproduce.py: wrote {path}")
+FILES = FigureFolder(np, plt, fail, "plot_reproduce.py", "terracut reproduce", dpi=110)
 
 
 def fig8(out_dir, meta, rep):
     """Contact length vs time, one panel per resolution, and blade Z vs time."""
-    exact = read_csv(os.path.join(out_dir, meta["exp1"]["exact_csv"]))
+    exact = FILES.read_csv(os.path.join(out_dir, meta["exp1"]["exact_csv"]))
     resolutions = meta["exp1"]["fig8_resolutions"]
     fig, axes = plt.subplots(len(resolutions) + 1, 1, sharex=True, figsize=(10, 11),
                              gridspec_kw=dict(height_ratios=[2] * len(resolutions) + [1.4]))
     peak = float(np.max(exact["exact_contact"]))
     for ax, n, colour in zip(axes, resolutions, RES_COLOURS):
-        run = read_csv(os.path.join(out_dir, "exp1", rep, str(n), "contact.csv"))
+        run = FILES.read_csv(os.path.join(out_dir, "exp1", rep, str(n), "contact.csv"))
         ax.plot(exact["t"], exact["exact_contact"], color="black", lw=1.2, ls="--",
                 label="exact chord")
         ax.plot(run["t"], run["contact_length"], color=colour, lw=1.0,
@@ -95,7 +60,7 @@ def fig8(out_dir, meta, rep):
     fig.suptitle(f"Experiment 1, {rep} representation: contact length of a horizontal cut "
                  f"through the mound\n(blade at y = half the peak; X and Y constant)")
     fig.tight_layout()
-    save(fig, out_dir, f"fig8_{rep}.png")
+    FILES.save(fig, out_dir, f"fig8_{rep}.png")
 
 
 def fig9(out_dir, meta, rep):
@@ -103,7 +68,7 @@ def fig9(out_dir, meta, rep):
     sequences = meta["exp2"]["sequences"]
     fig, axes = plt.subplots(len(sequences), 1, sharex=True, sharey=True, figsize=(10, 8))
     for ax, seq in zip(axes, sequences):
-        run = read_csv(os.path.join(out_dir, "exp2", rep, seq, "contact.csv"))
+        run = FILES.read_csv(os.path.join(out_dir, "exp2", rep, seq, "contact.csv"))
         cuts = np.asarray(run["cut"]).astype(str)
         t = run["t"]
         # One line per cut, and a dotted line where the next cut starts.
@@ -124,13 +89,13 @@ def fig9(out_dir, meta, rep):
     fig.suptitle(f"Experiment 2, {rep} representation: contact length for three orders of "
                  f"cuts A, B, C (2 s each)")
     fig.tight_layout()
-    save(fig, out_dir, f"fig9_{rep}.png")
+    FILES.save(fig, out_dir, f"fig9_{rep}.png")
 
 
 def layers(out_dir, rep, seq):
     run_dir = os.path.join(out_dir, "exp2", rep, seq)
-    return (read_npy(os.path.join(run_dir, "height.npy")),
-            read_npy(os.path.join(run_dir, "removed.npy")))
+    return (FILES.read_npy(os.path.join(run_dir, "height.npy")),
+            FILES.read_npy(os.path.join(run_dir, "removed.npy")))
 
 
 def heightmap_figure(out_dir, meta, rep, seq, name, title, compare_seq, show_difference):
@@ -164,12 +129,12 @@ def heightmap_figure(out_dir, meta, rep, seq, name, title, compare_seq, show_dif
         fig.colorbar(image, ax=ax, label=label, shrink=0.9)
     fig.suptitle(title)
     fig.tight_layout()
-    save(fig, out_dir, name)
+    FILES.save(fig, out_dir, name)
 
 
 def convergence(out_dir, meta):
     """RMS and mean absolute error against resolution, log-log."""
-    table = read_csv(os.path.join(out_dir, meta["exp1"]["errors_csv"]))
+    table = FILES.read_csv(os.path.join(out_dir, meta["exp1"]["errors_csv"]))
     reps = np.asarray(table["representation"]).astype(str)
     fig, ax = plt.subplots(figsize=(8, 5.5))
     for rep in meta["representations"]:
@@ -192,22 +157,12 @@ def convergence(out_dir, meta):
     ax.legend(fontsize=9)
     ax.set_title("Experiment 1: contact length error against the exact chord")
     fig.tight_layout()
-    save(fig, out_dir, "convergence.png")
+    FILES.save(fig, out_dir, "convergence.png")
 
 
 def main(argv):
-    global QUIET
-    args = [a for a in argv[1:] if a != "--quiet"]
-    QUIET = len(args) != len(argv) - 1
-    if len(args) != 1 or args[0] in ("-h", "--help"):
-        print(__doc__)
-        return 0 if args in (["-h"], ["--help"]) else 2
-    out_dir = args[0]
-    meta_path = os.path.join(out_dir, "reproduce.json")
-    if not os.path.isfile(meta_path):
-        fail(f"{meta_path} not found (run `terracut reproduce --out {out_dir}` first)")
-    with open(meta_path, encoding="utf-8") as f:
-        meta = json.load(f)
+    out_dir, FILES.quiet = parse_folder_args(argv, __doc__)
+    meta = FILES.read_meta(out_dir, "reproduce.json")
     for rep in meta["representations"]:
         fig8(out_dir, meta, rep)
         fig9(out_dir, meta, rep)

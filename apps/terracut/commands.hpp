@@ -11,13 +11,15 @@ namespace terracut::cli {
 
 /// Exit codes shared by every subcommand.
 inline constexpr int kExitOk = 0;
-inline constexpr int kExitError = 1;     ///< bad input, a failed run or an unwritable output
-inline constexpr int kExitNoFigures = 3; ///< reproduce: results written, figures could not be made
+inline constexpr int kExitError = 1;     ///< bad input, a failed run or an unwritable output;
+                                         ///< validate: a check failed
+inline constexpr int kExitNoFigures = 3; ///< reproduce, validate: results written, figures could not be made
 
 using Command = std::function<int()>;
 
 Command add_run_command(CLI::App& app);
 Command add_heightmap_command(CLI::App& app);
 Command add_reproduce_command(CLI::App& app);
+Command add_validate_command(CLI::App& app);
 
 }  // namespace terracut::cli

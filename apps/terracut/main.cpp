@@ -21,13 +21,15 @@ int main(int argc, char** argv) {
       "Run `terracut SUBCOMMAND --help` for the options of each subcommand.\n"
       "Units are SI (metres, seconds). World frame: right-handed, Y up, ground plane X-Z;\n"
       "heightmap column index runs along +X, row index along +Z.\n"
-      "Exit codes: 0 success; 1 bad input or failed output; 2 bad command line;\n"
-      "3 (reproduce) results written but figures not made.\n"
-      "Scenario format: docs/scenario-format.md. Experiments: docs/experiments.md.");
+      "Exit codes: 0 success; 1 bad input or failed output (validate: a check failed);\n"
+      "2 bad command line; 3 (reproduce, validate) results written but figures not made.\n"
+      "Scenario format: docs/scenario-format.md. Experiments: docs/experiments.md.\n"
+      "The soil's physical checks (terracut validate): docs/validation.md.");
 
   const terracut::cli::Command run = terracut::cli::add_run_command(app);
   const terracut::cli::Command heightmap = terracut::cli::add_heightmap_command(app);
   const terracut::cli::Command reproduce = terracut::cli::add_reproduce_command(app);
+  const terracut::cli::Command validate = terracut::cli::add_validate_command(app);
   const terracut::cli::Command haptics = terracut::cli::add_haptics_command(app);
 
   try {
@@ -42,6 +44,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("run")) return run();
     if (app.got_subcommand("heightmap")) return heightmap();
     if (app.got_subcommand("reproduce")) return reproduce();
+    if (app.got_subcommand("validate")) return validate();
     if (app.got_subcommand("haptics")) return haptics();
   } catch (const terracut::InputError& e) {
     std::cerr << "terracut: error: " << e.what() << "\n";
@@ -53,6 +56,6 @@ int main(int argc, char** argv) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
   }
-  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, haptics)\n";
+  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, validate, haptics)\n";
   return 2;
 }

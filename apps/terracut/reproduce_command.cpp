@@ -4,10 +4,8 @@
 // docs/experiments.md.
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -17,7 +15,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "subprocess.hpp"
+#include "report_files.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/core/generators.hpp"
 #include "terracut/io/image.hpp"
@@ -41,12 +39,6 @@ const std::vector<std::vector<std::string>> kExp2Sequences = {
     {"A", "B", "C"}, {"C", "A", "B"}, {"B", "C", "A"}, {"A", "B"}};
 constexpr int kOrdersCompared = 3;  // the first three sequences are complete orders
 
-std::string fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
-
 std::string concat(const std::vector<std::string>& names, std::string_view sep = "") {
   std::string out;
   for (std::size_t i = 0; i < names.size(); ++i) {
@@ -54,14 +46,6 @@ std::string concat(const std::vector<std::string>& names, std::string_view sep =
     out += names[i];
   }
   return out;
-}
-
-void write_file(const fs::path& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) throw InputError(path.string() + ": cannot create the file");
-  f << text;
-  f.close();
-  if (!f) throw InputError(path.string() + ": write failed");
 }
 
 // Contact-length errors of one experiment-1 run against the exact dome.
@@ -339,13 +323,8 @@ std::string report_markdown(const ReportInput& in) {
 }  // namespace
 
 Command add_reproduce_command(CLI::App& app) {
-  struct Options {
-    std::string out;
+  struct Options : ReportOptions {
     std::string scenarios = TERRACUT_SCENARIOS_DIR;
-    std::string tools = TERRACUT_TOOLS_DIR;
-    std::string python = "/usr/bin/python3";
-    bool no_plots = false;
-    bool quiet = false;
   };
   auto opt = std::make_shared<Options>();
 
@@ -354,23 +333,12 @@ Command add_reproduce_command(CLI::App& app) {
       "Reproduce the paper's two experiments from the shipped scenario files: run them for\n"
       "both representations, compare the contact length with exact geometry, and write the\n"
       "outputs, a report (report.md) and figures into a folder.");
-  sub->add_option("--out,-o", opt->out, "Output folder; created if missing")
-      ->required()
-      ->type_name("DIR");
+  add_report_options(*sub, *opt, "plot_reproduce.py",
+                     "Do not make figures (report.md then has tables only); exit code 0");
   sub->add_option("--scenarios", opt->scenarios,
                   "Folder holding paper_experiment1.yaml and paper_experiment2.yaml")
       ->capture_default_str()
       ->type_name("DIR");
-  sub->add_option("--tools-dir", opt->tools, "Folder holding plot_reproduce.py")
-      ->capture_default_str()
-      ->type_name("DIR");
-  sub->add_option("--python", opt->python, "Python interpreter used for the figures (needs "
-                                           "numpy and matplotlib)")
-      ->capture_default_str()
-      ->type_name("PATH");
-  sub->add_flag("--no-plots", opt->no_plots,
-                "Do not make figures (report.md then has tables only); exit code 0");
-  sub->add_flag("--quiet,-q", opt->quiet, "No progress lines on stderr");
   sub->footer(
       "Experiment 1 (paper_experiment1.yaml): a mound image, one horizontal cut through it,\n"
       "run at 5x5, 15x15, 25x25, 35x35, 50x50, 100x100 and 200x200 for the 'columns' and\n"
@@ -394,10 +362,7 @@ Command add_reproduce_command(CLI::App& app) {
 
   return [opt]() {
     const fs::path out(opt->out);
-    std::error_code ec;
-    fs::create_directories(out, ec);
-    if (ec || !fs::is_directory(out))
-      throw InputError(opt->out + ": cannot create the output folder");
+    create_output_folder(out);
     auto say = [&](const std::string& line) {
       if (!opt->quiet) std::cerr << "reproduce: " << line << "\n" << std::flush;
     };
@@ -543,27 +508,8 @@ Command add_reproduce_command(CLI::App& app) {
     }
 
     // Figures, by the plot script; on failure the report says so.
-    const fs::path script = fs::path(opt->tools) / "plot_reproduce.py";
-    std::optional<std::string> problem;
-    if (access(opt->python.c_str(), X_OK) != 0) {
-      problem = "the Python interpreter " + opt->python +
-                " is missing (on Debian: apt-get install python3 python3-matplotlib "
-                "python3-numpy)";
-    } else if (!fs::exists(script)) {
-      problem = "the plot script " + script.string() + " is missing (use --tools-dir)";
-    } else {
-      say("drawing figures: " + opt->python + " " + script.string() + " " + out.string());
-      std::vector<std::string> argv{opt->python, script.string(), out.string()};
-      if (opt->quiet) argv.push_back("--quiet");
-      const int code = run_program(argv);
-      if (code == 3) {
-        problem = "Python modules are missing (see the message above; on Debian: apt-get install "
-                  "python3-matplotlib python3-numpy)";
-      } else if (code != 0) {
-        problem = "the plot script " + script.string() + " failed (exit code " +
-                  std::to_string(code) + "; see the messages above)";
-      }
-    }
+    const std::optional<std::string> problem =
+        draw_figures(opt->python, fs::path(opt->tools) / "plot_reproduce.py", out, opt->quiet, say);
     if (problem) {
       report.figures_problem = problem;
       write_file(out / "report.md", report_markdown(report));

@@ -1,6 +1,7 @@
 // The `terracut` command-line tool, run as a separate process: help texts,
 // a successful run, bad input giving a message and exit code 1 (never a
-// crash), heightmap, and reproduce with and without figures.
+// crash), heightmap, reproduce with and without figures, and validate (the
+// soil's physical checks).
 #include <gtest/gtest.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -107,7 +108,7 @@ void expect_clean_failure(const Result& r, const std::vector<std::string>& fragm
 TEST_F(CliTest, HelpOfEveryCommandSucceedsAndDescribesTheOptions) {
   const Result top = terracut({"--help"});
   EXPECT_EQ(top.code, 0);
-  for (const char* word : {"run", "heightmap", "reproduce", "Exit codes"})
+  for (const char* word : {"run", "heightmap", "reproduce", "validate", "Exit codes"})
     EXPECT_NE(top.out.find(word), std::string::npos) << word;
 
   const Result run = terracut({"run", "--help"});
@@ -129,6 +130,14 @@ TEST_F(CliTest, HelpOfEveryCommandSucceedsAndDescribesTheOptions) {
   for (const char* word : {"--out", "--scenarios", "--tools-dir", "--python", "--no-plots",
                            "report.md", "fig8_", "fig9_", "fig13_", "fig14_", "convergence.png"})
     EXPECT_NE(rep.out.find(word), std::string::npos) << word;
+
+  const Result val = terracut({"validate", "--help"});
+  EXPECT_EQ(val.code, 0);
+  for (const char* word : {"--out", "--no-plot", "--quiet", "--python", "--tools-dir",
+                           "report.md", "checks.csv", "cone/profiles.csv", "bulldozing/pile.csv",
+                           "conservation/volume.csv", "soil_cone.png", "degrees", "m^3",
+                           "microseconds", "Exit code"})
+    EXPECT_NE(val.out.find(word), std::string::npos) << word;
 
   EXPECT_EQ(terracut({"--version"}).code, 0);
 }
@@ -401,6 +410,34 @@ TEST_F(CliTest, ReproduceDrawsEveryFigure) {
     EXPECT_NE(slurp(out / "report.md").find(std::string("](") + name + ")"), std::string::npos)
         << name << " not embedded in report.md";
   }
+}
+
+// The soil's physical checks (docs/validation.md) end to end: every output
+// is written, and every check passes (exit code 0, no FAIL in the report).
+TEST_F(CliTest, ValidateWritesItsOutputsAndEveryCheckPasses) {
+  const fs::path out = dir_ / "val";
+  const Result r = terracut({"validate", "--out", out.string(), "--no-plot", "--quiet"});
+  ASSERT_TRUE(r.exited) << "killed by signal " << r.signal;
+  for (const char* name :
+       {"report.md", "checks.csv", "validate.json", "cone/profiles.csv", "cone/flanks.csv",
+        "cone/height_34.npy", "cone/height_45.npy", "slope/profiles.csv", "slope/slopes.csv",
+        "bulldozing/pile.csv", "bulldozing/centre.csv", "bulldozing/height_w1.npy",
+        "bulldozing/height_w2.npy", "conservation/scenario.yaml", "conservation/volume.csv"})
+    ASSERT_TRUE(fs::exists(out / name)) << name << "\n" << r.err;
+  const std::string report = slurp(out / "report.md");
+  for (const char* word : {"A column of sand collapses into a cone", "Slopes below and above",
+                           "Bulldozing", "Conservation over a long mixed run", "Speed"})
+    EXPECT_NE(report.find(word), std::string::npos) << word;
+  EXPECT_EQ(report.find("soil_cone.png"), std::string::npos);  // --no-plot: no figure links
+  // The mixed run's scenario is one `terracut run` accepts.
+  EXPECT_EQ(terracut({"run", (out / "conservation" / "scenario.yaml").string(), "--out",
+                      (dir_ / "mixed").string(), "--quiet"})
+                .code,
+            0);
+  // Every check passes; stderr names the failing ones.
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(report.find("FAIL"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(out / "checks.csv").find("FAIL"), std::string::npos);
 }
 
 }  // namespace
