@@ -97,7 +97,7 @@ struct SoilStepResult {
 };
 
 /// The soil phase's state (kFlow): the active cells and the scratch of the
-/// passes, sized at construction (about 10 bytes per sample) so that a step
+/// passes, sized at construction (6 bytes per sample) so that a step
 /// allocates nothing once its scratch has grown to the blade's footprint.
 class SoilFlow {
  public:
@@ -148,9 +148,8 @@ class SoilFlow {
   };
   BladeLine blade_{};
 
-  std::vector<std::uint32_t> active_;  // cells to examine in the next pass
-  std::vector<std::uint32_t> next_;    // built during a pass
-  std::vector<std::uint8_t> queued_;   // per cell: 1 while in active_ (or next_)
+  std::vector<std::uint32_t> active_;  // cells to examine in the next pass (the backlog between steps)
+  std::vector<std::uint8_t> queued_;   // per cell: 1 while in active_
   std::vector<float> delta_;           // per cell: the pass's net flux, metres
   std::vector<std::uint32_t> touched_;  // cells with a delta this pass
   std::vector<std::uint8_t> near_blade_;  // per cell: 1 within reach of the step's blade
