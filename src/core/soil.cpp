@@ -35,6 +35,9 @@ struct Neighbour {
   int dr;
   int kind;
 };
+/// The cell index standing for the bare ground beyond an open edge.
+constexpr std::uint32_t kOutside = 0xffffffffu;
+
 constexpr Neighbour kNeighbours[8] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 1},  {0, -1, 1},
                                       {1, 1, 2},  {-1, 1, 2}, {1, -1, 2}, {-1, -1, 2}};
 
@@ -46,6 +49,8 @@ std::string_view to_string(SoilModel model) {
   return model == SoilModel::kFlow ? "flow" : "vanish";
 }
 
+std::string_view to_string(SoilEdge edge) { return edge == SoilEdge::kOpen ? "open" : "wall"; }
+
 std::optional<SoilModel> parse_soil_model(std::string_view name) {
   if (name == "vanish") return SoilModel::kVanish;
   if (name == "flow") return SoilModel::kFlow;
@@ -55,6 +60,7 @@ std::optional<SoilModel> parse_soil_model(std::string_view name) {
 std::string validate(const SoilFlowParams& p) {
   if (p.model != SoilModel::kVanish && p.model != SoilModel::kFlow)
     return "soil.model must be vanish or flow";
+  if (p.edge != SoilEdge::kWall && p.edge != SoilEdge::kOpen) return "soil.edge must be wall or open";
   if (!(std::isfinite(p.repose_deg) && p.repose_deg > 0.0 && p.repose_deg <= 80.0))
     return must_be("soil.repose_deg", "in (0, 80] degrees", p.repose_deg);
   if (!(p.max_pair_checks_per_step >= 1000 && p.max_pair_checks_per_step <= 1000000000))
@@ -259,7 +265,13 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       const double s = (x - to.a.x) * nx + (z - to.a.z) * nz;
       const double side = moving || s >= 0.0 ? 1.0 : -1.0;
       const double go = side * (kDepositAheadCells * cell) - s;
-      // The grid's edge is a wall: a target beyond it is its last cell.
+      // Beyond a wall, a target is its last cell; beyond an open edge, the
+      // soil leaves the terrain.
+      const auto beyond = [&](double along) {
+        const double u = to_cells(x + nx * along, spec.origin_m.x, dx_);
+        const double v = to_cells(z + nz * along, spec.origin_m.z, dz_);
+        return u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_;
+      };
       const auto cell_at = [&](double along) {
         const int tc = std::clamp(int(std::floor(to_cells(x + nx * along, spec.origin_m.x, dx_))),
                                   0, cols_ - 1);
@@ -308,6 +320,13 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       std::int64_t t = length > 0 ? ray[length - 1] : ray[0];
       float level = length > 0 ? layers.height_m[t] : before_[k];
       for (int m = length > 0 ? length : 0; m < kMaxPushCells && rest > 0.0f; ++m) {
+        if (params_.edge == SoilEdge::kOpen && beyond(go + side * m * step)) {
+          // Pushed off the terrain: it is gone, and counted.
+          out.left_over_edge_m3 += double(rest) * spec.cell_area_m2();
+          taken -= double(rest);
+          rest = 0.0f;
+          break;
+        }
         const std::int64_t u = cell_at(go + side * m * step);
         if (u == t && m > 0) break;  // against the grid's edge
         const float top = level - float(limit_step);
@@ -345,7 +364,10 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   float* h = layers.height_m;
   const float tol = tolerance_m_;
   const bool blade = blade_.present;
+  const bool open_edge = params_.edge == SoilEdge::kOpen;
+  const double cell_area = dx_ * dz_;
   while (!active_.empty()) {
+    double left_m = 0.0;  // height that slid off the grid in this pass
     // A pass is run whole or not at all (its fluxes come from one frozen
     // state); it starts only when it fits in what is left of the cap, except
     // the step's first pass, which always runs.
@@ -365,13 +387,16 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       float max_excess = 0.0f, sum_excess = 0.0f;
       for (const Neighbour& nb : kNeighbours) {
         const int cb = ca + nb.dc, rb = ra + nb.dr;
-        if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_) continue;
-        const std::uint32_t b = std::uint32_t(std::int64_t(rb) * cols_ + cb);
-        const float e = ha - h[b] - float(limit_[nb.kind]);
+        const bool outside = cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_;
+        // Beyond an open edge lies bare ground (height 0) that takes what
+        // slides onto it; a wall takes nothing.
+        if (outside && !open_edge) continue;
+        const std::uint32_t b = outside ? kOutside : std::uint32_t(std::int64_t(rb) * cols_ + cb);
+        const float e = ha - (outside ? 0.0f : h[b]) - float(limit_[nb.kind]);
         if (!(e > tol)) continue;
         // The blade is a wall between the cells on its two sides, and soil
         // does not flow into the cells it passes through.
-        if (blade && near_blade_[a] && near_blade_[b] && blade_blocks(a, b, ha)) continue;
+        if (blade && !outside && near_blade_[a] && near_blade_[b] && blade_blocks(a, b, ha)) continue;
         lower[n] = b;
         excess[n] = e;
         ++n;
@@ -384,9 +409,13 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       if (delta_[a] == 0.0f) touched_.push_back(a);
       for (int k = 0; k < n; ++k) {
         const float flux = share * excess[k];
+        delta_[a] -= flux;
+        if (lower[k] == kOutside) {
+          left_m += double(flux);
+          continue;
+        }
         if (delta_[lower[k]] == 0.0f) touched_.push_back(lower[k]);
         delta_[lower[k]] += flux;
-        delta_[a] -= flux;
       }
       out.moved_pairs += n;
     }
@@ -397,7 +426,7 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
     // The fluxes cancel exactly; the float heights do not quite: what the
     // pass gained or lost by rounding is measured in double and given back
     // to the highest cell it changed, so no bias builds up over a run.
-    double gained = 0.0;
+    double gained = left_m;  // what left over the edge in this pass is no gain
     std::uint32_t highest = 0;
     float highest_h = -1.0f;
     for (std::uint32_t t : touched_) {
@@ -426,6 +455,7 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       h[highest] = float(std::max(0.0, double(h[highest]) - gained));
       layers.removed_m[highest] = layers.initial_m[highest] - h[highest];
     }
+    out.left_over_edge_m3 += left_m * cell_area;
     touched_.clear();
   }
   out.backlog_cells = std::int64_t(active_.size());

@@ -546,12 +546,14 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
 
   // What happens to the cut soil (soil.hpp): vanish, or flow to the repose angle.
   if (const auto f = top.get("soil")) {
-    const Map soil(*f, {"model", "repose_deg", "max_pair_checks_per_step"});
+    const Map soil(*f, {"model", "repose_deg", "max_pair_checks_per_step", "edge"});
     if (const auto m = soil.get("model"))
       sc.soil.model = m->choice({SoilModel::kVanish, SoilModel::kFlow}, "soil model");
     if (const auto a = soil.get("repose_deg")) sc.soil.repose_deg = a->in_range(0.0, 80.0, yaml::Field::Ends::kOpenLow);
     if (const auto w = soil.get("max_pair_checks_per_step"))
       sc.soil.max_pair_checks_per_step = w->integer_in(1000, 1000000000);
+    if (const auto e = soil.get("edge"))
+      sc.soil.edge = e->choice({SoilEdge::kWall, SoilEdge::kOpen}, "soil edge");
   }
 
   // The other layers' sections (e.g. bodies:, haptics:), by their readers.

@@ -109,11 +109,11 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
     const SoilRunStats& s = *r.soil;
     out["soil"] = {{"model", "flow"},
                    {"repose_deg", sc.soil.repose_deg},
-                   {"edge", "wall"},
+                   {"edge", std::string(to_string(sc.soil.edge))},
                    {"volume_m3",
                     {{"initial", r.initial_volume_m3},
                      {"final", r.final_volume_m3},
-                     {"left_over_edge", 0.0},
+                     {"left_over_edge", s.left_over_edge_m3},
                      {"error", r.volume_error_m3}}},
                    {"displaced_volume_m3", s.displaced_volume_m3},
                    {"relaxation",
@@ -254,6 +254,7 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
       if (listening) listeners_s.push_back(out.timers.listeners_s);
       if (flow) {
         soil.displaced_volume_m3 += out.soil.displaced_volume_m3;
+        soil.left_over_edge_m3 += out.soil.left_over_edge_m3;
         soil.passes += out.soil.passes;
         soil.pair_checks += out.soil.pair_checks;
         soil.max_backlog_cells = std::max(soil.max_backlog_cells, out.soil.backlog_cells);
@@ -276,8 +277,9 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
   result.steps = done;
   result.final_volume_m3 = grid.volume_m3();
   result.max_sample_error_m = grid.conservation_error_m();
-  // With flow nothing vanishes: what was cut is still on the grid.
-  const double vanished_m3 = flow ? 0.0 : result.removed_volume_m3;
+  // With flow nothing vanishes: what was cut is still on the grid, or left
+  // it over an open edge.
+  const double vanished_m3 = flow ? soil.left_over_edge_m3 : result.removed_volume_m3;
   result.volume_error_m3 = result.initial_volume_m3 - result.final_volume_m3 - vanished_m3;
   result.contact_timing = timing_stats(contact_s);
   result.cut_timing = timing_stats(cut_s);

@@ -212,6 +212,59 @@ TEST(SoilFlow, WorkPerStepIsCappedAndTheBacklogCarriedOver) {
   EXPECT_NEAR(sum_heights(g), before, 1e-6 * before);
 }
 
+TEST(SoilFlow, AnOpenEdgeLetsSoilLeaveAndCountsIt) {
+  // A block of sand against the grid's edge: a wall keeps every bit of it,
+  // an open edge lets what slides past it go, and counts it.
+  const int n = 60;
+  std::vector<float> h(std::size_t(n) * n, 0.0f);
+  for (int r = 20; r < 40; ++r)
+    for (int c = 0; c < 12; ++c) h[std::size_t(r) * n + c] = 0.2f;
+  for (const SoilEdge edge : {SoilEdge::kWall, SoilEdge::kOpen}) {
+    HeightGrid g(square_grid(n, 0.01), h);
+    SoilFlowParams p = flow(34.0);
+    p.edge = edge;
+    SoilFlow f(p, g);
+    const double before = g.volume_m3();
+    double left = 0.0;
+    while (f.active_cells() > 0) left += f.relax(g).left_over_edge_m3;
+    if (edge == SoilEdge::kWall) {
+      EXPECT_EQ(left, 0.0);
+      EXPECT_NEAR(g.volume_m3(), before, 1e-6 * before);
+    } else {
+      EXPECT_GT(left, 0.05 * before);  // a good part slid off
+      EXPECT_NEAR(g.volume_m3() + left, before, 1e-6 * before);
+      // What is left at the edge stands at the repose angle against the
+      // bare ground beyond: at most tan(34) x a cell, plus the tolerance.
+      for (int r = 0; r < n; ++r)
+        EXPECT_LE(g.height(0, r), std::tan(34.0 * kDeg) * 0.01 * 1.02 + 1e-6) << r;
+    }
+  }
+  EXPECT_EQ(to_string(SoilEdge::kOpen), "open");
+}
+
+TEST(SoilDisplacement, APilePushedOffAnOpenEdgeIsCounted) {
+  // The blade pushes a 5 cm cut to within a few cells of the grid's far
+  // edge (z = 2 m): with an open edge what is pushed past it leaves.
+  SimParams params;
+  params.grid.cols = 100;
+  params.grid.rows = 200;
+  params.grid.size_x_m = 1.0;
+  params.grid.size_z_m = 2.0;
+  params.grid.full_scale_m = 1.0;
+  params.blade.length_m = 0.5;
+  params.soil = flow(34.0, 400000);
+  params.soil.edge = SoilEdge::kOpen;
+  Simulation sim(params, std::vector<float>(std::size_t(100) * 200, 0.2f));
+  const double before = sim.grid().volume_m3();
+  double left = 0.0;
+  const int steps = int(std::lround(0.5 / 0.0006));
+  for (int i = 0; i <= steps; ++i) {
+    left += sim.step({{0.5, 0.15, 1.45 + 0.5 * i / steps}, Quat{}}).soil.left_over_edge_m3;
+  }
+  EXPECT_GT(left, 0.0);
+  EXPECT_NEAR(sim.grid().volume_m3() + left, before, 1e-6 * before);
+}
+
 TEST(SoilFlow, RefusesBadParameters) {
   HeightGrid g(square_grid(4, 0.1), std::vector<float>(16, 0.1f));
   SoilFlowParams p = flow(0.0);

@@ -222,6 +222,10 @@ TEST(ScenarioSoil, TheSoilSectionChoosesTheModel) {
   expect_error(zero, line_of(zero, "repose_deg: 0"), "soil.repose_deg", "(0, 80]");
   const std::string mud = replace(text, "model: flow", "model: mud");
   expect_error(mud, line_of(mud, "model: mud"), "soil.model", "allowed: vanish, flow");
+  EXPECT_EQ(sc.soil.edge, SoilEdge::kWall);
+  EXPECT_EQ(parse_scenario(text + "  edge: open\n", "x.yaml").soil.edge, SoilEdge::kOpen);
+  const std::string edge = text + "  edge: cliff\n";
+  expect_error(edge, line_of(edge, "edge: cliff"), "soil.edge", "allowed: wall, open");
   const std::string typo = text + "  repose: 30\n";
   expect_error(typo, line_of(typo, "repose: 30"), "soil.repose", "unknown key");
 }

@@ -43,8 +43,9 @@
 // left active is carried to the next step (the backlog), so a large
 // collapse is spread over ticks and the 1 kHz loop keeps its millisecond.
 //
-// The rigid floor stays: heights never go below 0 (a flux moves at most an
-// eighth of a height difference). The grid's edge is a wall: no soil leaves.
+// The rigid floor stays: heights never go below 0. The grid's edge is a wall
+// (no soil leaves) or, with SoilEdge::kOpen, bare ground beyond which soil
+// slides or is pushed off the terrain, counted in left_over_edge_m3.
 #pragma once
 
 #include <cstdint>
@@ -68,6 +69,14 @@ std::string_view to_string(SoilModel model);
 /// Inverse of to_string; nullopt for anything else.
 std::optional<SoilModel> parse_soil_model(std::string_view name);
 
+/// What the grid's edge does to soil that reaches it.
+enum class SoilEdge {
+  kWall,  ///< no soil leaves the terrain (the default)
+  kOpen,  ///< soil sliding or pushed past the edge leaves it, and is counted
+};
+/// "wall" or "open".
+std::string_view to_string(SoilEdge edge);
+
 /// Soil parameters; read-only during a run.
 struct SoilFlowParams {
   SoilModel model = SoilModel::kVanish;
@@ -81,6 +90,8 @@ struct SoilFlowParams {
   /// The default, about 0.45 ms on a 2-core 2020s server, leaves a 1 kHz
   /// loop half its millisecond.
   std::int64_t max_pair_checks_per_step = 100000;
+  /// The grid's edge: a wall, or open (bare ground beyond it at height 0).
+  SoilEdge edge = SoilEdge::kWall;
 };
 
 /// Returns an empty string when params are valid, else a message naming the field.
@@ -93,6 +104,7 @@ struct SoilStepResult {
   std::int64_t pair_checks = 0;      ///< neighbour pairs examined
   std::int64_t moved_pairs = 0;      ///< pairs that exchanged soil
   std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
+  double left_over_edge_m3 = 0.0;    ///< soil that left over an open edge, m^3
   Rect changed{};                    ///< samples whose height the phase changed
 };
 

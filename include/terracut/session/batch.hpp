@@ -77,6 +77,7 @@ struct CutStats {
 /// What the soil phase did over a run (SoilModel::kFlow).
 struct SoilRunStats {
   double displaced_volume_m3 = 0.0;  ///< cut soil put down ahead of the blade, m^3
+  double left_over_edge_m3 = 0.0;    ///< soil that left over an open edge, m^3
   std::int64_t passes = 0;           ///< relaxation passes
   std::int64_t pair_checks = 0;      ///< neighbour pairs examined
   std::int64_t max_backlog_cells = 0;  ///< largest number of cells carried to the next step
@@ -92,7 +93,7 @@ struct RunResult {
   double removed_volume_m3 = 0.0;    ///< sum of every step's cut volume, m^3 (vanished with kVanish, moved with kFlow)
   double max_sample_error_m = 0.0;   ///< max over samples of |height + removed - initial|, metres
   /// initial - final - vanished, m^3 (vanished: the cut volume with
-  /// kVanish, 0 with kFlow, where nothing leaves the grid).
+  /// kVanish; with kFlow what left over an open edge, 0 with a wall).
   double volume_error_m3 = 0.0;
   std::vector<CutStats> cuts;        ///< one per entry of the sequence
   TimingStats contact_timing{};      ///< StepTimers::contact_s
