@@ -46,11 +46,7 @@ Stats stats_of(std::vector<double>& s, std::int64_t max_backlog) {
 Stats bulldoze(int side) {
   const double cell = 0.01;
   SimParams p;
-  p.grid.cols = side;
-  p.grid.rows = side;
-  p.grid.size_x_m = side * cell;
-  p.grid.size_z_m = side * cell;
-  p.grid.full_scale_m = 1.0;
+  p.grid = grid_of_cells(side, side, cell);
   p.blade.length_m = 2.0;
   p.soil.model = SoilModel::kFlow;
   Simulation sim(p, std::vector<float>(std::size_t(side) * side, 0.2f));
@@ -69,12 +65,7 @@ Stats bulldoze(int side) {
 
 Stats collapse() {
   const int side = 300;
-  GridSpec spec;
-  spec.cols = side;
-  spec.rows = side;
-  spec.size_x_m = side * 0.01;
-  spec.size_z_m = side * 0.01;
-  spec.full_scale_m = 1.0;
+  const GridSpec spec = grid_of_cells(side, side, 0.01);
   std::vector<float> h(std::size_t(side) * side, 0.0f);
   for (int r = 100; r < 200; ++r)
     for (int c = 100; c < 200; ++c) h[std::size_t(r) * side + c] = 0.5f;

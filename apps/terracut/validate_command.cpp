@@ -47,15 +47,6 @@ double deg(double radians) { return radians / kDeg; }
 
 // ---- Shared measurements ------------------------------------------------------
 
-GridSpec square_cells(int cols, int rows, double cell_m) {
-  GridSpec s;
-  s.cols = cols;
-  s.rows = rows;
-  s.size_x_m = cols * cell_m;
-  s.size_z_m = rows * cell_m;
-  s.full_scale_m = 1.0;
-  return s;
-}
 
 SoilFlowParams flow_params(double repose_deg) {
   SoilFlowParams p;
@@ -213,7 +204,7 @@ ConeResult run_cone(double repose_deg, const fs::path& dir) {
       if ((c - centre) * (c - centre) + (r - centre) * (r - centre) <=
           kColumnRadiusCells * kColumnRadiusCells)
         column[std::size_t(r) * n + c] = kColumnHeight_m;
-  HeightGrid g(square_cells(n, n, kConeCell_m), column);
+  HeightGrid g(grid_of_cells(n, n, kConeCell_m), column);
   ConeResult res;
   res.repose_deg = repose_deg;
   res.volume_before_m3 = g.volume_m3();
@@ -303,7 +294,7 @@ RampResult run_ramp(const std::string& name, double initial_deg, bool diagonal) 
       const double along = diagonal ? (c + r) * kRampCell_m / std::sqrt(2.0) : c * kRampCell_m;
       h[std::size_t(r) * n + c] = float(kRampBase_m + t * along);
     }
-  HeightGrid g(square_cells(n, n, kRampCell_m), h);
+  HeightGrid g(grid_of_cells(n, n, kRampCell_m), h);
   const double tallest = tallest_m(g);  // relaxing never raises the top
   RampResult res;
   res.name = name;
@@ -482,7 +473,7 @@ DozeResult run_doze(double width_m, const fs::path& dir) {
   res.rows = int(std::lround((kDozeStart_z_m + kDozePush_m + 0.6) / kDozeCell_m));
   res.x_centre_m = 0.5 * res.cols * kDozeCell_m;
   SimParams p;
-  p.grid = square_cells(res.cols, res.rows, kDozeCell_m);
+  p.grid = grid_of_cells(res.cols, res.rows, kDozeCell_m);
   p.blade.length_m = width_m;
   p.soil = flow_params(kDozeRepose);
   Simulation sim(p, std::vector<float>(std::size_t(res.cols) * res.rows, float(kDozeLayer_m)));

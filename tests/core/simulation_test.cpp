@@ -141,12 +141,7 @@ TEST(Simulation, SmallStepsCutEveryRowTheyCross) {
   // overlap, so no row is missed (before, 6 of 10 rows were never cut).
   for (const double origin : {-1.0, 0.0, 0.37}) {
     SimParams p;
-    p.grid.cols = 200;
-    p.grid.rows = 200;
-    p.grid.size_x_m = 2.0;
-    p.grid.size_z_m = 2.0;
-    p.grid.full_scale_m = 1.0;
-    p.grid.origin_m = {origin, 0.0, origin};
+    p.grid = grid_of_cells(200, 200, 0.01, {origin, 0.0, origin});
     p.blade.length_m = 0.4;
     for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
       p.representation = rep;

@@ -23,15 +23,6 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-GridSpec square_grid(int n, double cell_m) {
-  GridSpec s;
-  s.cols = n;
-  s.rows = n;
-  s.size_x_m = n * cell_m;
-  s.size_z_m = n * cell_m;
-  s.full_scale_m = 1.0;
-  return s;
-}
 
 SoilFlowParams flow(double repose_deg, std::int64_t checks = 200000) {
   SoilFlowParams p;
@@ -107,7 +98,7 @@ TEST(SoilFlow, AColumnCollapsesIntoARoundConeAtTheReposeAngle) {
   for (const double repose : {34.0, 45.0}) {
     const int n = 161;
     const double cell = 0.01;
-    HeightGrid g(square_grid(n, cell), column(n, 15.0, 0.4f));
+    HeightGrid g(grid_of_cells(n, n, cell), column(n, 15.0, 0.4f));
     const double before = sum_heights(g);
     SoilFlow f(flow(repose), g);
     EXPECT_GT(f.active_cells(), 0);  // the column's walls are too steep
@@ -147,7 +138,7 @@ TEST(SoilFlow, ASlopeBelowTheReposeAngleNeverMoves) {
         const double along = diagonal ? (c + r) * cell / std::sqrt(2.0) : c * cell;
         h[std::size_t(r) * n + c] = float(0.05 + slope * along);
       }
-    HeightGrid g(square_grid(n, cell), h);
+    HeightGrid g(grid_of_cells(n, n, cell), h);
     SoilFlow f(flow(34.0), g);
     EXPECT_EQ(f.active_cells(), 0) << diagonal;
     const SoilStepResult r = f.relax(g);
@@ -168,7 +159,7 @@ TEST(SoilFlow, DeterministicAndMirrorSymmetric) {
   for (int r = 0; r < n; ++r)
     for (int c = 0; c < n; ++c) mirrored[std::size_t(r) * n + c] = h[std::size_t(r) * n + (n - 1 - c)];
 
-  HeightGrid a(square_grid(n, 0.01), h), b(square_grid(n, 0.01), h), m(square_grid(n, 0.01), mirrored);
+  HeightGrid a(grid_of_cells(n, n, 0.01), h), b(grid_of_cells(n, n, 0.01), h), m(grid_of_cells(n, n, 0.01), mirrored);
   SoilFlow fa(flow(34.0), a), fb(flow(34.0), b), fm(flow(34.0), m);
   settle(fa, a);
   settle(fb, b);
@@ -188,7 +179,7 @@ TEST(SoilFlow, WorkPerStepIsCappedAndTheBacklogCarriedOver) {
   std::vector<float> h(std::size_t(n) * n, 0.0f);
   for (int r = 50; r < 150; ++r)
     for (int c = 50; c < 150; ++c) h[std::size_t(r) * n + c] = 0.5f;
-  HeightGrid g(square_grid(n, 0.01), h);
+  HeightGrid g(grid_of_cells(n, n, 0.01), h);
   const std::int64_t cap = 20000;
   SoilFlow f(flow(34.0, cap), g);
   const double before = sum_heights(g);
@@ -220,7 +211,7 @@ TEST(SoilFlow, AnOpenEdgeLetsSoilLeaveAndCountsIt) {
   for (int r = 20; r < 40; ++r)
     for (int c = 0; c < 12; ++c) h[std::size_t(r) * n + c] = 0.2f;
   for (const SoilEdge edge : {SoilEdge::kWall, SoilEdge::kOpen}) {
-    HeightGrid g(square_grid(n, 0.01), h);
+    HeightGrid g(grid_of_cells(n, n, 0.01), h);
     SoilFlowParams p = flow(34.0);
     p.edge = edge;
     SoilFlow f(p, g);
@@ -246,11 +237,7 @@ TEST(SoilDisplacement, APilePushedOffAnOpenEdgeIsCounted) {
   // The blade pushes a 5 cm cut to within a few cells of the grid's far
   // edge (z = 2 m): with an open edge what is pushed past it leaves.
   SimParams params;
-  params.grid.cols = 100;
-  params.grid.rows = 200;
-  params.grid.size_x_m = 1.0;
-  params.grid.size_z_m = 2.0;
-  params.grid.full_scale_m = 1.0;
+  params.grid = grid_of_cells(100, 200, 0.01);
   params.blade.length_m = 0.5;
   params.soil = flow(34.0, 400000);
   params.soil.edge = SoilEdge::kOpen;
@@ -266,7 +253,7 @@ TEST(SoilDisplacement, APilePushedOffAnOpenEdgeIsCounted) {
 }
 
 TEST(SoilFlow, RefusesBadParameters) {
-  HeightGrid g(square_grid(4, 0.1), std::vector<float>(16, 0.1f));
+  HeightGrid g(grid_of_cells(4, 4, 0.1), std::vector<float>(16, 0.1f));
   SoilFlowParams p = flow(0.0);
   EXPECT_NE(validate(p).find("soil.repose_deg"), std::string::npos);
   EXPECT_THROW(SoilFlow(p, g), InputError);
@@ -287,11 +274,7 @@ struct Dozing {
   std::unique_ptr<Simulation> sim;
 
   explicit Dozing(SoilModel model) {
-    params.grid.cols = 200;
-    params.grid.rows = 200;
-    params.grid.size_x_m = 2.0;
-    params.grid.size_z_m = 2.0;
-    params.grid.full_scale_m = 1.0;
+    params.grid = grid_of_cells(200, 200, 0.01);
     params.blade.length_m = 1.0;
     params.soil = flow(34.0, 400000);
     params.soil.model = model;

@@ -10,18 +10,8 @@
 namespace terracut::haptics {
 namespace {
 
-GridSpec grid_1cm(int n) {
-  GridSpec s;
-  s.cols = n;
-  s.rows = n;
-  s.size_x_m = n * 0.01;
-  s.size_z_m = n * 0.01;
-  s.full_scale_m = 1.0;
-  return s;
-}
-
 TEST(CutDepth, WithoutAPileTheDepthIsTheDepthAhead) {
-  HeightGrid g(grid_1cm(100), std::vector<float>(100 * 100, 0.2f));
+  HeightGrid g(grid_of_cells(100, 100, 0.01), std::vector<float>(100 * 100, 0.2f));
   const Segment edge{{0.3, 0.15, 0.4}, {0.7, 0.15, 0.4}};
   const Vec3 v{0.0, 0.0, 0.5};
   const double look = depth_lookahead_m(g.spec());
@@ -36,7 +26,7 @@ TEST(CutDepth, APileAheadIsNotDepthButSurchargeHeight) {
   // edge (from z = 0.40 m on, the edge at 0.40), over more than the failure
   // wedge's length.
   std::vector<float> initial(100 * 100, 0.2f);
-  HeightGrid g(grid_1cm(100), initial);
+  HeightGrid g(grid_of_cells(100, 100, 0.01), initial);
   std::vector<float> piled(100 * 100, 0.2f);
   for (int r = 40; r < 100; ++r)
     for (int c = 0; c < 100; ++c) piled[std::size_t(r) * 100 + c] = 0.3f;

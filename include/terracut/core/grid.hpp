@@ -47,6 +47,20 @@ inline constexpr std::int64_t kMaxGridSamples = std::int64_t(1) << 30;
 /// Returns an empty string when spec is valid, else a message naming the bad field.
 std::string validate(const GridSpec& spec);
 
+/// A grid of cols x rows square cells of side cell_m, metres, its origin
+/// corner at origin_m, a white pixel full_scale_m high.
+inline GridSpec grid_of_cells(int cols, int rows, double cell_m, Vec3 origin_m = {},
+                              double full_scale_m = 1.0) {
+  GridSpec s;
+  s.cols = cols;
+  s.rows = rows;
+  s.size_x_m = cols * cell_m;
+  s.size_z_m = rows * cell_m;
+  s.origin_m = origin_m;
+  s.full_scale_m = full_scale_m;
+  return s;
+}
+
 /// A half-open rectangle of samples [c0, c1) x [r0, r1); empty when c0 >= c1 or r0 >= r1.
 struct Rect {
   int c0 = 0;
