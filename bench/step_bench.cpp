@@ -7,7 +7,8 @@
 // 0.1 m above the ground, through a plane of material 0.2 m high with a
 // +-0.02 m undulation, so the whole blade is inside material on every step.
 // When the blade reaches the far side the terrain is restored and the blade
-// put down again (untimed).
+// put down again (untimed). The direction and tilt cases move the blade
+// along its own normal instead, across the middle of the terrain.
 //
 // Each step is timed on its own (steady_clock, manual timing), so the JSON
 // carries per-step percentiles as counters: p50_us, p99_us, max_us, plus
@@ -24,6 +25,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -46,6 +48,13 @@ constexpr double kBruteForceLimitS = 1.0;   // brute-force sides whose step woul
 // Runs of the cases with targets: the table takes the median run, which
 // keeps a burst of other work on a shared machine from deciding a figure.
 constexpr int kRepetitions = 3;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+// Blades of the direction cases: 0.7 of the side, so that the footprint
+// fits the terrain at any yaw with room to travel.
+constexpr double kDirectionBladeFraction = 0.7;
+// Blade of the tilt cases, cells: short enough that a 20-degree tilt keeps
+// both ends inside the material and above the floor.
+constexpr double kTiltBladeCells = 400.0;
 
 /// One benchmark case.
 struct Case {
@@ -56,6 +65,10 @@ struct Case {
   bool brute_force = false;  ///< step with the paper's algorithm instead of the traversal
   int steps = 0;             ///< timed steps
   int warmup_steps = 0;      ///< untimed steps before them
+  /// Moves along the blade's own normal (as a blade works) across the
+  /// middle of the terrain, instead of along +Z; blade_cells must be set.
+  bool along_normal = false;
+  double tilt_deg = 0.0;  ///< blade rotation about its direction of travel (before the yaw)
 };
 
 /// A plane of material with a smooth undulation (separable, cheap to build at 8192^2).
@@ -89,30 +102,46 @@ class Runner {
  public:
   explicit Runner(const Case& c)
       : case_(c), sim_(params_for(c), plane_terrain(c.side)) {
-    double yaw = c.yaw_deg * std::numbers::pi / 180.0;
-    orientation_ = quat_from_axis_angle({0.0, 1.0, 0.0}, yaw);
-    double size = c.side * kCellM;
-    double half_extent_z = 0.5 * sim_.params().blade.length_m * std::abs(std::sin(yaw));
-    z_lo_ = half_extent_z + 2.0 * kCellM;
-    z_hi_ = std::max(z_lo_ + kTravelPerStepM, size - half_extent_z - 2.0 * kCellM);
-    x_ = 0.5 * size;
-    z_ = z_lo_;
+    const double deg = std::numbers::pi / 180.0;
+    const Quat yaw = quat_from_axis_angle({0.0, 1.0, 0.0}, c.yaw_deg * deg);
+    orientation_ = yaw * quat_from_axis_angle({0.0, 0.0, 1.0}, c.tilt_deg * deg);
+    const double size = c.side * kCellM, margin = 2.0 * kCellM;
+    // The blade's footprint half extents.
+    const Vec3 half = rotate(orientation_, {0.5 * sim_.params().blade.length_m, 0.0, 0.0});
+    const double hx = std::abs(half.x), hz = std::abs(half.z);
+    if (c.along_normal) {
+      // Across the middle along the normal, as far as the footprint stays on the terrain.
+      travel_ = rotate(yaw, {0.0, 0.0, 1.0});
+      origin_ = {0.5 * size, 0.0, 0.5 * size};
+      double reach = kInfinity;
+      if (std::abs(travel_.x) > 1e-9) reach = std::min(reach, (0.5 * size - margin - hx) / std::abs(travel_.x));
+      if (std::abs(travel_.z) > 1e-9) reach = std::min(reach, (0.5 * size - margin - hz) / std::abs(travel_.z));
+      s_lo_ = -reach;
+      s_hi_ = std::max(s_lo_ + kTravelPerStepM, reach);
+    } else {
+      travel_ = {0.0, 0.0, 1.0};
+      origin_ = {0.5 * size, 0.0, 0.0};
+      s_lo_ = hz + margin;
+      s_hi_ = std::max(s_lo_ + kTravelPerStepM, size - hz - margin);
+    }
+    s_ = s_lo_;
   }
 
   /// Moves the blade one step forward; at the far side restores the terrain
   /// and puts the blade down at the start again. Untimed.
   void advance() {
-    z_ += kTravelPerStepM;
-    if (z_ > z_hi_) {
+    s_ += kTravelPerStepM;
+    if (s_ > s_hi_) {
       sim_.reset();
       has_previous_ = false;
-      z_ = z_lo_;
+      s_ = s_lo_;
     }
   }
 
   /// One step at the current pose; returns the cells examined.
   std::int64_t step() {
-    BladePose pose{{x_, kBladeYM, z_}, orientation_};
+    const Vec3 centre = origin_ + travel_ * s_;
+    BladePose pose{{centre.x, kBladeYM, centre.z}, orientation_};
     if (!case_.brute_force) {
       const StepOutput& o = sim_.step(pose);
       last_contact_s_ = o.timers.contact_s;
@@ -138,7 +167,8 @@ class Runner {
   Case case_;
   Simulation sim_;
   Quat orientation_{};
-  double x_ = 0.0, z_ = 0.0, z_lo_ = 0.0, z_hi_ = 0.0;
+  Vec3 origin_{}, travel_{};  ///< the blade's centre is origin_ + travel_ * s_ (ground plane)
+  double s_ = 0.0, s_lo_ = 0.0, s_hi_ = 0.0;
   Segment previous_{};
   bool has_previous_ = false;
   double last_contact_s_ = 0.0, last_cut_s_ = 0.0;
@@ -267,6 +297,25 @@ void register_all() {
       Case c{rep, 4096, 0.0, yaw, false, 5000, 300};
       std::string name = std::string("headline/") + rep_name(rep) + "/yaw:" + std::to_string(int(yaw)) +
                          "/side:4096";
+      benchmark::RegisterBenchmark(name.c_str(), bm_steps, c)
+          ->Iterations(c.steps)->Repetitions(kRepetitions)->UseManualTime()->Unit(benchmark::kMicrosecond);
+    }
+  }
+  // (a2) Every direction: a blade of 0.7 x the side moving along its own
+  // normal across the middle of 4096^2, at several yaws, and a tilted blade
+  // (rotated about its travel) against the same blade level.
+  for (Representation rep : reps) {
+    for (double yaw : {0.0, 10.0, 30.0, 45.0, 60.0, 90.0}) {
+      Case c{rep, 4096, kDirectionBladeFraction * 4096, yaw, false, 4000, 300, true};
+      std::string name = std::string("direction/") + rep_name(rep) + "/yaw:" + std::to_string(int(yaw)) +
+                         "/side:4096";
+      benchmark::RegisterBenchmark(name.c_str(), bm_steps, c)
+          ->Iterations(c.steps)->Repetitions(kRepetitions)->UseManualTime()->Unit(benchmark::kMicrosecond);
+    }
+    for (double tilt : {0.0, 20.0}) {
+      Case c{rep, 4096, kTiltBladeCells, 0.0, false, 4000, 300, true, tilt};
+      std::string name = std::string("tilt/") + rep_name(rep) + "/tilt:" + std::to_string(int(tilt)) +
+                         "/blade:400/side:4096";
       benchmark::RegisterBenchmark(name.c_str(), bm_steps, c)
           ->Iterations(c.steps)->Repetitions(kRepetitions)->UseManualTime()->Unit(benchmark::kMicrosecond);
     }

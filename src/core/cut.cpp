@@ -46,6 +46,20 @@ struct RowChange {
   int visited = 0;
 };
 
+/// HeightGrid::lower for sample c of the row starting at index row, with
+/// target t (metres above the ground), booked in change (first and last
+/// sample, removed height; not visited, which the caller counts).
+inline void lower_one(const HeightGrid::EditLayers& layers, std::int64_t row, int c, float t, RowChange& change) {
+  float h = t > 0.0f ? t : 0.0f;
+  float old = layers.height_m[row + c];
+  if (!(h < old)) return;
+  layers.height_m[row + c] = h;
+  layers.removed_m[row + c] = layers.initial_m[row + c] - h;
+  change.removed_m += double(old - h);
+  if (change.first < 0) change.first = c;
+  change.last = c;
+}
+
 /// What a cut has changed so far: height removed (sum over samples, metres),
 /// the rectangle of changed samples (as plain inclusive bounds), samples
 /// examined. Kept as a local of each rasteriser so that it stays in registers.
@@ -175,17 +189,7 @@ inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& f
     // moves obliquely): inline, without the batch machinery.
     float t[kSmallSpan];
     fill(c_lo, change.visited, t);
-    for (int k = 0; k < change.visited; ++k) {
-      int c = c_lo + k;
-      float h = t[k] > 0.0f ? t[k] : 0.0f;
-      float old = height[c];
-      if (!(h < old)) continue;
-      height[c] = h;
-      removed[c] = initial[c] - h;
-      change.removed_m += double(old - h);
-      if (change.first < 0) change.first = c;
-      change.last = c;
-    }
+    for (int k = 0; k < change.visited; ++k) lower_one(layers, row, c_lo + k, t[k], change);
     return change;
   }
   // Ask for the row's first cache lines in the three layers at once, so that
@@ -489,10 +493,20 @@ struct ObliqueSweep {
 /// Rows crossed from which a translation takes the parallelogram walk.
 constexpr double kObliqueMinRows = 8.0;
 
-/// Sets up the parallelogram walk; false when the sweep is not a translation
-/// crossing at least kObliqueMinRows rows with a well-shaped footprint (then
-/// the triangles' walk takes it).
-bool setup_oblique(const GridFrame& f, const Segment& from, const Segment& to, ObliqueSweep& w) {
+/// A sweep that is a translation, as a parallelogram: its vertices (from.a,
+/// from.b, to.b, to.a, heights relative to the ground) and its plane,
+/// y = v[0].y + slope_x (x - v[0].x) + slope_z (z - v[0].z).
+struct Parallelogram {
+  Point v[4];
+  bool ccw = false;  ///< counter-clockwise seen with x right and z up
+  double slope_x = 0.0, slope_z = 0.0;
+  double zmin = 0.0, zmax = 0.0;
+};
+
+/// The sweep as a parallelogram; false when it is not a translation crossing
+/// at least kObliqueMinRows rows with a well-shaped footprint (then the
+/// triangles' walk takes it).
+bool translation_parallelogram(const GridFrame& f, const Segment& from, const Segment& to, Parallelogram& p) {
   Vec3 e = from.b - from.a, e_to = to.b - to.a, sh = to.a - from.a;
   double e_len = std::abs(e.x) + std::abs(e.y) + std::abs(e.z);
   Vec3 de = e_to - e;
@@ -501,29 +515,42 @@ bool setup_oblique(const GridFrame& f, const Segment& from, const Segment& to, O
   double det = e.x * sh.z - e.z * sh.x;
   if (!(std::abs(det) > 1e-6 * (std::abs(e.x * sh.z) + std::abs(e.z * sh.x)))) return false;
   const Vec3 v[4] = {from.a, from.b, to.b, to.a};
-  double zmin = v[0].z, zmax = v[0].z;
-  for (const Vec3& p : v) {
-    zmin = std::min(zmin, p.z);
-    zmax = std::max(zmax, p.z);
+  p.zmin = v[0].z, p.zmax = v[0].z;
+  for (int k = 0; k < 4; ++k) {
+    p.v[k] = {v[k].x, v[k].y - f.ground_y, v[k].z};
+    p.zmin = std::min(p.zmin, v[k].z);
+    p.zmax = std::max(p.zmax, v[k].z);
   }
-  if (!((zmax - zmin) * f.inv_cz >= kObliqueMinRows)) return false;
+  if (!((p.zmax - p.zmin) * f.inv_cz >= kObliqueMinRows)) return false;
+  p.ccw = det > 0.0;
+  // The plane spanned by the edge and the shift.
+  p.slope_x = (e.y * sh.z - e.z * sh.y) / det;
+  p.slope_z = (e.x * sh.y - e.y * sh.x) / det;
+  return std::isfinite(p.slope_x) && std::isfinite(p.slope_z);
+}
+
+/// The parallelogram's section bounds in w (see ObliqueSweep), in grid
+/// coordinates u = (x - x0) / cx - centre and rd = (z - z0) / cz - centre:
+/// centre 0.5 puts sample c's centre at u = c (surface), centre 0 puts cell
+/// c at [c, c + 1] (columns). False when a side is nearly along a row.
+bool set_section_bounds(const GridFrame& f, const Parallelogram& p, double centre, ObliqueSweep& w) {
   // Sides going up in z bound the section from one side, sides going down
   // from the other (which is which depends on the winding); sides along a
   // row lie at the footprint's lowest or highest z and bound only the rows.
-  bool ccw = det > 0.0;
   int n_lo = 0, n_hi = 0;
   for (int k = 0; k < 4; ++k) {
-    const Vec3& p = v[k];
-    const Vec3& q = v[(k + 1) % 4];
-    double dz = q.z - p.z;
-    if (dz == 0.0) continue;
-    if (std::abs(dz) < 1e-9 * f.cz) return false;  // nearly along a row: left to the triangles
-    double u_p = (p.x - f.x0) * f.inv_cx - 0.5;
-    double rd_p = (p.z - f.z0) * f.inv_cz - 0.5;
-    double u_k = (q.x - p.x) / dz * f.cz * f.inv_cx;
-    // Counter-clockwise seen with x right and z up, the inside is left of
-    // each side: a side going up bounds x from above.
-    if ((dz > 0.0) == ccw) {
+    const Point& a = p.v[k];
+    const Point& b = p.v[(k + 1) % 4];
+    double dz = b.z - a.z;
+    // A side along a row, or within rounding of one (a yaw of 90 degrees
+    // leaves cos(pi/2) ~ 6e-17 in the shift), bounds only the rows.
+    if (!(std::abs(dz) >= 1e-9 * f.cz)) continue;
+    double u_p = (a.x - f.x0) * f.inv_cx - centre;
+    double rd_p = (a.z - f.z0) * f.inv_cz - centre;
+    double u_k = (b.x - a.x) / dz * f.cz * f.inv_cx;
+    // Counter-clockwise, the inside is left of each side: a side going up
+    // bounds x from above.
+    if ((dz > 0.0) == p.ccw) {
       if (n_hi == ObliqueSweep::kBounds) return false;
       w.hi_u[n_hi] = u_p, w.hi_r[n_hi] = rd_p, w.hi_k[n_hi++] = u_k;
     } else {
@@ -534,17 +561,20 @@ bool setup_oblique(const GridFrame& f, const Segment& from, const Segment& to, O
   if (n_lo == 0 || n_hi == 0) return false;
   for (; n_lo < ObliqueSweep::kBounds; ++n_lo) w.lo_u[n_lo] = -kInf, w.lo_r[n_lo] = 0.0, w.lo_k[n_lo] = 0.0;
   for (; n_hi < ObliqueSweep::kBounds; ++n_hi) w.hi_u[n_hi] = kInf, w.hi_r[n_hi] = 0.0, w.hi_k[n_hi] = 0.0;
-  // The plane through from.a spanned by the edge and the shift: y = y_a +
-  // slope_x (x - x_a) + slope_z (z - z_a), heights relative to the ground.
-  double slope_x = (e.y * sh.z - e.z * sh.y) / det;
-  double slope_z = (e.x * sh.y - e.y * sh.x) / det;
-  double y_origin = (from.a.y - f.ground_y) + slope_x * (f.x0 + 0.5 * f.cx - from.a.x) +
-                    slope_z * (f.z0 + 0.5 * f.cz - from.a.z);
+  return true;
+}
+
+/// Sets up the parallelogram walk of the surface representation.
+bool setup_oblique(const GridFrame& f, const Parallelogram& p, ObliqueSweep& w) {
+  if (!set_section_bounds(f, p, 0.5, w)) return false;
+  // The plane at sample centres: y = base0 + rd * base_k + c * step.
+  double y_origin = p.v[0].y + p.slope_x * (f.x0 + 0.5 * f.cx - p.v[0].x) +
+                    p.slope_z * (f.z0 + 0.5 * f.cz - p.v[0].z);
   w.base0 = y_origin;
-  w.base_k = slope_z * f.cz;
-  w.step = slope_x * f.cx;
-  w.r_lo = ceil_clamped((zmin - f.z0) * f.inv_cz - 0.5, 0, f.rows);
-  w.r_hi = floor_clamped((zmax - f.z0) * f.inv_cz - 0.5, -1, f.rows - 1);
+  w.base_k = p.slope_z * f.cz;
+  w.step = p.slope_x * f.cx;
+  w.r_lo = ceil_clamped((p.zmin - f.z0) * f.inv_cz - 0.5, 0, f.rows);
+  w.r_hi = floor_clamped((p.zmax - f.z0) * f.inv_cz - 0.5, -1, f.rows - 1);
   return std::isfinite(w.base0) && std::isfinite(w.base_k) && std::isfinite(w.step);
 }
 
@@ -553,9 +583,6 @@ bool setup_oblique(const GridFrame& f, const Segment& from, const Segment& to, O
 void cut_oblique_points(HeightGrid& grid, const GridFrame& f, const ObliqueSweep& w, CutBook& book) {
   CutBook rows;  // a local, so that its fields stay in registers
   const HeightGrid::EditLayers layers = grid.edit_layers();
-  float* height = layers.height_m;
-  float* removed = layers.removed_m;
-  const float* initial = layers.initial_m;
   const double step = w.step;
   for (int r = w.r_lo; r <= w.r_hi; ++r) {
     double rd = r;
@@ -569,27 +596,17 @@ void cut_oblique_points(HeightGrid& grid, const GridFrame& f, const ObliqueSweep
     }
     int c_lo = ceil_clamped(lo, 0, f.cols);
     int c_hi = floor_clamped(hi, -1, f.cols - 1);
-    if (c_lo > c_hi) continue;
     double base = w.base0 + rd * w.base_k;
+    if (c_lo > c_hi) continue;
     if (c_hi - c_lo >= kSmallSpan) {
       rows.add(r, lower_row(grid, r, c_lo, c_hi, linear_targets(base, step)));
       continue;
     }
-    // A sample or few: inline, as lower_row's small path.
+    // A few samples: inline, as lower_row's small path.
     const std::int64_t row = grid.index(0, r);
     RowChange change;
     change.visited = c_hi - c_lo + 1;
-    for (int c = c_lo; c <= c_hi; ++c) {
-      float t = float(base + double(c) * step);
-      float h = t > 0.0f ? t : 0.0f;
-      float old = height[row + c];
-      if (!(h < old)) continue;
-      height[row + c] = h;
-      removed[row + c] = initial[row + c] - h;
-      change.removed_m += double(old - h);
-      if (change.first < 0) change.first = c;
-      change.last = c;
-    }
+    for (int c = c_lo; c <= c_hi; ++c) lower_one(layers, row, c, float(base + double(c) * step), change);
     rows.add(r, change);
   }
   book.add(rows);
@@ -810,6 +827,129 @@ void cut_sweep_columns(HeightGrid& grid, const GridFrame& f, const Vec3 (&tris)[
   book.add(rows);
 }
 
+/// Columns representation, a translation across many rows: the
+/// parallelogram's cells row by row, each cell lowered to the plane's lowest
+/// point over the parallelogram's part in the (closed) cell, found without
+/// building the row's polygon. In grid units (cell c spans u in [c, c + 1],
+/// row r spans v in [r, r + 1]) the part of the parallelogram in row r is a
+/// convex polygon Q; the plane's height Y = y0 + gu u + gv v is linear, so
+/// its lowest point over Q is a vertex of Q (u_star, y_min), and over the
+/// part of Q in cell c it is that vertex when u_star lies in [c, c + 1], and
+/// otherwise on the cell's side line nearer to it (a linear function over a
+/// convex set cut by a line through it: when the unconstrained minimum is
+/// beyond the line, a constrained one is on it). On a side line u = U the
+/// part of Q is a chord from its lower chain to its upper chain (each the
+/// envelope of the parallelogram's sides facing that way, clipped to the
+/// row), and Y along it is lowest at the end gv points away from.
+struct ColumnsOblique {
+  ObliqueSweep bounds;  ///< the section's u bounds against v (centre 0)
+  static constexpr int kChains = 3;
+  /// Lower and upper chains, v(u) = v_p + (u - u_p) k, padded with lines at
+  /// -inf (lower) and +inf (upper).
+  double low_u[kChains], low_v[kChains], low_k[kChains];
+  double up_u[kChains], up_v[kChains], up_k[kChains];
+  double vert_u[4], vert_v[4];  ///< the parallelogram's vertices
+  double y0 = 0.0, gu = 0.0, gv = 0.0;
+  double vmin = 0.0, vmax = 0.0;
+  int r_lo = 0, r_hi = -1;
+};
+
+bool setup_oblique_columns(const GridFrame& f, const Parallelogram& p, ColumnsOblique& w) {
+  if (!set_section_bounds(f, p, 0.0, w.bounds)) return false;
+  int n_low = 0, n_up = 0;
+  for (int k = 0; k < 4; ++k) {
+    const Point& a = p.v[k];
+    const Point& b = p.v[(k + 1) % 4];
+    w.vert_u[k] = (a.x - f.x0) * f.inv_cx;
+    w.vert_v[k] = (a.z - f.z0) * f.inv_cz;
+    double du = (b.x - a.x) * f.inv_cx;
+    // A side along a column, or within rounding of one, bounds only the
+    // section's ends (the section bounds above hold it).
+    if (!(std::abs(du) >= 1e-9)) continue;
+    double u_p = (a.x - f.x0) * f.inv_cx, v_p = (a.z - f.z0) * f.inv_cz;
+    double k_uv = (b.z - a.z) * f.inv_cz / du;
+    // Counter-clockwise, the inside is left of each side: a side going
+    // towards +x has the inside above it (it is on the lower chain).
+    if ((du > 0.0) == p.ccw) {
+      if (n_low == ColumnsOblique::kChains) return false;
+      w.low_u[n_low] = u_p, w.low_v[n_low] = v_p, w.low_k[n_low++] = k_uv;
+    } else {
+      if (n_up == ColumnsOblique::kChains) return false;
+      w.up_u[n_up] = u_p, w.up_v[n_up] = v_p, w.up_k[n_up++] = k_uv;
+    }
+  }
+  for (; n_low < ColumnsOblique::kChains; ++n_low) w.low_u[n_low] = 0.0, w.low_v[n_low] = -kInf, w.low_k[n_low] = 0.0;
+  for (; n_up < ColumnsOblique::kChains; ++n_up) w.up_u[n_up] = 0.0, w.up_v[n_up] = kInf, w.up_k[n_up] = 0.0;
+  w.gu = p.slope_x * f.cx;
+  w.gv = p.slope_z * f.cz;
+  w.y0 = p.v[0].y + p.slope_x * (f.x0 - p.v[0].x) + p.slope_z * (f.z0 - p.v[0].z);
+  w.vmin = (p.zmin - f.z0) * f.inv_cz;
+  w.vmax = (p.zmax - f.z0) * f.inv_cz;
+  w.r_lo = std::max(0, ceil_clamped(w.vmin, 0, f.rows + 1) - 1);
+  w.r_hi = floor_clamped(w.vmax, -1, f.rows - 1);
+  return std::isfinite(w.y0) && std::isfinite(w.gu) && std::isfinite(w.gv);
+}
+
+void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsOblique& w, CutBook& book) {
+  CutBook rows;  // a local, so that its fields stay in registers
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  const ObliqueSweep& b = w.bounds;
+  const bool low_end = w.gv >= 0.0;  // Y along a chord is lowest at its lower end
+  for (int r = w.r_lo; r <= w.r_hi; ++r) {
+    const double va = std::max(double(r), w.vmin), vb = std::min(double(r) + 1.0, w.vmax);
+    if (va > vb) continue;
+    // Q's vertices: the section's ends at va and vb, and the
+    // parallelogram's vertices strictly between.
+    double cand_u[8], cand_v[8];
+    int n = 0;
+    for (double v : {va, vb}) {
+      double lo = b.lo_u[0] + (v - b.lo_r[0]) * b.lo_k[0];
+      double hi = b.hi_u[0] + (v - b.hi_r[0]) * b.hi_k[0];
+      for (int k = 1; k < ObliqueSweep::kBounds; ++k) {
+        lo = std::max(lo, b.lo_u[k] + (v - b.lo_r[k]) * b.lo_k[k]);
+        hi = std::min(hi, b.hi_u[k] + (v - b.hi_r[k]) * b.hi_k[k]);
+      }
+      cand_u[n] = lo, cand_v[n++] = v;
+      cand_u[n] = hi, cand_v[n++] = v;
+    }
+    for (int k = 0; k < 4; ++k) {
+      if (w.vert_v[k] > va && w.vert_v[k] < vb) cand_u[n] = w.vert_u[k], cand_v[n++] = w.vert_v[k];
+    }
+    double umin = cand_u[0], umax = cand_u[0], u_star = cand_u[0];
+    double y_min = w.y0 + w.gu * cand_u[0] + w.gv * cand_v[0];
+    for (int k = 1; k < n; ++k) {
+      umin = std::min(umin, cand_u[k]);
+      umax = std::max(umax, cand_u[k]);
+      double y = w.y0 + w.gu * cand_u[k] + w.gv * cand_v[k];
+      if (y < y_min) y_min = y, u_star = cand_u[k];
+    }
+    const int c_lo = std::max(0, ceil_clamped(umin, 0, f.cols + 1) - 1);
+    const int c_hi = floor_clamped(umax, -1, f.cols - 1);
+    if (c_lo > c_hi) continue;
+    // The lowest Y on the chord of Q at u = U (U within Q's extent).
+    auto chord_min = [&](double U) {
+      double v;
+      if (low_end) {
+        v = va;
+        for (int k = 0; k < ColumnsOblique::kChains; ++k) v = std::max(v, w.low_v[k] + (U - w.low_u[k]) * w.low_k[k]);
+      } else {
+        v = vb;
+        for (int k = 0; k < ColumnsOblique::kChains; ++k) v = std::min(v, w.up_v[k] + (U - w.up_u[k]) * w.up_k[k]);
+      }
+      return w.y0 + w.gu * U + w.gv * v;
+    };
+    const std::int64_t row = grid.index(0, r);
+    RowChange change;
+    change.visited = c_hi - c_lo + 1;
+    for (int c = c_lo; c <= c_hi; ++c) {
+      double lowest = u_star < c ? chord_min(c) : u_star > c + 1 ? chord_min(c + 1) : y_min;
+      lower_one(layers, row, c, float(lowest), change);
+    }
+    rows.add(r, change);
+  }
+  book.add(rows);
+}
+
 /// Prefetch hints for the samples along the edge where the blade would be
 /// a step from now if it kept its motion (to + (to - from)): on a terrain
 /// larger than the caches the next step's cut and contact then find their
@@ -852,9 +992,15 @@ CutResult cut_sweep(HeightGrid& grid, Representation representation, const Segme
     }
   };
   ObliqueSweep oblique;
+  ColumnsOblique oblique_columns;
+  Parallelogram parallelogram;
   if (detail::sweep_above_floor(from, to, f.ground_y)) {
-    if (representation == Representation::kSurface && setup_oblique(f, from, to, oblique)) {
+    bool translation = translation_parallelogram(f, from, to, parallelogram);
+    if (translation && representation == Representation::kSurface && setup_oblique(f, parallelogram, oblique)) {
       cut_oblique_points(grid, f, oblique, book);
+    } else if (translation && representation == Representation::kColumns &&
+               setup_oblique_columns(f, parallelogram, oblique_columns)) {
+      cut_oblique_columns(grid, f, oblique_columns, book);
     } else {
       Vec3 tri[2][3];
       detail::sweep_triangles(from, to, tri);

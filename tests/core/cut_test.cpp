@@ -268,8 +268,8 @@ TEST(Cut, TraversalEqualsBruteForceOnRandomCases) {
 }
 
 // Long blades translated obliquely across many sample rows (the case the
-// surface cut's parallelogram fast path handles) cut exactly what the brute
-// force cuts.
+// parallelogram walks of both representations handle) cut exactly what the
+// brute force cuts.
 TEST(Cut, ObliqueTranslationsEqualBruteForce) {
   std::mt19937 rng(31);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -292,6 +292,40 @@ TEST(Cut, ObliqueTranslationsEqualBruteForce) {
     }
     for (std::int64_t i = 0; i < s.sample_count(); ++i)
       ASSERT_NEAR(fast.heights()[i], slow.heights()[i], 1e-6) << to_string(rep) << " sample " << i;
+  }
+}
+
+// Blades turned by a quaternion to the grid's axes and diagonals (yaw 90
+// degrees leaves cos(pi/2) ~ 6e-17 in the edge, a side "nearly along a
+// row"), moving along their normal a fraction of a cell per step as a
+// haptic hand does: the parallelogram walks take them and cut what the
+// brute force cuts, step after step.
+TEST(Cut, AxisAndDiagonalTranslationsEqualBruteForce) {
+  GridSpec s = test::square_spec(64, 64, 1.0, 1.0);
+  std::vector<float> h(size_t(s.sample_count()));
+  for (int r = 0; r < s.rows; ++r)
+    for (int c = 0; c < s.cols; ++c) h[size_t(r * s.cols + c)] = float(0.4 + 0.05 * std::sin(0.3 * c + 0.2 * r));
+  for (Representation rep : kBoth) {
+    for (double yaw_deg : {90.0, 270.0, 45.0, 135.0, 180.0}) {
+      HeightGrid fast(s, h), slow(s, h);
+      const Quat q = quat_from_axis_angle({0.0, 1.0, 0.0}, yaw_deg * std::numbers::pi / 180.0);
+      const Vec3 half = rotate(q, {0.3, 0.0, 0.0}), normal = rotate(q, {0.0, 0.0, 1.0});
+      Vec3 centre{0.5, 0.38, 0.5};
+      centre = centre - normal * 0.1;
+      Segment from{centre - half, centre + half};
+      for (int k = 0; k < 60; ++k) {
+        // 0.37 cells per step, slightly descending: a plane, not a level cut.
+        const Vec3 shift = normal * (0.37 / 64.0) + Vec3{0.0, -0.0004, 0.0};
+        const Segment to{from.a + shift, from.b + shift};
+        CutResult a = cut_sweep(fast, rep, from, to);
+        CutResult b = cut_sweep_brute_force(slow, rep, from, to);
+        ASSERT_NEAR(a.removed_volume_m3, b.removed_volume_m3, 1e-7) << to_string(rep) << " yaw " << yaw_deg << " k " << k;
+        from = to;
+      }
+      for (std::int64_t i = 0; i < s.sample_count(); ++i)
+        ASSERT_NEAR(fast.heights()[i], slow.heights()[i], kFloatTol) << to_string(rep) << " yaw " << yaw_deg << " sample " << i;
+      EXPECT_LE(fast.conservation_error_m(), 1e-6);
+    }
   }
 }
 
