@@ -49,6 +49,15 @@ std::string validate(const SimParams& params) {
     return must_be("blade.length_m", "finite and > 0", params.blade.length_m);
   if (!(params.max_arc_error_cells > 0.0 && params.max_arc_error_cells <= 1.0))
     return must_be("max_arc_error_cells", "in (0, 1]", params.max_arc_error_cells);
+  const BucketSpec& bucket = params.blade.bucket;
+  if (!(std::isfinite(bucket.depth_m) && bucket.depth_m >= 0.0))
+    return must_be("blade.bucket.depth_m", "finite and >= 0", bucket.depth_m);
+  if (bucket.enabled()) {
+    if (!(std::isfinite(bucket.height_m) && bucket.height_m > 0.0))
+      return must_be("blade.bucket.height_m", "finite and > 0", bucket.height_m);
+    if (params.soil.model != SoilModel::kFlow)
+      return "blade.bucket: a bucket carries soil, so it needs soil model flow (soil: {model: flow})";
+  }
   if (params.representation != Representation::kColumns &&
       params.representation != Representation::kSurface)
     return "representation must be columns or surface";
@@ -62,7 +71,7 @@ static const SimParams& checked(const SimParams& params) {
 
 Simulation::Simulation(const SimParams& params, std::vector<float> initial_heights_m)
     : params_(checked(params)), grid_(params.grid, std::move(initial_heights_m)) {
-  if (params_.soil.model == SoilModel::kFlow) soil_ = std::make_unique<SoilFlow>(params_.soil, grid_);
+  if (params_.soil.model == SoilModel::kFlow) soil_ = std::make_unique<SoilFlow>(params_.soil, grid_, params_.blade);
 }
 
 const StepOutput& Simulation::begin_step(const BladePose& pose) {
@@ -135,7 +144,7 @@ const StepOutput& Simulation::finish_step() {
   // Soil that flows: what was cut goes ahead of the blade, slopes relax.
   double soil_end = cut_end;
   if (soil_) {
-    out_.soil = soil_->after_cut(grid_, step_from, out_.edge);
+    out_.soil = soil_->after_cut(grid_, step_from, out_.edge, out_.pose.orientation);
     out_.changed.include(out_.soil.changed);
     soil_end = now_s();
     out_.timers.soil_s = soil_end - cut_end;
@@ -172,7 +181,7 @@ void Simulation::remove_listener(StepListener& listener) {
 
 void Simulation::reset() {
   grid_.reset();
-  if (soil_) soil_ = std::make_unique<SoilFlow>(params_.soil, grid_);
+  if (soil_) soil_ = std::make_unique<SoilFlow>(params_.soil, grid_, params_.blade);
   has_previous_ = false;
   in_step_ = false;
   step_count_ = 0;

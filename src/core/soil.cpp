@@ -69,8 +69,53 @@ std::string validate(const SoilFlowParams& p) {
   return {};
 }
 
-SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid)
-    : params_(params), cols_(grid.cols()), rows_(grid.rows()) {
+double bucket_retained_m3(const BladeSpec& blade, const Quat& orientation, double repose_deg) {
+  const BucketSpec& bucket = blade.bucket;
+  if (!bucket.enabled()) return 0.0;
+  // The blade frame's Y and Z in the world, and the horizontal direction
+  // into the bucket (the floor's, from the lip to the back).
+  const Vec3 fy = rotate(orientation, {0.0, 1.0, 0.0}), fz = rotate(orientation, {0.0, 0.0, 1.0});
+  // Something must carry the soil: the floor (inner normal +Y) or the back
+  // wall (inner normal -Z) facing up; upside down it all falls out.
+  if (!(std::max(fy.y, -fz.y) > 1e-9)) return 0.0;
+  const double slope = std::tan(repose_deg * std::numbers::pi / 180.0);
+  const double inward = std::hypot(fz.x, fz.z);
+  // A section point (z, y) stands h = z fz.y + y fy.y above the lip and
+  // s = (z fz + y fy) . u inward of it (u the unit inward direction); it is
+  // held while h <= tan(repose) s: a z + b y <= 0.
+  double a = fz.y, b = fy.y;
+  if (inward > 1e-12) {
+    const double ux = fz.x / inward, uz = fz.z / inward;
+    a -= slope * (fz.x * ux + fz.z * uz);
+    b -= slope * (fy.x * ux + fy.z * uz);
+  }
+  // The section's triangle clipped by that half-plane (Sutherland-Hodgman),
+  // its area by the shoelace formula.
+  const double tri[3][2] = {{0.0, 0.0}, {bucket.depth_m, 0.0}, {bucket.depth_m, bucket.height_m}};
+  double poly[4][2];
+  int n = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double* p = tri[k];
+    const double* q = tri[(k + 1) % 3];
+    const double fp = a * p[0] + b * p[1], fq = a * q[0] + b * q[1];
+    if (fp <= 0.0) poly[n][0] = p[0], poly[n++][1] = p[1];
+    if ((fp < 0.0 && fq > 0.0) || (fp > 0.0 && fq < 0.0)) {
+      const double t = fp / (fp - fq);
+      poly[n][0] = p[0] + t * (q[0] - p[0]);
+      poly[n++][1] = p[1] + t * (q[1] - p[1]);
+    }
+  }
+  double twice_area = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const double* p = poly[k];
+    const double* q = poly[(k + 1) % n];
+    twice_area += p[0] * q[1] - q[0] * p[1];
+  }
+  return 0.5 * std::abs(twice_area) * blade.length_m;
+}
+
+SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const BladeSpec& blade)
+    : params_(params), blade_spec_(blade), cols_(grid.cols()), rows_(grid.rows()) {
   if (std::string m = validate(params); !m.empty()) throw InputError(m);
   const GridSpec& spec = grid.spec();
   dx_ = spec.cell_x_m();
@@ -205,7 +250,7 @@ bool SoilFlow::blade_blocks(std::uint32_t high, std::uint32_t low, float top_m) 
 }
 
 void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to,
-                        SoilStepResult& out) {
+                        double bucket_room_m3, SoilStepResult& out) {
   const GridSpec& spec = grid.spec();
   const double cell = std::max(dx_, dz_);
   // The edge's horizontal normal, turned to the side it moved to.
@@ -249,14 +294,32 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
     layers.removed_m[cell] = layers.initial_m[cell] - value;
     last_put = cell;
   };
+  // The share of each sample's cut that goes into the bucket: all of it
+  // while the bucket has room for the step's cut, else what fits.
+  double keep = 0.0;
+  if (bucket_room_m3 > 0.0) {
+    double cut = 0.0;
+    std::size_t j = 0;
+    for (int row = r.r0; row < r.r1; ++row)
+      for (int c = r.c0; c < r.c1; ++c, ++j) {
+        const float lost = before_[j] - layers.height_m[std::int64_t(row) * cols_ + c];
+        if (lost > 0.0f) cut += double(lost);
+      }
+    cut *= spec.cell_area_m2();
+    keep = cut > 0.0 ? std::min(1.0, bucket_room_m3 / cut) : 0.0;
+  }
   std::size_t k = 0;
   for (int row = r.r0; row < r.r1; ++row)
     for (int c = r.c0; c < r.c1; ++c, ++k) {
       const std::int64_t i = std::int64_t(row) * cols_ + c;
-      const float lost = before_[k] - layers.height_m[i];
-      if (!(lost > 0.0f)) continue;
-      taken += double(before_[k]) - double(layers.height_m[i]);
+      const float cut = before_[k] - layers.height_m[i];
+      if (!(cut > 0.0f)) continue;
       activate(std::uint32_t(i));  // its walls may now be too steep
+      const float kept = keep >= 1.0 ? cut : float(double(cut) * keep);
+      out.bucket_in_m3 += double(kept) * spec.cell_area_m2();
+      const float lost = cut - kept;  // what is displaced
+      if (!(lost > 0.0f)) continue;
+      taken += double(before_[k]) - double(layers.height_m[i]) - double(kept);
       // Straight ahead of the edge: the cell centre's distance to the edge's
       // line along the normal, plus kDepositAheadCells. At rest, away from
       // the line on the cell's own side.
@@ -285,12 +348,13 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       // a pile pushed by a blade does; what the shift does not account for
       // (the cut layer itself) is put down just beyond the pile's toe. On
       // flat ground nothing shifts and the cut soil is put down ahead.
-      const float edge_top = before_[k] - lost;  // the cut column's new height
+      const float edge_top = layers.height_m[i];  // the cut column's new height
       std::int64_t ray[kMaxPushCells];
       int length = 0;
       ray[length++] = cell_at(go);
       float previous = before_[k];
-      if (layers.height_m[ray[0]] < previous && !(layers.height_m[ray[0]] < edge_top)) {
+      // A bucket taking soil in does not push a pile.
+      if (kept == 0.0f && layers.height_m[ray[0]] < previous && !(layers.height_m[ray[0]] < edge_top)) {
         while (length < kMaxPushCells) {
           const std::int64_t next = cell_at(go + side * length * step);
           if (next == ray[length - 1]) break;  // against the grid's edge
@@ -461,13 +525,68 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   out.backlog_cells = std::int64_t(active_.size());
 }
 
-SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const Segment& to) {
+SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const Segment& to,
+                                   const Quat& orientation) {
   SoilStepResult out;
   mark_blade(grid, to);
-  displace(grid, from, to, out);
+  double room = 0.0, holds = 0.0;
+  if (blade_spec_.bucket.enabled()) {
+    holds = bucket_retained_m3(blade_spec_, orientation, params_.repose_deg);
+    // It takes soil in only while its lip leads: moving toward its opening
+    // (the blade frame's -Z, in plan).
+    const Vec3 opening = rotate(orientation, {0.0, 0.0, -1.0});
+    const double mx = 0.5 * ((to.a.x + to.b.x) - (from.a.x + from.b.x));
+    const double mz = 0.5 * ((to.a.z + to.b.z) - (from.a.z + from.b.z));
+    if (mx * opening.x + mz * opening.z > 0.0) room = std::max(0.0, holds - load_m3_);
+  }
+  displace(grid, from, to, room, out);
+  load_m3_ += out.bucket_in_m3;
+  if (load_m3_ > holds && blade_spec_.bucket.enabled()) {
+    pour(grid, to, load_m3_ - holds, out);
+    load_m3_ = holds;
+  }
+  out.bucket_load_m3 = load_m3_;
   run_passes(grid, out);
   clear_blade();
   return out;
+}
+
+void SoilFlow::pour(HeightGrid& grid, const Segment& lip, double volume_m3, SoilStepResult& out) {
+  // Spread along the lip's plan, a point per half cell, each point's share
+  // put on the cell under it (or, beyond an open edge, counted as gone).
+  const GridSpec& spec = grid.spec();
+  const double span = std::hypot(lip.b.x - lip.a.x, lip.b.z - lip.a.z);
+  const int points = 1 + int(std::ceil(span / (0.5 * std::min(dx_, dz_))));
+  const double share_m = volume_m3 / points / spec.cell_area_m2();
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  double put = 0.0, wanted = 0.0;
+  std::int64_t last = -1;
+  for (int p = 0; p < points; ++p) {
+    const double t = points > 1 ? double(p) / (points - 1) : 0.5;
+    const double u = to_cells(lip.a.x + t * (lip.b.x - lip.a.x), spec.origin_m.x, dx_);
+    const double v = to_cells(lip.a.z + t * (lip.b.z - lip.a.z), spec.origin_m.z, dz_);
+    if (params_.edge == SoilEdge::kOpen && (u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_)) {
+      out.left_over_edge_m3 += share_m * spec.cell_area_m2();
+      continue;
+    }
+    const int c = std::clamp(int(std::floor(u)), 0, cols_ - 1), r = std::clamp(int(std::floor(v)), 0, rows_ - 1);
+    const std::int64_t i = std::int64_t(r) * cols_ + c;
+    const float now = float(double(layers.height_m[i]) + share_m);
+    put += double(now) - double(layers.height_m[i]);
+    wanted += share_m;
+    layers.height_m[i] = now;
+    layers.removed_m[i] = layers.initial_m[i] - now;
+    last = i;
+    out.changed.include(c, r);
+    activate(std::uint32_t(i));
+  }
+  // Give back the rounding of the writes on the last cell written.
+  if (last >= 0 && put != wanted) {
+    const float corrected = float(std::max(0.0, double(layers.height_m[last]) + (wanted - put)));
+    layers.height_m[last] = corrected;
+    layers.removed_m[last] = layers.initial_m[last] - corrected;
+  }
+  out.poured_m3 += volume_m3;
 }
 
 SoilStepResult SoilFlow::relax(HeightGrid& grid) {

@@ -206,8 +206,11 @@ ForceOutput HapticLoop::world_force(const StepOutput& out, const CutLoad& load) 
                        : surface_y_m(sim_.grid(), sim_.params().representation,
                                      out.pose.position_m.x, out.pose.position_m.z);
   ForceOutput force = params_.force_model().compute(in);
-  if (!sim_.listeners().empty()) {
-    force.world_n = force.world_n + out.listener_force_world_n;
+  // The soil a bucket carries weighs on it (unit weight x volume, straight down).
+  const double load_n = params_.force_model().params().earthmoving.soil.unit_weight_n_per_m3 *
+                        out.soil.bucket_load_m3;
+  if (!sim_.listeners().empty() || load_n > 0.0) {
+    force.world_n = force.world_n + out.listener_force_world_n + Vec3{0.0, -load_n, 0.0};
     force.device_n = force.world_n * params_.force_model().params().force_scale;
   }
   return force;

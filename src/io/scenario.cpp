@@ -485,8 +485,15 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     if (sc.rate_hz > kMaxRateHz) f->fail(must_be("in (0, 1e6]", sc.rate_hz));
   }
 
-  const Map blade(top.require("blade"), {"length_m"});
+  const Map blade(top.require("blade"), {"length_m", "bucket"});
   sc.blade.length_m = blade.require("length_m").positive();
+  const std::optional<Field> bucket_field = blade.get("bucket");
+  if (const auto& b = bucket_field) {
+    // A bucket behind the edge (blade.hpp, BucketSpec): its floor and back.
+    const Map bucket(*b, {"depth_m", "height_m"});
+    sc.blade.bucket.depth_m = bucket.require("depth_m").positive();
+    sc.blade.bucket.height_m = bucket.require("height_m").positive();
+  }
 
   const std::optional<PendingImage> image = parse_terrain(ctx, top.require("terrain"), sc);
 
@@ -555,6 +562,8 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     if (const auto e = soil.get("edge"))
       sc.soil.edge = e->choice({SoilEdge::kWall, SoilEdge::kOpen}, "soil edge");
   }
+  if (bucket_field && sc.soil.model != SoilModel::kFlow)
+    bucket_field->fail("a bucket carries the soil it digs, so it needs soil that flows: add 'soil: {model: flow}'");
 
   // The other layers' sections (e.g. bodies:, haptics:), by their readers.
   for (SectionReader* reader : sections)

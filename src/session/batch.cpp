@@ -122,6 +122,14 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
                      {"max_backlog_cells", s.max_backlog_cells},
                      {"final_backlog_cells", s.final_backlog_cells},
                      {"max_pair_checks_per_step", sc.soil.max_pair_checks_per_step}}}};
+    if (sc.blade.bucket.enabled())
+      out["soil"]["bucket"] = {{"depth_m", sc.blade.bucket.depth_m},
+                               {"height_m", sc.blade.bucket.height_m},
+                               {"level_capacity_m3", bucket_retained_m3(sc.blade, Quat{}, sc.soil.repose_deg)},
+                               {"taken_in_m3", s.bucket_in_m3},
+                               {"poured_m3", s.poured_m3},
+                               {"max_load_m3", s.max_bucket_load_m3},
+                               {"final_load_m3", s.final_bucket_load_m3}};
     out["outputs"]["deposited_npy"] = "deposited.npy";
     out["outputs"]["deposited_png"] = "deposited.png";
   }
@@ -258,6 +266,10 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
         soil.passes += out.soil.passes;
         soil.pair_checks += out.soil.pair_checks;
         soil.max_backlog_cells = std::max(soil.max_backlog_cells, out.soil.backlog_cells);
+        soil.bucket_in_m3 += out.soil.bucket_in_m3;
+        soil.poured_m3 += out.soil.poured_m3;
+        soil.max_bucket_load_m3 = std::max(soil.max_bucket_load_m3, out.soil.bucket_load_m3);
+        soil.final_bucket_load_m3 = out.soil.bucket_load_m3;
         soil_s.push_back(out.timers.soil_s);
       }
       if (options.keep_records) result.records.push_back(rec);
@@ -279,7 +291,7 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
   result.max_sample_error_m = grid.conservation_error_m();
   // With flow nothing vanishes: what was cut is still on the grid, or left
   // it over an open edge.
-  const double vanished_m3 = flow ? soil.left_over_edge_m3 : result.removed_volume_m3;
+  const double vanished_m3 = flow ? soil.left_over_edge_m3 + soil.final_bucket_load_m3 : result.removed_volume_m3;
   result.volume_error_m3 = result.initial_volume_m3 - result.final_volume_m3 - vanished_m3;
   result.contact_timing = timing_stats(contact_s);
   result.cut_timing = timing_stats(cut_s);

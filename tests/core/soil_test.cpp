@@ -351,5 +351,156 @@ TEST(SoilDisplacement, SoilLayersKeepTheirIdentity) {
   EXPECT_GT(deposited, 100);
 }
 
+// --- The bucket -------------------------------------------------------------
+
+BladeSpec test_bucket(double length_m = 0.4, double depth_m = 0.3, double height_m = 0.15) {
+  BladeSpec b;
+  b.length_m = length_m;
+  b.bucket.depth_m = depth_m;
+  b.bucket.height_m = height_m;
+  return b;
+}
+
+// Rotation about the blade's X (the lip): a negative angle raises the back.
+Quat pitch(double deg) { return quat_from_axis_angle({1.0, 0.0, 0.0}, deg * kDeg); }
+
+TEST(Bucket, HoldsItsStruckCapacityLevelAndNothingPastTheReposeAngle) {
+  const double repose = 34.0, slope = std::tan(repose * kDeg);
+  // Level, with height <= depth tan(repose): the whole triangle, L D H / 2.
+  const BladeSpec b = test_bucket(0.4, 0.3, 0.15);
+  const double struck = 0.4 * 0.3 * 0.15 / 2.0;
+  EXPECT_NEAR(bucket_retained_m3(b, Quat{}, repose), struck, 1e-15);
+  // Yaw does not matter, and nor does a curl (back lowered): still full.
+  EXPECT_NEAR(bucket_retained_m3(b, quat_from_axis_angle({0.0, 1.0, 0.0}, 1.1), repose), struck, 1e-15);
+  EXPECT_NEAR(bucket_retained_m3(b, pitch(40.0), repose), struck, 1e-15);
+  // A tall back: the soil stands at the repose angle from the lip, the
+  // triangle under y = z tan(repose): L D (D tan) / 2.
+  const BladeSpec tall = test_bucket(0.4, 0.3, 0.5);
+  EXPECT_NEAR(bucket_retained_m3(tall, Quat{}, repose), 0.4 * 0.3 * 0.3 * slope / 2.0, 1e-15);
+  // Tilting the back up: less and less, and nothing once the floor is
+  // steeper than the repose angle.
+  double last = struck;
+  for (double tilt = 1.0; tilt < repose; tilt += 1.0) {
+    const double held = bucket_retained_m3(b, pitch(-tilt), repose);
+    EXPECT_LE(held, last + 1e-15) << tilt;
+    EXPECT_GT(held, 0.0) << tilt;
+    last = held;
+  }
+  EXPECT_LT(last, 0.1 * struck);
+  EXPECT_EQ(bucket_retained_m3(b, pitch(-(repose + 0.5)), repose), 0.0);
+  EXPECT_EQ(bucket_retained_m3(b, pitch(-90.0), repose), 0.0);
+  // Curled past a right angle, the back wall is below and carries it all.
+  EXPECT_NEAR(bucket_retained_m3(b, pitch(100.0), repose), struck, 1e-15);
+  // Upside down it holds nothing.
+  EXPECT_NEAR(bucket_retained_m3(b, pitch(180.0), repose), 0.0, 1e-15);
+  // No bucket, nothing.
+  EXPECT_EQ(bucket_retained_m3(BladeSpec{}, Quat{}, repose), 0.0);
+}
+
+// A bucket on a flat layer of sand: digs along its opening (-Z), lifts,
+// moves sideways and dumps by raising its back.
+struct BucketCycle {
+  static constexpr double kLayer = 0.2, kCell = 0.01;
+  SimParams params;
+  std::unique_ptr<Simulation> sim;
+  double initial_m3 = 0.0;
+  double worst_conservation_m3 = 0.0;  // |grid + load - initial| over every step
+
+  BucketCycle() {
+    params.grid = grid_of_cells(200, 200, kCell);
+    params.blade = test_bucket();
+    params.soil = flow(34.0, 400000);
+    sim = std::make_unique<Simulation>(params, std::vector<float>(std::size_t(200) * 200, float(kLayer)));
+    initial_m3 = sim->grid().volume_m3();
+  }
+  double load() const { return sim->last().soil.bucket_load_m3; }
+  void step(const Vec3& p, const Quat& q) {
+    sim->step({p, q});
+    worst_conservation_m3 =
+        std::max(worst_conservation_m3, std::abs(sim->grid().volume_m3() + load() - initial_m3));
+  }
+  /// Moves from a to b (and turns from qa to qb) in n steps.
+  void move(const Vec3& a, const Vec3& b, int n, const Quat& qa = {}, const Quat& qb = {}) {
+    for (int i = 1; i <= n; ++i) step(lerp(a, b, double(i) / n), slerp(qa, qb, double(i) / n));
+  }
+  double max_height() const {
+    const HeightGrid& g = sim->grid();
+    return *std::max_element(g.heights(), g.heights() + g.spec().sample_count());
+  }
+};
+
+TEST(Bucket, ScoopsCarriesAndDumpsWithoutLosingAnything) {
+  BucketCycle b;
+  const double depth = 0.03, lip_y = BucketCycle::kLayer - depth;
+  // Scoop 0.5 m along -Z, 3 cm deep, 0.6 mm per step: 0.4 x 0.03 x 0.5 =
+  // 0.006 m^3, under the struck capacity 0.009 m^3: all of it goes in.
+  b.step({1.0, lip_y, 1.6}, Quat{});
+  b.move({1.0, lip_y, 1.6}, {1.0, lip_y, 1.1}, 833);
+  const double scooped = b.load();
+  EXPECT_NEAR(scooped, 0.4 * depth * 0.5, 0.4 * depth * 2.0 * BucketCycle::kCell);
+  // No pile ahead of the lip: nothing stands above the layer.
+  EXPECT_LE(b.max_height(), BucketCycle::kLayer + 1e-6);
+  // Lift out and carry it 0.6 m sideways, above the sand: the load stays.
+  b.move({1.0, lip_y, 1.1}, {1.0, 0.5, 1.1}, 300);
+  const double carried = b.load();
+  EXPECT_NEAR(carried, scooped, 0.02 * scooped);  // the lift cuts the slumped walls aside
+  b.move({1.0, 0.5, 1.1}, {0.4, 0.5, 1.1}, 600);
+  EXPECT_EQ(b.load(), carried);
+  // Dump: raise the back past the repose angle (70 degrees over 0.5 s).
+  b.move({0.4, 0.5, 1.1}, {0.4, 0.5, 1.1}, 500, Quat{}, pitch(-70.0));
+  EXPECT_EQ(b.load(), 0.0);
+  for (int i = 0; i < 2000; ++i) b.step({0.4, 0.5, 1.1}, pitch(-70.0));  // let the dump settle
+  // Everything is back on the ground, and the dump lies under the lip: the
+  // soil above the layer within 0.35 m of the lip's line holds what was
+  // carried.
+  const HeightGrid& g = b.sim->grid();
+  double dumped = 0.0;
+  for (int r = 0; r < 200; ++r)
+    for (int c = 0; c < 200; ++c) {
+      const double x = (c + 0.5) * BucketCycle::kCell, z = (r + 0.5) * BucketCycle::kCell;
+      if (std::abs(x - 0.4) < 0.2 + 0.35 && std::abs(z - 1.1) < 0.35)
+        dumped += std::max(0.0, double(g.height(c, r)) - BucketCycle::kLayer) * BucketCycle::kCell * BucketCycle::kCell;
+    }
+  EXPECT_NEAR(dumped, carried, 0.05 * carried);
+  // Conserved at every step, to float rounding of the cells' heights.
+  const double rounding = 200.0 * 200.0 * 0.3 * 1.2e-7 * BucketCycle::kCell * BucketCycle::kCell;
+  EXPECT_LT(b.worst_conservation_m3, 4.0 * rounding + 1e-9);
+  EXPECT_NEAR(g.volume_m3(), b.initial_m3, 4.0 * rounding + 1e-9);
+}
+
+TEST(Bucket, AFullBucketSpillsAheadLikeABlade) {
+  BucketCycle b;
+  const double lip_y = BucketCycle::kLayer - 0.03;
+  // 1.5 m at 3 cm: 0.018 m^3 cut, twice the struck capacity.
+  b.step({1.0, lip_y, 1.8}, Quat{});
+  b.move({1.0, lip_y, 1.8}, {1.0, lip_y, 0.3}, 2500);
+  const double struck = 0.4 * 0.3 * 0.15 / 2.0;
+  EXPECT_NEAR(b.load(), struck, 1e-12);
+  // The rest went ahead into a pile above the layer.
+  EXPECT_GT(b.max_height(), BucketCycle::kLayer + 0.02);
+  EXPECT_NEAR(b.sim->grid().volume_m3() + b.load(), b.initial_m3, 1e-6);
+}
+
+TEST(Bucket, NeedsSoilThatFlowsAndAShape) {
+  SimParams p;
+  p.grid = grid_of_cells(20, 20, 0.01);
+  p.blade = test_bucket();
+  try {
+    Simulation s(p, std::vector<float>(400, 0.1f));
+    ADD_FAILURE() << "a bucket with soil that vanishes must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("blade.bucket"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("flow"), std::string::npos) << e.what();
+  }
+  p.soil = flow(34.0);
+  p.blade.bucket.height_m = 0.0;
+  EXPECT_THROW(Simulation(p, std::vector<float>(400, 0.1f)), InputError);
+  p.blade.bucket.height_m = std::nan("");
+  EXPECT_THROW(Simulation(p, std::vector<float>(400, 0.1f)), InputError);
+  p.blade.bucket.height_m = 0.1;
+  p.blade.bucket.depth_m = -0.1;
+  EXPECT_THROW(Simulation(p, std::vector<float>(400, 0.1f)), InputError);
+}
+
 }  // namespace
 }  // namespace terracut

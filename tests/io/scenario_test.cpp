@@ -230,6 +230,25 @@ TEST(ScenarioSoil, TheSoilSectionChoosesTheModel) {
   expect_error(typo, line_of(typo, "repose: 30"), "soil.repose", "unknown key");
 }
 
+TEST(ScenarioSoil, ABucketIsAShapeBehindTheEdgeAndNeedsSoilThatFlows) {
+  const std::string flow = replace(kGood, "blade: {length_m: 1.25}",
+                                   "blade:\n  length_m: 1.25\n  bucket: {depth_m: 0.4, height_m: 0.3}\n") +
+                           "soil: {model: flow}\n";
+  const Scenario sc = parse_scenario(flow, "x.yaml");
+  EXPECT_EQ(sc.blade.bucket.depth_m, 0.4);
+  EXPECT_EQ(sc.blade.bucket.height_m, 0.3);
+  EXPECT_TRUE(sim_params(sc).blade.bucket.enabled());
+  // Without it, a flat blade.
+  EXPECT_FALSE(parse_scenario(kGood, "x.yaml").blade.bucket.enabled());
+  // Errors name the line and the field.
+  const std::string vanish = replace(flow, "soil: {model: flow}\n", "");
+  expect_error(vanish, line_of(vanish, "bucket:"), "blade.bucket", "soil that flows");
+  const std::string flat = replace(flow, "height_m: 0.3", "height_m: 0");
+  expect_error(flat, line_of(flat, "bucket:"), "blade.bucket.height_m", "> 0");
+  const std::string typo = replace(flow, "depth_m: 0.4", "deep_m: 0.4");
+  expect_error(typo, line_of(typo, "bucket:"), "blade.bucket.deep_m", "unknown key");
+}
+
 TEST(ScenarioOptions, ParseResolutionAndNameLists) {
   EXPECT_EQ(parse_resolution("50"), (Resolution{50, 50}));
   EXPECT_EQ(parse_resolution("64x32"), (Resolution{64, 32}));

@@ -222,5 +222,42 @@ TEST(Session, TheForceGrowsWithThePileTheBladePushes) {
   EXPECT_NEAR(a.loop().simulation().grid().volume_m3(), 2.0 * 2.0 * 0.3, 1e-5);
 }
 
+TEST(Session, TheOperatorFeelsTheWeightOfTheBucketsLoad) {
+  // scenarios/bucket_cycle.yaml: the bucket scoops, lifts out and carries
+  // its load sideways (1.9-3.4 s: out of the sand, no cutting force), then
+  // dumps it (4.0 s on). While it carries, the force is the load's weight,
+  // straight down: unit weight x volume.
+  const Scenario sc = load_scenario(fs::path(TERRACUT_SOURCE_DIR) / "scenarios/bucket_cycle.yaml");
+  ASSERT_TRUE(sc.base.blade.bucket.enabled());
+  SessionOptions o;
+  o.clock = ClockMode::kFake;
+  HapticSession s(sc, o);
+  s.run();
+  const Simulation& sim = s.loop().simulation();
+  const double unit_weight = s.loop().force_model().params().earthmoving.soil.unit_weight_n_per_m3;
+  const double initial_m3 = 2.0 * 2.0 * 0.3;
+  double carry_y = 0.0, carry_xz = 0.0;
+  int n = 0;
+  double after_dump_y = 0.0;
+  for (const haptics::LoopRecord& r : s.loop().records()) {
+    if (r.t_s > 2.6 && r.t_s < 3.3) {
+      carry_y += r.force_world_n.y;
+      carry_xz = std::max(carry_xz, std::hypot(r.force_world_n.x, r.force_world_n.z));
+      ++n;
+    }
+    if (r.t_s > 4.8) after_dump_y = r.force_world_n.y;
+  }
+  ASSERT_GT(n, 100);
+  // All of it poured by the end, and nothing lost.
+  EXPECT_EQ(sim.last().soil.bucket_load_m3, 0.0);
+  EXPECT_NEAR(sim.grid().volume_m3(), initial_m3, 1e-5);
+  // 0.4 m x 3.5 cm x 0.6 m scooped, plus the plunge's share: 0.0084-0.0090 m^3.
+  const double weight = -carry_y / n;
+  EXPECT_GT(weight, unit_weight * 0.0084 * 0.98);
+  EXPECT_LT(weight, unit_weight * 0.0090 * 1.02);
+  EXPECT_LT(carry_xz, 0.01 * weight);  // straight down
+  EXPECT_NEAR(after_dump_y, 0.0, 1e-9);  // empty, out of the sand: nothing
+}
+
 }  // namespace
 }  // namespace terracut::session

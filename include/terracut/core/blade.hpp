@@ -11,9 +11,25 @@
 
 namespace terracut {
 
+/// A bucket behind the cutting edge (its lip), in the blade frame: the edge
+/// along local X is the lip; the bucket opens toward local -Z (the way it
+/// digs); its flat floor runs from the lip back to local z = depth_m and its
+/// back wall up to local y = height_m. Its section (local y-z) is the right
+/// triangle lip (0, 0), heel (z = depth_m, y = 0), back top (z = depth_m,
+/// y = height_m), over the edge's length: the struck capacity (below the
+/// plane from the lip to the back's top edge, the SAE J296 definition) is
+/// length x depth x height / 2. Zero depth = no bucket (a flat blade).
+struct BucketSpec {
+  double depth_m = 0.0;   ///< floor length from the lip to the back, metres, >= 0 (0 = no bucket)
+  double height_m = 0.0;  ///< back wall height above the floor, metres, > 0 with a bucket
+
+  bool enabled() const { return depth_m > 0.0; }
+};
+
 /// Blade parameters; read-only during a run.
 struct BladeSpec {
   double length_m = 1.0;  ///< length of the cutting edge, metres, > 0
+  BucketSpec bucket{};    ///< a bucket behind the edge (soil model flow only)
 };
 
 /// Pose of the blade frame in the world: the edge runs from

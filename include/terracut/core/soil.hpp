@@ -43,6 +43,18 @@
 // left active is carried to the next step (the backlog), so a large
 // collapse is spread over ticks and the 1 kHz loop keeps its millisecond.
 //
+// A bucket (BladeSpec::bucket) takes what its lip cuts while it digs
+// forward (toward its opening), up to what it can hold in its present
+// orientation; the rest is displaced ahead as from a blade. What it holds is
+// carried with it (SoilStepResult::bucket_load_m3: grid volume plus load is
+// conserved). It holds the soil below a surface rising from the lip into
+// the bucket at the repose angle (bucket_retained_m3): level, a bucket whose
+// back is no steeper than the repose angle holds its struck capacity; tilted
+// back up, it holds less, and nothing once its floor is steeper than the
+// repose angle. What it can no longer hold pours from the lip onto the
+// terrain below the lip, where it relaxes. Only the lip cuts: the bucket's
+// floor and back are not obstacles for the terrain.
+//
 // The rigid floor stays: heights never go below 0. The grid's edge is a wall
 // (no soil leaves) or, with SoilEdge::kOpen, bare ground beyond which soil
 // slides or is pushed off the terrain, counted in left_over_edge_m3.
@@ -105,8 +117,20 @@ struct SoilStepResult {
   std::int64_t moved_pairs = 0;      ///< pairs that exchanged soil
   std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
   double left_over_edge_m3 = 0.0;    ///< soil that left over an open edge, m^3
+  double bucket_in_m3 = 0.0;         ///< cut soil the bucket took in this step, m^3
+  double poured_m3 = 0.0;            ///< soil poured from the bucket's lip this step, m^3
+  double bucket_load_m3 = 0.0;       ///< soil in the bucket after the step, m^3
   Rect changed{};                    ///< samples whose height the phase changed
 };
+
+/// Soil a bucket holds in the given orientation, m^3: its section (see
+/// BucketSpec) below the surface that rises from the lip into the bucket
+/// at the repose angle (steeper, the soil would slide out over the lip),
+/// times its length. Level, that is the struck capacity when height_m <=
+/// depth_m x tan(repose); tilted so the floor is steeper than the repose
+/// angle, zero; with neither the floor nor the back wall facing up (upside
+/// down), zero. 0 without a bucket.
+double bucket_retained_m3(const BladeSpec& blade, const Quat& orientation, double repose_deg);
 
 /// The soil phase's state (kFlow): the active cells and the scratch of the
 /// passes, sized at construction (6 bytes per sample) so that a step
@@ -116,7 +140,7 @@ class SoilFlow {
   /// Builds the state over the grid (which must outlive it) and marks every
   /// cell steeper than the repose angle active. Throws InputError naming the
   /// field on bad params.
-  SoilFlow(const SoilFlowParams& params, const HeightGrid& grid);
+  SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const BladeSpec& blade = {});
 
   /// Before the cut of a step: remembers the heights under the region the
   /// edge may sweep from `from` to `to` (their bounding rectangle plus a
@@ -124,12 +148,17 @@ class SoilFlow {
   void before_cut(const HeightGrid& grid, const Segment& from, const Segment& to);
 
   /// After the cut: displacement of what was cut ahead of the edge `to`
-  /// (moving from `from`), the edge's cells capped, then relaxation.
-  SoilStepResult after_cut(HeightGrid& grid, const Segment& from, const Segment& to);
+  /// (moving from `from`) or into the bucket, the bucket's pour at its
+  /// `orientation` (the blade frame's), the edge's cells capped, then
+  /// relaxation.
+  SoilStepResult after_cut(HeightGrid& grid, const Segment& from, const Segment& to,
+                           const Quat& orientation = {});
 
   /// Relaxation only (no blade): e.g. between strokes, or a settling run.
   SoilStepResult relax(HeightGrid& grid);
 
+  /// Soil in the bucket, m^3 (0 without one).
+  double bucket_load_m3() const { return load_m3_; }
   /// Cells still active (the backlog).
   std::int64_t active_cells() const { return std::int64_t(active_.size()); }
   const SoilFlowParams& params() const { return params_; }
@@ -139,10 +168,14 @@ class SoilFlow {
   void mark_blade(const HeightGrid& grid, const Segment& edge);
   void clear_blade();
   bool blade_blocks(std::uint32_t high, std::uint32_t low, float top_m) const;
-  void displace(HeightGrid& grid, const Segment& from, const Segment& to, SoilStepResult& out);
+  void displace(HeightGrid& grid, const Segment& from, const Segment& to, double bucket_room_m3,
+                SoilStepResult& out);
+  void pour(HeightGrid& grid, const Segment& lip, double volume_m3, SoilStepResult& out);
   void run_passes(HeightGrid& grid, SoilStepResult& out);
 
   SoilFlowParams params_;
+  BladeSpec blade_spec_{};
+  double load_m3_ = 0.0;  // soil in the bucket
   int cols_ = 0;
   int rows_ = 0;
   double dx_ = 0.0;

@@ -82,6 +82,10 @@ struct SoilRunStats {
   std::int64_t pair_checks = 0;      ///< neighbour pairs examined
   std::int64_t max_backlog_cells = 0;  ///< largest number of cells carried to the next step
   std::int64_t final_backlog_cells = 0;  ///< cells still active at the end
+  double bucket_in_m3 = 0.0;          ///< cut soil the bucket took in, m^3 (0 without a bucket)
+  double poured_m3 = 0.0;             ///< soil poured from the bucket, m^3
+  double max_bucket_load_m3 = 0.0;    ///< largest load the bucket carried, m^3
+  double final_bucket_load_m3 = 0.0;  ///< soil still in the bucket at the end, m^3
   TimingStats soil_timing{};          ///< StepTimers::soil_s
 };
 
@@ -93,7 +97,8 @@ struct RunResult {
   double removed_volume_m3 = 0.0;    ///< sum of every step's cut volume, m^3 (vanished with kVanish, moved with kFlow)
   double max_sample_error_m = 0.0;   ///< max over samples of |height + removed - initial|, metres
   /// initial - final - vanished, m^3 (vanished: the cut volume with
-  /// kVanish; with kFlow what left over an open edge, 0 with a wall).
+  /// kVanish; with kFlow what left over an open edge, 0 with a wall, plus
+  /// what a bucket still holds).
   double volume_error_m3 = 0.0;
   std::vector<CutStats> cuts;        ///< one per entry of the sequence
   TimingStats contact_timing{};      ///< StepTimers::contact_s
