@@ -318,6 +318,48 @@ def conservation(out_dir, meta):
     FILES.save(fig, out_dir, "soil_conservation.png")
 
 
+def bucket(out_dir, meta):
+    b = meta["bucket"]
+    v = read_csv(out_dir, b["volume_csv"])
+    phases = np.asarray(v["phase"]).astype(str)
+    t = np.asarray(v["t_s"], dtype=float)
+    load = np.asarray(v["load_m3"], dtype=float)
+    grid = np.asarray(v["grid_m3"], dtype=float)
+    fig, (ax, ax_map) = plt.subplots(1, 2, figsize=(12, 4.6), gridspec_kw={"width_ratios": [1.5, 1]})
+    initial = grid[0] + load[0]
+    ax.plot(t, load * 1e3, color="tab:orange", lw=1.6, label="in the bucket")
+    ax.plot(t, (initial - grid) * 1e3, color="tab:blue", lw=1.2, ls="--",
+            label="taken from the grid (initial - grid volume)")
+    ax.axhline(b["capacity_m3"] * 1e3, color="gray", ls=":", lw=1, label="what the bucket holds level")
+    start = 0
+    for i in range(1, len(phases) + 1):
+        if i == len(phases) or phases[i] != phases[start]:
+            ax.text(0.5 * (t[start] + t[i - 1]), b["capacity_m3"] * 1e3 * 1.04, phases[start],
+                    ha="center", fontsize=8)
+            if i < len(phases):
+                ax.axvline(t[i], color="gray", lw=0.6)
+            start = i
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("volume (litres, 1e-3 m^3)")
+    ax.set_ylim(bottom=0, top=b["capacity_m3"] * 1e3 * 1.12)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="center right")
+    err = np.max(np.abs(grid + load - initial))
+    ax.set_title(f"Check 5: bucket cycle; grid + load within {err:.1e} m^3 of the start", fontsize=10)
+    h = read_npy(out_dir, b["height_npy"]) - b["layer_m"]
+    n_rows, n_cols = h.shape
+    cell = b["cell_m"]
+    lim = max(abs(float(h.min())), abs(float(h.max())), 1e-6)
+    im = ax_map.imshow(h, origin="lower", extent=[0, n_cols * cell, 0, n_rows * cell], cmap="RdBu_r",
+                       vmin=-lim, vmax=lim)
+    ax_map.set_xlabel("x (m)")
+    ax_map.set_ylabel("z (m)")
+    ax_map.set_title("the end: the scoop's trench (blue), the dump (red)", fontsize=10)
+    fig.colorbar(im, ax=ax_map, label="height - layer (m)")
+    fig.tight_layout()
+    FILES.save(fig, out_dir, "soil_bucket.png")
+
+
 def main(argv):
     out_dir, FILES.quiet = parse_folder_args(argv, __doc__)
     meta = FILES.read_meta(out_dir, "validate.json")
@@ -325,6 +367,7 @@ def main(argv):
     slope(out_dir, meta)
     bulldozing(out_dir, meta)
     conservation(out_dir, meta)
+    bucket(out_dir, meta)
     return 0
 
 

@@ -623,6 +623,101 @@ ConservationResult run_conservation(const fs::path& dir) {
   return res;
 }
 
+// ---- The bucket cycle ----------------------------------------------------------
+
+// A 0.4 m bucket (floor 0.3 m, back 0.15 m: 0.009 m^3 struck) on a 0.3 m
+// layer of sand on 1 cm cells: it plunges, scoops 0.6 m along its opening
+// (-Z) 3.5 cm deep, lifts out, carries the load 0.6 m sideways and dumps by
+// raising its back 70 degrees (as scenarios/bucket_cycle.yaml).
+constexpr double kBucketCell_m = 0.01, kBucketLayer_m = 0.3, kBucketRepose = 34.0;
+constexpr int kBucketCells = 200;
+constexpr double kBucketLength_m = 0.4, kBucketDepth_m = 0.3, kBucketHeight_m = 0.15;
+constexpr double kScoopDepth_m = 0.035, kScoop_m = 0.6;
+constexpr double kDumpX_m = 1.6, kDumpZ_m = 0.9;  // where the lip dumps (grid from 0 to 2 m)
+
+struct BucketResult {
+  double capacity_m3 = 0.0;
+  double scooped_m3 = 0.0;     // in the bucket at the end of the scoop
+  double taken_m3 = 0.0;       // the grid's loss over the scoop
+  double pile_m = 0.0;         // tallest height above the layer at the end of the scoop
+  double carry_first_m3 = 0.0, carry_last_m3 = 0.0;  // load at the start and end of the carry
+  double final_load_m3 = 0.0;
+  double dumped_near_m3 = 0.0;  // soil above the layer near the dump at the end
+  double worst_error_m3 = 0.0;  // |grid + load - initial| over every step
+  double tolerance_m3 = 0.0;
+};
+
+BucketResult run_bucket(const fs::path& dir) {
+  SimParams p;
+  p.grid = grid_of_cells(kBucketCells, kBucketCells, kBucketCell_m);
+  p.blade.length_m = kBucketLength_m;
+  p.blade.bucket = {kBucketDepth_m, kBucketHeight_m};
+  p.soil = flow_params(kBucketRepose);
+  Simulation sim(p, std::vector<float>(std::size_t(kBucketCells) * kBucketCells, float(kBucketLayer_m)));
+  BucketResult res;
+  res.capacity_m3 = bucket_retained_m3(p.blade, Quat{}, kBucketRepose);
+  const double initial = sim.grid().volume_m3();
+  const double lip_y = kBucketLayer_m - kScoopDepth_m, z0 = 1.6, x0 = 1.0;
+  const Quat level{}, dump = quat_from_axis_angle({1.0, 0.0, 0.0}, rad(-70.0));
+  struct Leg {
+    const char* phase;
+    Vec3 to;
+    Quat turn;
+    double seconds;
+  };
+  const Leg legs[] = {{"scoop", {x0, lip_y, z0 - kScoop_m}, level, 1.0},
+                      {"lift", {x0, 0.6, z0 - kScoop_m}, level, 0.5},
+                      {"carry", {kDumpX_m, 0.6, kDumpZ_m}, level, 1.0},
+                      {"dump", {kDumpX_m, 0.6, kDumpZ_m}, dump, 0.6},
+                      {"settle", {kDumpX_m, 0.6, kDumpZ_m}, dump, 2.0}};
+  std::string csv = "step,t_s,phase,grid_m3,load_m3,error_m3\n";
+  std::int64_t updates = 0;
+  double tallest = kBucketLayer_m;
+  Vec3 at{x0, lip_y, z0};
+  Quat q = level;
+  auto step = [&](const char* phase, const BladePose& pose) {
+    const StepOutput& out = sim.step(pose);
+    updates += 2 * out.soil.moved_pairs + out.changed.area();
+    tallest = std::max(tallest, tallest_m(sim.grid()));
+    const double v = sim.grid().volume_m3(), load = out.soil.bucket_load_m3;
+    res.worst_error_m3 = std::max(res.worst_error_m3, std::abs(v + load - initial));
+    csv += std::to_string(out.step) + "," + csv_number(out.t_s) + "," + phase + "," + fmt("%.12g", v) + "," +
+           fmt("%.12g", load) + "," + fmt("%.6e", v + load - initial) + "\n";
+  };
+  step("scoop", {at, q});
+  for (const Leg& leg : legs) {
+    const int n = int(std::lround(leg.seconds * 1000.0));
+    const Vec3 from = at;
+    const Quat q_from = q;
+    for (int i = 1; i <= n; ++i) {
+      const double t = double(i) / n;
+      step(leg.phase, {lerp(from, leg.to, t), slerp(q_from, leg.turn, t)});
+      if (std::string(leg.phase) == "carry" && i == 1) res.carry_first_m3 = sim.last().soil.bucket_load_m3;
+    }
+    at = leg.to;
+    q = leg.turn;
+    const HeightGrid& g = sim.grid();
+    if (std::string(leg.phase) == "scoop") {
+      res.scooped_m3 = sim.last().soil.bucket_load_m3;
+      res.taken_m3 = initial - g.volume_m3();
+      res.pile_m = tallest_m(g) - kBucketLayer_m;
+    }
+    if (std::string(leg.phase) == "carry") res.carry_last_m3 = sim.last().soil.bucket_load_m3;
+  }
+  res.final_load_m3 = sim.last().soil.bucket_load_m3;
+  const HeightGrid& g = sim.grid();
+  for (int r = 0; r < kBucketCells; ++r)
+    for (int c = 0; c < kBucketCells; ++c) {
+      const double x = (c + 0.5) * kBucketCell_m, z = (r + 0.5) * kBucketCell_m;
+      if (std::abs(x - kDumpX_m) < 0.5 * kBucketLength_m + 0.35 && std::abs(z - kDumpZ_m) < 0.35)
+        res.dumped_near_m3 += std::max(0.0, double(g.height(c, r)) - kBucketLayer_m) * kBucketCell_m * kBucketCell_m;
+    }
+  res.tolerance_m3 = rounding_tolerance_rel(updates, tallest, g, initial) * initial;
+  write_file(dir / "volume.csv", csv);
+  io::write_npy(dir / "height.npy", g.heights(), g.rows(), g.cols());
+  return res;
+}
+
 // ---- The checks and the report -----------------------------------------------
 
 // One row of the summary table.
@@ -645,6 +740,7 @@ struct Report {
   std::vector<RampResult> ramps;
   std::vector<DozeResult> dozes;
   ConservationResult conservation;
+  BucketResult bucket;
   std::vector<Check> checks;
   std::optional<std::string> figures_problem;
   bool figures_skipped = false;  // --no-plot: no figures, so no links to them
@@ -768,6 +864,34 @@ std::vector<Check> make_checks(const Report& r) {
                  "worst " + fmt("%.2e", c.max_sample_error_m) + " m",
                  "<= " + fmt("%.2e", c.max_sample_tolerance_m) + " m",
                  c.max_sample_error_m <= c.max_sample_tolerance_m});
+  const BucketResult& b = r.bucket;
+  const double cut_cell_m3 = kBucketLength_m * kScoopDepth_m * kBucketCell_m;  // one cell of the scoop
+  out.push_back({"5a", "bucket scoop: the load is what the grid lost, under the capacity",
+                 "load " + fmt("%.6f", b.scooped_m3) + " m^3, grid lost " + fmt("%.6f", b.taken_m3) +
+                     " m^3, capacity " + fmt("%.6f", b.capacity_m3) + " m^3",
+                 "abs(load - lost) <= " + fmt("%.1e", b.tolerance_m3) + " m^3; load <= capacity",
+                 std::abs(b.scooped_m3 - b.taken_m3) <= b.tolerance_m3 && b.scooped_m3 <= b.capacity_m3});
+  out.push_back({"5b", "bucket scoop: the load is w d x (0.4 m x 0.035 m x 0.6 m)",
+                 fmt("%.6f", b.scooped_m3) + " m^3 against " + fmt("%.6f", kBucketLength_m * kScoopDepth_m * kScoop_m) +
+                     " m^3",
+                 "within [w d x - 2 cells, w d x + 10 cells] (cell: w d dz = " + fmt("%.1e", cut_cell_m3) + " m^3)",
+                 b.scooped_m3 >= kBucketLength_m * kScoopDepth_m * kScoop_m - 2 * cut_cell_m3 &&
+                     b.scooped_m3 <= kBucketLength_m * kScoopDepth_m * kScoop_m + 10 * cut_cell_m3});
+  out.push_back({"5c", "bucket scoop: no pile ahead of a bucket with room",
+                 "tallest above the layer " + fmt("%.2e", b.pile_m) + " m", "<= a float step of the layer",
+                 b.pile_m <= 2.0 * kBucketLayer_m * kHalfUlp});
+  out.push_back({"5d", "bucket carry: the load does not change",
+                 fmt("%.9f", b.carry_first_m3) + " to " + fmt("%.9f", b.carry_last_m3) + " m^3", "equal",
+                 b.carry_first_m3 == b.carry_last_m3 && b.carry_first_m3 > 0.0});
+  out.push_back({"5e", "bucket dump (back raised 70 deg > repose): empty, the load on the ground under the lip",
+                 "load " + fmt("%.2e", b.final_load_m3) + " m^3; above the layer within 0.35 m of the lip " +
+                     fmt("%.6f", b.dumped_near_m3) + " m^3 of " + fmt("%.6f", b.carry_last_m3),
+                 "load 0; near the lip >= 95 % of the carried load",
+                 b.final_load_m3 == 0.0 && b.dumped_near_m3 >= 0.95 * b.carry_last_m3});
+  out.push_back({"5f", "bucket cycle: grid + load = initial at every step",
+                 "worst " + fmt("%.2e", b.worst_error_m3) + " m^3",
+                 "<= the float rounding of the updates, " + fmt("%.2e", b.tolerance_m3) + " m^3",
+                 b.worst_error_m3 <= b.tolerance_m3});
   return out;
 }
 
@@ -931,7 +1055,25 @@ std::string report_markdown(const Report& r) {
     md << "![Relative volume error over the mixed run](soil_conservation.png)\n\n";
 
   // ---- 5 ----
-  md << "## 5. Speed (this machine; informative, not a check)\n\n"
+  const BucketResult& b = r.bucket;
+  md << "## 5. A bucket cycle: scoop, carry, dump\n\n"
+     << "A " << fmt("%g", kBucketLength_m) << " m bucket (floor " << fmt("%g", kBucketDepth_m) << " m, back "
+     << fmt("%g", kBucketHeight_m) << " m; it holds " << fmt("%.4f", b.capacity_m3)
+     << " m^3 level, its struck capacity W D H / 2) on a " << fmt("%g", kBucketLayer_m)
+     << " m layer, 1 cm cells, repose " << fmt("%g", kBucketRepose) << " degrees: it scoops "
+     << fmt("%g", kScoop_m) << " m along its opening " << fmt("%g", kScoopDepth_m * 100) << " cm deep, lifts out, "
+        "carries the load 0.6 m sideways and dumps it by raising its back 70 degrees (past the repose "
+        "angle: the floor itself is then steeper than the soil can stand, so the bucket holds nothing). "
+        "The grid's volume and the bucket's load at every step are in `bucket/volume.csv`.\n\n"
+     << "Scooped " << fmt("%.5f", b.scooped_m3) << " m^3 (the grid lost " << fmt("%.5f", b.taken_m3)
+     << " m^3), carried " << fmt("%.5f", b.carry_last_m3) << " m^3, " << fmt("%.5f", b.dumped_near_m3)
+     << " m^3 lies above the layer near the dump at the end; grid + load stayed within "
+     << fmt("%.1e", b.worst_error_m3) << " m^3 of the start.\n\n";
+  if (r.with_figures())
+    md << "![Bucket cycle: the load and the grid's volume over the cycle, and the terrain at the end](soil_bucket.png)\n\n";
+
+  // ---- 6 ----
+  md << "## 6. Speed (this machine; informative, not a check)\n\n"
      << "The soil phase's time per step (`StepTimers::soil_s`: displacement and relaxation) "
         "and the whole step's, in the bulldozing runs above, with the default work cap "
         "(200000 pair checks per step).\n\n"
@@ -1057,6 +1199,12 @@ void write_outputs(const fs::path& out, const Report& r) {
                         {"runs", widths},
                         {"pile_csv", "bulldozing/pile.csv"},
                         {"centre_csv", "bulldozing/centre.csv"}};
+  meta["bucket"] = {{"volume_csv", "bucket/volume.csv"},
+                    {"height_npy", "bucket/height.npy"},
+                    {"cell_m", kBucketCell_m},
+                    {"layer_m", kBucketLayer_m},
+                    {"capacity_m3", r.bucket.capacity_m3},
+                    {"dump_m", {kDumpX_m, kDumpZ_m}}};
   meta["conservation"] = {{"volume_csv", "conservation/volume.csv"},
                           {"tolerance_rel", r.conservation.tolerance_rel},
                           {"sequence", r.conservation.sequence}};
@@ -1108,7 +1256,8 @@ Command add_validate_command(CLI::App& app) {
       "  conservation/volume.csv         step, t_s, cut, volume_m3, relative_error,\n"
       "                                  tolerance_rel\n"
       "  validate.json        parameters and tolerances (read by the plot script)\n"
-      "  soil_cone.png, soil_slope.png, soil_bulldozing.png, soil_conservation.png  figures\n"
+      "  bucket/              volume.csv (grid and load per step), height.npy (the end)\n"
+      "  soil_cone.png, soil_slope.png, soil_bulldozing.png, soil_conservation.png, soil_bucket.png  figures\n"
       "Figures are drawn by `PYTHON TOOLS/plot_validate.py DIR` (matplotlib).\n"
       "\n"
       "Exit code: 0 every check passes; 1 a check fails (report.md and checks.csv say\n"
@@ -1118,7 +1267,7 @@ Command add_validate_command(CLI::App& app) {
   return [opt]() {
     const fs::path out(opt->out);
     create_output_folder(out);
-    for (const char* d : {"cone", "slope", "bulldozing", "conservation"})
+    for (const char* d : {"cone", "slope", "bulldozing", "conservation", "bucket"})
       create_output_folder(out / d);
     const auto say = [&](const std::string& line) {
       if (!opt->quiet) std::cerr << "validate: " << line << "\n" << std::flush;
@@ -1160,6 +1309,14 @@ Command add_validate_command(CLI::App& app) {
       say("conservation: " + std::to_string(report.conservation.steps) +
           " steps, worst relative volume error " + fmt("%.2e", report.conservation.worst_rel) +
           ", " + seconds_since(t0));
+    }
+    {
+      const Clock::time_point t0 = Clock::now();
+      report.bucket = run_bucket(out / "bucket");
+      say("bucket cycle: scooped " + fmt("%.5f", report.bucket.scooped_m3) + " m^3, carried " +
+          fmt("%.5f", report.bucket.carry_last_m3) + " m^3, left " + fmt("%.1e", report.bucket.final_load_m3) +
+          " m^3 in the bucket, worst volume error " + fmt("%.1e", report.bucket.worst_error_m3) + " m^3, " +
+          seconds_since(t0));
     }
     report.checks = make_checks(report);
     const bool all_pass = std::all_of(report.checks.begin(), report.checks.end(),
