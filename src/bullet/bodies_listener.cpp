@@ -1,7 +1,10 @@
 // The rigid bodies as a step listener. See bodies_listener.hpp.
 #include "terracut/bullet/bodies_listener.hpp"
 
+#include <btBulletDynamicsCommon.h>
+
 #include <algorithm>
+#include <cmath>
 
 namespace terracut::bullet {
 
@@ -15,6 +18,7 @@ BodiesListener::BodiesListener(Simulation& sim, std::vector<BodySpec> bodies,
     csv_ = std::make_unique<BodiesCsvWriter>(options_.csv_path);
     csv_->write_step(*world_);  // the initial state, t = 0
   }
+  obstacles_.reserve(bodies_.size());
   sim_.add_listener(*this);
 }
 
@@ -29,6 +33,25 @@ Vec3 BodiesListener::on_step(const StepOutput& out) noexcept {
   ++steps_;
   physics_sum_s_ += info.physics_s;
   physics_max_s_ = std::max(physics_max_s_, info.physics_s);
+  if (SoilFlow* soil = sim_.soil()) {
+    // Each body's bounding box (Bullet's, margin included) as an obstacle:
+    // the samples whose centres lie under it, and its lowest point.
+    const GridSpec& g = sim_.grid().spec();
+    const double cx = g.cell_x_m(), cz = g.cell_z_m();
+    obstacles_.clear();
+    for (int i = 0; i < world_->body_count(); ++i) {
+      btVector3 lo, hi;
+      world_->body(i).getAabb(lo, hi);
+      const double c0 = std::ceil((double(lo.x()) - g.origin_m.x) / cx - 0.5);
+      const double c1 = std::floor((double(hi.x()) - g.origin_m.x) / cx - 0.5) + 1.0;
+      const double r0 = std::ceil((double(lo.z()) - g.origin_m.z) / cz - 0.5);
+      const double r1 = std::floor((double(hi.z()) - g.origin_m.z) / cz - 0.5) + 1.0;
+      const auto to_int = [](double v) { return v == v ? int(std::clamp(v, -1.0, 2e9)) : -1; };  // NaN -> -1
+      obstacles_.push_back({{to_int(c0), to_int(r0), to_int(c1), to_int(r1)},
+                            float(double(lo.y()) - g.origin_m.y)});
+    }
+    soil->set_obstacles(obstacles_);
+  }
   return info.tool_force_n;
 }
 

@@ -132,6 +132,8 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   queued_.assign(n, 0);
   delta_.assign(n, 0.0f);
   near_blade_.assign(n, 0);
+  obstacle_.assign(n, 0);
+  obstacles_.reserve(16);
 
   // Every cell of a slope already steeper than the repose angle starts active.
   const float* h = grid.heights();
@@ -148,6 +150,53 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
         }
       }
     }
+}
+
+void SoilFlow::set_obstacles(std::span<const SoilObstacle> obstacles) noexcept {
+  // Bodies at rest give the same list step after step: nothing to do.
+  const auto clipped = [this](const SoilObstacle& o) {
+    return SoilObstacle{{std::max(o.cells.c0, 0), std::max(o.cells.r0, 0), std::min(o.cells.c1, cols_),
+                         std::min(o.cells.r1, rows_)},
+                        o.bottom_m};
+  };
+  {
+    std::size_t k = 0;
+    bool same = true;
+    for (const SoilObstacle& given : obstacles) {
+      if (k == std::size_t(kMaxObstacles)) break;
+      const SoilObstacle o = clipped(given);
+      if (o.cells.empty() || !(o.bottom_m == o.bottom_m)) continue;
+      same = same && k < obstacles_.size() && obstacles_[k].cells == o.cells && obstacles_[k].bottom_m == o.bottom_m;
+      ++k;
+    }
+    if (same && k == obstacles_.size()) return;
+  }
+  // Clear the old ones; the soil banked against them may now slide on, so
+  // the cells along their sides (inside and out) are examined again.
+  for (const SoilObstacle& o : obstacles_) {
+    for (int r = o.cells.r0; r < o.cells.r1; ++r)
+      std::fill_n(obstacle_.begin() + std::int64_t(r) * cols_ + o.cells.c0, o.cells.c1 - o.cells.c0, 0);
+    const int c0 = std::max(o.cells.c0 - 1, 0), c1 = std::min(o.cells.c1, cols_ - 1);
+    const int r0 = std::max(o.cells.r0 - 1, 0), r1 = std::min(o.cells.r1, rows_ - 1);
+    for (int r = r0; r <= r1; ++r)
+      for (int c = c0; c <= c1; ++c)
+        if (r <= r0 + 1 || r >= r1 - 1 || c <= c0 + 1 || c >= c1 - 1)
+          activate(std::uint32_t(std::int64_t(r) * cols_ + c));
+  }
+  obstacles_.clear();
+  for (const SoilObstacle& given : obstacles) {
+    if (int(obstacles_.size()) == kMaxObstacles) break;
+    const SoilObstacle o = clipped(given);
+    if (o.cells.empty() || !(o.bottom_m == o.bottom_m)) continue;  // off the grid, or NaN
+    obstacles_.push_back(o);
+    const auto id = std::uint8_t(obstacles_.size());
+    for (int r = o.cells.r0; r < o.cells.r1; ++r)
+      for (int c = o.cells.c0; c < o.cells.c1; ++c) {
+        std::uint8_t& mark = obstacle_[std::size_t(std::int64_t(r) * cols_ + c)];
+        // Where two overlap, the lower underside counts.
+        if (mark == 0 || o.bottom_m < obstacles_[mark - 1u].bottom_m) mark = id;
+      }
+  }
 }
 
 void SoilFlow::activate(std::uint32_t cell) {
@@ -354,12 +403,13 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       ray[length++] = cell_at(go);
       float previous = before_[k];
       // A bucket taking soil in does not push a pile.
-      if (kept == 0.0f && layers.height_m[ray[0]] < previous && !(layers.height_m[ray[0]] < edge_top)) {
+      if (kept == 0.0f && layers.height_m[ray[0]] < previous && !(layers.height_m[ray[0]] < edge_top) &&
+          !obstructed(std::uint32_t(ray[0]), previous)) {
         while (length < kMaxPushCells) {
           const std::int64_t next = cell_at(go + side * length * step);
           if (next == ray[length - 1]) break;  // against the grid's edge
           const float here = layers.height_m[ray[length - 1]], ahead = layers.height_m[next];
-          if (!(ahead < here) || ahead < edge_top) break;
+          if (!(ahead < here) || ahead < edge_top || obstructed(std::uint32_t(next), here)) break;
           ray[length++] = next;
         }
         for (int j = 0; j < length; ++j) {
@@ -383,6 +433,9 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       out.displaced_volume_m3 += double(lost) * spec.cell_area_m2();
       std::int64_t t = length > 0 ? ray[length - 1] : ray[0];
       float level = length > 0 ? layers.height_m[t] : before_[k];
+      // The last cell reached that is not under a rigid body (the cut
+      // column itself when the body stands right ahead).
+      std::int64_t free = length > 0 ? t : i;
       for (int m = length > 0 ? length : 0; m < kMaxPushCells && rest > 0.0f; ++m) {
         if (params_.edge == SoilEdge::kOpen && beyond(go + side * m * step)) {
           // Pushed off the terrain: it is gone, and counted.
@@ -393,13 +446,15 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
         }
         const std::int64_t u = cell_at(go + side * m * step);
         if (u == t && m > 0) break;  // against the grid's edge
-        const float top = level - float(limit_step);
+        float top = level - float(limit_step);
+        if (obstacle_[u] != 0) top = std::min(top, obstacles_[obstacle_[u] - 1u].bottom_m);
         const float room = top - layers.height_m[u];
         t = u;
         if (!(room > 0.0f)) {
-          if (m > 0 || length > 0) break;
+          if (m > 0 || length > 0 || obstacle_[u] != 0) break;  // never through a body
           continue;
         }
+        if (obstacle_[u] == 0) free = u;
         const float add = std::min(rest, room);
         write(u, layers.height_m[u] + add);
         rest -= add;
@@ -409,6 +464,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       }
       // What did not fit (or, by rounding, came out negative) is settled on
       // the last cell reached, keeping the volume.
+      if (obstacle_[t] != 0 && rest > 0.0f) t = free;
       if (rest != 0.0f) {
         write(t, std::max(0.0f, layers.height_m[t] + rest));
         out.changed.include(int(t % cols_), int(t / cols_));
@@ -461,6 +517,9 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
         // The blade is a wall between the cells on its two sides, and soil
         // does not flow into the cells it passes through.
         if (blade && !outside && near_blade_[a] && near_blade_[b] && blade_blocks(a, b, ha)) continue;
+        // Nor into a rigid body: not once the receiving cell's soil would
+        // rise (by at most half the excess) into its underside.
+        if (!outside && obstructed(b, h[b] + kShedFraction * e)) continue;
         lower[n] = b;
         excess[n] = e;
         ++n;

@@ -351,6 +351,68 @@ TEST(SoilDisplacement, SoilLayersKeepTheirIdentity) {
   EXPECT_GT(deposited, 100);
 }
 
+// --- Rigid obstacles ----------------------------------------------------------
+
+TEST(SoilObstacles, ACollapsingColumnBanksAgainstABodyInsteadOfFlowingIntoIt) {
+  // A column of radius 10 cells, 0.4 m tall, collapses into a cone of about
+  // 26 cells' radius; a body standing on the floor 14 to 24 cells from the
+  // column's centre takes none of it, and the soil banks against its face.
+  const int n = 101;
+  const double cell = 0.01;
+  const Rect body{64, 40, 75, 61};
+  HeightGrid free_grid(grid_of_cells(n, n, cell), column(n, 10.0, 0.4f));
+  HeightGrid blocked(grid_of_cells(n, n, cell), column(n, 10.0, 0.4f));
+  const double before = sum_heights(blocked);
+  SoilFlow free_flow(flow(34.0), free_grid), blocked_flow(flow(34.0), blocked);
+  const SoilObstacle obstacle{body, 0.0f};
+  blocked_flow.set_obstacles({&obstacle, 1});
+  settle(free_flow, free_grid);
+  settle(blocked_flow, blocked);
+  ASSERT_EQ(blocked_flow.active_cells(), 0);
+  double inside_free = 0.0;
+  for (int r = body.r0; r < body.r1; ++r)
+    for (int c = body.c0; c < body.c1; ++c) {
+      EXPECT_EQ(blocked.height(c, r), 0.0f) << c << "," << r;
+      inside_free += free_grid.height(c, r);
+    }
+  EXPECT_GT(inside_free * cell * cell, 1e-4);  // without the body, soil goes there
+  // Banked against the face: higher just in front of it than without.
+  EXPECT_GT(blocked.height(body.c0 - 1, 50), free_grid.height(body.c0 - 1, 50) + 0.005);
+  EXPECT_NEAR(sum_heights(blocked), before, 1e-6 * before);
+  // The same list again changes nothing; taken away, the banked soil flows
+  // on into the cells it stood against.
+  blocked_flow.set_obstacles({&obstacle, 1});
+  EXPECT_EQ(blocked_flow.active_cells(), 0);
+  blocked_flow.set_obstacles({});
+  EXPECT_GT(blocked_flow.active_cells(), 0);
+  settle(blocked_flow, blocked);
+  EXPECT_GT(blocked.height(body.c0, 50), 0.005f);
+  EXPECT_NEAR(sum_heights(blocked), before, 1e-6 * before);
+}
+
+TEST(SoilObstacles, ABladePushesThePileUpToABodyAndNotThroughIt) {
+  // The dozing run of TheBladePushesAPile..., with a body standing on the
+  // sand 10 cm beyond the end of the push: the pile grows against it, and
+  // none of it enters the body's cells above the sand.
+  SimParams params;
+  params.grid = grid_of_cells(200, 200, 0.01);
+  params.blade.length_m = 1.0;
+  params.soil = flow(34.0, 400000);
+  const float layer = 0.2f;
+  Simulation sim(params, std::vector<float>(std::size_t(200) * 200, layer));
+  const Rect body{60, 110, 140, 130};  // x 0.6-1.4 m, z 1.1-1.3 m
+  const SoilObstacle obstacle{body, layer};
+  sim.soil()->set_obstacles({&obstacle, 1});
+  const int steps = int(std::lround(0.6 / 0.0006));
+  for (int i = 0; i <= steps; ++i) sim.step({{1.0, 0.15, 0.4 + 0.6 * i / steps}, Quat{}});
+  const HeightGrid& g = sim.grid();
+  for (int r = body.r0; r < body.r1; ++r)
+    for (int c = body.c0; c < body.c1; ++c) EXPECT_LE(g.height(c, r), layer) << c << "," << r;
+  // The pile stands against the body's face (z = 1.1 m), above the layer.
+  EXPECT_GT(g.height(100, body.r0 - 1), layer + 0.05);
+  EXPECT_NEAR(g.volume_m3(), 200 * 200 * 0.01 * 0.01 * layer, 1e-6);
+}
+
 // --- The bucket -------------------------------------------------------------
 
 BladeSpec test_bucket(double length_m = 0.4, double depth_m = 0.3, double height_m = 0.15) {

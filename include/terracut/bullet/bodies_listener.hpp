@@ -8,8 +8,10 @@
 // stale contacts dropped; the tool plate to the blade pose; one Bullet step
 // of 1 / rate), then a row per body to bodies.csv when one is written, and
 // the bodies' force on the tool plate is returned to the step (the haptic
-// loop adds it to the force the operator feels). It also tells the viewer
-// where the bodies are (BodySource).
+// loop adds it to the force the operator feels). With soil that flows it
+// sets the soil's obstacles (SoilFlow::set_obstacles) to the bodies'
+// bounding boxes, for the next step. It also tells the viewer where the
+// bodies are (BodySource).
 #pragma once
 
 #include <cstdint>
@@ -22,6 +24,7 @@
 #include "terracut/bullet/terrain_world.hpp"
 #include "terracut/core/bodies.hpp"
 #include "terracut/core/simulation.hpp"
+#include "terracut/core/soil.hpp"
 #include "terracut/core/step_listener.hpp"
 
 namespace terracut::bullet {
@@ -91,6 +94,7 @@ class BodiesListener final : public StepListener, public BodySource {
   std::vector<Vec3> half_extents_;
   std::unique_ptr<TerrainWorld> world_;
   std::unique_ptr<BodiesCsvWriter> csv_;
+  std::vector<SoilObstacle> obstacles_;  // the bodies' boxes, for soil that flows
   double peak_tool_force_n_ = 0.0;
   std::int64_t steps_touching_ = 0;
   std::int64_t steps_ = 0;

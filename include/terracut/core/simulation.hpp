@@ -96,6 +96,8 @@ class Simulation {
 
   /// The soil phase's state (kFlow), or null with kVanish.
   const SoilFlow* soil() const { return soil_.get(); }
+  /// The soil phase, to set its obstacles (a step listener between steps).
+  SoilFlow* soil() { return soil_.get(); }
 
   /// Phase 1: move the blade and measure contact before any cut.
   const StepOutput& begin_step(const BladePose& pose);

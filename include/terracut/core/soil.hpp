@@ -55,6 +55,12 @@
 // terrain below the lip, where it relaxes. Only the lip cuts: the bucket's
 // floor and back are not obstacles for the terrain.
 //
+// Rigid obstacles (set_obstacles; the Bullet bodies' listener sets them
+// from the bodies' bounding boxes every step): no soil flows or is pushed
+// into a cell under an obstacle once it would rise above the obstacle's
+// underside there, so soil banks against a body instead of passing through
+// it. Soil under a body can still slide out from under it.
+//
 // The rigid floor stays: heights never go below 0. The grid's edge is a wall
 // (no soil leaves) or, with SoilEdge::kOpen, bare ground beyond which soil
 // slides or is pushed off the terrain, counted in left_over_edge_m3.
@@ -64,6 +70,7 @@
 #include <string>
 #include <string_view>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "terracut/core/blade.hpp"
@@ -123,6 +130,13 @@ struct SoilStepResult {
   Rect changed{};                    ///< samples whose height the phase changed
 };
 
+/// A rigid obstacle for flowing soil: the samples under it and the height of
+/// its underside above the ground there, metres.
+struct SoilObstacle {
+  Rect cells{};
+  float bottom_m = 0.0f;
+};
+
 /// Soil a bucket holds in the given orientation, m^3: its section (see
 /// BucketSpec) below the surface that rises from the lip into the bucket
 /// at the repose angle (steeper, the soil would slide out over the lip),
@@ -133,7 +147,7 @@ struct SoilStepResult {
 double bucket_retained_m3(const BladeSpec& blade, const Quat& orientation, double repose_deg);
 
 /// The soil phase's state (kFlow): the active cells and the scratch of the
-/// passes, sized at construction (6 bytes per sample) so that a step
+/// passes, sized at construction (7 bytes per sample) so that a step
 /// allocates nothing once its scratch has grown to the blade's footprint.
 class SoilFlow {
  public:
@@ -157,6 +171,11 @@ class SoilFlow {
   /// Relaxation only (no blade): e.g. between strokes, or a settling run.
   SoilStepResult relax(HeightGrid& grid);
 
+  /// The obstacles for the next steps (replacing the previous ones), at most
+  /// kMaxObstacles (more are ignored); rectangles are clipped to the grid.
+  /// Allocation-free once the list has grown to its largest size.
+  void set_obstacles(std::span<const SoilObstacle> obstacles) noexcept;
+  static constexpr int kMaxObstacles = 255;
   /// Soil in the bucket, m^3 (0 without one).
   double bucket_load_m3() const { return load_m3_; }
   /// Cells still active (the backlog).
@@ -198,6 +217,12 @@ class SoilFlow {
   std::vector<float> delta_;           // per cell: the pass's net flux, metres
   std::vector<std::uint32_t> touched_;  // cells with a delta this pass
   std::vector<std::uint8_t> near_blade_;  // per cell: 1 within reach of the step's blade
+  std::vector<std::uint8_t> obstacle_;    // per cell: 1 + index into obstacles_, 0 for none
+  std::vector<SoilObstacle> obstacles_;   // the obstacles, their cells clipped to the grid
+  /// True when the cell's soil at height_m would stand inside an obstacle.
+  bool obstructed(std::uint32_t cell, float height_m) const {
+    return obstacle_[cell] != 0 && height_m > obstacles_[obstacle_[cell] - 1u].bottom_m;
+  }
   std::vector<std::uint32_t> marked_;     // cells with near_blade_ set
 
   Rect before_rect_{};        // where before_ holds the pre-cut heights
