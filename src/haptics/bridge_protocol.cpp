@@ -3,57 +3,19 @@
 // code is independent of the host's endianness and alignment.
 #include "terracut/haptics/bridge_protocol.hpp"
 
-#include <cstring>
+#include "terracut/core/wire.hpp"
 
 namespace terracut::haptics {
 namespace {
 
-// CRC-32 table (reflected polynomial 0xEDB88320), built at compile time.
-constexpr std::array<std::uint32_t, 256> make_crc_table() {
-  std::array<std::uint32_t, 256> table{};
-  for (std::uint32_t i = 0; i < 256; ++i) {
-    std::uint32_t c = i;
-    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-    table[i] = c;
-  }
-  return table;
-}
-constexpr std::array<std::uint32_t, 256> kCrcTable = make_crc_table();
-
-void put_u16(std::uint8_t* p, std::uint16_t v) {
-  p[0] = static_cast<std::uint8_t>(v);
-  p[1] = static_cast<std::uint8_t>(v >> 8);
-}
-void put_u32(std::uint8_t* p, std::uint32_t v) {
-  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
-void put_u64(std::uint8_t* p, std::uint64_t v) {
-  for (int i = 0; i < 8; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
-void put_f64(std::uint8_t* p, double v) {
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &v, sizeof bits);
-  put_u64(p, bits);
-}
-std::uint16_t get_u16(const std::uint8_t* p) {
-  return static_cast<std::uint16_t>(p[0] | (p[1] << 8));
-}
-std::uint32_t get_u32(const std::uint8_t* p) {
-  std::uint32_t v = 0;
-  for (int i = 3; i >= 0; --i) v = (v << 8) | p[i];
-  return v;
-}
-std::uint64_t get_u64(const std::uint8_t* p) {
-  std::uint64_t v = 0;
-  for (int i = 7; i >= 0; --i) v = (v << 8) | p[i];
-  return v;
-}
-double get_f64(const std::uint8_t* p) {
-  const std::uint64_t bits = get_u64(p);
-  double v = 0.0;
-  std::memcpy(&v, &bits, sizeof v);
-  return v;
-}
+using wire::get_f64;
+using wire::get_u16;
+using wire::get_u32;
+using wire::get_u64;
+using wire::put_f64;
+using wire::put_u16;
+using wire::put_u32;
+using wire::put_u64;
 
 // Header and CRC around a payload already written at out + kBridgeHeaderSize.
 std::size_t finish_packet(const PacketHeader& header, PacketType type, std::size_t payload_size,
@@ -96,9 +58,7 @@ Reject check_format(const std::uint8_t* data, std::size_t size, PacketType want,
 }  // namespace
 
 std::uint32_t crc32(const std::uint8_t* data, std::size_t size) noexcept {
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (std::size_t i = 0; i < size; ++i) c = kCrcTable[(c ^ data[i]) & 0xFFu] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFu;
+  return wire::crc32(data, size);
 }
 
 std::size_t encode_pose(const PacketHeader& header, const PosePayload& pose,
@@ -177,26 +137,17 @@ Reject decode_force(const std::uint8_t* data, std::size_t size, PacketHeader& he
 }
 
 Reject SequenceFilter::check(const PacketHeader& header) noexcept {
-  // Another session (or the first packet): a device process (re)started.
-  if (!has_session_ || header.session != session_) {
-    has_session_ = true;
-    new_session_ = true;
-    session_ = header.session;
-    last_sequence_ = header.sequence;
-    last_timestamp_ns_ = header.timestamp_ns;
-    ++sessions_;
-    return Reject::kNone;
+  switch (order_.check(header.session, header.sequence, header.timestamp_ns)) {
+    case wire::Order::kAccepted:
+      return Reject::kNone;
+    case wire::Order::kDuplicate:
+      return Reject::kDuplicate;
+    case wire::Order::kReordered:
+      return Reject::kReordered;
+    case wire::Order::kStale:
+      return Reject::kStale;
   }
-  // Serial-number arithmetic, so the sequence may wrap around 2^32.
-  const std::int32_t ahead = static_cast<std::int32_t>(header.sequence - last_sequence_);
-  if (ahead == 0) return Reject::kDuplicate;
-  if (ahead < 0) return Reject::kReordered;
-  if (header.timestamp_ns < last_timestamp_ns_) return Reject::kStale;
-  new_session_ = false;
-  lost_ += ahead - 1;
-  last_sequence_ = header.sequence;
-  last_timestamp_ns_ = header.timestamp_ns;
-  return Reject::kNone;
+  return Reject::kStale;
 }
 
 }  // namespace terracut::haptics

@@ -25,6 +25,7 @@
 #include <string_view>
 
 #include "terracut/core/math.hpp"
+#include "terracut/core/wire.hpp"
 
 namespace terracut::haptics {
 
@@ -135,21 +136,15 @@ class SequenceFilter {
   Reject check(const PacketHeader& header) noexcept;
 
   /// True when the last accepted packet started a new session (the first one included).
-  bool new_session() const { return new_session_; }
+  bool new_session() const { return order_.new_session(); }
   /// Sessions seen (1 after the first accepted packet).
-  std::int64_t sessions() const { return sessions_; }
+  std::int64_t sessions() const { return order_.sessions(); }
   /// Packets skipped by gaps in the sequence numbers (lost or never sent).
-  std::int64_t lost() const { return lost_; }
-  std::uint32_t last_sequence() const { return last_sequence_; }
+  std::int64_t lost() const { return order_.lost(); }
+  std::uint32_t last_sequence() const { return order_.last_sequence(); }
 
  private:
-  bool has_session_ = false;
-  bool new_session_ = false;
-  std::uint32_t session_ = 0;
-  std::uint32_t last_sequence_ = 0;
-  std::uint64_t last_timestamp_ns_ = 0;
-  std::int64_t sessions_ = 0;
-  std::int64_t lost_ = 0;
+  wire::SequenceFilter order_;  // the rule shared with the teleoperation link (core/wire.hpp)
 };
 
 }  // namespace terracut::haptics
