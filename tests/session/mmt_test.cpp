@@ -1,0 +1,333 @@
+// Model-mediated teleoperation in one process: determinism, convergence of
+// the local model to the remote's terrain and soil, the bound on force steps
+// at updates, bad packets on both stations, and a link gone silent.
+#include "terracut/session/mmt.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "terracut/core/error.hpp"
+#include "terracut/core/wire.hpp"
+#include "terracut/session/scenario.hpp"
+#include "terracut/session/world.hpp"
+#include "../support/scenario_text.hpp"
+
+namespace terracut::session {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kTrench = fs::path(TERRACUT_SOURCE_DIR) / "scenarios" / "mmt_trench_clay.yaml";
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The trench scenario, with the remote's world written next to it from the
+// same text after the edit (a different plane height, another soil).
+Scenario trench_with_remote(const std::string& name, double remote_height_m,
+                            const std::string& remote_soil) {
+  const fs::path dir = fs::temp_directory_path() / ("terracut_mmt_" + name);
+  fs::create_directories(dir);
+  std::string remote = read_text(kTrench);
+  std::ostringstream h;
+  h << "height_m: " << remote_height_m;
+  remote = test::replace(remote, "height_m: 0.3", h.str());
+  remote = test::replace(remote, "soil: dry_sand", "soil: " + remote_soil);
+  std::ofstream(dir / "remote.yaml") << remote;
+  Scenario sc = load_scenario(kTrench);
+  sc.mmt->remote_scenario = dir / "remote.yaml";
+  sc.mmt->remote_soil.reset();
+  return sc;
+}
+
+TEST(Mmt, SameSeedSameRunOtherSeedOtherLink) {
+  Scenario sc = load_scenario(kTrench);
+  MmtOverrides o;
+  o.rtt_s = 0.1;
+  o.loss = 0.05;
+  o.jitter_s = 0.003;
+  o.seed = 7;
+  MmtRun a(sc, o), b(sc, o);
+  a.run();
+  b.run();
+  const auto& ra = a.operator_station().records();
+  const auto& rb = b.operator_station().records();
+  ASSERT_EQ(ra.size(), rb.size());
+  for (std::size_t i = 0; i < ra.size(); ++i) {
+    ASSERT_EQ(ra[i].force_world_n.z, rb[i].force_world_n.z) << i;
+    ASSERT_EQ(ra[i].remote_force_world_n.z, rb[i].remote_force_world_n.z) << i;
+  }
+  const auto& qa = a.remote_station().records();
+  const auto& qb = b.remote_station().records();
+  for (std::size_t i = 0; i < qa.size(); ++i) ASSERT_EQ(qa[i].tool_m.z, qb[i].tool_m.z) << i;
+  EXPECT_EQ(a.summary().force_error_rms_mmt_n, b.summary().force_error_rms_mmt_n);
+  // Jitter of 3 ms over 1 ms spacing reorders; loss loses.
+  EXPECT_GT(a.operator_station().counters().rejected[net::Reject::kReordered], 0);
+  EXPECT_GT(a.link().b().emulator().counters().lost, 0);
+  o.seed = 8;
+  MmtRun c(sc, o);
+  c.run();
+  EXPECT_NE(c.link().b().emulator().counters().lost, a.link().b().emulator().counters().lost);
+}
+
+TEST(Mmt, LocalModelConvergesToTheRemoteTerrainAndSoil) {
+  // The remote's sand surface is 2 cm lower and its soil is clay.
+  const Scenario sc = trench_with_remote("converge", 0.28, "clay");
+  MmtRun run(sc);
+  run.run();
+  const MmtSummary s = run.summary();
+  // Before the updates landed the worked region differed by the 2 cm (and
+  // by the cuts made at different depths).
+  EXPECT_GT(s.terrain_rms_max_m, 0.01);
+  // After: equal to the remote's except where the local tool cut ahead of
+  // what the remote had reported (the lower of the two is kept there); the
+  // follower lags the command by less than a cell, so within a tenth of
+  // the mismatch.
+  EXPECT_LT(s.terrain_rms_final_m, 0.002);
+  // The soil factor: the remote's clay against the operator's sand model at
+  // the remote's cut (depth 0.28 - 0.22 = 6 cm, the 0.4 m blade).
+  EarthmovingParams sand, clay;
+  sand.soil = soil_preset(SoilPreset::kDrySand);
+  clay.soil = soil_preset(SoilPreset::kClay);
+  const double truth = earthmoving_force(clay, 0.4, 0.06).horizontal_n /
+                       earthmoving_force(sand, 0.4, 0.06).horizontal_n;
+  EXPECT_NEAR(s.force_scale_final, truth, 0.05 * truth);
+  // ... and the operator applies it.
+  EXPECT_NEAR(s.force_scale_applied, s.force_scale_final, 1e-9);
+  EXPECT_GT(s.estimate_samples, 500);
+}
+
+TEST(Mmt, ForceStepAtUpdatesStaysUnderTheBound) {
+  // Frequent large updates: patches every 10 ms of a terrain 3 cm off, a
+  // soil twice as resistant, a short blend.
+  Scenario sc = trench_with_remote("steps", 0.27, "clay");
+  sc.mmt->sense_period_s = 0.01;
+  sc.mmt->blend_s = 0.02;
+  sc.mmt->max_update_step_n = 0.005;
+  MmtRun run(sc);
+  run.run();
+  const MmtSummary s = run.summary();
+  EXPECT_GT(s.patches, 50);
+  EXPECT_GT(s.estimates, 100);
+  EXPECT_LE(s.max_update_step_n, 0.005 + 1e-12);
+  // The bound held and still the factor got where it was going.
+  EXPECT_NEAR(s.force_scale_applied, s.force_scale_final, 1e-9);
+  // Without the bound, the same updates step the force by more.
+  sc.mmt->max_update_step_n = 100.0;
+  MmtRun unbounded(sc);
+  unbounded.run();
+  EXPECT_GT(unbounded.summary().max_update_step_n, 10 * 0.005);
+}
+
+TEST(Mmt, DirectReflectionFailsWithDelayMmtHolds) {
+  const Scenario sc = load_scenario(kTrench);
+  MmtOverrides o;
+  o.rtt_s = 0.0;
+  MmtRun near(sc, o);
+  near.run();
+  o.rtt_s = 0.5;
+  MmtRun far(sc, o);
+  far.run();
+  const MmtSummary a = near.summary(), b = far.summary();
+  // Direct reflection renders a force a round trip old: its error grows
+  // with the delay; the local model's does not grow as much.
+  EXPECT_GT(b.force_error_rms_dfr_n, 1.5 * a.force_error_rms_dfr_n);
+  EXPECT_LT(b.force_error_rms_mmt_n, b.force_error_rms_dfr_n);
+}
+
+TEST(Mmt, DeadbandSavesUpdatePackets) {
+  Scenario sc = trench_with_remote("deadband", 0.28, "clay");
+  MmtRun every(sc);
+  every.run();
+  sc.mmt->deadband = 0.1;
+  MmtRun jnd(sc);
+  jnd.run();
+  EXPECT_LT(jnd.summary().update_packets_per_s, 0.8 * every.summary().update_packets_per_s);
+  EXPECT_GT(jnd.summary().patches, 0);
+}
+
+// Stations driven by hand over one in-memory link.
+struct Pair {
+  explicit Pair(const Scenario& sc)
+      : settings(*sc.mmt),
+        remote_sc(load_remote_scenario(sc)),
+        device(make_operator_device(sc)),
+        link(settings.to_remote, settings.to_operator),
+        op(sc, settings, *device, link.a(), 1u),
+        remote(remote_sc, settings, op.rig().loop().force_model(), op.simulation().grid(),
+               link.b(), 2u) {}
+  MmtSettings settings;
+  Scenario remote_sc;
+  std::unique_ptr<haptics::Device> device;
+  net::MemoryLink link;
+  OperatorStation op;
+  RemoteStation remote;
+};
+
+TEST(Mmt, BadPacketsOnBothStationsAreCountedNeverFatal) {
+  Scenario sc = load_scenario(kTrench);
+  sc.mmt->to_remote.delay_s = sc.mmt->to_operator.delay_s = 0.0;
+  sc.mmt->to_remote.jitter_s = sc.mmt->to_operator.jitter_s = 0.0;
+  Pair p(sc);
+  const std::uint32_t link = sc.mmt->link_id;
+  auto inject = [](net::Endpoint& from, const std::vector<std::uint8_t>& d) {
+    from.send(net::Channel::kUnreliable, d.data(), d.size(), 0.0);
+  };
+  // A valid command, replayed, an older one, a foreign one, a truncated
+  // one, a corrupted one and a measurement sent the wrong way.
+  net::Command c;
+  c.pose.position_m = {0, 0.35, 0.75};
+  std::vector<std::uint8_t> d(net::kHeaderSize + net::kCommandPayloadSize + net::kCrcSize);
+  auto command = [&](std::uint32_t session, std::uint32_t seq, std::uint32_t link_id) {
+    net::encode_command({net::MessageType::kCommand, link_id, session, seq, 1000u * seq}, c, d.data());
+    return d;
+  };
+  inject(p.link.a(), command(99, 10, link));
+  inject(p.link.a(), command(99, 10, link));  // replayed
+  inject(p.link.a(), command(99, 9, link));   // older
+  inject(p.link.a(), command(99, 11, link + 1));  // foreign
+  auto cut = command(99, 12, link);
+  cut.resize(20);
+  inject(p.link.a(), cut);
+  auto flipped = command(99, 13, link);
+  flipped[50] ^= 0x40;
+  inject(p.link.a(), flipped);
+  std::vector<std::uint8_t> m(net::kHeaderSize + net::kMeasurementPayloadSize + net::kCrcSize);
+  net::encode_measurement({net::MessageType::kMeasurement, link, 99, 1, 0}, net::Measurement{}, m.data());
+  inject(p.link.a(), m);
+  inject(p.link.a(), std::vector<std::uint8_t>{1, 2, 3});
+  p.remote.tick(0.0);
+  const net::RejectCounts& rr = p.remote.counters().rejected;
+  EXPECT_EQ(p.remote.counters().accepted, 1);
+  EXPECT_EQ(rr[net::Reject::kDuplicate], 1);
+  EXPECT_EQ(rr[net::Reject::kReordered], 1);
+  EXPECT_EQ(rr[net::Reject::kForeign], 1);
+  EXPECT_EQ(rr[net::Reject::kTruncated], 2);
+  EXPECT_EQ(rr[net::Reject::kBadChecksum], 1);
+  EXPECT_EQ(rr[net::Reject::kBadType], 1);
+
+  // The operator: a command (the wrong way), a patch outside the grid, a
+  // patch that is not zstd, a non-finite estimate, a stale measurement.
+  inject(p.link.b(), command(5, 1, link));
+  net::Patch patch;
+  patch.rect = {95, 95, 105, 100};  // the grid has 100 x 100 samples
+  patch.heights.assign(50, 0.3f);
+  std::vector<std::uint8_t> pd;
+  net::encode_patch({net::MessageType::kPatch, link, 5, 1, 0}, patch, pd);
+  inject(p.link.b(), pd);
+  patch.rect = {0, 0, 10, 5};
+  net::encode_patch({net::MessageType::kPatch, link, 5, 2, 0}, patch, pd);
+  for (std::size_t i = net::kHeaderSize + net::kPatchFixedSize; i + net::kCrcSize < pd.size(); ++i)
+    pd[i] = 0x5A;
+  wire::put_u32(pd.data() + pd.size() - 4, wire::crc32(pd.data(), pd.size() - 4));
+  inject(p.link.b(), pd);
+  std::vector<std::uint8_t> e(net::kHeaderSize + net::kEstimatePayloadSize + net::kCrcSize);
+  net::Estimate bad;
+  bad.force_scale = std::nan("");
+  net::encode_estimate({net::MessageType::kEstimate, link, 5, 1, 0}, bad, e.data());
+  inject(p.link.b(), e);
+  net::encode_measurement({net::MessageType::kMeasurement, link, 5, 2, 5000}, net::Measurement{}, m.data());
+  inject(p.link.b(), m);
+  net::encode_measurement({net::MessageType::kMeasurement, link, 5, 3, 4000}, net::Measurement{}, m.data());
+  inject(p.link.b(), m);  // newer sequence, older time: stale
+  p.op.tick(0.0);
+  const net::RejectCounts& ro = p.op.counters().rejected;
+  EXPECT_EQ(ro[net::Reject::kBadType], 1);
+  EXPECT_EQ(ro[net::Reject::kBadPayload], 3);
+  EXPECT_EQ(ro[net::Reject::kStale], 1);
+  EXPECT_EQ(p.op.counters().patches, 0);
+  // The stations go on working.
+  for (int i = 1; i < 100; ++i) {
+    p.op.tick(i * 0.001);
+    p.remote.tick(i * 0.001);
+  }
+  EXPECT_GT(p.op.counters().accepted, 50);
+}
+
+TEST(Mmt, SilentLinkStopsTheRemoteToolAndFadesTheOperatorsForce) {
+  Scenario sc = load_scenario(kTrench);
+  const double timeout = sc.mmt->timeout_s;
+  const double rate = sc.haptics.rate_hz;
+  // The operator goes quiet at 2.0 s, mid-trench (the tool moves at 1 m/s).
+  {
+    Pair p(sc);
+    int i = 0;
+    for (; i / rate < 2.0; ++i) {
+      p.op.tick(i / rate);
+      p.remote.tick(i / rate);
+    }
+    for (; i / rate < 2.6; ++i) p.remote.tick(i / rate);
+    const auto& r = p.remote.records();
+    // Commands stop arriving at 2.0 s + the 50 ms delay; the tool holds still
+    // once the timeout has passed, within one follower step.
+    const double hold_from = 2.0 + sc.mmt->to_remote.delay_s + sc.mmt->to_remote.jitter_s + timeout + 0.002;
+    const std::size_t k = std::size_t(std::ceil(hold_from * rate));
+    ASSERT_LT(k, r.size());
+    EXPECT_TRUE(r[k].holding);
+    const double step = sc.mmt->follower_speed_m_per_s / rate;
+    EXPECT_LE(length(r.back().tool_m - r[k].tool_m), step + 1e-12);
+    // Before the silence it was moving.
+    EXPECT_GT(length(r[std::size_t(1.9 * rate)].tool_m - r[std::size_t(1.8 * rate)].tool_m), 0.05);
+  }
+  // The remote goes quiet at 2.0 s: the operator's force fades to zero.
+  {
+    Pair p(sc);
+    int i = 0;
+    for (; i / rate < 2.0; ++i) {
+      p.op.tick(i / rate);
+      p.remote.tick(i / rate);
+    }
+    const double before = length(p.op.records().back().force_device_n);
+    EXPECT_GT(before, 0.5);
+    for (; i / rate < 2.6; ++i) p.op.tick(i / rate);
+    const auto& r = p.op.records();
+    const double safety = sc.haptics.safety.watchdog_timeout_s + sc.haptics.safety.watchdog_ramp_s;
+    const double faded_by = 2.0 + sc.mmt->to_operator.delay_s + sc.mmt->to_operator.jitter_s + timeout + safety + 0.002;
+    const std::size_t k = std::size_t(std::ceil(faded_by * rate));
+    ASSERT_LT(k, r.size());
+    EXPECT_TRUE(r[k].link_silent);
+    for (std::size_t j = k; j < r.size(); ++j) EXPECT_EQ(length(r[j].force_device_n), 0.0) << j;
+  }
+}
+
+TEST(Mmt, BadSettingsNameTheField) {
+  const std::string text = read_text(kTrench);
+  auto fails = [&](const std::string& from, const std::string& to, const std::string& want) {
+    try {
+      parse_scenario(test::replace(text, from, to), kTrench);
+      ADD_FAILURE() << "accepted: " << to;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+    }
+  };
+  fails("loss: 0.0", "loss: 1.5", "mmt.link.loss: must be in [0, 1)");
+  fails("blend_s: 0.1", "blend_s: -1", "mmt.operator.blend_s");
+  fails("sense_period_s: 0.05", "sense_periods: 0.05", "sense_periods");
+  fails("soil: clay", "soil: mud", "unknown");
+  // A remote whose grid is not the operator's.
+  const fs::path dir = fs::temp_directory_path() / "terracut_mmt_grid";
+  fs::create_directories(dir);
+  std::ofstream(dir / "remote.yaml") << test::replace(text, "resolution: 100", "resolution: 50");
+  Scenario sc = load_scenario(kTrench);
+  sc.mmt->remote_scenario = dir / "remote.yaml";
+  try {
+    MmtRun run(sc);
+    ADD_FAILURE() << "accepted a remote grid of another size";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("mmt.remote.scenario"), std::string::npos) << e.what();
+  }
+  MmtOverrides o;
+  o.loss = 1.0;
+  EXPECT_THROW(MmtRun(load_scenario(kTrench), o), InputError);
+}
+
+}  // namespace
+}  // namespace terracut::session
