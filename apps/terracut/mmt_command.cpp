@@ -164,6 +164,7 @@ int run_sweep(const Options& o, const session::Scenario& sc) {
                              : std::string("")) << " |\n";
     }
   }
+  csv.close();
   if (!csv) throw InputError((fs::path(o.out) / "study.csv").string() + ": cannot be written");
   std::ofstream(fs::path(o.out) / "study.md") << md.str();
   if (!o.quiet) std::cout << md.str();

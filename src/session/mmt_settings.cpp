@@ -39,6 +39,8 @@ void read_link(const yaml::Map& link, net::LinkConditions& c) {
 std::string validate(const MmtSettings& s) {
   if (!in(s.follower_speed_m_per_s, 0.0, 100.0) || s.follower_speed_m_per_s <= 0.0)
     return must_be("remote.follower_speed_m_per_s", "in (0, 100]", s.follower_speed_m_per_s);
+  if (!in(s.follower_time_constant_s, 0.0, 10.0))
+    return must_be("remote.follower_time_constant_s", "in [0, 10]", s.follower_time_constant_s);
   if (!in(s.sense_period_s, 0.0, 10.0) || s.sense_period_s <= 0.0)
     return must_be("remote.sense_period_s", "in (0, 10]", s.sense_period_s);
   if (!in(s.sense_radius_m, 0.0, 100.0) || s.sense_radius_m <= 0.0)
@@ -69,7 +71,8 @@ void MmtReader::read(const YAML::Node& value, const std::string& file) {
   }
   const yaml::Map top(root, {"remote", "link", "operator", "timeout_s", "udp", "link_id"});
   const yaml::Map remote =
-      top.section("remote", {"scenario", "soil", "follower_speed_m_per_s", "sense_period_s",
+      top.section("remote", {"scenario", "soil", "follower_speed_m_per_s",
+                             "follower_time_constant_s", "sense_period_s",
                              "sense_radius_m", "estimate", "forgetting"});
   if (const auto f = remote.get("scenario")) {
     const std::filesystem::path p = f->text();
@@ -78,6 +81,7 @@ void MmtReader::read(const YAML::Node& value, const std::string& file) {
   if (const auto f = remote.get("soil"))
     s.remote_soil = f->choice({SoilPreset::kDrySand, SoilPreset::kLooseSand, SoilPreset::kClay});
   remote.read_number("follower_speed_m_per_s", s.follower_speed_m_per_s);
+  remote.read_number("follower_time_constant_s", s.follower_time_constant_s);
   remote.read_number("sense_period_s", s.sense_period_s);
   remote.read_number("sense_radius_m", s.sense_radius_m);
   remote.read_boolean("estimate", s.estimate);

@@ -55,13 +55,17 @@ void include_rect(Rect& into, const Rect& r) {
 }  // namespace
 
 // ---------------------------------------------------------------------------
-// The remote's arm: follows the newest command at a limited speed.
+// The remote's arm: follows the newest command as a first-order servo at a
+// limited speed (a real arm lags, and does not jump when a command is late).
 // ---------------------------------------------------------------------------
 
 class FollowerDevice final : public haptics::Device {
  public:
-  FollowerDevice(const haptics::WorkspaceMapping& mapping, double speed_m_per_s, double rate_hz)
-      : workspace_(mapping), step_m_(speed_m_per_s / rate_hz) {}
+  FollowerDevice(const haptics::WorkspaceMapping& mapping, double speed_m_per_s,
+                 double time_constant_s, double rate_hz)
+      : workspace_(mapping),
+        step_m_(speed_m_per_s / rate_hz),
+        gain_(std::min(1.0, 1.0 / (time_constant_s * rate_hz))) {}
 
   std::string_view kind() const override { return "follower"; }
 
@@ -77,7 +81,9 @@ class FollowerDevice final : public haptics::Device {
 
   bool read(double, haptics::DeviceSample& out) noexcept override {
     if (!has_pose_) return false;
-    Vec3 d = target_.position_m - pose_.position_m;
+    // A first-order servo (time constant tau: the step is the error x dt /
+    // tau), limited to the arm's speed.
+    Vec3 d = (target_.position_m - pose_.position_m) * gain_;
     const double l = length(d);
     if (l > step_m_) d = d * (step_m_ / l);
     pose_.position_m = pose_.position_m + d;
@@ -93,7 +99,8 @@ class FollowerDevice final : public haptics::Device {
 
  private:
   haptics::Workspace workspace_;
-  double step_m_;
+  double step_m_;  // largest step per tick, m
+  double gain_;    // dt / tau, at most 1
   BladePose pose_{}, target_{};
   bool has_pose_ = false;
 };
@@ -186,7 +193,8 @@ RemoteStation::RemoteStation(const Scenario& remote, const MmtSettings& settings
     : settings_(settings), nominal_(nominal), link_(link), session_(session) {
   const haptics::LoopParams params = loop_params(remote);
   device_ = std::make_unique<FollowerDevice>(params.settings().workspace,
-                                             settings_.follower_speed_m_per_s, params.rate_hz());
+                                             settings_.follower_speed_m_per_s,
+                                             settings_.follower_time_constant_s, params.rate_hz());
   RigOptions ro;
   ro.loop.record_capacity = 0;
   ro.loop.realtime = false;

@@ -22,6 +22,9 @@ struct MmtSettings {
   std::optional<SoilPreset> remote_soil;
   /// Largest speed of the remote tool following the commands, m/s, (0, 100].
   double follower_speed_m_per_s = 1.5;
+  /// Time constant of the remote tool's servo toward the command, s, [0, 10]
+  /// (0: it reaches each command at once, within the speed limit).
+  double follower_time_constant_s = 0.02;
   /// Period of the remote's terrain sensing and estimate updates, s, (0, 10].
   double sense_period_s = 0.05;
   /// Half side of the square sensed around the remote tool, m, (0, 100].
