@@ -95,7 +95,7 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
   RemoteStation station(remote, s, nominal.force_model(), local.simulation().grid(), *link,
                         std::uint32_t(Clock::now().time_since_epoch().count()));
   if (o.log)
-    *o.log << "terracut mmt: remote listening on " << address << ":" << link->port() << "\n";
+    *o.log << "terracut mmt: remote listening on " << address << ":" << link->port() << std::endl;
   const double max_s = o.remote_max_s > 0.0 ? o.remote_max_s : operator_duration_s(op) + 10.0;
   double last_command_s = -1.0;
   std::int64_t accepted = 0;
