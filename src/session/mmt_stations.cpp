@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "terracut/core/error.hpp"
+#include "terracut/haptics/cut_depth.hpp"
 #include "terracut/haptics/workspace.hpp"
 #include "terracut/session/mmt.hpp"
 
@@ -274,6 +275,13 @@ void RemoteStation::update_estimate(const haptics::LoopRecord& r) {
   in.edge_direction = simulation().last().edge.b - simulation().last().edge.a;
   in.device_point_m = r.tool.position_m;
   in.surface_y_m = simulation().grid().spec().origin_m.y;
+  if (simulation().params().soil.model == SoilModel::kFlow) {
+    // The pile ahead weighs on the wedge in the operator's model too.
+    const haptics::SoilAhead ahead = haptics::soil_ahead(
+        simulation().grid(), simulation().params().representation, simulation().last().edge,
+        r.velocity_m_per_s, haptics::depth_lookahead_m(simulation().grid().spec()));
+    in.surcharge_pa = nominal_.params().earthmoving.soil.unit_weight_n_per_m3 * ahead.pile_m;
+  }
   const double x = length(horizontal(nominal_.compute(in).cutting_n)) / 100.0;
   const double y = length(horizontal(r.force_world_n)) / 100.0;
   if (!(x > 0.01) || !std::isfinite(y)) return;  // below 1 N the ratio says little
@@ -285,18 +293,20 @@ void RemoteStation::update_estimate(const haptics::LoopRecord& r) {
 }
 
 // The sensed patch: the rectangle changed since the last one and the square
-// around the tool, cut down to the samples that differ from what the
-// operator was sent by more than the threshold (any difference, or with the
-// deadband a JND fraction of the cut depth: the force of a cut grows at
-// least linearly with its depth, so a relative depth change of the JND
-// changes it by at least the JND).
+// around the tool. With the deadband it is cut down to the samples that
+// differ from what the operator was sent by more than a JND fraction of the
+// cut depth (the force of a cut grows at least linearly with its depth, so
+// a relative depth change of the JND changes it by at least the JND).
 void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
   Rect cand = dirty_;
   dirty_ = {};
   if (has_command_) include_rect(cand, window_around(device_->pose().position_m));
   const HeightGrid& grid = simulation().grid();
+  // Without the deadband the whole sensed rectangle goes (a depth camera's
+  // frame: it also corrects what the operator's model did on its own);
+  // with it, only the samples past the threshold, and nothing below it.
   const double threshold =
-      settings_.deadband > 0.0 ? settings_.deadband * std::max(r.cut_depth_m, 0.02) : 1e-7;
+      settings_.deadband > 0.0 ? settings_.deadband * std::max(r.cut_depth_m, 0.02) : -1.0;
   Rect diff{};
   for (int row = cand.r0; row < cand.r1; ++row)
     for (int col = cand.c0; col < cand.c1; ++col) {
@@ -522,9 +532,9 @@ void OperatorStation::receive(double t_s) {
 // samples near its edge (within exclusion_m, where the force is read: the
 // depth ahead and the failure wedge) are not touched: their ramp starts
 // again from their current height once the tool has left them, so a patch
-// never changes the terrain the tool is feeling. A sample the local tool
-// cut recently keeps the lower of its height and the blend (the remote has
-// not seen that cut yet).
+// never changes the terrain the tool is feeling. Samples the local tool
+// changed recently wait the same way (the remote has not seen that change
+// yet); every sample ends at the remote's height.
 void OperatorStation::merge(double t_s) {
   HeightGrid& grid = rig_->world().simulation().grid();
   const haptics::LoopRecord& last = rig_->loop().last();
@@ -554,9 +564,17 @@ void OperatorStation::merge(double t_s) {
                                 ? std::clamp((t_s - b.t0_s[k]) / settings_.blend_s, 0.0, 1.0)
                                 : 1.0;
         if (ramp < 1.0) b.done = false;
-        float h = float(b.from[k] + (b.to[k] - b.from[k]) * ramp);
-        if (t_s - stamp_s_[std::size_t(i)] < protect_s_) h = std::min(h, now);
-        b.scratch[k] = h;
+        // A sample the local tool changed within the last round trip is
+        // ahead of what the remote has reported: it waits like the samples
+        // under the tool, and ramps from where it is once it is settled.
+        if (t_s - stamp_s_[std::size_t(i)] < protect_s_) {
+          b.t0_s[k] = float(t_s);
+          b.from[k] = now;
+          b.scratch[k] = now;
+          b.done = false;
+          continue;
+        }
+        b.scratch[k] = float(b.from[k] + (b.to[k] - b.from[k]) * ramp);
       }
     grid.set_heights(b.rect, b.scratch.data());
     include_rect(worked_, b.rect);
