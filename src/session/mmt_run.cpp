@@ -119,9 +119,14 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
                                             operator_->rig().loop().force_model(),
                                             operator_->simulation().grid(), link_->b(), 2u);
   rate_hz_ = operator_->rate_hz();
+  // After the path: a round trip, a sensing period and a blend for the last
+  // updates to land, and on a lossy link three retransmissions more.
+  const net::LinkConditions& back = settings_.to_operator;
+  const bool lossy = back.loss > 0.0 || back.burst.p_good_to_bad > 0.0;
+  const double retransmit_s = back.retransmit_s.value_or(2.0 * back.delay_s + 0.02);
   const double duration = overrides.duration_s.value_or(
-      operator_duration_s(*op_) + settings_.to_remote.delay_s + settings_.to_operator.delay_s +
-      settings_.sense_period_s + settings_.blend_s + 0.2);
+      operator_duration_s(*op_) + settings_.to_remote.delay_s + back.delay_s +
+      settings_.sense_period_s + settings_.blend_s + 0.2 + (lossy ? 3.0 * retransmit_s : 0.0));
   if (!(duration > 0.0) || duration > 3600.0)
     throw InputError(must_be("--duration", "in (0, 3600]", duration));
   total_ticks_ = std::max<std::int64_t>(1, std::llround(duration * rate_hz_));
@@ -177,6 +182,12 @@ MmtSummary MmtRun::summary() const {
   for (std::size_t i = 0; i < op.size(); ++i) {
     const std::size_t j = i + std::size_t(lag);
     if (j >= rm.size() || !rm[j].active) continue;
+    // Over the ticks where some force is felt or measured: the time in
+    // soil, not the idle time before and after, so that runs of different
+    // lengths compare.
+    if (length(op[i].force_world_n) == 0.0 && length(op[i].remote_force_world_n) == 0.0 &&
+        length(rm[j].force_world_n) == 0.0)
+      continue;
     e_mmt.push_back(length(op[i].force_world_n - rm[j].force_world_n));
     e_dfr.push_back(length(op[i].remote_force_world_n - rm[j].force_world_n));
     f_rem.push_back(length(rm[j].force_world_n));
