@@ -26,6 +26,22 @@ std::uint32_t crc32(const std::uint8_t* data, std::size_t size) noexcept {
   return c ^ 0xFFFFFFFFu;
 }
 
+Frame check_frame(const std::uint8_t* data, std::size_t size, const FrameLayout& layout,
+                  std::size_t& payload_size) noexcept {
+  if (size < 4) return Frame::kTruncated;
+  if (get_u32(data) != layout.magic) return Frame::kBadMagic;
+  if (size < layout.header_size + 4) return Frame::kTruncated;
+  if (get_u16(data + 4) != layout.version) return Frame::kBadVersion;
+  const std::uint64_t declared = get_u32(data + layout.size_offset);
+  const std::uint64_t expected = layout.header_size + declared + 4;
+  if (size < expected) return Frame::kTruncated;
+  if (size > expected) return Frame::kBadLength;
+  const std::size_t body = layout.header_size + static_cast<std::size_t>(declared);
+  if (crc32(data, body) != get_u32(data + body)) return Frame::kBadChecksum;
+  payload_size = static_cast<std::size_t>(declared);
+  return Frame::kOk;
+}
+
 Order SequenceFilter::check(std::uint32_t session, std::uint32_t sequence,
                             std::uint64_t timestamp_ns) noexcept {
   // Another session (or the first datagram): the sender (re)started.

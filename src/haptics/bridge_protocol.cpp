@@ -28,25 +28,18 @@ std::size_t finish_packet(const PacketHeader& header, PacketType type, std::size
   put_u64(out + 16, header.timestamp_ns);
   put_u32(out + 24, static_cast<std::uint32_t>(payload_size));
   put_u32(out + 28, 0);
-  const std::size_t body = kBridgeHeaderSize + payload_size;
-  put_u32(out + body, crc32(out, body));
-  return body + kBridgeCrcSize;
+  return wire::seal_frame(out, kBridgeHeaderSize + payload_size);
 }
 
 // The format checks shared by both packet types (see decode_pose's comment
 // for the order). On kNone, header is filled.
 Reject check_format(const std::uint8_t* data, std::size_t size, PacketType want,
                     std::size_t want_payload, PacketHeader& header) {
-  if (size < 4) return Reject::kTruncated;
-  if (get_u32(data) != kBridgeMagic) return Reject::kBadMagic;
-  if (size < kBridgeHeaderSize + kBridgeCrcSize) return Reject::kTruncated;
-  if (get_u16(data + 4) != kBridgeVersion) return Reject::kBadVersion;
-  const std::uint64_t declared = get_u32(data + 24);
-  const std::uint64_t expected = kBridgeHeaderSize + declared + kBridgeCrcSize;
-  if (size < expected) return Reject::kTruncated;
-  if (size > expected) return Reject::kBadLength;
-  const std::size_t body = kBridgeHeaderSize + static_cast<std::size_t>(declared);
-  if (crc32(data, body) != get_u32(data + body)) return Reject::kBadChecksum;
+  std::size_t declared = 0;
+  const wire::Frame frame = wire::check_frame(
+      data, size, {kBridgeMagic, kBridgeVersion, kBridgeHeaderSize, 24}, declared);
+  // wire::Frame's values are the first of Reject's, in the same order.
+  if (frame != wire::Frame::kOk) return static_cast<Reject>(frame);
   if (get_u16(data + 6) != static_cast<std::uint16_t>(want)) return Reject::kBadType;
   if (declared != want_payload) return Reject::kBadLength;
   header.session = get_u32(data + 8);
@@ -64,13 +57,8 @@ std::uint32_t crc32(const std::uint8_t* data, std::size_t size) noexcept {
 std::size_t encode_pose(const PacketHeader& header, const PosePayload& pose,
                         std::uint8_t* out) noexcept {
   std::uint8_t* p = out + kBridgeHeaderSize;
-  put_f64(p + 0, pose.position_m.x);
-  put_f64(p + 8, pose.position_m.y);
-  put_f64(p + 16, pose.position_m.z);
-  put_f64(p + 24, pose.orientation.w);
-  put_f64(p + 32, pose.orientation.x);
-  put_f64(p + 40, pose.orientation.y);
-  put_f64(p + 48, pose.orientation.z);
+  wire::put_vec3(p, pose.position_m);
+  wire::put_quat(p + 24, pose.orientation);
   put_u32(p + 56, pose.buttons);
   put_u32(p + 60, pose.flags);
   return finish_packet(header, PacketType::kPose, kPosePayloadSize, out);
@@ -79,9 +67,7 @@ std::size_t encode_pose(const PacketHeader& header, const PosePayload& pose,
 std::size_t encode_force(const PacketHeader& header, const ForcePayload& force,
                          std::uint8_t* out) noexcept {
   std::uint8_t* p = out + kBridgeHeaderSize;
-  put_f64(p + 0, force.force_n.x);
-  put_f64(p + 8, force.force_n.y);
-  put_f64(p + 16, force.force_n.z);
+  wire::put_vec3(p, force.force_n);
   put_u32(p + 24, force.flags);
   put_u32(p + 28, force.pose_sequence);
   return finish_packet(header, PacketType::kForce, kForcePayloadSize, out);
@@ -118,8 +104,8 @@ Reject decode_pose(const std::uint8_t* data, std::size_t size, PacketHeader& hea
   const Reject r = check_format(data, size, PacketType::kPose, kPosePayloadSize, header);
   if (r != Reject::kNone) return r;
   const std::uint8_t* p = data + kBridgeHeaderSize;
-  pose.position_m = {get_f64(p + 0), get_f64(p + 8), get_f64(p + 16)};
-  pose.orientation = {get_f64(p + 24), get_f64(p + 32), get_f64(p + 40), get_f64(p + 48)};
+  pose.position_m = wire::get_vec3(p);
+  pose.orientation = wire::get_quat(p + 24);
   pose.buttons = get_u32(p + 56);
   pose.flags = get_u32(p + 60);
   return Reject::kNone;
@@ -130,7 +116,7 @@ Reject decode_force(const std::uint8_t* data, std::size_t size, PacketHeader& he
   const Reject r = check_format(data, size, PacketType::kForce, kForcePayloadSize, header);
   if (r != Reject::kNone) return r;
   const std::uint8_t* p = data + kBridgeHeaderSize;
-  force.force_n = {get_f64(p + 0), get_f64(p + 8), get_f64(p + 16)};
+  force.force_n = wire::get_vec3(p);
   force.flags = get_u32(p + 24);
   force.pose_sequence = get_u32(p + 28);
   return Reject::kNone;

@@ -34,24 +34,17 @@ std::size_t finish(const Header& h, MessageType type, std::size_t payload, std::
   put_u64(out + 24, h.timestamp_ns);
   put_u32(out + 32, static_cast<std::uint32_t>(payload));
   put_u32(out + 36, 0);
-  const std::size_t body = kHeaderSize + payload;
-  put_u32(out + body, wire::crc32(out, body));
-  return body + kCrcSize;
+  return wire::seal_frame(out, kHeaderSize + payload);
 }
 
 void put_pose(std::uint8_t* p, const BladePose& pose) {
-  put_f64(p + 0, pose.position_m.x);
-  put_f64(p + 8, pose.position_m.y);
-  put_f64(p + 16, pose.position_m.z);
-  put_f64(p + 24, pose.orientation.w);
-  put_f64(p + 32, pose.orientation.x);
-  put_f64(p + 40, pose.orientation.y);
-  put_f64(p + 48, pose.orientation.z);
+  wire::put_vec3(p, pose.position_m);
+  wire::put_quat(p + 24, pose.orientation);
 }
 BladePose get_pose(const std::uint8_t* p) {
   BladePose pose;
-  pose.position_m = {get_f64(p + 0), get_f64(p + 8), get_f64(p + 16)};
-  pose.orientation = {get_f64(p + 24), get_f64(p + 32), get_f64(p + 40), get_f64(p + 48)};
+  pose.position_m = wire::get_vec3(p);
+  pose.orientation = wire::get_quat(p + 24);
   return pose;
 }
 bool finite_pose(const BladePose& pose) {
@@ -82,6 +75,16 @@ std::string_view to_string(Reject reason) {
   return "unknown";
 }
 
+Reject to_reject(wire::Order order) {
+  switch (order) {
+    case wire::Order::kAccepted: return Reject::kNone;
+    case wire::Order::kDuplicate: return Reject::kDuplicate;
+    case wire::Order::kReordered: return Reject::kReordered;
+    case wire::Order::kStale: return Reject::kStale;
+  }
+  return Reject::kStale;
+}
+
 std::int64_t RejectCounts::total() const {
   std::int64_t sum = 0;
   for (std::size_t i = 1; i < kRejectReasonCount; ++i) sum += by_reason[i];
@@ -103,9 +106,7 @@ std::size_t encode_measurement(Header header, const Measurement& m, std::uint8_t
   put_u32(p + 8, m.command_sequence);
   put_u32(p + 12, m.flags);
   put_pose(p + 16, m.pose);
-  put_f64(p + 72, m.force_world_n.x);
-  put_f64(p + 80, m.force_world_n.y);
-  put_f64(p + 88, m.force_world_n.z);
+  wire::put_vec3(p + 72, m.force_world_n);
   put_f64(p + 96, m.contact_length_m);
   put_f64(p + 104, m.cut_depth_m);
   return finish(header, MessageType::kMeasurement, kMeasurementPayloadSize, out);
@@ -151,16 +152,11 @@ std::size_t encode_patch(Header header, const Patch& patch, std::vector<std::uin
 
 Reject decode_header(const std::uint8_t* data, std::size_t size, std::uint32_t link,
                      Header& header) noexcept {
-  if (size < 4) return Reject::kTruncated;
-  if (get_u32(data) != kMagic) return Reject::kBadMagic;
-  if (size < kHeaderSize + kCrcSize) return Reject::kTruncated;
-  if (get_u16(data + 4) != kVersion) return Reject::kBadVersion;
-  const std::uint64_t declared = get_u32(data + 32);
-  const std::uint64_t expected = kHeaderSize + declared + kCrcSize;
-  if (size < expected) return Reject::kTruncated;
-  if (size > expected) return Reject::kBadLength;
-  const std::size_t body = kHeaderSize + static_cast<std::size_t>(declared);
-  if (wire::crc32(data, body) != get_u32(data + body)) return Reject::kBadChecksum;
+  std::size_t declared = 0;
+  const wire::Frame frame =
+      wire::check_frame(data, size, {kMagic, kVersion, kHeaderSize, 32}, declared);
+  // wire::Frame's values are the first of Reject's, in the same order.
+  if (frame != wire::Frame::kOk) return static_cast<Reject>(frame);
   const std::uint16_t type = get_u16(data + 6);
   if (type == 0 || type >= kMessageTypeCount) return Reject::kBadType;
   if (get_u32(data + 8) != link) return Reject::kForeign;
@@ -189,7 +185,7 @@ Reject decode_measurement(const std::uint8_t* data, std::size_t, Measurement& ou
   out.command_sequence = get_u32(p + 8);
   out.flags = get_u32(p + 12);
   out.pose = get_pose(p + 16);
-  out.force_world_n = {get_f64(p + 72), get_f64(p + 80), get_f64(p + 88)};
+  out.force_world_n = wire::get_vec3(p + 72);
   out.contact_length_m = get_f64(p + 96);
   out.cut_depth_m = get_f64(p + 104);
   if (!std::isfinite(out.t_s) || !finite_pose(out.pose) || !is_finite(out.force_world_n) ||

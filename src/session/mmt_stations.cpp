@@ -220,14 +220,8 @@ void RemoteStation::receive(double t_s) {
     if (r == net::Reject::kNone && h.type != net::MessageType::kCommand) r = net::Reject::kBadType;
     net::Command c;
     if (r == net::Reject::kNone) r = net::decode_command(d.data(), d.size(), c);
-    if (r == net::Reject::kNone) {
-      switch (commands_.check(h.session, h.sequence, h.timestamp_ns)) {
-        case wire::Order::kAccepted: break;
-        case wire::Order::kDuplicate: r = net::Reject::kDuplicate; break;
-        case wire::Order::kReordered: r = net::Reject::kReordered; break;
-        case wire::Order::kStale: r = net::Reject::kStale; break;
-      }
-    }
+    if (r == net::Reject::kNone)
+      r = net::to_reject(commands_.check(h.session, h.sequence, h.timestamp_ns));
     if (r != net::Reject::kNone) {
       counters_.rejected.add(r);
       continue;
@@ -480,14 +474,8 @@ void OperatorStation::receive(double t_s) {
           r = net::Reject::kBadType;
       }
     }
-    if (r == net::Reject::kNone) {
-      switch (filter->check(h.session, h.sequence, h.timestamp_ns)) {
-        case wire::Order::kAccepted: break;
-        case wire::Order::kDuplicate: r = net::Reject::kDuplicate; break;
-        case wire::Order::kReordered: r = net::Reject::kReordered; break;
-        case wire::Order::kStale: r = net::Reject::kStale; break;
-      }
-    }
+    if (r == net::Reject::kNone)
+      r = net::to_reject(filter->check(h.session, h.sequence, h.timestamp_ns));
     if (r != net::Reject::kNone) {
       counters_.rejected.add(r);
       continue;

@@ -13,6 +13,20 @@ mkdir -p "$work"
 scenario="$src/scenarios/mmt_trench_clay.yaml"
 link="--rtt-ms 100 --jitter-ms 2 --loss 0.05"
 
+# Bad command lines are refused with a message naming the option (exit 1).
+refuse() {
+  expect=$1
+  shift
+  if "$terracut" mmt "$@" > "$work/refused.log" 2>&1; then
+    echo "accepted: $*"; exit 1
+  fi
+  grep -q -- "$expect" "$work/refused.log" || { echo "no '$expect' in:"; cat "$work/refused.log"; exit 1; }
+}
+refuse "no mmt: section" "$src/scenarios/trench_dry_sand.yaml" --out "$work/x"
+refuse "--loss must be in" "$scenario" --out "$work/x" --loss 2
+refuse "expected ADDR:PORT" "$scenario" --out "$work/x" --role operator --connect nowhere
+refuse "--rtts: 'abc'" "$scenario" --out "$work/x" --sweep --rtts 0,abc --no-plot
+
 # The remote binds any free port and says which.
 "$terracut" mmt "$scenario" --role remote --listen 127.0.0.1:0 $link --out "$work/remote" \
   > "$work/remote.log" 2>&1 &

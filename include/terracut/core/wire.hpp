@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "terracut/core/math.hpp"
+
 namespace terracut::wire {
 
 inline void put_u16(std::uint8_t* p, std::uint16_t v) {
@@ -59,9 +61,60 @@ inline float get_f32(const std::uint8_t* p) {
   return v;
 }
 
+/// A vector as three doubles (x, y, z) and a rotation as four (w, x, y, z).
+inline void put_vec3(std::uint8_t* p, Vec3 v) {
+  put_f64(p + 0, v.x);
+  put_f64(p + 8, v.y);
+  put_f64(p + 16, v.z);
+}
+inline void put_quat(std::uint8_t* p, Quat q) {
+  put_f64(p + 0, q.w);
+  put_f64(p + 8, q.x);
+  put_f64(p + 16, q.y);
+  put_f64(p + 24, q.z);
+}
+inline Vec3 get_vec3(const std::uint8_t* p) { return {get_f64(p), get_f64(p + 8), get_f64(p + 16)}; }
+inline Quat get_quat(const std::uint8_t* p) {
+  return {get_f64(p), get_f64(p + 8), get_f64(p + 16), get_f64(p + 24)};
+}
+
 /// CRC-32 (IEEE 802.3, reflected, polynomial 0xEDB88320, init and final xor
 /// 0xFFFFFFFF: zlib's crc32 and Python's zlib.crc32).
 std::uint32_t crc32(const std::uint8_t* data, std::size_t size) noexcept;
+
+/// Where a datagram's framing is: its magic and version, its header size
+/// and where the header says how long the payload is (u32). A frame is
+/// header, payload, CRC-32 of both (u32) -- the bridge's and the link's.
+struct FrameLayout {
+  std::uint32_t magic = 0;       ///< at offset 0
+  std::uint16_t version = 0;     ///< at offset 4
+  std::size_t header_size = 0;   ///< bytes before the payload
+  std::size_t size_offset = 0;   ///< offset of the payload size field
+};
+
+/// What the framing check says of a datagram (same order as the first
+/// rejection reasons of both protocols).
+enum class Frame : std::uint8_t {
+  kOk = 0,
+  kTruncated,    ///< shorter than its header, or than the size it declares
+  kBadLength,    ///< longer than declared
+  kBadMagic,
+  kBadVersion,
+  kBadChecksum,
+};
+
+/// Checks length, magic, version, declared size and CRC, in that order:
+/// length >= 4, magic, length >= header + CRC, version, declared size, CRC.
+/// On kOk, payload_size is the declared payload size.
+Frame check_frame(const std::uint8_t* data, std::size_t size, const FrameLayout& layout,
+                  std::size_t& payload_size) noexcept;
+
+/// Writes the CRC-32 of the body bytes [0, body) after them; returns the
+/// frame's size (body + 4).
+inline std::size_t seal_frame(std::uint8_t* out, std::size_t body) noexcept {
+  put_u32(out + body, crc32(out, body));
+  return body + 4;
+}
 
 /// What the ordering rule says of a datagram.
 enum class Order : std::uint8_t {

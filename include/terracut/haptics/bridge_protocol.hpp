@@ -99,6 +99,9 @@ enum class Reject : std::uint8_t {
   kReordered,    ///< a sequence number older than the last accepted one
   kStale,        ///< a newer sequence but a timestamp older than the last accepted one
 };
+static_assert(int(Reject::kBadChecksum) == int(wire::Frame::kBadChecksum) &&
+                  int(Reject::kTruncated) == int(wire::Frame::kTruncated),
+              "the framing reasons are wire::Frame's, in its order");
 inline constexpr std::size_t kRejectReasonCount = 10;  // including kNone
 /// "none", "truncated", "bad_length", "bad_magic", "bad_version",
 /// "bad_checksum", "bad_type", "duplicate", "reordered", "stale".

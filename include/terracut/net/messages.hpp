@@ -32,6 +32,7 @@
 #include "terracut/core/blade.hpp"
 #include "terracut/core/grid.hpp"
 #include "terracut/core/math.hpp"
+#include "terracut/core/wire.hpp"
 
 namespace terracut::net {
 
@@ -134,6 +135,13 @@ inline constexpr std::size_t kRejectReasonCount = 12;  // including kNone
 /// "bad_checksum", "bad_type", "foreign", "bad_payload", "duplicate",
 /// "reordered", "stale".
 std::string_view to_string(Reject reason);
+
+static_assert(int(Reject::kBadChecksum) == int(wire::Frame::kBadChecksum) &&
+                  int(Reject::kTruncated) == int(wire::Frame::kTruncated),
+              "the framing reasons are wire::Frame's, in its order");
+
+/// The reason for an ordering verdict (kNone when accepted).
+Reject to_reject(wire::Order order);
 
 /// Counts of rejected datagrams by reason (index = Reject value; [0] unused).
 struct RejectCounts {
