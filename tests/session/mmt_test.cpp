@@ -50,6 +50,12 @@ Scenario trench_with_remote(const std::string& name, double remote_height_m,
 
 TEST(Mmt, SameSeedSameRunOtherSeedOtherLink) {
   Scenario sc = load_scenario(kTrench);
+  // Bursty loss and held-back datagrams on top of the overrides' loss and jitter.
+  for (net::LinkConditions* c : {&sc.mmt->to_remote, &sc.mmt->to_operator}) {
+    c->burst.p_good_to_bad = 0.01;
+    c->burst.p_bad_to_good = 0.3;
+    c->reorder = 0.02;
+  }
   MmtOverrides o;
   o.rtt_s = 0.1;
   o.loss = 0.05;
@@ -72,6 +78,12 @@ TEST(Mmt, SameSeedSameRunOtherSeedOtherLink) {
   // Jitter of 3 ms over 1 ms spacing reorders; loss loses.
   EXPECT_GT(a.operator_station().counters().rejected[net::Reject::kReordered], 0);
   EXPECT_GT(a.link().b().emulator().counters().lost, 0);
+  EXPECT_GT(a.link().a().emulator().counters().held_back, 0);
+  EXPECT_GT(a.link().b().emulator().counters().retransmits, 0);  // patches lost and resent
+  // Every patch arrived, but the last few still on their way (resent) at the end.
+  EXPECT_LE(a.summary().patches - a.operator_station().counters().patches, 3);
+  EXPECT_EQ(a.operator_station().counters().rejected.total(),
+            a.operator_station().counters().rejected[net::Reject::kReordered]);
   o.seed = 8;
   MmtRun c(sc, o);
   c.run();
@@ -296,6 +308,34 @@ TEST(Mmt, SilentLinkStopsTheRemoteToolAndFadesTheOperatorsForce) {
     EXPECT_TRUE(r[k].link_silent);
     for (std::size_t j = k; j < r.size(); ++j) EXPECT_EQ(length(r[j].force_device_n), 0.0) << j;
   }
+}
+
+TEST(Mmt, ARestartedOperatorIsANewSession) {
+  Scenario sc = load_scenario(kTrench);
+  sc.mmt->to_remote.delay_s = sc.mmt->to_operator.delay_s = 0.0;
+  sc.mmt->to_remote.jitter_s = sc.mmt->to_operator.jitter_s = 0.0;
+  Pair p(sc);
+  const std::uint32_t link = sc.mmt->link_id;
+  std::vector<std::uint8_t> d(net::kHeaderSize + net::kCommandPayloadSize + net::kCrcSize);
+  auto send = [&](std::uint32_t session, std::uint32_t seq, Vec3 at, double t) {
+    net::Command c;
+    c.pose.position_m = at;
+    net::encode_command({net::MessageType::kCommand, link, session, seq, std::uint64_t(t * 1e9)},
+                        c, d.data());
+    p.link.a().send(net::Channel::kUnreliable, d.data(), d.size(), t);
+    p.remote.tick(t);
+  };
+  // An operator at sequence 500, then one restarted from sequence 0 elsewhere.
+  send(1, 500, {0, 0.35, 0.75}, 0.0);
+  send(1, 501, {0, 0.35, 0.75}, 0.001);
+  send(2, 0, {0.3, 0.35, 0.5}, 0.002);
+  send(2, 1, {0.3, 0.35, 0.5}, 0.003);
+  EXPECT_EQ(p.remote.counters().accepted, 4);
+  EXPECT_EQ(p.remote.counters().sessions, 2);
+  EXPECT_EQ(p.remote.counters().rejected.total(), 0);
+  // The new session's packets are ordered among themselves.
+  send(2, 0, {0.3, 0.35, 0.5}, 0.004);
+  EXPECT_EQ(p.remote.counters().rejected[net::Reject::kReordered], 1);
 }
 
 TEST(Mmt, BadSettingsNameTheField) {
