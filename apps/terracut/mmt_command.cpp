@@ -17,6 +17,7 @@
 #include "subprocess.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/haptics/device_option.hpp"
 #include "terracut/session/mmt.hpp"
 #include "terracut/session/mmt_process.hpp"
 
@@ -33,6 +34,7 @@ struct Options {
   bool sweep = false;
   std::string rtts = "0,50,100,200,500,1000";
   std::string losses = "0,0.01,0.1";
+  std::string device;
   std::string role;
   std::string listen, connect;
   bool no_plot = false;
@@ -198,6 +200,9 @@ Command add_mmt_command(CLI::App& app) {
                   "variant's fraction (default 0.1)");
   sub->add_option("--blend", opt->blend_s, "Blend time of terrain patches, s");
   sub->add_option("--duration", opt->duration_s, "Run length, s (default: the path, settle and a round trip)");
+  sub->add_option("--device", opt->device,
+                  "The operator's device: script, sim, or udp[:ADDR:PORT] (a real device over the\n"
+                  "bridge, docs/bridge-protocol.md; with --role operator only); default haptics.device");
   sub->add_flag("--sweep", opt->sweep, "Run the study over --rtts x --losses");
   sub->add_option("--rtts", opt->rtts, "Study: round trips, ms, comma-separated")
       ->capture_default_str();
@@ -214,7 +219,13 @@ Command add_mmt_command(CLI::App& app) {
   sub->add_option("--tools-dir", opt->tools, "Folder of plot_mmt.py")->capture_default_str();
   sub->add_flag("--quiet,-q", opt->quiet, "No progress lines");
   return [opt]() -> int {
-    const session::Scenario sc = session::load_scenario(opt->scenario);
+    session::Scenario sc = session::load_scenario(opt->scenario);
+    if (!opt->device.empty()) {
+      const haptics::DeviceOption d = haptics::parse_device_option(opt->device);
+      sc.haptics.device = d.kind;
+      if (d.address) sc.haptics.udp.address = *d.address;
+      if (d.port) sc.haptics.udp.port = *d.port;
+    }
     if (!opt->role.empty()) {
       session::ProcessOptions po;
       po.overrides = overrides_of(*opt);

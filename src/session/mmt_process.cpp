@@ -10,6 +10,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/haptics/device_option.hpp"
 #include "terracut/net/enet_transport.hpp"
 #include "terracut/session/world.hpp"
 
@@ -64,22 +65,13 @@ double paced(double rate_hz, Tick&& tick, Done&& done) {
 
 }  // namespace
 
-std::pair<std::string, int> parse_endpoint(const std::string& text, const std::string& option) {
-  const std::size_t colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size())
-    throw InputError(option + ": expected ADDR:PORT (IPv4), got '" + text + "'");
-  const std::string port_text = text.substr(colon + 1);
-  int port = -1;
-  try {
-    std::size_t used = 0;
-    port = std::stoi(port_text, &used);
-    if (used != port_text.size()) port = -1;
-  } catch (const std::exception&) {
-    port = -1;
-  }
-  if (port < 0 || port > 65535)
-    throw InputError(option + ": the port must be a number in [0, 65535], got '" + port_text + "'");
-  return {text.substr(0, colon), port};
+std::pair<std::string, int> parse_endpoint(const std::string& text, const std::string& option,
+                                           const std::string& default_address) {
+  std::optional<std::string> address;
+  std::optional<int> port;
+  haptics::parse_endpoint(text, option, address, port);
+  if (!port) throw InputError(option + ": expected ADDR:PORT or PORT (IPv4), got '" + text + "'");
+  return {address.value_or(default_address), *port};
 }
 
 int run_remote_process(const Scenario& op, const ProcessOptions& o) {
@@ -88,7 +80,7 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
   const MmtSettings s = apply_overrides(*op.mmt, o.overrides);
   const Scenario remote = load_remote_scenario(op);
   const auto [address, port] =
-      o.endpoint.empty() ? std::pair{s.address, s.port} : parse_endpoint(o.endpoint, "--listen");
+      o.endpoint.empty() ? std::pair{s.address, s.port} : parse_endpoint(o.endpoint, "--listen", s.address);
   const haptics::LoopParams nominal(op.haptics, op.base.blade);
   const World local(op);  // the operator's initial terrain: what the deadband compares against
   auto link = net::EnetEndpoint::listen(address, port, s.to_operator);
@@ -126,7 +118,7 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
     throw InputError(op.base.source_path.string() + ": mmt: the scenario has no mmt: section");
   const MmtSettings s = apply_overrides(*op.mmt, o.overrides);
   const auto [address, port] =
-      o.endpoint.empty() ? std::pair{s.address, s.port} : parse_endpoint(o.endpoint, "--connect");
+      o.endpoint.empty() ? std::pair{s.address, s.port} : parse_endpoint(o.endpoint, "--connect", s.address);
   auto link = net::EnetEndpoint::connect(address, port, s.to_remote);
   // Wait for the connection before the loop starts.
   const auto start = Clock::now();

@@ -10,6 +10,7 @@
 #include "terracut/core/format.hpp"
 #include "terracut/haptics/script_device.hpp"
 #include "terracut/haptics/sim_hand.hpp"
+#include "terracut/haptics/udp_device.hpp"
 #include "terracut/haptics/workspace.hpp"
 #include "terracut/session/mmt.hpp"
 
@@ -45,11 +46,15 @@ std::ofstream open_out(const std::filesystem::path& p) {
 double operator_duration_s(const Scenario& op) {
   const Motion* cut = followed_cut(op);
   if (op.haptics.duration_s) return *op.haptics.duration_s;
+  if (op.haptics.device == haptics::DeviceKind::kUdp) return 30.0;  // as terracut haptics
   if (!cut) throw InputError(op.base.source_path.string() + ": haptics.cut: the operator's device follows a cut, and the scenario has none");
   return cut->duration_s() + op.haptics.settle_s;
 }
 
 std::unique_ptr<haptics::Device> make_operator_device(const Scenario& op) {
+  if (op.haptics.device == haptics::DeviceKind::kUdp)
+    // A real device through the bridge (docs/bridge-protocol.md).
+    return std::make_unique<haptics::UdpDevice>(op.haptics.udp.address, op.haptics.udp.port);
   const Motion* cut = followed_cut(op);
   if (!cut)
     throw InputError(op.base.source_path.string() +
@@ -63,11 +68,9 @@ std::unique_ptr<haptics::Device> make_operator_device(const Scenario& op) {
           haptics::SimHand(op.haptics.hand, op.haptics.forces.device.inherent_damping_n_s_per_m,
                            haptics::DevicePath(*cut, ws), op.haptics.rate_hz));
     case haptics::DeviceKind::kUdp:
-      break;
+      break;  // above
   }
-  throw InputError(op.base.source_path.string() +
-                   ": haptics.device: an mmt run drives the operator with the script or sim "
-                   "device (udp: use terracut haptics with a bridge)");
+  throw InputError(op.base.source_path.string() + ": haptics.device: unknown device");
 }
 
 void write_operator_csv(const std::vector<OperatorRecord>& records,
@@ -112,6 +115,10 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
     throw InputError(settings_.remote_scenario.string() +
                      ": haptics.rate_hz: the remote must run at the operator's rate (" +
                      format_number(op_->haptics.rate_hz) + " Hz)");
+  if (op_->haptics.device == haptics::DeviceKind::kUdp)
+    throw InputError(op.base.source_path.string() +
+                     ": haptics.device: a real device over udp runs in real time: run the "
+                     "stations as two processes (--role remote / --role operator)");
   device_ = make_operator_device(*op_);
   link_ = std::make_unique<net::MemoryLink>(settings_.to_remote, settings_.to_operator);
   operator_ = std::make_unique<OperatorStation>(*op_, settings_, *device_, link_->a(), 1u);

@@ -24,7 +24,8 @@ refuse() {
 }
 refuse "no mmt: section" "$src/scenarios/trench_dry_sand.yaml" --out "$work/x"
 refuse "--loss must be in" "$scenario" --out "$work/x" --loss 2
-refuse "expected ADDR:PORT" "$scenario" --out "$work/x" --role operator --connect nowhere
+refuse "--connect: .nowhere." "$scenario" --out "$work/x" --role operator --connect nowhere
+refuse "runs in real time" "$scenario" --out "$work/x" --device udp
 refuse "--rtts: 'abc'" "$scenario" --out "$work/x" --sweep --rtts 0,abc --no-plot
 
 # The remote binds any free port and says which.

@@ -308,10 +308,10 @@ void write_operator_csv(const std::vector<OperatorRecord>& records,
                         const std::filesystem::path& path);
 void write_remote_csv(const std::vector<RemoteRecord>& records, const std::filesystem::path& path);
 
-/// The operator's device of an mmt run: the scenario's script or sim device
-/// (haptics.device; udp is refused). Throws InputError.
+/// The operator's device of an mmt run: the scenario's script, sim or udp
+/// (bridge) device, haptics.device. Throws InputError (e.g. a port in use).
 std::unique_ptr<haptics::Device> make_operator_device(const Scenario& op);
-/// The duration of the operator's path plus settle_s (or haptics.duration_s), s.
+/// haptics.duration_s, else the operator's path plus settle_s (udp: 30 s), s.
 double operator_duration_s(const Scenario& op);
 
 }  // namespace terracut::session

@@ -16,7 +16,7 @@ namespace terracut::session {
 
 struct ProcessOptions {
   MmtOverrides overrides;
-  /// "ADDR:PORT" (IPv4); empty: mmt.udp.
+  /// "ADDR:PORT" or "PORT" (IPv4); empty: mmt.udp.
   std::string endpoint;
   std::filesystem::path out;     ///< output folder (created)
   std::ostream* log = nullptr;   ///< one-line messages, or null
@@ -29,8 +29,10 @@ struct ProcessOptions {
   double connect_timeout_s = 5.0;
 };
 
-/// Splits "ADDR:PORT"; throws InputError naming option on bad text.
-std::pair<std::string, int> parse_endpoint(const std::string& text, const std::string& option);
+/// "ADDR:PORT" or "PORT" (then default_address), as --device udp: reads it
+/// (haptics/device_option.hpp). Throws InputError naming option on bad text.
+std::pair<std::string, int> parse_endpoint(const std::string& text, const std::string& option,
+                                           const std::string& default_address);
 
 /// Runs the remote station (returns the exit code, 0). Throws InputError.
 int run_remote_process(const Scenario& op, const ProcessOptions& options);
