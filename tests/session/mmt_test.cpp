@@ -310,6 +310,60 @@ TEST(Mmt, SilentLinkStopsTheRemoteToolAndFadesTheOperatorsForce) {
   }
 }
 
+// Runs the trench to mid-cut (edge at z = 0.3, 8 cm deep, moving along -Z),
+// then sends the operator a patch 5 cm below the sand over the whole region
+// around the tool, and reads two samples 50 ms and 150 ms later: one ahead
+// of the edge, within 0.15 m of it all that time and not yet cut (x = 0.01,
+// z = 0.19), one far from the tool (x = 0.51, z = 0.41).
+struct PatchUnderTool {
+  float ahead_50ms, far_50ms, far_150ms;
+};
+PatchUnderTool patch_under_tool(double exclusion_m) {
+  Scenario sc = load_scenario(kTrench);
+  sc.mmt->to_remote.delay_s = sc.mmt->to_operator.delay_s = 0.0;
+  sc.mmt->to_remote.jitter_s = sc.mmt->to_operator.jitter_s = 0.0;
+  sc.mmt->exclusion_m = exclusion_m;
+  const double rate = sc.haptics.rate_hz;
+  Pair p(sc);
+  int i = 0;
+  for (; i / rate < 1.8; ++i) {
+    p.op.tick(i / rate);
+    p.remote.tick(i / rate);
+  }
+  EXPECT_GT(p.op.rig().loop().last().contact_length_m, 0.3);
+  net::Patch patch;
+  patch.rect = {20, 40, 80, 90};  // x in [-0.6, 0.6], z in [-0.2, 0.8]
+  patch.heights.assign(std::size_t(patch.rect.area()), 0.25f);
+  std::vector<std::uint8_t> d;
+  net::encode_patch({net::MessageType::kPatch, sc.mmt->link_id, 77, 0, 0}, patch, d);
+  const double t0 = i / rate;
+  p.link.b().send(net::Channel::kReliable, d.data(), d.size(), t0);
+  const HeightGrid& g = p.op.simulation().grid();
+  EXPECT_NEAR(g.sample_z(59), 0.19, 1e-9);
+  EXPECT_NEAR(g.sample_x(75), 0.51, 1e-9);
+  PatchUnderTool out{};
+  for (; i / rate <= t0 + 0.05 + 1e-9; ++i) p.op.tick(i / rate);  // the remote is quiet now
+  out.ahead_50ms = g.height(50, 59);
+  out.far_50ms = g.height(75, 70);
+  for (; i / rate <= t0 + 0.15 + 1e-9; ++i) p.op.tick(i / rate);
+  out.far_150ms = g.height(75, 70);
+  return out;
+}
+
+TEST(Mmt, PatchesLeaveTheSoilUnderTheToolAloneWhileItCuts) {
+  const double blend_s = load_scenario(kTrench).mmt->blend_s;  // 0.1
+  const PatchUnderTool with = patch_under_tool(0.15);
+  EXPECT_EQ(with.ahead_50ms, 0.3f);  // untouched while the tool feels it
+  // Away from the tool the blend runs: half-way at 50 ms (one tick of
+  // ramp either way), done at 150 ms.
+  const double tick = 0.05 / (blend_s * 1000.0);
+  EXPECT_NEAR(with.far_50ms, 0.3 - 0.05 * (0.05 / blend_s), tick + 1e-6);
+  EXPECT_FLOAT_EQ(with.far_150ms, 0.25f);
+  // Without the exclusion the same patch lowers the soil ahead of the edge.
+  const PatchUnderTool without = patch_under_tool(0.0);
+  EXPECT_LT(without.ahead_50ms, 0.3f - 0.01f);
+}
+
 TEST(Mmt, ARestartedOperatorIsANewSession) {
   Scenario sc = load_scenario(kTrench);
   sc.mmt->to_remote.delay_s = sc.mmt->to_operator.delay_s = 0.0;
