@@ -3,6 +3,7 @@
 # remote station in one process, the operator in another, with delay,
 # jitter, loss and reordering emulated at each sender. Checks that commands,
 # measurements, patches and estimates crossed, and that both wrote their files.
+# Also the single-process run and a small study, with their figures.
 # Usage: mmt_two_process_test.sh TERRACUT SOURCE_DIR WORK_DIR
 set -eu
 terracut=$1
@@ -27,6 +28,18 @@ refuse "--loss must be in" "$scenario" --out "$work/x" --loss 2
 refuse "--connect: .nowhere." "$scenario" --out "$work/x" --role operator --connect nowhere
 refuse "runs in real time" "$scenario" --out "$work/x" --device udp
 refuse "--rtts: 'abc'" "$scenario" --out "$work/x" --sweep --rtts 0,abc --no-plot
+
+# One process: the run's files and figure; a small study: its table and figure.
+"$terracut" mmt "$scenario" --out "$work/single" -q
+for f in operator.csv remote.csv terrain_error.csv summary.json mmt.png; do
+  [ -s "$work/single/$f" ] || { echo "single-process run: no $f"; exit 1; }
+done
+"$terracut" mmt "$scenario" --sweep --rtts 0,200 --losses 0,0.1 --out "$work/study" -q
+for f in study.csv study.md study.png; do
+  [ -s "$work/study/$f" ] || { echo "study: no $f"; exit 1; }
+done
+# 2 RTTs x 2 losses, plus the deadband variant per RTT, and the header.
+[ "$(wc -l < "$work/study/study.csv")" -eq 7 ] || { echo "study.csv:"; cat "$work/study/study.csv"; exit 1; }
 
 # The remote binds any free port and says which.
 "$terracut" mmt "$scenario" --role remote --listen 127.0.0.1:0 $link --out "$work/remote" \
