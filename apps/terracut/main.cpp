@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "haptics_command.hpp"
+#include "mmt_command.hpp"
 #include "terracut/core/error.hpp"
 
 int main(int argc, char** argv) {
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
   const terracut::cli::Command reproduce = terracut::cli::add_reproduce_command(app);
   const terracut::cli::Command validate = terracut::cli::add_validate_command(app);
   const terracut::cli::Command haptics = terracut::cli::add_haptics_command(app);
+  const terracut::cli::Command mmt = terracut::cli::add_mmt_command(app);
 
   try {
     app.parse(argc, argv);
@@ -46,6 +48,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("reproduce")) return reproduce();
     if (app.got_subcommand("validate")) return validate();
     if (app.got_subcommand("haptics")) return haptics();
+    if (app.got_subcommand("mmt")) return mmt();
   } catch (const terracut::InputError& e) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
@@ -56,6 +59,6 @@ int main(int argc, char** argv) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
   }
-  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, validate, haptics)\n";
+  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, validate, haptics, mmt)\n";
   return 2;
 }

@@ -3,57 +3,19 @@
 // code is independent of the host's endianness and alignment.
 #include "terracut/haptics/bridge_protocol.hpp"
 
-#include <cstring>
+#include "terracut/core/wire.hpp"
 
 namespace terracut::haptics {
 namespace {
 
-// CRC-32 table (reflected polynomial 0xEDB88320), built at compile time.
-constexpr std::array<std::uint32_t, 256> make_crc_table() {
-  std::array<std::uint32_t, 256> table{};
-  for (std::uint32_t i = 0; i < 256; ++i) {
-    std::uint32_t c = i;
-    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-    table[i] = c;
-  }
-  return table;
-}
-constexpr std::array<std::uint32_t, 256> kCrcTable = make_crc_table();
-
-void put_u16(std::uint8_t* p, std::uint16_t v) {
-  p[0] = static_cast<std::uint8_t>(v);
-  p[1] = static_cast<std::uint8_t>(v >> 8);
-}
-void put_u32(std::uint8_t* p, std::uint32_t v) {
-  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
-void put_u64(std::uint8_t* p, std::uint64_t v) {
-  for (int i = 0; i < 8; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
-void put_f64(std::uint8_t* p, double v) {
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &v, sizeof bits);
-  put_u64(p, bits);
-}
-std::uint16_t get_u16(const std::uint8_t* p) {
-  return static_cast<std::uint16_t>(p[0] | (p[1] << 8));
-}
-std::uint32_t get_u32(const std::uint8_t* p) {
-  std::uint32_t v = 0;
-  for (int i = 3; i >= 0; --i) v = (v << 8) | p[i];
-  return v;
-}
-std::uint64_t get_u64(const std::uint8_t* p) {
-  std::uint64_t v = 0;
-  for (int i = 7; i >= 0; --i) v = (v << 8) | p[i];
-  return v;
-}
-double get_f64(const std::uint8_t* p) {
-  const std::uint64_t bits = get_u64(p);
-  double v = 0.0;
-  std::memcpy(&v, &bits, sizeof v);
-  return v;
-}
+using wire::get_f64;
+using wire::get_u16;
+using wire::get_u32;
+using wire::get_u64;
+using wire::put_f64;
+using wire::put_u16;
+using wire::put_u32;
+using wire::put_u64;
 
 // Header and CRC around a payload already written at out + kBridgeHeaderSize.
 std::size_t finish_packet(const PacketHeader& header, PacketType type, std::size_t payload_size,
@@ -66,25 +28,18 @@ std::size_t finish_packet(const PacketHeader& header, PacketType type, std::size
   put_u64(out + 16, header.timestamp_ns);
   put_u32(out + 24, static_cast<std::uint32_t>(payload_size));
   put_u32(out + 28, 0);
-  const std::size_t body = kBridgeHeaderSize + payload_size;
-  put_u32(out + body, crc32(out, body));
-  return body + kBridgeCrcSize;
+  return wire::seal_frame(out, kBridgeHeaderSize + payload_size);
 }
 
 // The format checks shared by both packet types (see decode_pose's comment
 // for the order). On kNone, header is filled.
 Reject check_format(const std::uint8_t* data, std::size_t size, PacketType want,
                     std::size_t want_payload, PacketHeader& header) {
-  if (size < 4) return Reject::kTruncated;
-  if (get_u32(data) != kBridgeMagic) return Reject::kBadMagic;
-  if (size < kBridgeHeaderSize + kBridgeCrcSize) return Reject::kTruncated;
-  if (get_u16(data + 4) != kBridgeVersion) return Reject::kBadVersion;
-  const std::uint64_t declared = get_u32(data + 24);
-  const std::uint64_t expected = kBridgeHeaderSize + declared + kBridgeCrcSize;
-  if (size < expected) return Reject::kTruncated;
-  if (size > expected) return Reject::kBadLength;
-  const std::size_t body = kBridgeHeaderSize + static_cast<std::size_t>(declared);
-  if (crc32(data, body) != get_u32(data + body)) return Reject::kBadChecksum;
+  std::size_t declared = 0;
+  const wire::Frame frame = wire::check_frame(
+      data, size, {kBridgeMagic, kBridgeVersion, kBridgeHeaderSize, 24}, declared);
+  // wire::Frame's values are the first of Reject's, in the same order.
+  if (frame != wire::Frame::kOk) return static_cast<Reject>(frame);
   if (get_u16(data + 6) != static_cast<std::uint16_t>(want)) return Reject::kBadType;
   if (declared != want_payload) return Reject::kBadLength;
   header.session = get_u32(data + 8);
@@ -96,21 +51,14 @@ Reject check_format(const std::uint8_t* data, std::size_t size, PacketType want,
 }  // namespace
 
 std::uint32_t crc32(const std::uint8_t* data, std::size_t size) noexcept {
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (std::size_t i = 0; i < size; ++i) c = kCrcTable[(c ^ data[i]) & 0xFFu] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFu;
+  return wire::crc32(data, size);
 }
 
 std::size_t encode_pose(const PacketHeader& header, const PosePayload& pose,
                         std::uint8_t* out) noexcept {
   std::uint8_t* p = out + kBridgeHeaderSize;
-  put_f64(p + 0, pose.position_m.x);
-  put_f64(p + 8, pose.position_m.y);
-  put_f64(p + 16, pose.position_m.z);
-  put_f64(p + 24, pose.orientation.w);
-  put_f64(p + 32, pose.orientation.x);
-  put_f64(p + 40, pose.orientation.y);
-  put_f64(p + 48, pose.orientation.z);
+  wire::put_vec3(p, pose.position_m);
+  wire::put_quat(p + 24, pose.orientation);
   put_u32(p + 56, pose.buttons);
   put_u32(p + 60, pose.flags);
   return finish_packet(header, PacketType::kPose, kPosePayloadSize, out);
@@ -119,9 +67,7 @@ std::size_t encode_pose(const PacketHeader& header, const PosePayload& pose,
 std::size_t encode_force(const PacketHeader& header, const ForcePayload& force,
                          std::uint8_t* out) noexcept {
   std::uint8_t* p = out + kBridgeHeaderSize;
-  put_f64(p + 0, force.force_n.x);
-  put_f64(p + 8, force.force_n.y);
-  put_f64(p + 16, force.force_n.z);
+  wire::put_vec3(p, force.force_n);
   put_u32(p + 24, force.flags);
   put_u32(p + 28, force.pose_sequence);
   return finish_packet(header, PacketType::kForce, kForcePayloadSize, out);
@@ -158,8 +104,8 @@ Reject decode_pose(const std::uint8_t* data, std::size_t size, PacketHeader& hea
   const Reject r = check_format(data, size, PacketType::kPose, kPosePayloadSize, header);
   if (r != Reject::kNone) return r;
   const std::uint8_t* p = data + kBridgeHeaderSize;
-  pose.position_m = {get_f64(p + 0), get_f64(p + 8), get_f64(p + 16)};
-  pose.orientation = {get_f64(p + 24), get_f64(p + 32), get_f64(p + 40), get_f64(p + 48)};
+  pose.position_m = wire::get_vec3(p);
+  pose.orientation = wire::get_quat(p + 24);
   pose.buttons = get_u32(p + 56);
   pose.flags = get_u32(p + 60);
   return Reject::kNone;
@@ -170,33 +116,24 @@ Reject decode_force(const std::uint8_t* data, std::size_t size, PacketHeader& he
   const Reject r = check_format(data, size, PacketType::kForce, kForcePayloadSize, header);
   if (r != Reject::kNone) return r;
   const std::uint8_t* p = data + kBridgeHeaderSize;
-  force.force_n = {get_f64(p + 0), get_f64(p + 8), get_f64(p + 16)};
+  force.force_n = wire::get_vec3(p);
   force.flags = get_u32(p + 24);
   force.pose_sequence = get_u32(p + 28);
   return Reject::kNone;
 }
 
 Reject SequenceFilter::check(const PacketHeader& header) noexcept {
-  // Another session (or the first packet): a device process (re)started.
-  if (!has_session_ || header.session != session_) {
-    has_session_ = true;
-    new_session_ = true;
-    session_ = header.session;
-    last_sequence_ = header.sequence;
-    last_timestamp_ns_ = header.timestamp_ns;
-    ++sessions_;
-    return Reject::kNone;
+  switch (order_.check(header.session, header.sequence, header.timestamp_ns)) {
+    case wire::Order::kAccepted:
+      return Reject::kNone;
+    case wire::Order::kDuplicate:
+      return Reject::kDuplicate;
+    case wire::Order::kReordered:
+      return Reject::kReordered;
+    case wire::Order::kStale:
+      return Reject::kStale;
   }
-  // Serial-number arithmetic, so the sequence may wrap around 2^32.
-  const std::int32_t ahead = static_cast<std::int32_t>(header.sequence - last_sequence_);
-  if (ahead == 0) return Reject::kDuplicate;
-  if (ahead < 0) return Reject::kReordered;
-  if (header.timestamp_ns < last_timestamp_ns_) return Reject::kStale;
-  new_session_ = false;
-  lost_ += ahead - 1;
-  last_sequence_ = header.sequence;
-  last_timestamp_ns_ = header.timestamp_ns;
-  return Reject::kNone;
+  return Reject::kStale;
 }
 
 }  // namespace terracut::haptics

@@ -17,11 +17,13 @@ template <class Load>
 Scenario read_with_sections(Load&& load) {
   bullet::BodiesReader bodies;
   haptics::SettingsReader settings;
-  io::SectionReader* const sections[] = {&bodies, &settings};
+  MmtReader mmt;
+  io::SectionReader* const sections[] = {&bodies, &settings, &mmt};
   Scenario out;
   out.base = load(std::span<io::SectionReader* const>(sections));
   out.haptics = std::move(settings.settings);
   out.bodies = std::move(bodies.bodies);
+  out.mmt = std::move(mmt.settings);
   return out;
 }
 

@@ -25,6 +25,7 @@
 #include <string_view>
 
 #include "terracut/core/math.hpp"
+#include "terracut/core/wire.hpp"
 
 namespace terracut::haptics {
 
@@ -98,6 +99,9 @@ enum class Reject : std::uint8_t {
   kReordered,    ///< a sequence number older than the last accepted one
   kStale,        ///< a newer sequence but a timestamp older than the last accepted one
 };
+static_assert(int(Reject::kBadChecksum) == int(wire::Frame::kBadChecksum) &&
+                  int(Reject::kTruncated) == int(wire::Frame::kTruncated),
+              "the framing reasons are wire::Frame's, in its order");
 inline constexpr std::size_t kRejectReasonCount = 10;  // including kNone
 /// "none", "truncated", "bad_length", "bad_magic", "bad_version",
 /// "bad_checksum", "bad_type", "duplicate", "reordered", "stale".
@@ -135,21 +139,15 @@ class SequenceFilter {
   Reject check(const PacketHeader& header) noexcept;
 
   /// True when the last accepted packet started a new session (the first one included).
-  bool new_session() const { return new_session_; }
+  bool new_session() const { return order_.new_session(); }
   /// Sessions seen (1 after the first accepted packet).
-  std::int64_t sessions() const { return sessions_; }
+  std::int64_t sessions() const { return order_.sessions(); }
   /// Packets skipped by gaps in the sequence numbers (lost or never sent).
-  std::int64_t lost() const { return lost_; }
-  std::uint32_t last_sequence() const { return last_sequence_; }
+  std::int64_t lost() const { return order_.lost(); }
+  std::uint32_t last_sequence() const { return order_.last_sequence(); }
 
  private:
-  bool has_session_ = false;
-  bool new_session_ = false;
-  std::uint32_t session_ = 0;
-  std::uint32_t last_sequence_ = 0;
-  std::uint64_t last_timestamp_ns_ = 0;
-  std::int64_t sessions_ = 0;
-  std::int64_t lost_ = 0;
+  wire::SequenceFilter order_;  // the rule shared with the teleoperation link (core/wire.hpp)
 };
 
 }  // namespace terracut::haptics

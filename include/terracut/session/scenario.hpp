@@ -12,6 +12,7 @@
 #include "terracut/core/bodies.hpp"
 #include "terracut/haptics/settings.hpp"
 #include "terracut/io/scenario.hpp"
+#include "terracut/session/mmt_settings.hpp"
 
 namespace terracut::session {
 
@@ -23,6 +24,8 @@ struct Scenario {
   haptics::HapticSettings haptics{};
   /// The `bodies:` list (docs/bullet.md); empty when not given.
   std::vector<BodySpec> bodies;
+  /// The `mmt:` section (docs/teleoperation.md); nullopt when not given.
+  std::optional<MmtSettings> mmt;
 };
 
 /// Reads and validates a scenario file with all its sections. Throws

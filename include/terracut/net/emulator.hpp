@@ -1,0 +1,86 @@
+// The network emulator of the teleoperation link: one direction of a link,
+// at the sender. Linux `tc netem` is not available on the machines terracut
+// is developed on, so the conditions are made in-process, the same way for
+// the in-memory link of a single-process run and for the UDP (ENet) link of
+// a two-process run: the sender asks the emulator when (and whether) a
+// datagram arrives, and holds it until then.
+//
+// Per datagram, in this order (one seeded std::mt19937_64, so a run is
+// reproducible):
+//   - loss: independent (probability `loss`) or bursty: a Gilbert-Elliott
+//     chain of two states, good and bad, stepped once per datagram, losing
+//     with probability loss_good / loss_bad in each state;
+//   - delay: one-way delay + a jitter uniform in [-jitter, +jitter] (never
+//     below zero), so datagrams closer together than the jitter reorder;
+//   - reordering: with probability `reorder` a datagram is held back a
+//     further reorder_delay_s, so later ones overtake it.
+// A reliable datagram is never lost: each loss costs it one retransmission
+// timeout (retransmit_s) instead, and reliable datagrams arrive in the order
+// they were sent (as over ENet's reliable channel).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <random>
+#include <string>
+
+namespace terracut::net {
+
+/// Gilbert-Elliott bursty loss. Defaults: off (never bad).
+struct GilbertElliott {
+  double p_good_to_bad = 0.0;  ///< per datagram, [0, 1]
+  double p_bad_to_good = 1.0;  ///< per datagram, (0, 1]
+  double loss_good = 0.0;      ///< loss probability in the good state, [0, 1]
+  double loss_bad = 1.0;       ///< loss probability in the bad state, [0, 1]
+};
+
+/// The conditions of one direction of a link.
+struct LinkConditions {
+  double delay_s = 0.0;          ///< one-way delay, s, [0, 10]
+  double jitter_s = 0.0;         ///< half-width of the uniform jitter, s, [0, 10]
+  double loss = 0.0;             ///< independent loss probability, [0, 1)
+  GilbertElliott burst{};        ///< bursty loss, combined with `loss`
+  double reorder = 0.0;          ///< probability a datagram is held back, [0, 1]
+  double reorder_delay_s = 0.005;  ///< how long it is held back, s, [0, 10]
+  /// Retransmission timeout of a lost reliable datagram, s, (0, 60];
+  /// nullopt: 2 x delay + 20 ms (a round trip and a margin).
+  std::optional<double> retransmit_s;
+  std::uint64_t seed = 1;  ///< RNG seed
+};
+
+/// Empty when valid, else a message naming the field ("delay_s must be ...").
+std::string validate(const LinkConditions& c);
+
+/// Counters of one direction.
+struct EmulatorCounters {
+  std::int64_t datagrams = 0;    ///< scheduled
+  std::int64_t lost = 0;         ///< unreliable datagrams dropped
+  std::int64_t retransmits = 0;  ///< losses of reliable datagrams (each cost a timeout)
+  std::int64_t held_back = 0;    ///< datagrams held back for reordering
+};
+
+class LinkEmulator {
+ public:
+  /// Throws InputError naming the field when the conditions are invalid.
+  explicit LinkEmulator(const LinkConditions& conditions);
+
+  /// When a datagram sent at now_s arrives, s; nullopt when it is lost
+  /// (unreliable only).
+  std::optional<double> schedule(double now_s, bool reliable) noexcept;
+
+  const LinkConditions& conditions() const { return c_; }
+  const EmulatorCounters& counters() const { return counters_; }
+
+ private:
+  bool lose() noexcept;   // one loss draw (steps the Gilbert-Elliott chain)
+  double uniform() noexcept;  // [0, 1)
+
+  LinkConditions c_;
+  double retransmit_s_ = 0.0;
+  std::mt19937_64 rng_;
+  bool bad_ = false;
+  double last_reliable_s_ = 0.0;
+  EmulatorCounters counters_{};
+};
+
+}  // namespace terracut::net

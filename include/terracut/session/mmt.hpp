@@ -1,0 +1,317 @@
+// Model-mediated teleoperation (MMT): two stations joined by a delayed,
+// lossy link (net/), built from a scenario's `mmt:` section
+// (docs/teleoperation.md).
+//
+//  - RemoteStation: the "real" world, a terracut world of its own (its own
+//    scenario: terrain, soil, hidden bodies). Its tool follows the
+//    operator's commands at a limited speed (a real arm lags); it measures
+//    the tool force and pose every tick and, every sensing period, the
+//    heights around the tool and those it changed (a dirty rectangle, sent
+//    reliably as a zstd patch), and it estimates the soil: a recursive
+//    least-squares fit of the factor between its measured force and the
+//    operator's force model at the same cut.
+//  - OperatorStation: the haptic loop (HapticRig) on the local model with a
+//    device of the caller's. It sends the tool pose every tick and merges
+//    what comes back without force jumps: patches blend in over blend_s,
+//    the soil factor moves at a bounded rate of force change.
+//  - MmtRun: both stations in one process over an in-memory link, stepped
+//    in lock-step at the loop rate in simulated time (reproducible for a
+//    seed), with per-tick records, the summary of `terracut mmt`, and its
+//    outputs.
+// Safety: a station that hears nothing for timeout_s stops: the remote
+// tool holds still, and the operator's device is reported silent to its
+// loop, whose watchdog fades the force out.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "terracut/core/forces.hpp"
+#include "terracut/core/wire.hpp"
+#include "terracut/core/stats.hpp"
+#include "terracut/haptics/device.hpp"
+#include "terracut/io/scenario.hpp"
+#include "terracut/net/emulator.hpp"
+#include "terracut/net/messages.hpp"
+#include "terracut/net/transport.hpp"
+#include "terracut/session/haptic.hpp"
+#include "terracut/session/mmt_settings.hpp"
+
+namespace terracut::session {
+
+/// The remote world of a scenario with an `mmt:` section (its remote
+/// scenario loaded, the soil override applied). Throws InputError naming
+/// mmt.remote.scenario when it cannot be loaded or its grid differs.
+Scenario load_remote_scenario(const Scenario& operator_scenario);
+
+/// One remote tick.
+struct RemoteRecord {
+  double t_s = 0.0;
+  std::uint32_t command_sequence = 0;  ///< newest command followed
+  Vec3 commanded_m{};                  ///< its position, world
+  Vec3 tool_m{};                       ///< the follower's position, world
+  Vec3 force_world_n{};                ///< measured force on the tool, world N
+  double contact_length_m = 0.0;
+  double cut_depth_m = 0.0;
+  double force_scale = 1.0;  ///< the estimate
+  bool holding = false;      ///< link silent: holding still
+  bool active = false;       ///< a command has arrived
+  double compute_s = 0.0;
+};
+
+/// One operator tick.
+struct OperatorRecord {
+  double t_s = 0.0;
+  Vec3 tool_m{};               ///< commanded tool position, world
+  Vec3 device_m{};             ///< device handle, device frame
+  Vec3 force_world_n{};        ///< the local model's force (MMT), world N
+  Vec3 force_device_n{};       ///< rendered, device frame, device N
+  Vec3 remote_force_world_n{}; ///< newest measured force received (direct reflection), world N
+  double contact_length_m = 0.0;
+  double scale_applied = 1.0;
+  double scale_target = 1.0;
+  bool updating = false;      ///< an update was being merged this tick
+  bool link_silent = false;
+  double passivity_j = 0.0;      ///< energy into the hand over the last window, MMT, J
+  double passivity_dfr_j = 0.0;  ///< the same for direct force reflection, J
+  double compute_s = 0.0;
+};
+
+/// Counts of what a station received.
+struct StationCounters {
+  net::RejectCounts rejected{};
+  std::int64_t accepted = 0;
+  std::int64_t patches = 0;    ///< patches sent (remote) / merged (operator)
+  std::int64_t estimates = 0;  ///< estimates sent / applied
+  std::int64_t sessions = 0;   ///< sessions of the peer seen
+  std::int64_t silent_ticks = 0;
+};
+
+class FollowerDevice;
+class LinkGuardDevice;
+class ScaleCorrection;
+
+class RemoteStation {
+ public:
+  /// remote: the remote world (load_remote_scenario); nominal: the
+  /// operator's force model (the soil estimate is against it); mirror: the
+  /// operator's initial heights (what the deadband compares against).
+  /// Throws InputError naming the field.
+  RemoteStation(const Scenario& remote, const MmtSettings& settings,
+                const ForceModel& nominal, const HeightGrid& operator_initial,
+                net::Endpoint& link, std::uint32_t session);
+  ~RemoteStation();
+  /// One tick at station time t_s.
+  void tick(double t_s);
+
+  const std::vector<RemoteRecord>& records() const { return records_; }
+  const StationCounters& counters() const { return counters_; }
+  const Simulation& simulation() const;
+  const HapticRig& rig() const { return *rig_; }
+  /// Every sample the remote changed so far.
+  const Rect& worked() const { return worked_; }
+  double force_scale() const { return theta_; }
+  std::int64_t estimate_samples() const { return rls_samples_; }
+  /// Packets sent that carried model updates (patches + estimates).
+  std::int64_t update_packets() const { return counters_.patches + counters_.estimates; }
+
+ private:
+  void receive(double t_s);
+  void update_estimate(const haptics::LoopRecord& r);
+  void sense(double t_s, const haptics::LoopRecord& r);
+  Rect window_around(Vec3 p) const;
+
+  MmtSettings settings_;
+  ForceModel nominal_;
+  net::Endpoint& link_;
+  std::uint32_t session_;
+  std::unique_ptr<FollowerDevice> device_;
+  std::unique_ptr<HapticRig> rig_;
+  std::vector<float> mirror_;  // what the operator was sent (starts as its initial heights)
+  wire::SequenceFilter commands_;
+  std::uint32_t command_sequence_ = 0;
+  Vec3 commanded_m_{};
+  bool has_command_ = false;
+  double last_command_s_ = 0.0;
+  std::uint32_t seq_measurement_ = 0, seq_patch_ = 0, seq_estimate_ = 0;
+  double next_sense_s_ = 0.0;
+  Rect dirty_{};
+  Rect worked_{};
+  double theta_ = 1.0, p_ = 10.0, theta_sent_ = 1.0;
+  std::int64_t rls_samples_ = 0;
+  bool estimate_sent_ = false;
+  double previous_t_s_ = 0.0;
+  std::vector<RemoteRecord> records_;
+  StationCounters counters_{};
+  std::vector<std::vector<std::uint8_t>> inbox_;
+  std::vector<std::uint8_t> buffer_;
+  net::Patch patch_;
+};
+
+class OperatorStation {
+ public:
+  /// The operator's haptic loop over op's world with device (which must
+  /// outlive the station). Throws InputError naming the field.
+  OperatorStation(const Scenario& op, const MmtSettings& settings, haptics::Device& device,
+                  net::Endpoint& link, std::uint32_t session);
+  ~OperatorStation();
+  void tick(double t_s);
+
+  const std::vector<OperatorRecord>& records() const { return records_; }
+  const StationCounters& counters() const { return counters_; }
+  const HapticRig& rig() const { return *rig_; }
+  const Simulation& simulation() const;
+  const Rect& worked() const { return worked_; }
+  /// Largest change of the device force an update caused in one tick,
+  /// device N: the soil factor's (bounded by max_update_step_n); terrain
+  /// patches do not touch the samples the tool feels while in contact.
+  double max_update_step_n() const { return max_update_step_n_; }
+  /// Largest tick-to-tick change of the device force (whatever its cause:
+  /// motion included) on ticks while an update was being merged, device N.
+  double max_step_while_updating_n() const { return max_step_while_updating_n_; }
+  /// Ticks of the run, duration (path + settle).
+  std::int64_t ticks() const { return ticks_; }
+  double rate_hz() const;
+
+ private:
+  struct Blend {
+    Rect rect;
+    std::vector<float> t0_s;  // per sample: when its ramp started, s
+    std::vector<float> from, to, scratch;
+    bool done = false;
+  };
+  void receive(double t_s);
+  void merge(double t_s);
+
+  MmtSettings settings_;
+  net::Endpoint& link_;
+  std::uint32_t session_;
+  std::unique_ptr<LinkGuardDevice> guard_;
+  std::unique_ptr<HapticRig> rig_;
+  std::unique_ptr<ScaleCorrection> correction_;
+  std::vector<float> stamp_s_;  // time each sample was last changed by the local tool
+  double protect_s_ = 0.0;
+  std::vector<Blend> blends_;
+  wire::SequenceFilter measurements_, patches_, estimates_;
+  std::uint32_t seq_command_ = 0;
+  Vec3 remote_force_{};
+  double last_heard_s_ = 0.0;
+  bool heard_ = false;
+  Rect worked_{};
+  std::int64_t ticks_ = 0;
+  double previous_t_s_ = 0.0;
+  Vec3 previous_device_m_{};
+  Vec3 previous_force_device_n_{};
+  Vec3 previous_dfr_device_n_{};
+  bool has_previous_ = false;
+  std::vector<double> power_, power_dfr_;  // ring over the passivity window
+  std::size_t power_at_ = 0;
+  double window_j_ = 0.0, window_dfr_j_ = 0.0;
+  double max_update_step_n_ = 0.0;
+  double max_step_while_updating_n_ = 0.0;
+  std::vector<OperatorRecord> records_;
+  StationCounters counters_{};
+  std::vector<std::vector<std::uint8_t>> inbox_;
+  std::vector<std::uint8_t> buffer_;
+  net::Patch patch_;
+};
+
+/// Command-line choices over the `mmt:` section.
+struct MmtOverrides {
+  std::optional<double> rtt_s;     ///< round trip: each way's delay = rtt / 2
+  std::optional<double> loss;      ///< independent loss each way, [0, 1)
+  std::optional<double> jitter_s;  ///< each way
+  std::optional<std::uint64_t> seed;
+  std::optional<double> deadband;
+  std::optional<double> blend_s;
+  std::optional<double> duration_s;
+};
+/// The settings with the overrides applied (validated). Throws InputError
+/// naming the option.
+MmtSettings apply_overrides(MmtSettings s, const MmtOverrides& o);
+
+/// The figures of one run (summary.json's "results").
+struct MmtSummary {
+  double duration_s = 0.0;
+  double rtt_s = 0.0;
+  double loss = 0.0;
+  double deadband = 0.0;
+  double force_rms_remote_n = 0.0;  ///< RMS of the remote's measured force
+  double force_error_rms_mmt_n = 0.0;
+  double force_error_max_mmt_n = 0.0;
+  double force_error_rms_dfr_n = 0.0;  ///< direct force reflection
+  double force_error_max_dfr_n = 0.0;
+  double terrain_rms_max_m = 0.0;    ///< local - remote over the worked region, largest
+  double terrain_rms_final_m = 0.0;  ///< at the end
+  double tracking_rms_m = 0.0;
+  double tracking_max_m = 0.0;
+  double packets_per_s_to_remote = 0.0, bytes_per_s_to_remote = 0.0;
+  double packets_per_s_to_operator = 0.0, bytes_per_s_to_operator = 0.0;
+  double update_packets_per_s = 0.0;
+  std::int64_t patches = 0, estimates = 0;
+  double max_update_step_n = 0.0;
+  double max_step_while_updating_n = 0.0;
+  double passivity_max_mmt_j = 0.0, passivity_max_dfr_j = 0.0;
+  double force_scale_final = 1.0;    ///< the remote's estimate
+  double force_scale_applied = 1.0;  ///< what the operator applied at the end
+  std::int64_t estimate_samples = 0;
+  TimingStats operator_compute{}, remote_compute{};
+};
+
+/// Both stations in one process.
+class MmtRun {
+ public:
+  /// Builds both stations over an in-memory link from a scenario with an
+  /// `mmt:` section. Throws InputError naming the field.
+  MmtRun(const Scenario& op, const MmtOverrides& overrides = {});
+  ~MmtRun();
+  /// Runs to the end: the operator's path and settle time, plus a round
+  /// trip and the blend for the last updates to land.
+  void run();
+  /// Or one tick at a time (t = i / rate).
+  void tick();
+  std::int64_t ticks_run() const { return tick_; }
+  std::int64_t total_ticks() const { return total_ticks_; }
+
+  /// Figures over the run so far.
+  MmtSummary summary() const;
+  /// operator.csv, remote.csv, terrain_error.csv, summary.json into dir.
+  void write_outputs(const std::filesystem::path& dir) const;
+
+  const MmtSettings& settings() const { return settings_; }
+  OperatorStation& operator_station() { return *operator_; }
+  RemoteStation& remote_station() { return *remote_; }
+  net::MemoryLink& link() { return *link_; }
+  /// RMS of local - remote heights over the worked region, sampled every 50 ms: (t, rms).
+  const std::vector<std::pair<double, double>>& terrain_error() const { return terrain_error_; }
+
+ private:
+  double terrain_rms() const;
+  MmtSettings settings_;
+  std::unique_ptr<Scenario> op_, remote_scn_;
+  std::unique_ptr<haptics::Device> device_;
+  std::unique_ptr<net::MemoryLink> link_;
+  std::unique_ptr<OperatorStation> operator_;
+  std::unique_ptr<RemoteStation> remote_;
+  std::int64_t tick_ = 0, total_ticks_ = 0;
+  double rate_hz_ = 1000.0;
+  std::vector<std::pair<double, double>> terrain_error_;
+};
+
+/// The per-tick files (docs/teleoperation.md lists the columns). Throw
+/// InputError naming the file when it cannot be written.
+void write_operator_csv(const std::vector<OperatorRecord>& records,
+                        const std::filesystem::path& path);
+void write_remote_csv(const std::vector<RemoteRecord>& records, const std::filesystem::path& path);
+
+/// The operator's device of an mmt run: the scenario's script, sim or udp
+/// (bridge) device, haptics.device. Throws InputError (e.g. a port in use).
+std::unique_ptr<haptics::Device> make_operator_device(const Scenario& op);
+/// haptics.duration_s, else the operator's path plus settle_s (udp: 30 s), s.
+double operator_duration_s(const Scenario& op);
+
+}  // namespace terracut::session

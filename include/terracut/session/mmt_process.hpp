@@ -1,0 +1,43 @@
+// Two-process model-mediated teleoperation: one station per process, over
+// UDP (net/enet_transport.hpp), paced by the wall clock at the loop rate.
+// The remote listens on mmt.udp (or ADDR:PORT given), the operator
+// connects; both apply the scenario's link conditions at their sender.
+// Each writes its own per-tick CSV and a summary.json into its folder.
+#pragma once
+
+#include <atomic>
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+
+#include "terracut/session/mmt.hpp"
+
+namespace terracut::session {
+
+struct ProcessOptions {
+  MmtOverrides overrides;
+  /// "ADDR:PORT" or "PORT" (IPv4); empty: mmt.udp.
+  std::string endpoint;
+  std::filesystem::path out;     ///< output folder (created)
+  std::ostream* log = nullptr;   ///< one-line messages, or null
+  /// The remote ends after this long without commands once it had some, s.
+  double remote_idle_end_s = 1.0;
+  /// The remote ends after this long in any case, s (0: the operator's
+  /// duration + 10 s).
+  double remote_max_s = 0.0;
+  /// How long the operator waits for the connection, s.
+  double connect_timeout_s = 5.0;
+};
+
+/// "ADDR:PORT" or "PORT" (then default_address), as --device udp: reads it
+/// (haptics/device_option.hpp). Throws InputError naming option on bad text.
+std::pair<std::string, int> parse_endpoint(const std::string& text, const std::string& option,
+                                           const std::string& default_address);
+
+/// Runs the remote station (returns the exit code, 0). Throws InputError.
+int run_remote_process(const Scenario& op, const ProcessOptions& options);
+/// Runs the operator station for its duration. Throws InputError (e.g. no
+/// connection within connect_timeout_s).
+int run_operator_process(const Scenario& op, const ProcessOptions& options);
+
+}  // namespace terracut::session

@@ -1,0 +1,87 @@
+// The link emulator (emulator.hpp).
+#include "terracut/net/emulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
+
+namespace terracut::net {
+namespace {
+
+bool in(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
+
+}  // namespace
+
+std::string validate(const LinkConditions& c) {
+  if (!in(c.delay_s, 0.0, 10.0)) return must_be("delay_s", "in [0, 10]", c.delay_s);
+  if (!in(c.jitter_s, 0.0, 10.0)) return must_be("jitter_s", "in [0, 10]", c.jitter_s);
+  if (!in(c.loss, 0.0, 1.0) || c.loss >= 1.0) return must_be("loss", "in [0, 1)", c.loss);
+  if (!in(c.burst.p_good_to_bad, 0.0, 1.0))
+    return must_be("burst.p_good_to_bad", "in [0, 1]", c.burst.p_good_to_bad);
+  if (!in(c.burst.p_bad_to_good, 0.0, 1.0) || c.burst.p_bad_to_good <= 0.0)
+    return must_be("burst.p_bad_to_good", "in (0, 1]", c.burst.p_bad_to_good);
+  if (!in(c.burst.loss_good, 0.0, 1.0))
+    return must_be("burst.loss_good", "in [0, 1]", c.burst.loss_good);
+  if (!in(c.burst.loss_bad, 0.0, 1.0))
+    return must_be("burst.loss_bad", "in [0, 1]", c.burst.loss_bad);
+  if (!in(c.reorder, 0.0, 1.0)) return must_be("reorder", "in [0, 1]", c.reorder);
+  if (!in(c.reorder_delay_s, 0.0, 10.0))
+    return must_be("reorder_delay_s", "in [0, 10]", c.reorder_delay_s);
+  if (c.retransmit_s && (!in(*c.retransmit_s, 0.0, 60.0) || *c.retransmit_s <= 0.0))
+    return must_be("retransmit_s", "in (0, 60]", *c.retransmit_s);
+  return {};
+}
+
+LinkEmulator::LinkEmulator(const LinkConditions& conditions)
+    : c_(conditions), rng_(conditions.seed) {
+  if (const std::string problem = validate(c_); !problem.empty()) throw InputError(problem);
+  retransmit_s_ = c_.retransmit_s.value_or(2.0 * c_.delay_s + 0.02);
+}
+
+double LinkEmulator::uniform() noexcept {
+  // 53 random bits: the same doubles from the same seed on every platform.
+  return double(rng_() >> 11) * 0x1.0p-53;
+}
+
+bool LinkEmulator::lose() noexcept {
+  // The chain moves first, then this datagram's fate is drawn in its state.
+  if (c_.burst.p_good_to_bad > 0.0) {
+    const double u = uniform();
+    bad_ = bad_ ? !(u < c_.burst.p_bad_to_good) : (u < c_.burst.p_good_to_bad);
+  }
+  const double burst_loss = bad_ ? c_.burst.loss_bad : c_.burst.loss_good;
+  const bool burst_lost = c_.burst.p_good_to_bad > 0.0 && uniform() < burst_loss;
+  const bool independent_lost = c_.loss > 0.0 && uniform() < c_.loss;
+  return burst_lost || independent_lost;
+}
+
+std::optional<double> LinkEmulator::schedule(double now_s, bool reliable) noexcept {
+  ++counters_.datagrams;
+  double extra_s = 0.0;
+  if (reliable) {
+    // Each loss costs one retransmission timeout (at most 50 in a row).
+    for (int tries = 0; tries < 50 && lose(); ++tries) {
+      ++counters_.retransmits;
+      extra_s += retransmit_s_;
+    }
+  } else if (lose()) {
+    ++counters_.lost;
+    return std::nullopt;
+  }
+  double delay = c_.delay_s;
+  if (c_.jitter_s > 0.0) delay = std::max(0.0, delay + c_.jitter_s * (2.0 * uniform() - 1.0));
+  if (c_.reorder > 0.0 && uniform() < c_.reorder) {
+    ++counters_.held_back;
+    delay += c_.reorder_delay_s;
+  }
+  double arrive = now_s + delay + extra_s;
+  if (reliable) {
+    arrive = std::max(arrive, last_reliable_s_);  // in order, as a reliable channel delivers
+    last_reliable_s_ = arrive;
+  }
+  return arrive;
+}
+
+}  // namespace terracut::net

@@ -1,0 +1,172 @@
+// The ENet carrier (enet_transport.hpp).
+#include "terracut/net/enet_transport.hpp"
+
+#include <enet/enet.h>
+
+#include <algorithm>
+#include <deque>
+#include <mutex>
+
+#include "terracut/core/error.hpp"
+
+namespace terracut::net {
+namespace {
+
+// ENet's global initialisation, counted across endpoints.
+std::mutex g_enet_mutex;
+int g_enet_users = 0;
+
+void enet_acquire() {
+  std::lock_guard<std::mutex> lock(g_enet_mutex);
+  if (g_enet_users == 0 && enet_initialize() != 0) throw InputError("ENet could not be initialised");
+  ++g_enet_users;
+}
+void enet_release() {
+  std::lock_guard<std::mutex> lock(g_enet_mutex);
+  if (--g_enet_users == 0) enet_deinitialize();
+}
+
+ENetAddress make_address(const std::string& address, int port, const char* what) {
+  if (port < 0 || port > 65535)
+    throw InputError(std::string(what) + ": port must be in [0, 65535], got " +
+                     std::to_string(port));
+  ENetAddress a{};
+  if (address.empty() || address == "0.0.0.0") {
+    a.host = ENET_HOST_ANY;
+  } else if (enet_address_set_host_ip(&a, address.c_str()) != 0) {
+    throw InputError(std::string(what) + ": '" + address +
+                     "' is not an IPv4 address (ENet 1.3 speaks IPv4 only)");
+  }
+  a.port = static_cast<enet_uint16>(port);
+  return a;
+}
+
+constexpr std::size_t kChannels = 2;
+
+}  // namespace
+
+struct EnetEndpoint::State {
+  explicit State(const LinkConditions& c) : emulator(c) {}
+  ~State() {
+    if (host) enet_host_destroy(host);
+    enet_release();
+  }
+  struct Held {
+    double release_s;
+    std::int64_t order;
+    Channel channel;
+    std::vector<std::uint8_t> bytes;
+  };
+  LinkEmulator emulator;
+  ENetHost* host = nullptr;
+  ENetPeer* peer = nullptr;  // the connected peer, or null
+  bool connected = false;
+  std::int64_t connections = 0;
+  std::int64_t dropped_unconnected = 0;
+  std::int64_t next_order = 0;
+  std::deque<Held> held;  // sorted by (release_s, order)
+};
+
+EnetEndpoint::EnetEndpoint(std::unique_ptr<State> state) : s_(std::move(state)) {}
+
+EnetEndpoint::~EnetEndpoint() {
+  if (s_->peer && s_->connected) {
+    enet_peer_disconnect_now(s_->peer, 0);
+    enet_host_flush(s_->host);
+  }
+}
+
+std::unique_ptr<EnetEndpoint> EnetEndpoint::listen(const std::string& address, int port,
+                                                   const LinkConditions& sending) {
+  enet_acquire();
+  auto state = std::make_unique<State>(sending);
+  const ENetAddress a = make_address(address, port, "--listen");
+  state->host = enet_host_create(&a, 4, kChannels, 0, 0);
+  if (!state->host)
+    throw InputError("cannot bind UDP " + address + ":" + std::to_string(port) +
+                     " (in use, or not an address of this machine)");
+  return std::unique_ptr<EnetEndpoint>(new EnetEndpoint(std::move(state)));
+}
+
+std::unique_ptr<EnetEndpoint> EnetEndpoint::connect(const std::string& address, int port,
+                                                    const LinkConditions& sending) {
+  enet_acquire();
+  auto state = std::make_unique<State>(sending);
+  if (port < 1) throw InputError("--connect: port must be in [1, 65535], got " + std::to_string(port));
+  const ENetAddress remote = make_address(address, port, "--connect");
+  state->host = enet_host_create(nullptr, 1, kChannels, 0, 0);
+  if (!state->host) throw InputError("cannot create a UDP socket");
+  state->peer = enet_host_connect(state->host, &remote, kChannels, 0);
+  if (!state->peer) throw InputError("cannot connect to " + address + ":" + std::to_string(port));
+  return std::unique_ptr<EnetEndpoint>(new EnetEndpoint(std::move(state)));
+}
+
+void EnetEndpoint::send(Channel channel, const std::uint8_t* data, std::size_t size, double now_s) {
+  ++traffic_.sent;
+  traffic_.sent_bytes += std::int64_t(size);
+  const auto release_at = s_->emulator.schedule(now_s, channel == Channel::kReliable);
+  if (!release_at) return;
+  State::Held h{*release_at, s_->next_order++, channel, std::vector<std::uint8_t>(data, data + size)};
+  const auto at = std::upper_bound(
+      s_->held.begin(), s_->held.end(), h, [](const State::Held& x, const State::Held& y) {
+        return x.release_s < y.release_s || (x.release_s == y.release_s && x.order < y.order);
+      });
+  s_->held.insert(at, std::move(h));
+  release(now_s);
+}
+
+void EnetEndpoint::release(double now_s) {
+  while (!s_->held.empty() && s_->held.front().release_s <= now_s) {
+    State::Held& h = s_->held.front();
+    if (!s_->connected) {
+      // Nobody to send to: an unreliable datagram is gone; a reliable one waits.
+      if (h.channel == Channel::kReliable) break;
+      ++s_->dropped_unconnected;
+      s_->held.pop_front();
+      continue;
+    }
+    const enet_uint32 flags = h.channel == Channel::kReliable ? ENET_PACKET_FLAG_RELIABLE : 0;
+    ENetPacket* packet = enet_packet_create(h.bytes.data(), h.bytes.size(), flags);
+    if (packet && enet_peer_send(s_->peer, static_cast<enet_uint8>(h.channel), packet) != 0)
+      enet_packet_destroy(packet);
+    s_->held.pop_front();
+  }
+  enet_host_flush(s_->host);
+}
+
+void EnetEndpoint::receive(double now_s, std::vector<std::vector<std::uint8_t>>& out) {
+  ENetEvent event;
+  while (enet_host_service(s_->host, &event, 0) > 0) {
+    switch (event.type) {
+      case ENET_EVENT_TYPE_CONNECT:
+        // A new peer (or a restarted one) replaces the old.
+        if (s_->peer && s_->peer != event.peer && s_->connected) enet_peer_reset(s_->peer);
+        s_->peer = event.peer;
+        s_->connected = true;
+        ++s_->connections;
+        break;
+      case ENET_EVENT_TYPE_DISCONNECT:
+        if (event.peer == s_->peer) s_->connected = false;
+        break;
+      case ENET_EVENT_TYPE_RECEIVE:
+        if (event.peer == s_->peer) {
+          ++traffic_.received;
+          traffic_.received_bytes += std::int64_t(event.packet->dataLength);
+          out.emplace_back(event.packet->data, event.packet->data + event.packet->dataLength);
+        }
+        enet_packet_destroy(event.packet);
+        break;
+      case ENET_EVENT_TYPE_NONE:
+        break;
+    }
+  }
+  release(now_s);
+}
+
+const LinkEmulator& EnetEndpoint::emulator() const { return s_->emulator; }
+int EnetEndpoint::port() const { return s_->host ? int(s_->host->address.port) : -1; }
+bool EnetEndpoint::connected() const { return s_->connected; }
+std::int64_t EnetEndpoint::connections() const { return s_->connections; }
+std::int64_t EnetEndpoint::dropped_unconnected() const { return s_->dropped_unconnected; }
+
+}  // namespace terracut::net

@@ -1,0 +1,172 @@
+// The `mmt:` section: reading, validation, overrides and the remote world
+// (mmt_settings.hpp, mmt.hpp).
+#include "terracut/session/mmt_settings.hpp"
+
+#include <cmath>
+
+#include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
+#include "terracut/io/yaml_reader.hpp"
+#include "terracut/session/mmt.hpp"
+#include "terracut/session/scenario.hpp"
+
+namespace terracut::session {
+namespace {
+
+namespace yaml = io::yaml;
+
+bool in(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
+
+// One direction's conditions from `link:`.
+void read_link(const yaml::Map& link, net::LinkConditions& c) {
+  link.read_number("delay_s", c.delay_s);
+  link.read_number("jitter_s", c.jitter_s);
+  link.read_number("loss", c.loss);
+  link.read_number("reorder", c.reorder);
+  link.read_number("reorder_delay_s", c.reorder_delay_s);
+  if (const auto f = link.get("retransmit_s")) c.retransmit_s = f->number();
+  if (const auto f = link.get("seed")) c.seed = std::uint64_t(f->integer_in(0, 1000000000));
+  const yaml::Map burst =
+      link.section("burst", {"p_good_to_bad", "p_bad_to_good", "loss_good", "loss_bad"});
+  burst.read_number("p_good_to_bad", c.burst.p_good_to_bad);
+  burst.read_number("p_bad_to_good", c.burst.p_bad_to_good);
+  burst.read_number("loss_good", c.burst.loss_good);
+  burst.read_number("loss_bad", c.burst.loss_bad);
+}
+
+}  // namespace
+
+std::string validate(const MmtSettings& s) {
+  if (!in(s.follower_speed_m_per_s, 0.0, 100.0) || s.follower_speed_m_per_s <= 0.0)
+    return must_be("remote.follower_speed_m_per_s", "in (0, 100]", s.follower_speed_m_per_s);
+  if (!in(s.follower_time_constant_s, 0.0, 10.0))
+    return must_be("remote.follower_time_constant_s", "in [0, 10]", s.follower_time_constant_s);
+  if (!in(s.sense_period_s, 0.0, 10.0) || s.sense_period_s <= 0.0)
+    return must_be("remote.sense_period_s", "in (0, 10]", s.sense_period_s);
+  if (!in(s.sense_radius_m, 0.0, 100.0) || s.sense_radius_m <= 0.0)
+    return must_be("remote.sense_radius_m", "in (0, 100]", s.sense_radius_m);
+  if (!in(s.forgetting, 0.0, 1.0) || s.forgetting <= 0.0)
+    return must_be("remote.forgetting", "in (0, 1]", s.forgetting);
+  if (std::string p = net::validate(s.to_remote); !p.empty()) return "link." + p;
+  if (std::string p = net::validate(s.to_operator); !p.empty()) return "link." + p;
+  if (!in(s.blend_s, 0.0, 10.0)) return must_be("operator.blend_s", "in [0, 10]", s.blend_s);
+  if (!in(s.max_update_step_n, 0.0, 100.0) || s.max_update_step_n <= 0.0)
+    return must_be("operator.max_update_step_n", "in (0, 100]", s.max_update_step_n);
+  if (!in(s.exclusion_m, 0.0, 100.0))
+    return must_be("operator.exclusion_m", "in [0, 100]", s.exclusion_m);
+  if (!in(s.deadband, 0.0, 1.0) || s.deadband >= 1.0)
+    return must_be("operator.deadband", "in [0, 1)", s.deadband);
+  if (!in(s.timeout_s, 0.0, 60.0) || s.timeout_s <= 0.0)
+    return must_be("timeout_s", "in (0, 60]", s.timeout_s);
+  if (s.port < 1 || s.port > 65535) return must_be("udp.port", "in [1, 65535]", s.port);
+  return {};
+}
+
+void MmtReader::read(const YAML::Node& value, const std::string& file) {
+  MmtSettings s;
+  const yaml::Field root(yaml::Context(file), value, "mmt", value.Mark());
+  if (value.IsNull()) {
+    settings = s;
+    return;
+  }
+  const yaml::Map top(root, {"remote", "link", "operator", "timeout_s", "udp", "link_id"});
+  const yaml::Map remote =
+      top.section("remote", {"scenario", "soil", "follower_speed_m_per_s",
+                             "follower_time_constant_s", "sense_period_s",
+                             "sense_radius_m", "estimate", "forgetting"});
+  if (const auto f = remote.get("scenario")) {
+    const std::filesystem::path p = f->text();
+    s.remote_scenario = p.is_absolute() ? p : std::filesystem::path(file).parent_path() / p;
+  }
+  if (const auto f = remote.get("soil"))
+    s.remote_soil = f->choice({SoilPreset::kDrySand, SoilPreset::kLooseSand, SoilPreset::kClay});
+  remote.read_number("follower_speed_m_per_s", s.follower_speed_m_per_s);
+  remote.read_number("follower_time_constant_s", s.follower_time_constant_s);
+  remote.read_number("sense_period_s", s.sense_period_s);
+  remote.read_number("sense_radius_m", s.sense_radius_m);
+  remote.read_boolean("estimate", s.estimate);
+  remote.read_number("forgetting", s.forgetting);
+
+  const yaml::Map link = top.section("link", {"delay_s", "jitter_s", "loss", "reorder",
+                                              "reorder_delay_s", "retransmit_s", "seed", "burst"});
+  read_link(link, s.to_remote);
+  s.to_operator = s.to_remote;
+  s.to_operator.seed = s.to_remote.seed + 1;  // the two directions draw independently
+
+  const yaml::Map op =
+      top.section("operator", {"blend_s", "max_update_step_n", "exclusion_m", "deadband"});
+  op.read_number("blend_s", s.blend_s);
+  op.read_number("max_update_step_n", s.max_update_step_n);
+  op.read_number("exclusion_m", s.exclusion_m);
+  op.read_number("deadband", s.deadband);
+  top.read_number("timeout_s", s.timeout_s);
+  const yaml::Map udp = top.section("udp", {"address", "port"});
+  udp.read_text("address", s.address);
+  udp.read_integer("port", s.port);
+  if (const auto f = top.get("link_id")) s.link_id = std::uint32_t(f->integer_in(0, 1000000000));
+  if (const std::string problem = validate(s); !problem.empty()) {
+    const yaml::Problem p = yaml::split_problem(problem);
+    root.fail_at(p.path, p.what);
+  }
+  settings = s;
+}
+
+MmtSettings apply_overrides(MmtSettings s, const MmtOverrides& o) {
+  if (o.rtt_s) {
+    if (!in(*o.rtt_s, 0.0, 20.0)) throw InputError(must_be("--rtt-ms", "in [0, 20000]", *o.rtt_s * 1e3));
+    s.to_remote.delay_s = s.to_operator.delay_s = 0.5 * *o.rtt_s;
+  }
+  if (o.loss) {
+    if (!in(*o.loss, 0.0, 1.0) || *o.loss >= 1.0) throw InputError(must_be("--loss", "in [0, 1)", *o.loss));
+    s.to_remote.loss = s.to_operator.loss = *o.loss;
+  }
+  if (o.jitter_s) {
+    if (!in(*o.jitter_s, 0.0, 10.0)) throw InputError(must_be("--jitter-ms", "in [0, 10000]", *o.jitter_s * 1e3));
+    s.to_remote.jitter_s = s.to_operator.jitter_s = *o.jitter_s;
+  }
+  if (o.seed) {
+    s.to_remote.seed = *o.seed;
+    s.to_operator.seed = *o.seed + 1;
+  }
+  if (o.deadband) {
+    if (!in(*o.deadband, 0.0, 1.0) || *o.deadband >= 1.0)
+      throw InputError(must_be("--deadband", "in [0, 1)", *o.deadband));
+    s.deadband = *o.deadband;
+  }
+  if (o.blend_s) {
+    if (!in(*o.blend_s, 0.0, 10.0)) throw InputError(must_be("--blend", "in [0, 10]", *o.blend_s));
+    s.blend_s = *o.blend_s;
+  }
+  if (const std::string problem = validate(s); !problem.empty()) throw InputError("mmt." + problem);
+  return s;
+}
+
+Scenario load_remote_scenario(const Scenario& op) {
+  if (!op.mmt)
+    throw InputError(op.base.source_path.string() +
+                     ": mmt: the scenario has no mmt: section (the remote world and the link)");
+  const MmtSettings& s = *op.mmt;
+  Scenario remote;
+  try {
+    remote = s.remote_scenario.empty() ? op : load_scenario(s.remote_scenario);
+  } catch (const InputError& e) {
+    throw InputError(op.base.source_path.string() + ": mmt.remote.scenario: " + e.what());
+  }
+  remote.mmt.reset();
+  if (s.remote_soil) remote.haptics.forces.earthmoving.soil = soil_preset(*s.remote_soil);
+  // Both stations speak of the same samples: the grids must agree.
+  const GridSpec a = io::grid_spec(op.base), b = io::grid_spec(remote.base);
+  if (a.cols != b.cols || a.rows != b.rows || a.size_x_m != b.size_x_m ||
+      a.size_z_m != b.size_z_m || a.origin_m.x != b.origin_m.x ||
+      a.origin_m.y != b.origin_m.y || a.origin_m.z != b.origin_m.z)
+    throw InputError(op.base.source_path.string() +
+                     ": mmt.remote.scenario: the remote terrain's grid (" + std::to_string(b.cols) +
+                     "x" + std::to_string(b.rows) + " samples over " + format_number(b.size_x_m) +
+                     " x " + format_number(b.size_z_m) + " m) must be the operator's (" +
+                     std::to_string(a.cols) + "x" + std::to_string(a.rows) + " over " +
+                     format_number(a.size_x_m) + " x " + format_number(a.size_z_m) +
+                     " m, same origin)");
+  return remote;
+}
+
+}  // namespace terracut::session

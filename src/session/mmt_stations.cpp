@@ -1,0 +1,658 @@
+// The two stations of model-mediated teleoperation (mmt.hpp).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "terracut/core/error.hpp"
+#include "terracut/haptics/cut_depth.hpp"
+#include "terracut/haptics/workspace.hpp"
+#include "terracut/session/mmt.hpp"
+
+namespace terracut::session {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Vec3 horizontal(Vec3 v) { return {v.x, 0.0, v.z}; }
+
+std::uint64_t to_ns(double t_s) { return std::uint64_t(std::llround(std::max(0.0, t_s) * 1e9)); }
+
+// The loop's parameters of a scenario, with the scenario named in errors.
+haptics::LoopParams loop_params(const Scenario& sc) {
+  try {
+    return haptics::LoopParams(sc.haptics, sc.base.blade);
+  } catch (const InputError& e) {
+    throw InputError(sc.base.source_path.string() + ": " + e.what());
+  }
+}
+
+// The orientation of the first keyframe of the followed cut, or identity.
+Quat first_orientation(const Scenario& sc) {
+  const io::Scenario& b = sc.base;
+  const Motion* cut = nullptr;
+  if (!sc.haptics.cut.empty()) {
+    const int i = b.find_cut(sc.haptics.cut);
+    if (i >= 0) cut = &b.cuts[std::size_t(i)];
+  } else if (!b.sequence.empty()) {
+    cut = &b.cuts[std::size_t(b.sequence.front())];
+  } else if (!b.cuts.empty()) {
+    cut = &b.cuts.front();
+  }
+  return cut ? cut->keyframes.front().pose.orientation : Quat{};
+}
+
+// Adds a rectangle to the rectangle of everything worked so far.
+void include_rect(Rect& into, const Rect& r) {
+  if (r.empty()) return;
+  if (into.empty())
+    into = r;
+  else
+    into.include(r);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// The remote's arm: follows the newest command as a first-order servo at a
+// limited speed (a real arm lags, and does not jump when a command is late).
+// ---------------------------------------------------------------------------
+
+class FollowerDevice final : public haptics::Device {
+ public:
+  FollowerDevice(const haptics::WorkspaceMapping& mapping, double speed_m_per_s,
+                 double time_constant_s, double rate_hz)
+      : workspace_(mapping),
+        step_m_(speed_m_per_s / rate_hz),
+        gain_(std::min(1.0, 1.0 / (time_constant_s * rate_hz))) {}
+
+  std::string_view kind() const override { return "follower"; }
+
+  /// The newest command. The first one places the arm (it starts there).
+  void command(const BladePose& target) {
+    target_ = target;
+    if (!has_pose_) pose_ = target;
+    has_pose_ = true;
+  }
+  /// Link silent: stay where the arm is.
+  void hold() { target_ = pose_; }
+  const BladePose& pose() const { return pose_; }
+
+  bool read(double, haptics::DeviceSample& out) noexcept override {
+    if (!has_pose_) return false;
+    // A first-order servo (time constant tau: the step is the error x dt /
+    // tau), limited to the arm's speed.
+    Vec3 d = (target_.position_m - pose_.position_m) * gain_;
+    const double l = length(d);
+    if (l > step_m_) d = d * (step_m_ / l);
+    pose_.position_m = pose_.position_m + d;
+    pose_.orientation = target_.orientation;
+    out.position_m = workspace_.to_device(pose_.position_m);
+    out.orientation = workspace_.orientation_to_device(pose_.orientation);
+    out.has_orientation = true;
+    out.buttons = 0;
+    out.reconnected = false;
+    return true;
+  }
+  void write(const haptics::DeviceCommand&) noexcept override {}
+
+ private:
+  haptics::Workspace workspace_;
+  double step_m_;  // largest step per tick, m
+  double gain_;    // dt / tau, at most 1
+  BladePose pose_{}, target_{};
+  bool has_pose_ = false;
+};
+
+// ---------------------------------------------------------------------------
+// The operator's device seen through the link: while the link is silent the
+// loop gets no samples, so its watchdog fades the force out; the first
+// sample after a silence is a reconnection (no sweep, a new soft start).
+// ---------------------------------------------------------------------------
+
+class LinkGuardDevice final : public haptics::Device {
+ public:
+  explicit LinkGuardDevice(haptics::Device& inner) : inner_(inner) {}
+  std::string_view kind() const override { return inner_.kind(); }
+  void start(double t_s) override { inner_.start(t_s); }
+  void set_silent(bool silent) {
+    if (silent_ && !silent) resumed_ = true;
+    silent_ = silent;
+  }
+  bool read(double t_s, haptics::DeviceSample& out) noexcept override {
+    haptics::DeviceSample fresh = out;
+    const bool got = inner_.read(t_s, fresh);  // the hand moves on, heard or not
+    if (silent_ || !got) return false;
+    fresh.reconnected = fresh.reconnected || resumed_;
+    resumed_ = false;
+    out = fresh;
+    return true;
+  }
+  void write(const haptics::DeviceCommand& c) noexcept override { inner_.write(c); }
+  void stop() noexcept override { inner_.stop(); }
+  std::vector<haptics::DeviceStat> stats() const override { return inner_.stats(); }
+
+ private:
+  haptics::Device& inner_;
+  bool silent_ = false;
+  bool resumed_ = false;
+};
+
+// ---------------------------------------------------------------------------
+// The soil estimate on the operator's side: the horizontal cutting force of
+// the local model times (factor - 1), added as a step listener's force. The
+// factor applied moves toward the remote's estimate by at most
+// max_update_step_n of device force per tick. It reads the model's force of
+// the previous tick (the loop computes this tick's after the listeners):
+// one tick late, well inside the blend.
+// ---------------------------------------------------------------------------
+
+class ScaleCorrection final : public StepListener {
+ public:
+  ScaleCorrection(const haptics::HapticLoop& loop, double max_step_n)
+      : loop_(loop), max_step_n_(max_step_n) {}
+  void set_target(double k) { target_ = k; }
+  double applied() const { return applied_; }
+  double target() const { return target_; }
+  bool moving() const { return moving_; }
+
+  Vec3 on_step(const StepOutput&) noexcept override {
+    const haptics::LoopRecord& last = loop_.last();
+    const Vec3 model_h = horizontal(last.force_world_n - last.body_force_world_n);
+    const double device_n =
+        length(model_h) * loop_.force_model().params().force_scale;
+    const double max_change = device_n > 1e-12 ? max_step_n_ / device_n : 1e300;
+    const double change = std::clamp(target_ - applied_, -max_change, max_change);
+    moving_ = change != 0.0;
+    applied_ += change;
+    // What the update itself changed in the rendered force this tick:
+    // (the factor's change) x the model's force, device N.
+    last_step_n_ = std::fabs(change) * device_n;
+    return model_h * (applied_ - 1.0);
+  }
+  /// The device force the factor's change added this tick, N (<= max_step_n).
+  double last_step_n() const { return last_step_n_; }
+
+ private:
+  const haptics::HapticLoop& loop_;
+  double max_step_n_;
+  double target_ = 1.0;
+  double applied_ = 1.0;
+  bool moving_ = false;
+  double last_step_n_ = 0.0;
+};
+
+// ---------------------------------------------------------------------------
+// Remote station
+// ---------------------------------------------------------------------------
+
+RemoteStation::RemoteStation(const Scenario& remote, const MmtSettings& settings,
+                             const ForceModel& nominal, const HeightGrid& operator_initial,
+                             net::Endpoint& link, std::uint32_t session)
+    : settings_(settings), nominal_(nominal), link_(link), session_(session) {
+  const haptics::LoopParams params = loop_params(remote);
+  device_ = std::make_unique<FollowerDevice>(params.settings().workspace,
+                                             settings_.follower_speed_m_per_s,
+                                             settings_.follower_time_constant_s, params.rate_hz());
+  RigOptions ro;
+  ro.loop.record_capacity = 0;
+  ro.loop.realtime = false;
+  rig_ = std::make_unique<HapticRig>(remote, params, first_orientation(remote), *device_, ro);
+  const HeightGrid& grid = rig_->world().simulation().grid();
+  if (grid.cols() != operator_initial.cols() || grid.rows() != operator_initial.rows())
+    throw InputError("mmt.remote.scenario: the remote grid must have the operator's samples");
+  mirror_.assign(operator_initial.initial(),
+                 operator_initial.initial() + grid.spec().sample_count());
+}
+
+RemoteStation::~RemoteStation() = default;
+
+const Simulation& RemoteStation::simulation() const { return rig_->world().simulation(); }
+
+void RemoteStation::receive(double t_s) {
+  inbox_.clear();
+  link_.receive(t_s, inbox_);
+  for (const auto& d : inbox_) {
+    net::Header h;
+    net::Reject r = net::decode_header(d.data(), d.size(), settings_.link_id, h);
+    if (r == net::Reject::kNone && h.type != net::MessageType::kCommand) r = net::Reject::kBadType;
+    net::Command c;
+    if (r == net::Reject::kNone) r = net::decode_command(d.data(), d.size(), c);
+    if (r == net::Reject::kNone)
+      r = net::to_reject(commands_.check(h.session, h.sequence, h.timestamp_ns));
+    if (r != net::Reject::kNone) {
+      counters_.rejected.add(r);
+      continue;
+    }
+    ++counters_.accepted;
+    counters_.sessions = commands_.sessions();
+    // A new operator session, or a lifted tool: the next pose is a jump.
+    if ((c.flags & net::kCommandLifted) || (commands_.new_session() && has_command_))
+      rig_->world().simulation().lift();
+    device_->command(c.pose);
+    command_sequence_ = h.sequence;
+    commanded_m_ = c.pose.position_m;
+    has_command_ = true;
+    last_command_s_ = t_s;
+  }
+}
+
+Rect RemoteStation::window_around(Vec3 p) const {
+  const GridSpec& g = simulation().grid().spec();
+  const double r = settings_.sense_radius_m;
+  auto lo = [](double v, double origin, double cell) {
+    return int(std::ceil((v - origin) / cell - 0.5));
+  };
+  auto hi = [](double v, double origin, double cell) {
+    return int(std::floor((v - origin) / cell - 0.5)) + 1;
+  };
+  Rect w{lo(p.x - r, g.origin_m.x, g.cell_x_m()), lo(p.z - r, g.origin_m.z, g.cell_z_m()),
+         hi(p.x + r, g.origin_m.x, g.cell_x_m()), hi(p.z + r, g.origin_m.z, g.cell_z_m())};
+  w.c0 = std::clamp(w.c0, 0, g.cols);
+  w.c1 = std::clamp(w.c1, 0, g.cols);
+  w.r0 = std::clamp(w.r0, 0, g.rows);
+  w.r1 = std::clamp(w.r1, 0, g.rows);
+  return w;
+}
+
+// Recursive least squares of one factor: measured horizontal force =
+// factor x the operator's model's horizontal cutting force at the same cut
+// (contact, depth, velocity). Forces are taken in units of 100 N.
+void RemoteStation::update_estimate(const haptics::LoopRecord& r) {
+  if (!settings_.estimate || r.contact_length_m <= 0.0 || r.cut_depth_m <= 0.0) return;
+  ForceInput in;
+  in.velocity_m_per_s = r.velocity_m_per_s;
+  in.contact_length_m = r.contact_length_m;
+  in.cut_depth_m = r.cut_depth_m;
+  in.edge_direction = simulation().last().edge.b - simulation().last().edge.a;
+  in.device_point_m = r.tool.position_m;
+  in.surface_y_m = simulation().grid().spec().origin_m.y;
+  if (simulation().params().soil.model == SoilModel::kFlow) {
+    // The pile ahead weighs on the wedge in the operator's model too.
+    const haptics::SoilAhead ahead = haptics::soil_ahead(
+        simulation().grid(), simulation().params().representation, simulation().last().edge,
+        r.velocity_m_per_s, haptics::depth_lookahead_m(simulation().grid().spec()));
+    in.surcharge_pa = nominal_.params().earthmoving.soil.unit_weight_n_per_m3 * ahead.pile_m;
+  }
+  const double x = length(horizontal(nominal_.compute(in).cutting_n)) / 100.0;
+  const double y = length(horizontal(r.force_world_n)) / 100.0;
+  if (!(x > 0.01) || !std::isfinite(y)) return;  // below 1 N the ratio says little
+  const double lambda = settings_.forgetting;
+  const double k = p_ * x / (lambda + x * p_ * x);
+  theta_ = std::clamp(theta_ + k * (y - theta_ * x), 0.02, 50.0);
+  p_ = (p_ - k * x * p_) / lambda;
+  ++rls_samples_;
+}
+
+// The sensed patch: the rectangle changed since the last one and the square
+// around the tool. With the deadband it is cut down to the samples that
+// differ from what the operator was sent by more than a JND fraction of the
+// cut depth (the force of a cut grows at least linearly with its depth, so
+// a relative depth change of the JND changes it by at least the JND).
+void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
+  Rect cand = dirty_;
+  dirty_ = {};
+  if (has_command_) include_rect(cand, window_around(device_->pose().position_m));
+  const HeightGrid& grid = simulation().grid();
+  // Without the deadband the whole sensed rectangle goes (a depth camera's
+  // frame: it also corrects what the operator's model did on its own);
+  // with it, only the samples past the threshold, and nothing below it.
+  const double threshold =
+      settings_.deadband > 0.0 ? settings_.deadband * std::max(r.cut_depth_m, 0.02) : -1.0;
+  Rect diff{};
+  for (int row = cand.r0; row < cand.r1; ++row)
+    for (int col = cand.c0; col < cand.c1; ++col) {
+      const std::int64_t i = grid.index(col, row);
+      if (std::fabs(grid.heights()[i] - mirror_[std::size_t(i)]) > threshold) {
+        if (diff.empty())
+          diff = {col, row, col + 1, row + 1};
+        else
+          diff.include(col, row);
+      }
+    }
+  if (!diff.empty()) {
+    patch_.t_s = t_s;
+    patch_.rect = diff;
+    patch_.heights.resize(std::size_t(diff.area()));
+    std::size_t k = 0;
+    for (int row = diff.r0; row < diff.r1; ++row)
+      for (int col = diff.c0; col < diff.c1; ++col) {
+        const std::int64_t i = grid.index(col, row);
+        patch_.heights[k++] = grid.heights()[i];
+        mirror_[std::size_t(i)] = grid.heights()[i];
+      }
+    net::Header h{net::MessageType::kPatch, settings_.link_id, session_, seq_patch_++, to_ns(t_s)};
+    if (net::encode_patch(h, patch_, buffer_) > 0) {
+      link_.send(net::Channel::kReliable, buffer_.data(), buffer_.size(), t_s);
+      ++counters_.patches;
+    }
+  }
+  // The estimate, when it moved (by the JND fraction with the deadband).
+  if (rls_samples_ > 0) {
+    const double moved = std::fabs(theta_ - theta_sent_);
+    const bool send = settings_.deadband > 0.0 ? moved > settings_.deadband * theta_sent_
+                                               : (moved > 1e-9 || !estimate_sent_);
+    if (send) {
+      net::Estimate e;
+      e.t_s = t_s;
+      e.force_scale = theta_;
+      e.variance = p_;
+      e.samples = std::uint32_t(std::min<std::int64_t>(rls_samples_, 0xFFFFFFFF));
+      std::uint8_t out[net::kHeaderSize + net::kEstimatePayloadSize + net::kCrcSize];
+      net::Header h{net::MessageType::kEstimate, settings_.link_id, session_, seq_estimate_++,
+                    to_ns(t_s)};
+      const std::size_t n = net::encode_estimate(h, e, out);
+      link_.send(net::Channel::kReliable, out, n, t_s);
+      theta_sent_ = theta_;
+      estimate_sent_ = true;
+      ++counters_.estimates;
+    }
+  }
+}
+
+void RemoteStation::tick(double t_s) {
+  receive(t_s);
+  // Silence: the arm holds where it is.
+  const bool holding = has_command_ && t_s - last_command_s_ > settings_.timeout_s;
+  if (holding) {
+    device_->hold();
+    ++counters_.silent_ticks;
+  }
+  haptics::HapticLoop& loop = rig_->loop();
+  const Simulation& sim = simulation();
+  const std::int64_t steps_before = sim.step_count();
+  const auto start = std::chrono::steady_clock::now();
+  loop.step1(t_s);
+  const haptics::LoopRecord& r =
+      loop.step2(records_.empty() ? 0.0 : t_s - previous_t_s_, seconds_since(start), false);
+  const double compute_s = seconds_since(start);
+  previous_t_s_ = t_s;
+  if (sim.step_count() > steps_before) {
+    include_rect(dirty_, sim.last().changed);
+    include_rect(worked_, sim.last().changed);
+  }
+  // The measurement, every tick once commanded.
+  if (has_command_) {
+    net::Measurement m;
+    m.t_s = t_s;
+    m.command_sequence = command_sequence_;
+    m.flags = holding ? net::kMeasurementHolding : 0u;
+    m.pose = r.tool;
+    m.force_world_n = r.force_world_n;
+    m.contact_length_m = r.contact_length_m;
+    m.cut_depth_m = r.cut_depth_m;
+    std::uint8_t out[net::kHeaderSize + net::kMeasurementPayloadSize + net::kCrcSize];
+    net::Header h{net::MessageType::kMeasurement, settings_.link_id, session_,
+                  seq_measurement_++, to_ns(t_s)};
+    const std::size_t n = net::encode_measurement(h, m, out);
+    link_.send(net::Channel::kUnreliable, out, n, t_s);
+    update_estimate(r);
+  }
+  if (t_s + 1e-9 >= next_sense_s_) {
+    sense(t_s, r);
+    next_sense_s_ += settings_.sense_period_s;
+  }
+  RemoteRecord rec;
+  rec.t_s = t_s;
+  rec.command_sequence = command_sequence_;
+  rec.commanded_m = commanded_m_;
+  rec.tool_m = r.tool.position_m;
+  rec.force_world_n = has_command_ ? r.force_world_n : Vec3{};
+  rec.contact_length_m = r.contact_length_m;
+  rec.cut_depth_m = r.cut_depth_m;
+  rec.force_scale = theta_;
+  rec.holding = holding;
+  rec.active = has_command_;
+  rec.compute_s = compute_s;
+  records_.push_back(rec);
+}
+
+// ---------------------------------------------------------------------------
+// Operator station
+// ---------------------------------------------------------------------------
+
+OperatorStation::OperatorStation(const Scenario& op, const MmtSettings& settings,
+                                 haptics::Device& device, net::Endpoint& link,
+                                 std::uint32_t session)
+    : settings_(settings), link_(link), session_(session) {
+  const haptics::LoopParams params = loop_params(op);
+  guard_ = std::make_unique<LinkGuardDevice>(device);
+  RigOptions ro;
+  ro.loop.record_capacity = 0;
+  ro.loop.realtime = false;
+  rig_ = std::make_unique<HapticRig>(op, params, first_orientation(op), *guard_, ro);
+  correction_ = std::make_unique<ScaleCorrection>(rig_->loop(), settings_.max_update_step_n);
+  rig_->world().simulation().add_listener(*correction_);
+  const GridSpec& g = rig_->world().simulation().grid().spec();
+  stamp_s_.assign(std::size_t(g.sample_count()), -1e30f);
+  // A local cut younger than a round trip (plus the sensing period and the
+  // blend) is not yet in what the remote sends: keep it.
+  protect_s_ = settings_.to_remote.delay_s + settings_.to_operator.delay_s +
+               settings_.to_remote.jitter_s + settings_.to_operator.jitter_s +
+               settings_.sense_period_s + settings_.blend_s + 0.05;
+  const std::size_t window = std::size_t(std::llround(params.rate_hz()));  // 1 s
+  power_.assign(window, 0.0);
+  power_dfr_.assign(window, 0.0);
+}
+
+OperatorStation::~OperatorStation() {
+  rig_->world().simulation().remove_listener(*correction_);
+}
+
+const Simulation& OperatorStation::simulation() const { return rig_->world().simulation(); }
+double OperatorStation::rate_hz() const { return rig_->loop().params().rate_hz(); }
+
+void OperatorStation::receive(double t_s) {
+  inbox_.clear();
+  link_.receive(t_s, inbox_);
+  const GridSpec& g = simulation().grid().spec();
+  for (const auto& d : inbox_) {
+    net::Header h;
+    net::Reject r = net::decode_header(d.data(), d.size(), settings_.link_id, h);
+    net::Measurement m;
+    net::Estimate e;
+    wire::SequenceFilter* filter = nullptr;
+    if (r == net::Reject::kNone) {
+      switch (h.type) {
+        case net::MessageType::kMeasurement:
+          r = net::decode_measurement(d.data(), d.size(), m);
+          filter = &measurements_;
+          break;
+        case net::MessageType::kPatch:
+          r = net::decode_patch(d.data(), d.size(), patch_);
+          if (r == net::Reject::kNone && (patch_.rect.c1 > g.cols || patch_.rect.r1 > g.rows))
+            r = net::Reject::kBadPayload;  // outside the grid
+          filter = &patches_;
+          break;
+        case net::MessageType::kEstimate:
+          r = net::decode_estimate(d.data(), d.size(), e);
+          filter = &estimates_;
+          break;
+        default:
+          r = net::Reject::kBadType;
+      }
+    }
+    if (r == net::Reject::kNone)
+      r = net::to_reject(filter->check(h.session, h.sequence, h.timestamp_ns));
+    if (r != net::Reject::kNone) {
+      counters_.rejected.add(r);
+      continue;
+    }
+    ++counters_.accepted;
+    heard_ = true;
+    last_heard_s_ = t_s;
+    counters_.sessions = std::max(counters_.sessions, measurements_.sessions());
+    switch (h.type) {
+      case net::MessageType::kMeasurement:
+        remote_force_ = m.force_world_n;
+        break;
+      case net::MessageType::kPatch: {
+        ++counters_.patches;
+        // A new blend from the heights as they are now to the remote's.
+        Blend b;
+        b.rect = patch_.rect;
+        b.to = patch_.heights;
+        b.from.resize(b.to.size());
+        const HeightGrid& grid = simulation().grid();
+        std::size_t k = 0;
+        for (int row = b.rect.r0; row < b.rect.r1; ++row)
+          for (int col = b.rect.c0; col < b.rect.c1; ++col)
+            b.from[k++] = grid.heights()[grid.index(col, row)];
+        b.scratch.resize(b.to.size());
+        b.t0_s.assign(b.to.size(), float(t_s));
+        blends_.push_back(std::move(b));
+        break;
+      }
+      case net::MessageType::kEstimate:
+        ++counters_.estimates;
+        correction_->set_target(e.force_scale);
+        break;
+      default:
+        break;
+    }
+  }
+}
+
+// Moves every blend one tick on: each sample goes from its height when the
+// patch came to the remote's over blend_s. While the tool is in contact, the
+// samples near its edge (within exclusion_m, where the force is read: the
+// depth ahead and the failure wedge) are not touched: their ramp starts
+// again from their current height once the tool has left them, so a patch
+// never changes the terrain the tool is feeling. Samples the local tool
+// changed recently wait the same way (the remote has not seen that change
+// yet); every sample ends at the remote's height.
+void OperatorStation::merge(double t_s) {
+  HeightGrid& grid = rig_->world().simulation().grid();
+  const haptics::LoopRecord& last = rig_->loop().last();
+  const bool in_contact = last.contact_length_m > 0.0;
+  const Segment edge = simulation().last().edge;
+  const double ex = settings_.exclusion_m;
+  const double x0 = std::min(edge.a.x, edge.b.x) - ex, x1 = std::max(edge.a.x, edge.b.x) + ex;
+  const double z0 = std::min(edge.a.z, edge.b.z) - ex, z1 = std::max(edge.a.z, edge.b.z) + ex;
+  for (Blend& b : blends_) {
+    b.done = true;
+    std::size_t k = 0;
+    for (int row = b.rect.r0; row < b.rect.r1; ++row)
+      for (int col = b.rect.c0; col < b.rect.c1; ++col, ++k) {
+        const std::int64_t i = grid.index(col, row);
+        const float now = grid.heights()[i];
+        if (in_contact) {
+          const double x = grid.sample_x(col), z = grid.sample_z(row);
+          if (x >= x0 && x <= x1 && z >= z0 && z <= z1) {
+            b.t0_s[k] = float(t_s);  // wait, and start from here later
+            b.from[k] = now;
+            b.scratch[k] = now;
+            b.done = false;
+            continue;
+          }
+        }
+        const double ramp = settings_.blend_s > 0.0
+                                ? std::clamp((t_s - b.t0_s[k]) / settings_.blend_s, 0.0, 1.0)
+                                : 1.0;
+        if (ramp < 1.0) b.done = false;
+        // A sample the local tool changed within the last round trip is
+        // ahead of what the remote has reported: it waits like the samples
+        // under the tool, and ramps from where it is once it is settled.
+        if (t_s - stamp_s_[std::size_t(i)] < protect_s_) {
+          b.t0_s[k] = float(t_s);
+          b.from[k] = now;
+          b.scratch[k] = now;
+          b.done = false;
+          continue;
+        }
+        b.scratch[k] = float(b.from[k] + (b.to[k] - b.from[k]) * ramp);
+      }
+    grid.set_heights(b.rect, b.scratch.data());
+    include_rect(worked_, b.rect);
+  }
+  blends_.erase(std::remove_if(blends_.begin(), blends_.end(), [](const Blend& b) { return b.done; }),
+                blends_.end());
+}
+
+void OperatorStation::tick(double t_s) {
+  const auto start = std::chrono::steady_clock::now();
+  receive(t_s);
+  const bool updating_terrain = !blends_.empty();
+  merge(t_s);
+  const bool silent = heard_ && t_s - last_heard_s_ > settings_.timeout_s;
+  guard_->set_silent(silent);
+  if (silent) ++counters_.silent_ticks;
+
+  haptics::HapticLoop& loop = rig_->loop();
+  Simulation& sim = rig_->world().simulation();
+  const std::int64_t steps_before = sim.step_count();
+  loop.step1(t_s);
+  const double period = records_.empty() ? 0.0 : t_s - previous_t_s_;
+  const haptics::LoopRecord& r = loop.step2(period, seconds_since(start), false);
+  if (sim.step_count() > steps_before) {
+    const Rect c = sim.last().changed;
+    for (int row = c.r0; row < c.r1; ++row)
+      for (int col = c.c0; col < c.c1; ++col)
+        stamp_s_[std::size_t(sim.grid().index(col, row))] = float(t_s);
+    include_rect(worked_, c);
+  }
+
+  // The command: where the operator's tool is.
+  net::Command cmd;
+  cmd.t_s = t_s;
+  cmd.pose = r.tool;
+  cmd.flags = (r.flags & haptics::kFlagReconnected) ? net::kCommandLifted : 0u;
+  std::uint8_t out[net::kHeaderSize + net::kCommandPayloadSize + net::kCrcSize];
+  net::Header h{net::MessageType::kCommand, settings_.link_id, session_, seq_command_++,
+                to_ns(t_s)};
+  const std::size_t n = net::encode_command(h, cmd, out);
+  link_.send(net::Channel::kUnreliable, out, n, t_s);
+
+  // The passivity observer: energy the device put into the hand over the
+  // last second (force held over the tick times the handle's displacement),
+  // for the force rendered (MMT) and for the remote's force as it arrives
+  // (direct force reflection, on the same motion).
+  const haptics::Workspace& ws = loop.workspace();
+  const double scale = loop.force_model().params().force_scale;
+  double power = 0.0, power_dfr = 0.0;
+  const Vec3 dfr_device = ws.direction_to_device(remote_force_ * scale);
+  if (has_previous_) {
+    const Vec3 dx = r.device_position_m - previous_device_m_;
+    power = dot(previous_force_device_n_, dx);
+    power_dfr = dot(previous_dfr_device_n_, dx);
+  }
+  window_j_ += power - power_[power_at_];
+  window_dfr_j_ += power_dfr - power_dfr_[power_at_];
+  power_[power_at_] = power;
+  power_dfr_[power_at_] = power_dfr;
+  power_at_ = (power_at_ + 1) % power_.size();
+
+  const bool updating = updating_terrain || correction_->moving();
+  max_update_step_n_ = std::max(max_update_step_n_, correction_->last_step_n());
+  if (updating && has_previous_)
+    max_step_while_updating_n_ =
+        std::max(max_step_while_updating_n_, length(r.force_device_n - previous_force_device_n_));
+
+  previous_device_m_ = r.device_position_m;
+  previous_force_device_n_ = r.force_device_n;
+  previous_dfr_device_n_ = dfr_device;
+  has_previous_ = true;
+  previous_t_s_ = t_s;
+  ++ticks_;
+
+  OperatorRecord rec;
+  rec.t_s = t_s;
+  rec.tool_m = r.tool.position_m;
+  rec.device_m = r.device_position_m;
+  rec.force_world_n = r.force_world_n;
+  rec.force_device_n = r.force_device_n;
+  rec.remote_force_world_n = remote_force_;
+  rec.contact_length_m = r.contact_length_m;
+  rec.scale_applied = correction_->applied();
+  rec.scale_target = correction_->target();
+  rec.updating = updating;
+  rec.link_silent = silent;
+  rec.passivity_j = window_j_;
+  rec.passivity_dfr_j = window_dfr_j_;
+  rec.compute_s = seconds_since(start);
+  records_.push_back(rec);
+}
+
+}  // namespace terracut::session

@@ -1,0 +1,427 @@
+// Model-mediated teleoperation in one process: determinism, convergence of
+// the local model to the remote's terrain and soil, the bound on force steps
+// at updates, bad packets on both stations, and a link gone silent.
+#include "terracut/session/mmt.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "terracut/core/error.hpp"
+#include "terracut/core/wire.hpp"
+#include "terracut/session/scenario.hpp"
+#include "terracut/session/world.hpp"
+#include "../support/scenario_text.hpp"
+
+namespace terracut::session {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kTrench = fs::path(TERRACUT_SOURCE_DIR) / "scenarios" / "mmt_trench_clay.yaml";
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The trench scenario, with the remote's world written next to it from the
+// same text after the edit (a different plane height, another soil).
+Scenario trench_with_remote(const std::string& name, double remote_height_m,
+                            const std::string& remote_soil) {
+  const fs::path dir = fs::temp_directory_path() / ("terracut_mmt_" + name);
+  fs::create_directories(dir);
+  std::string remote = read_text(kTrench);
+  std::ostringstream h;
+  h << "height_m: " << remote_height_m;
+  remote = test::replace(remote, "height_m: 0.3", h.str());
+  remote = test::replace(remote, "soil: dry_sand", "soil: " + remote_soil);
+  std::ofstream(dir / "remote.yaml") << remote;
+  Scenario sc = load_scenario(kTrench);
+  sc.mmt->remote_scenario = dir / "remote.yaml";
+  sc.mmt->remote_soil.reset();
+  return sc;
+}
+
+TEST(Mmt, SameSeedSameRunOtherSeedOtherLink) {
+  Scenario sc = load_scenario(kTrench);
+  // Bursty loss and held-back datagrams on top of the overrides' loss and jitter.
+  for (net::LinkConditions* c : {&sc.mmt->to_remote, &sc.mmt->to_operator}) {
+    c->burst.p_good_to_bad = 0.01;
+    c->burst.p_bad_to_good = 0.3;
+    c->reorder = 0.02;
+  }
+  MmtOverrides o;
+  o.rtt_s = 0.1;
+  o.loss = 0.05;
+  o.jitter_s = 0.003;
+  o.seed = 7;
+  MmtRun a(sc, o), b(sc, o);
+  a.run();
+  b.run();
+  const auto& ra = a.operator_station().records();
+  const auto& rb = b.operator_station().records();
+  ASSERT_EQ(ra.size(), rb.size());
+  for (std::size_t i = 0; i < ra.size(); ++i) {
+    ASSERT_EQ(ra[i].force_world_n.z, rb[i].force_world_n.z) << i;
+    ASSERT_EQ(ra[i].remote_force_world_n.z, rb[i].remote_force_world_n.z) << i;
+  }
+  const auto& qa = a.remote_station().records();
+  const auto& qb = b.remote_station().records();
+  for (std::size_t i = 0; i < qa.size(); ++i) ASSERT_EQ(qa[i].tool_m.z, qb[i].tool_m.z) << i;
+  EXPECT_EQ(a.summary().force_error_rms_mmt_n, b.summary().force_error_rms_mmt_n);
+  // Jitter of 3 ms over 1 ms spacing reorders; loss loses.
+  EXPECT_GT(a.operator_station().counters().rejected[net::Reject::kReordered], 0);
+  EXPECT_GT(a.link().b().emulator().counters().lost, 0);
+  EXPECT_GT(a.link().a().emulator().counters().held_back, 0);
+  EXPECT_GT(a.link().b().emulator().counters().retransmits, 0);  // patches lost and resent
+  // Every patch arrived, but the last few still on their way (resent) at the end.
+  EXPECT_LE(a.summary().patches - a.operator_station().counters().patches, 3);
+  EXPECT_EQ(a.operator_station().counters().rejected.total(),
+            a.operator_station().counters().rejected[net::Reject::kReordered]);
+  o.seed = 8;
+  MmtRun c(sc, o);
+  c.run();
+  EXPECT_NE(c.link().b().emulator().counters().lost, a.link().b().emulator().counters().lost);
+}
+
+TEST(Mmt, LocalModelConvergesToTheRemoteTerrainAndSoil) {
+  // The remote's sand surface is 2 cm lower and its soil is clay.
+  const Scenario sc = trench_with_remote("converge", 0.28, "clay");
+  MmtRun run(sc);
+  run.run();
+  const MmtSummary s = run.summary();
+  // Before the updates landed the worked region differed by the 2 cm (and
+  // by the cuts made at different depths).
+  EXPECT_GT(s.terrain_rms_max_m, 0.01);
+  // After: equal to the remote's except where the local tool cut ahead of
+  // what the remote had reported (the lower of the two is kept there); the
+  // follower lags the command by less than a cell, so within a tenth of
+  // the mismatch.
+  EXPECT_LT(s.terrain_rms_final_m, 0.002);
+  // The soil factor: the remote's clay against the operator's sand model at
+  // the remote's cut (depth 0.28 - 0.22 = 6 cm, the 0.4 m blade).
+  EarthmovingParams sand, clay;
+  sand.soil = soil_preset(SoilPreset::kDrySand);
+  clay.soil = soil_preset(SoilPreset::kClay);
+  const double truth = earthmoving_force(clay, 0.4, 0.06).horizontal_n /
+                       earthmoving_force(sand, 0.4, 0.06).horizontal_n;
+  EXPECT_NEAR(s.force_scale_final, truth, 0.05 * truth);
+  // ... and the operator applies it.
+  EXPECT_NEAR(s.force_scale_applied, s.force_scale_final, 1e-9);
+  EXPECT_GT(s.estimate_samples, 500);
+}
+
+TEST(Mmt, ForceStepAtUpdatesStaysUnderTheBound) {
+  // Frequent large updates: patches every 10 ms of a terrain 3 cm off, a
+  // soil twice as resistant, a short blend.
+  Scenario sc = trench_with_remote("steps", 0.27, "clay");
+  sc.mmt->sense_period_s = 0.01;
+  sc.mmt->blend_s = 0.02;
+  sc.mmt->max_update_step_n = 0.005;
+  MmtRun run(sc);
+  run.run();
+  const MmtSummary s = run.summary();
+  EXPECT_GT(s.patches, 50);
+  EXPECT_GT(s.estimates, 100);
+  EXPECT_LE(s.max_update_step_n, 0.005 + 1e-12);
+  // The bound held and still the factor got where it was going.
+  EXPECT_NEAR(s.force_scale_applied, s.force_scale_final, 1e-9);
+  // Without the bound, the same updates step the force by more.
+  sc.mmt->max_update_step_n = 100.0;
+  MmtRun unbounded(sc);
+  unbounded.run();
+  EXPECT_GT(unbounded.summary().max_update_step_n, 10 * 0.005);
+}
+
+TEST(Mmt, DirectReflectionFailsWithDelayMmtHolds) {
+  const Scenario sc = load_scenario(kTrench);
+  MmtOverrides o;
+  o.rtt_s = 0.0;
+  MmtRun near(sc, o);
+  near.run();
+  o.rtt_s = 0.5;
+  MmtRun far(sc, o);
+  far.run();
+  const MmtSummary a = near.summary(), b = far.summary();
+  // Direct reflection renders a force a round trip old: its error grows
+  // with the delay; the local model's does not grow as much.
+  EXPECT_GT(b.force_error_rms_dfr_n, 1.5 * a.force_error_rms_dfr_n);
+  EXPECT_LT(b.force_error_rms_mmt_n, b.force_error_rms_dfr_n);
+}
+
+TEST(Mmt, DeadbandSavesUpdatePackets) {
+  Scenario sc = trench_with_remote("deadband", 0.28, "clay");
+  MmtRun every(sc);
+  every.run();
+  sc.mmt->deadband = 0.1;
+  MmtRun jnd(sc);
+  jnd.run();
+  EXPECT_LT(jnd.summary().update_packets_per_s, 0.8 * every.summary().update_packets_per_s);
+  EXPECT_GT(jnd.summary().patches, 0);
+}
+
+// Stations driven by hand over one in-memory link.
+struct Pair {
+  explicit Pair(const Scenario& sc)
+      : settings(*sc.mmt),
+        remote_sc(load_remote_scenario(sc)),
+        device(make_operator_device(sc)),
+        link(settings.to_remote, settings.to_operator),
+        op(sc, settings, *device, link.a(), 1u),
+        remote(remote_sc, settings, op.rig().loop().force_model(), op.simulation().grid(),
+               link.b(), 2u) {}
+  MmtSettings settings;
+  Scenario remote_sc;
+  std::unique_ptr<haptics::Device> device;
+  net::MemoryLink link;
+  OperatorStation op;
+  RemoteStation remote;
+};
+
+TEST(Mmt, BadPacketsOnBothStationsAreCountedNeverFatal) {
+  Scenario sc = load_scenario(kTrench);
+  sc.mmt->to_remote.delay_s = sc.mmt->to_operator.delay_s = 0.0;
+  sc.mmt->to_remote.jitter_s = sc.mmt->to_operator.jitter_s = 0.0;
+  Pair p(sc);
+  const std::uint32_t link = sc.mmt->link_id;
+  auto inject = [](net::Endpoint& from, const std::vector<std::uint8_t>& d) {
+    from.send(net::Channel::kUnreliable, d.data(), d.size(), 0.0);
+  };
+  // A valid command, replayed, an older one, a foreign one, a truncated
+  // one, a corrupted one and a measurement sent the wrong way.
+  net::Command c;
+  c.pose.position_m = {0, 0.35, 0.75};
+  std::vector<std::uint8_t> d(net::kHeaderSize + net::kCommandPayloadSize + net::kCrcSize);
+  auto command = [&](std::uint32_t session, std::uint32_t seq, std::uint32_t link_id) {
+    net::encode_command({net::MessageType::kCommand, link_id, session, seq, 1000u * seq}, c, d.data());
+    return d;
+  };
+  inject(p.link.a(), command(99, 10, link));
+  inject(p.link.a(), command(99, 10, link));  // replayed
+  inject(p.link.a(), command(99, 9, link));   // older
+  inject(p.link.a(), command(99, 11, link + 1));  // foreign
+  auto cut = command(99, 12, link);
+  cut.resize(20);
+  inject(p.link.a(), cut);
+  auto flipped = command(99, 13, link);
+  flipped[50] ^= 0x40;
+  inject(p.link.a(), flipped);
+  std::vector<std::uint8_t> m(net::kHeaderSize + net::kMeasurementPayloadSize + net::kCrcSize);
+  net::encode_measurement({net::MessageType::kMeasurement, link, 99, 1, 0}, net::Measurement{}, m.data());
+  inject(p.link.a(), m);
+  inject(p.link.a(), std::vector<std::uint8_t>{1, 2, 3});
+  p.remote.tick(0.0);
+  const net::RejectCounts& rr = p.remote.counters().rejected;
+  EXPECT_EQ(p.remote.counters().accepted, 1);
+  EXPECT_EQ(rr[net::Reject::kDuplicate], 1);
+  EXPECT_EQ(rr[net::Reject::kReordered], 1);
+  EXPECT_EQ(rr[net::Reject::kForeign], 1);
+  EXPECT_EQ(rr[net::Reject::kTruncated], 2);
+  EXPECT_EQ(rr[net::Reject::kBadChecksum], 1);
+  EXPECT_EQ(rr[net::Reject::kBadType], 1);
+
+  // The operator: a command (the wrong way), a patch outside the grid, a
+  // patch that is not zstd, a non-finite estimate, a stale measurement.
+  inject(p.link.b(), command(5, 1, link));
+  net::Patch patch;
+  patch.rect = {95, 95, 105, 100};  // the grid has 100 x 100 samples
+  patch.heights.assign(50, 0.3f);
+  std::vector<std::uint8_t> pd;
+  net::encode_patch({net::MessageType::kPatch, link, 5, 1, 0}, patch, pd);
+  inject(p.link.b(), pd);
+  patch.rect = {0, 0, 10, 5};
+  net::encode_patch({net::MessageType::kPatch, link, 5, 2, 0}, patch, pd);
+  for (std::size_t i = net::kHeaderSize + net::kPatchFixedSize; i + net::kCrcSize < pd.size(); ++i)
+    pd[i] = 0x5A;
+  wire::put_u32(pd.data() + pd.size() - 4, wire::crc32(pd.data(), pd.size() - 4));
+  inject(p.link.b(), pd);
+  std::vector<std::uint8_t> e(net::kHeaderSize + net::kEstimatePayloadSize + net::kCrcSize);
+  net::Estimate bad;
+  bad.force_scale = std::nan("");
+  net::encode_estimate({net::MessageType::kEstimate, link, 5, 1, 0}, bad, e.data());
+  inject(p.link.b(), e);
+  net::encode_measurement({net::MessageType::kMeasurement, link, 5, 2, 5000}, net::Measurement{}, m.data());
+  inject(p.link.b(), m);
+  net::encode_measurement({net::MessageType::kMeasurement, link, 5, 3, 4000}, net::Measurement{}, m.data());
+  inject(p.link.b(), m);  // newer sequence, older time: stale
+  p.op.tick(0.0);
+  const net::RejectCounts& ro = p.op.counters().rejected;
+  EXPECT_EQ(ro[net::Reject::kBadType], 1);
+  EXPECT_EQ(ro[net::Reject::kBadPayload], 3);
+  EXPECT_EQ(ro[net::Reject::kStale], 1);
+  EXPECT_EQ(p.op.counters().patches, p.remote.counters().patches);  // only the real ones
+  // The stations go on working.
+  for (int i = 1; i < 100; ++i) {
+    p.op.tick(i * 0.001);
+    p.remote.tick(i * 0.001);
+  }
+  EXPECT_GT(p.op.counters().accepted, 50);
+}
+
+TEST(Mmt, SilentLinkStopsTheRemoteToolAndFadesTheOperatorsForce) {
+  Scenario sc = load_scenario(kTrench);
+  const double timeout = sc.mmt->timeout_s;
+  const double rate = sc.haptics.rate_hz;
+  // The operator goes quiet at 2.0 s, mid-trench (the tool moves at 1 m/s).
+  {
+    Pair p(sc);
+    int i = 0;
+    for (; i / rate < 2.0; ++i) {
+      p.op.tick(i / rate);
+      p.remote.tick(i / rate);
+    }
+    for (; i / rate < 2.6; ++i) p.remote.tick(i / rate);
+    const auto& r = p.remote.records();
+    // Commands stop arriving at 2.0 s + the 50 ms delay; the tool holds still
+    // once the timeout has passed, within one follower step.
+    const double hold_from = 2.0 + sc.mmt->to_remote.delay_s + sc.mmt->to_remote.jitter_s + timeout + 0.002;
+    const std::size_t k = std::size_t(std::ceil(hold_from * rate));
+    ASSERT_LT(k, r.size());
+    EXPECT_TRUE(r[k].holding);
+    const double step = sc.mmt->follower_speed_m_per_s / rate;
+    EXPECT_LE(length(r.back().tool_m - r[k].tool_m), step + 1e-12);
+    // Before the silence it was moving.
+    EXPECT_GT(length(r[std::size_t(1.9 * rate)].tool_m - r[std::size_t(1.8 * rate)].tool_m), 0.05);
+  }
+  // The remote goes quiet at 2.0 s: the operator's force fades to zero.
+  {
+    Pair p(sc);
+    int i = 0;
+    for (; i / rate < 2.0; ++i) {
+      p.op.tick(i / rate);
+      p.remote.tick(i / rate);
+    }
+    const double before = length(p.op.records().back().force_device_n);
+    EXPECT_GT(before, 0.5);
+    for (; i / rate < 2.6; ++i) p.op.tick(i / rate);
+    const auto& r = p.op.records();
+    const double safety = sc.haptics.safety.watchdog_timeout_s + sc.haptics.safety.watchdog_ramp_s;
+    const double faded_by = 2.0 + sc.mmt->to_operator.delay_s + sc.mmt->to_operator.jitter_s + timeout + safety + 0.002;
+    const std::size_t k = std::size_t(std::ceil(faded_by * rate));
+    ASSERT_LT(k, r.size());
+    EXPECT_TRUE(r[k].link_silent);
+    for (std::size_t j = k; j < r.size(); ++j) EXPECT_EQ(length(r[j].force_device_n), 0.0) << j;
+  }
+}
+
+// Runs the trench to mid-cut (edge at z = 0.3, 8 cm deep, moving along -Z),
+// then sends the operator a patch 5 cm below the sand over the whole region
+// around the tool, and reads two samples 50 ms and 150 ms later: one ahead
+// of the edge, within 0.15 m of it all that time and not yet cut (x = 0.01,
+// z = 0.19), one far from the tool (x = 0.51, z = 0.41).
+struct PatchUnderTool {
+  float ahead_50ms, far_50ms, far_150ms;
+};
+PatchUnderTool patch_under_tool(double exclusion_m) {
+  Scenario sc = load_scenario(kTrench);
+  sc.mmt->to_remote.delay_s = sc.mmt->to_operator.delay_s = 0.0;
+  sc.mmt->to_remote.jitter_s = sc.mmt->to_operator.jitter_s = 0.0;
+  sc.mmt->exclusion_m = exclusion_m;
+  const double rate = sc.haptics.rate_hz;
+  Pair p(sc);
+  int i = 0;
+  for (; i / rate < 1.8; ++i) {
+    p.op.tick(i / rate);
+    p.remote.tick(i / rate);
+  }
+  EXPECT_GT(p.op.rig().loop().last().contact_length_m, 0.3);
+  net::Patch patch;
+  patch.rect = {20, 40, 80, 90};  // x in [-0.6, 0.6], z in [-0.2, 0.8]
+  patch.heights.assign(std::size_t(patch.rect.area()), 0.25f);
+  std::vector<std::uint8_t> d;
+  net::encode_patch({net::MessageType::kPatch, sc.mmt->link_id, 77, 0, 0}, patch, d);
+  const double t0 = i / rate;
+  p.link.b().send(net::Channel::kReliable, d.data(), d.size(), t0);
+  const HeightGrid& g = p.op.simulation().grid();
+  EXPECT_NEAR(g.sample_z(59), 0.19, 1e-9);
+  EXPECT_NEAR(g.sample_x(75), 0.51, 1e-9);
+  PatchUnderTool out{};
+  for (; i / rate <= t0 + 0.05 + 1e-9; ++i) p.op.tick(i / rate);  // the remote is quiet now
+  out.ahead_50ms = g.height(50, 59);
+  out.far_50ms = g.height(75, 70);
+  for (; i / rate <= t0 + 0.15 + 1e-9; ++i) p.op.tick(i / rate);
+  out.far_150ms = g.height(75, 70);
+  return out;
+}
+
+TEST(Mmt, PatchesLeaveTheSoilUnderTheToolAloneWhileItCuts) {
+  const double blend_s = load_scenario(kTrench).mmt->blend_s;  // 0.1
+  const PatchUnderTool with = patch_under_tool(0.15);
+  EXPECT_EQ(with.ahead_50ms, 0.3f);  // untouched while the tool feels it
+  // Away from the tool the blend runs: half-way at 50 ms (one tick of
+  // ramp either way), done at 150 ms.
+  const double tick = 0.05 / (blend_s * 1000.0);
+  EXPECT_NEAR(with.far_50ms, 0.3 - 0.05 * (0.05 / blend_s), tick + 1e-6);
+  EXPECT_FLOAT_EQ(with.far_150ms, 0.25f);
+  // Without the exclusion the same patch lowers the soil ahead of the edge.
+  const PatchUnderTool without = patch_under_tool(0.0);
+  EXPECT_LT(without.ahead_50ms, 0.3f - 0.01f);
+}
+
+TEST(Mmt, ARestartedOperatorIsANewSession) {
+  Scenario sc = load_scenario(kTrench);
+  sc.mmt->to_remote.delay_s = sc.mmt->to_operator.delay_s = 0.0;
+  sc.mmt->to_remote.jitter_s = sc.mmt->to_operator.jitter_s = 0.0;
+  Pair p(sc);
+  const std::uint32_t link = sc.mmt->link_id;
+  std::vector<std::uint8_t> d(net::kHeaderSize + net::kCommandPayloadSize + net::kCrcSize);
+  auto send = [&](std::uint32_t session, std::uint32_t seq, Vec3 at, double t) {
+    net::Command c;
+    c.pose.position_m = at;
+    net::encode_command({net::MessageType::kCommand, link, session, seq, std::uint64_t(t * 1e9)},
+                        c, d.data());
+    p.link.a().send(net::Channel::kUnreliable, d.data(), d.size(), t);
+    p.remote.tick(t);
+  };
+  // An operator at sequence 500, then one restarted from sequence 0 elsewhere.
+  send(1, 500, {0, 0.35, 0.75}, 0.0);
+  send(1, 501, {0, 0.35, 0.75}, 0.001);
+  send(2, 0, {0.3, 0.35, 0.5}, 0.002);
+  send(2, 1, {0.3, 0.35, 0.5}, 0.003);
+  EXPECT_EQ(p.remote.counters().accepted, 4);
+  EXPECT_EQ(p.remote.counters().sessions, 2);
+  EXPECT_EQ(p.remote.counters().rejected.total(), 0);
+  // The new session's packets are ordered among themselves.
+  send(2, 0, {0.3, 0.35, 0.5}, 0.004);
+  EXPECT_EQ(p.remote.counters().rejected[net::Reject::kReordered], 1);
+}
+
+TEST(Mmt, BadSettingsNameTheField) {
+  const std::string text = read_text(kTrench);
+  auto fails = [&](const std::string& from, const std::string& to, const std::string& want) {
+    try {
+      parse_scenario(test::replace(text, from, to), kTrench);
+      ADD_FAILURE() << "accepted: " << to;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+    }
+  };
+  fails("loss: 0.0", "loss: 1.5", "mmt.link.loss: must be in [0, 1)");
+  fails("blend_s: 0.1", "blend_s: -1", "mmt.operator.blend_s");
+  fails("sense_period_s: 0.05", "sense_periods: 0.05", "sense_periods");
+  fails("soil: clay", "soil: mud", "unknown");
+  // A remote whose grid is not the operator's.
+  const fs::path dir = fs::temp_directory_path() / "terracut_mmt_grid";
+  fs::create_directories(dir);
+  std::ofstream(dir / "remote.yaml") << test::replace(text, "resolution: 100", "resolution: 50");
+  Scenario sc = load_scenario(kTrench);
+  sc.mmt->remote_scenario = dir / "remote.yaml";
+  try {
+    MmtRun run(sc);
+    ADD_FAILURE() << "accepted a remote grid of another size";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("mmt.remote.scenario"), std::string::npos) << e.what();
+  }
+  MmtOverrides o;
+  o.loss = 1.0;
+  EXPECT_THROW(MmtRun(load_scenario(kTrench), o), InputError);
+}
+
+}  // namespace
+}  // namespace terracut::session
