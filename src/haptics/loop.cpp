@@ -89,6 +89,7 @@ void HapticLoop::step1(double t_s) noexcept {
   stepped_ = has_sample_ && !bad;
   if (!stepped_) {
     velocity_m_per_s_ = {};
+    yaw_rate_rad_per_s_ = 0.0;
     has_previous_tool_ = false;  // start the estimate afresh
     return;
   }
@@ -155,6 +156,20 @@ void HapticLoop::estimate_velocity(const BladePose& pose, double t_s) noexcept {
   } else {
     velocity_m_per_s_ = {};
   }
+  // The yaw rate: the turn of the edge's horizontal direction about +Y
+  // (Ry(a) X = (cos a, 0, -sin a)), filtered as the velocity is.
+  const Vec3 edge_dir = rotate(pose.orientation, Vec3{1.0, 0.0, 0.0});
+  const bool level = std::hypot(edge_dir.x, edge_dir.z) > 1e-6;
+  const double yaw = level ? std::atan2(-edge_dir.z, edge_dir.x) : previous_yaw_rad_;
+  if (has_previous_tool_ && t_s > previous_tool_t_s_) {
+    const double dt = t_s - previous_tool_t_s_;
+    const double turn = std::remainder(yaw - previous_yaw_rad_, 2.0 * std::numbers::pi);
+    const double alpha = filter_rc_s_ > 0.0 ? 1.0 - std::exp(-dt / filter_rc_s_) : 1.0;
+    yaw_rate_rad_per_s_ += (turn / dt - yaw_rate_rad_per_s_) * alpha;
+  } else {
+    yaw_rate_rad_per_s_ = 0.0;
+  }
+  previous_yaw_rad_ = yaw;
   previous_tool_m_ = pose.position_m;
   previous_tool_t_s_ = t_s;
   has_previous_tool_ = true;
@@ -205,6 +220,24 @@ ForceOutput HapticLoop::world_force(const StepOutput& out, const CutLoad& load) 
                        ? sim_.grid().spec().origin_m.y
                        : surface_y_m(sim_.grid(), sim_.params().representation,
                                      out.pose.position_m.x, out.pose.position_m.z);
+  // What penetration and twist read: how deep the edge sits in the soil
+  // beside it, and which parts of it a turn drives into soil.
+  const ForceModelParams& fp = params_.force_model().params();
+  in.blade_length_m = fp.max_contact_length_m;
+  if (fp.cutting != CuttingModel::kNone) {
+    if (fp.penetration.enabled) {
+      const Embedment emb =
+          embedment(sim_.grid(), sim_.params().representation, out.edge, lookahead_m_);
+      in.embedment_depth_m = emb.depth_m;
+      in.embedded_length_m = emb.length_m;
+    }
+    if (fp.twist_enabled && yaw_rate_rad_per_s_ != 0.0) {
+      in.yaw_rate_rad_per_s = yaw_rate_rad_per_s_;
+      in.twist = twist_engagement(sim_.grid(), sim_.params().representation, out.edge,
+                                  out.pose.position_m, yaw_rate_rad_per_s_, lookahead_m_,
+                                  in.twist_depth_m);
+    }
+  }
   ForceOutput force = params_.force_model().compute(in);
   if (!sim_.listeners().empty()) {
     force.world_n = force.world_n + out.listener_force_world_n;
@@ -229,6 +262,9 @@ LoopRecord& HapticLoop::write_record(const StepOutput& out, const ForceOutput& f
   r.velocity_m_per_s = velocity_m_per_s_;
   r.force_world_n = force.world_n;
   r.body_force_world_n = body_force;
+  r.penetration_force_n = force.penetration_n.y;
+  r.twist_torque_n_m = force.twist_torque_n_m;
+  r.yaw_rate_rad_per_s = yaw_rate_rad_per_s_;
   r.force_device_n = command.force_n;
   r.flags = command.flags;
   r.period_s = period_s;
@@ -257,6 +293,9 @@ void HapticLoop::publish_frame(const StepOutput& out, const ForceOutput& force,
   f.force_world_n = force.world_n;
   f.force_device_n = command.force_n;
   f.body_force_world_n = last_.body_force_world_n;
+  f.penetration_force_n = force.penetration_n.y;
+  f.twist_torque_n_m = force.twist_torque_n_m;
+  f.yaw_rate_rad_per_s = yaw_rate_rad_per_s_;
   f.step_time_s = compute_s;
   f.period_s = period_s;
   fill_bodies(f, options_.bodies);

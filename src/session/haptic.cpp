@@ -100,24 +100,7 @@ HapticRig::~HapticRig() {
 }
 
 std::vector<std::string> HapticRig::rendering_changes() const {
-  std::vector<std::string> out;
-  const RenderingCheck& rc = loop_->force_model().rendering();
-  const ForceModelParams& used = loop_->force_model().params();
-  if (rc.surface_stiffness_limited)
-    out.push_back("forces.surface.stiffness_n_per_m lowered to " +
-                  format_number(used.surface.stiffness_n_per_m) + " N/m (world; " +
-                  format_number(rc.surface_stiffness_n_per_m) +
-                  " N/m on the device) to stay passive and within the device");
-  if (rc.surface_damping_limited)
-    out.push_back("forces.surface.damping_n_s_per_m lowered to " +
-                  format_number(used.surface.damping_n_s_per_m) + " N s/m (world; " +
-                  format_number(rc.surface_damping_n_s_per_m) + " N s/m on the device)");
-  if (rc.cutting_damping_limited)
-    out.push_back("forces.low_speed_damping_n_s_per_m lowered to " +
-                  format_number(used.low_speed_damping_n_s_per_m) +
-                  " N s/m (world; cutting damping " +
-                  format_number(rc.cutting_damping_n_s_per_m) + " N s/m on the device, its limit)");
-  return out;
+  return loop_->force_model().limit_changes();
 }
 
 HapticSession::HapticSession(const Scenario& input, const SessionOptions& options)
@@ -359,7 +342,17 @@ std::string HapticSession::summary_json() const {
     << ", \"surface_stiffness_limited\": " << (rc.surface_stiffness_limited ? "true" : "false")
     << ", \"surface_damping_limited\": " << (rc.surface_damping_limited ? "true" : "false")
     << ", \"cutting_damping_limited\": " << (rc.cutting_damping_limited ? "true" : "false")
-    << "},\n";
+    << ", \"requested_surface_stiffness_n_per_m\": "
+    << json_number(rc.requested_surface_stiffness_n_per_m)
+    << ", \"requested_surface_damping_n_s_per_m\": "
+    << json_number(rc.requested_surface_damping_n_s_per_m)
+    << ", \"requested_cutting_damping_n_s_per_m\": "
+    << json_number(rc.requested_cutting_damping_n_s_per_m)
+    << ", \"cutting_gain\": " << json_number(rc.cutting_gain) << ", \"changes\": [";
+  const std::vector<std::string> changes = l.force_model().limit_changes();
+  for (std::size_t i = 0; i < changes.size(); ++i)
+    j << (i ? ", " : "") << json_string(changes[i]);
+  j << "]},\n";
   j << "    \"safety_limits\": {\"max_force_n\": " << json_number(st.safety.max_force_n)
     << ", \"max_force_rate_n_per_s\": " << json_number(st.safety.max_force_rate_n_per_s)
     << ", \"rise_time_s\": " << json_number(st.safety.rise_time_s)

@@ -79,6 +79,12 @@ struct LoopRecord {
   /// the blade's plate: StepOutput::listener_force_world_n), world N; zero
   /// without listeners.
   Vec3 body_force_world_n{};
+  /// The penetration model's part of force_world_n (vertical, +Y up), world N.
+  double penetration_force_n = 0.0;
+  /// Twist torque on the tool about world +Y, N m (not in any force: a 3-DOF
+  /// device cannot render it).
+  double twist_torque_n_m = 0.0;
+  double yaw_rate_rad_per_s = 0.0;  ///< estimated tool yaw rate about world +Y, rad/s
   Vec3 force_device_n{};           ///< force sent, device frame, device N (after safety)
   std::uint32_t flags = 0;         ///< kFlag* bits
   double period_s = 0.0;           ///< time since the previous tick's start, seconds
@@ -197,6 +203,8 @@ class HapticLoop {
   const Workspace& workspace() const { return workspace_; }
   const LoopCounters& counters() const { return counters_; }
   const LoopRecord& last() const { return last_; }
+  /// The tool's estimated yaw rate about world +Y, rad/s (filtered as the velocity).
+  double yaw_rate_rad_per_s() const { return yaw_rate_rad_per_s_; }
   /// The kept records, oldest first.
   std::vector<LoopRecord> records() const;
   /// Percentiles over the kept records: the period's deviation from the
@@ -264,6 +272,8 @@ class HapticLoop {
   double previous_tool_t_s_ = 0.0;
   bool has_previous_tool_ = false;
   Vec3 velocity_m_per_s_{};
+  double previous_yaw_rad_ = 0.0;    // the edge's heading at the previous good sample
+  double yaw_rate_rad_per_s_ = 0.0;  // filtered, about world +Y
   double t_s_ = 0.0;
   std::uint32_t tick_flags_ = 0;
   Vec3 device_position_m_{};
