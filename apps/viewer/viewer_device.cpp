@@ -183,6 +183,7 @@ void LoopTiming::clear() {
   ticks_.store(0, std::memory_order_relaxed);
   period_max_ns_.store(0, std::memory_order_relaxed);
   compute_max_ns_.store(0, std::memory_order_relaxed);
+  worst_jitter_ns_.store(0, std::memory_order_relaxed);
 }
 
 double LoopTiming::take_worst_jitter_s() {
@@ -213,6 +214,11 @@ void ViewerDevice::set_speed(double speed) {
   speed_.store(std::clamp(speed, 0.0, 16.0));
 }
 
+void ViewerDevice::request_step_s(double step_s) {
+  if (!(step_s > 0.0) || !std::isfinite(step_s)) return;
+  step_budget_s_.fetch_add(step_s, std::memory_order_relaxed);
+}
+
 void ViewerDevice::set_lag_s(double lag_s) {
   if (!std::isfinite(lag_s)) lag_s = kVirtualDeviceLag_s;
   lag_s_.store(std::clamp(lag_s, kVirtualDeviceLag_s, 1.0), std::memory_order_relaxed);
@@ -237,6 +243,18 @@ bool ViewerDevice::read(double t_s, haptics::DeviceSample& out) noexcept {
   // How far the device's own clock moves this tick.
   double advance = playing_.load(std::memory_order_relaxed) ? speed_.load(std::memory_order_relaxed) * dt : 0.0;
   advance += double(step_requests_.exchange(0, std::memory_order_relaxed)) * dt_s_;
+  if (advance == 0.0) {
+    // A timed step while paused: at the device's speed, until its budget is played.
+    const double budget = step_budget_s_.load(std::memory_order_relaxed);
+    if (budget > 0.0) {
+      const double rate = speed_.load(std::memory_order_relaxed);
+      const double a = std::min(budget, (rate > 0.0 ? rate : 1.0) * dt);
+      step_budget_s_.fetch_sub(a, std::memory_order_relaxed);
+      advance = a;
+    }
+  }
+  clock_s_ += advance;
+  clock_published_.store(clock_s_, std::memory_order_relaxed);
 
   const ToolSource wanted = ToolSource(source_.load(std::memory_order_relaxed));
   if (wanted != active_) {

@@ -10,9 +10,10 @@
 //    (mouse and keyboard) with a first-order lag of kVirtualDeviceLag_s, so
 //    60 Hz input becomes a smooth 1 kHz motion.
 //
-// Play/pause, single steps and speed act on the device's own clock: paused,
-// the handle holds still (the loop keeps ticking at its rate, as a haptic
-// loop must; a still blade cuts nothing and feels no drag). Speed scales the
+// Play/pause, steps and speed act on the device's own clock: paused, the
+// handle holds still (the loop keeps ticking at its rate, as a haptic loop
+// must; a still blade cuts nothing and feels no drag); a step plays a stated
+// time (request_step_s) and holds again. Speed scales the
 // script's time and the lag. The device also timestamps each read and write
 // with the wall clock, so the viewer sees the loop's period and compute time
 // live (LoopStats) without touching the loop's own records.
@@ -129,6 +130,15 @@ class ViewerDevice final : public haptics::Device {
   void set_speed(double speed);
   double speed() const { return speed_.load(); }
   void request_steps(int n) { step_requests_.fetch_add(n); }
+  /// While paused: play step_s more seconds of device time at the device's
+  /// speed (as if playing, over as many ticks), then hold still again. A
+  /// Step that is seen, unlike one loop period.
+  void request_step_s(double step_s);
+  /// True while a requested step is still being played.
+  bool stepping() const { return step_budget_s_.load(std::memory_order_relaxed) > 0.0; }
+  /// The device's own clock, seconds: the device time played so far (by
+  /// either source); it stands still while paused.
+  double clock_s() const { return clock_published_.load(std::memory_order_relaxed); }
   void set_source(ToolSource source) { source_.store(int(source)); }
   ToolSource source() const { return ToolSource(source_.load()); }
   void set_target(const BladePose& pose) { target_.write(pose); }
@@ -172,6 +182,9 @@ class ViewerDevice final : public haptics::Device {
   std::atomic<double> speed_{1.0};
   std::atomic<double> lag_s_{kVirtualDeviceLag_s};
   std::atomic<int> step_requests_{0};
+  std::atomic<double> step_budget_s_{0.0};
+  std::atomic<double> clock_published_{0.0};
+  double clock_s_ = 0.0;  // loop thread
   std::atomic<int> source_{0};
   std::atomic<double> script_time_published_{0.0};
   std::atomic<bool> script_finished_{false};
