@@ -389,8 +389,9 @@ bool ViewerApp::window_frame(GLFWwindow* window, double dt_s) {
     reset_session();
     if (options_.loop_script) driver_->device().set_playing(true);
   }
-  // Slow drawing posts sparse targets: let the tool glide between them.
-  driver_->device().set_lag_s(1.5 * std::min(dt_s, 0.1));
+  // Targets come once a frame: the device ramps to each over one frame
+  // interval, so the tool moves at a steady speed between them.
+  driver_->device().set_frame_interval_s(dt_s);
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   handle_window_input(window, dt_s);
