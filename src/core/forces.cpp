@@ -603,7 +603,7 @@ ForceOutput ForceModel::compute(const ForceInput& input) const noexcept {
                                          params_.low_speed_damping_n_s_per_m);
       break;
     case CuttingModel::kEarthmoving: {
-      double width = input.contact_length_m;
+      double width = input.cut_width_m >= 0.0 ? input.cut_width_m : input.contact_length_m;
       // Engaged width across the horizontal motion: L |e x u|.
       double edge_len = length(input.edge_direction);
       double speed_xz = std::hypot(v.x, v.z);

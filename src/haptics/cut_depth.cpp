@@ -13,10 +13,15 @@ double depth_lookahead_m(const GridSpec& spec) {
 
 double depth_ahead_m(const HeightGrid& grid, Representation representation, const Segment& edge,
                      Vec3 velocity_m_per_s, double lookahead_m) noexcept {
+  return cut_ahead(grid, representation, edge, velocity_m_per_s, lookahead_m).depth_m;
+}
+
+CutAhead cut_ahead(const HeightGrid& grid, Representation representation, const Segment& edge,
+                   Vec3 velocity_m_per_s, double lookahead_m) noexcept {
   const double speed_xz = std::hypot(velocity_m_per_s.x, velocity_m_per_s.z);
   if (!(speed_xz > 0.0) || !std::isfinite(speed_xz) || !is_finite(edge.a) || !is_finite(edge.b) ||
       !std::isfinite(lookahead_m))
-    return 0.0;
+    return {};
   const Vec3 ahead = Vec3{velocity_m_per_s.x, 0.0, velocity_m_per_s.z} * (lookahead_m / speed_xz);
   const GridSpec& spec = grid.spec();
   const double cell = std::min(spec.cell_x_m(), spec.cell_z_m());
@@ -32,7 +37,8 @@ double depth_ahead_m(const HeightGrid& grid, Representation representation, cons
       ++engaged;
     }
   }
-  return engaged > 0 ? sum / engaged : 0.0;
+  if (engaged == 0) return {};
+  return {sum / engaged, length(edge.b - edge.a) * engaged / n};
 }
 
 SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, const Segment& edge,
@@ -73,6 +79,7 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
   if (engaged > 0) {
     out.depth_m = depth_sum / engaged;
     out.pile_m = pile_sum / engaged;
+    out.width_m = length(edge.b - edge.a) * engaged / n;
   }
   return out;
 }

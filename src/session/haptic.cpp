@@ -176,6 +176,7 @@ HapticSession::HapticSession(const Scenario& input, const SessionOptions& option
   ro.loop.record_capacity = std::min<std::size_t>(options.max_records, std::size_t(ro.loop.ticks));
   ro.loop.realtime = options.realtime;
   ro.loop.snapshot = options.snapshot;
+  if (options.end_with_device) ro.loop.end_after_silence_s = kDeviceEndSilence_s;
   ro.bodies_csv = options.bodies_csv;
   try {
     rig_ = std::make_unique<HapticRig>(input, *params, default_orientation, *device_, ro);
@@ -240,10 +241,13 @@ std::vector<std::string> HapticSession::warnings() const {
   if (c.missed_deadlines > 0)
     w.push_back(std::to_string(c.missed_deadlines) +
                 " ticks started late: the tick before ran past their deadline (see timing_us)");
-  if (s.watchdog_trips > 0)
-    w.push_back("the watchdog ramped the force to zero " + std::to_string(s.watchdog_trips) +
-                " times (no device sample for more than safety.watchdog_timeout_s, counting the "
-                "wait for the first sample)");
+  // The waits before the device's first sample and after its last are
+  // expected (the safety limiter holds zero force then); a silence in between
+  // is not.
+  if (const std::int64_t trips = l.watchdog_trips_while_active(); trips > 0)
+    w.push_back("the watchdog ramped the force to zero " + std::to_string(trips) +
+                " times while the device was sending (no sample for more than "
+                "safety.watchdog_timeout_s)");
   if (c.records_dropped > 0)
     w.push_back(std::to_string(c.records_dropped) +
                 " oldest records were not kept (the session was longer than max_records)");
@@ -286,6 +290,7 @@ std::string HapticSession::summary_json() const {
   j << "  \"rate_hz\": " << json_number(st.rate_hz) << ",\n";
   j << "  \"duration_s\": " << json_number(duration_s_) << ",\n";
   j << "  \"ticks\": " << c.ticks << ",\n";
+  j << "  \"ended_with_device\": " << (l.ended_with_device() ? "true" : "false") << ",\n";
   j << "  \"wall_s\": " << json_number(wall_s_) << ",\n";
   j << "  \"realtime\": {\"fifo\": " << (l.realtime_status().fifo ? "true" : "false")
     << ", \"priority\": " << l.realtime_status().priority
@@ -308,6 +313,7 @@ std::string HapticSession::summary_json() const {
   j << "  \"safety\": {\"samples\": " << s.samples << ", \"clamped\": " << s.clamped
     << ", \"rate_limited\": " << s.rate_limited << ", \"ramping\": " << s.ramping
     << ", \"watchdog\": " << s.watchdog << ", \"watchdog_trips\": " << s.watchdog_trips
+    << ", \"watchdog_trips_while_active\": " << l.watchdog_trips_while_active()
     << ", \"nonfinite\": " << s.nonfinite << ", \"restarts\": " << s.restarts << "},\n";
 
   // Rejected bridge packets by reason (all zero for script and sim).

@@ -182,6 +182,36 @@ TEST(HapticLoop, TurningTheBuriedBladeMeetsATorque) {
   EXPECT_GT(negative, 800);
 }
 
+TEST(HapticLoop, EndsWhenTheDeviceFallsSilentAndCountsOnlyTheSilencesBetween) {
+  // The device is silent for its first 200 ticks (a bridge not yet sending),
+  // sends, falls silent for 120 ticks in the middle, sends again, and stops
+  // for good at tick 1500.
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice script(trench_path(s));
+  test::FaultyDevice device(script, nullptr, [](std::int64_t tick) {
+    return tick < 200 || (tick >= 800 && tick < 920) || tick >= 1500;
+  });
+  const io::Scenario& sc = trench().scenario;
+  LoopOptions o = test::test_loop_options(5000);
+  o.end_after_silence_s = 0.3;
+  auto loop = test::make_loop_rig(s, sc, sc.cuts[0].keyframes[0].pose.orientation, device, o);
+  loop->run_deterministic();
+  EXPECT_TRUE(loop->ended_with_device());
+  // The last sample at tick 1499, then 0.3 s of silence: about 1800 ticks.
+  EXPECT_NEAR(double(loop->counters().ticks), 1500.0 + 300.0, 2.0);
+  // Three trips (the wait at start, the gap, the end); only the gap counts.
+  EXPECT_EQ(loop->safety().counters().watchdog_trips, 3);
+  EXPECT_EQ(loop->watchdog_trips_while_active(), 1);
+  // Without the option the loop runs its ticks.
+  ScriptDevice script2(trench_path(s));
+  test::FaultyDevice quiet(script2, nullptr, [](std::int64_t tick) { return tick >= 1500; });
+  auto full = trench_loop(s, quiet, 2500);
+  full->run_deterministic();
+  EXPECT_FALSE(full->ended_with_device());
+  EXPECT_EQ(full->counters().ticks, 2500);
+  EXPECT_EQ(full->watchdog_trips_while_active(), 0);
+}
+
 TEST(HapticLoop, DeterministicRunsAreIdentical) {
   for (DeviceKind kind : {DeviceKind::kScript, DeviceKind::kSim}) {
     std::vector<LoopRecord> runs[2];

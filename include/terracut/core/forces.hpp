@@ -448,6 +448,9 @@ struct ForceInput {
   /// the blade pushes: unit weight x the pile's height over the failure
   /// wedge), Pa, finite, >= 0; added to the soil's own surcharge_pa.
   double surcharge_pa = 0.0;
+  /// Earthmoving: the length of edge with soil ahead of it, m (>= 0), used
+  /// instead of contact_length_m when given; negative: not given.
+  double cut_width_m = -1.0;
   /// Direction of the cutting edge (any length; zero = unknown, no projection).
   Vec3 edge_direction{};
   Vec3 device_point_m{};     ///< point held on the surface by the proxy, world metres

@@ -35,6 +35,20 @@ double depth_lookahead_m(const GridSpec& spec);
 double depth_ahead_m(const HeightGrid& grid, Representation representation, const Segment& edge,
                      Vec3 velocity_m_per_s, double lookahead_m) noexcept;
 
+/// The depth ahead (depth_ahead_m) with the length of edge it was read over.
+struct CutAhead {
+  double depth_m = 0.0;
+  /// The 3-D length of the parts of the edge with soil ahead of them, m,
+  /// >= 0: the earthmoving model's width. The contact length would do in a
+  /// steady cut, but on the surface representation the contact drops to
+  /// almost nothing for a tick or a few whenever a rising blade's edge passes
+  /// above the interpolated surface between a sample it cut lower and the
+  /// next (a flicker as the blade leaves the soil); the soil ahead is steady.
+  double width_m = 0.0;
+};
+CutAhead cut_ahead(const HeightGrid& grid, Representation representation, const Segment& edge,
+                   Vec3 velocity_m_per_s, double lookahead_m) noexcept;
+
 /// The soil ahead of the edge when soil flows (SoilModel::kFlow), where the
 /// surface ahead may be a pile the blade pushes.
 struct SoilAhead {
@@ -46,6 +60,8 @@ struct SoilAhead {
   /// wedge ahead (from the lookahead on, over wedge_per_depth x the local
   /// depth), metres (>= 0).
   double pile_m = 0.0;
+  /// The 3-D length of the edge with undisturbed soil ahead, m (as CutAhead::width_m).
+  double width_m = 0.0;
 };
 
 /// The failure wedge's length ahead of the blade per metre of cut depth:
