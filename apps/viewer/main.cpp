@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
                "benchmark: take the frames at 60/s without drawing them (the loop's reference)");
   app.add_option("--mesh-max", opt.mesh_max, "largest terrain mesh side, vertices (default 512)")
       ->check(CLI::Range(2, 8192));
-  app.add_option("--msaa", opt.msaa, "headless multisampling samples (default 4, 0: none)")
+  app.add_option("--msaa", opt.msaa, "multisampling samples, window and headless (default 4, 0: none)")
       ->check(CLI::Range(0, 16));
   app.add_option("--max-fps", opt.max_fps, "window: frame cap (default 60, 0: none)")
       ->check(CLI::Range(0, 1000));

@@ -212,7 +212,9 @@ void ViewerApp::draw_tool_section() {
     ImGui::Text("  depth %.3f m in the soil", r.depth_m);
   else
     ImGui::Text("  %.3f m above the soil", -r.depth_m);
-  ImGui::Text("yaw %.1f deg   tilt %.1f deg", r.yaw_deg + 0.0, r.tilt_deg + 0.0);  // no -0.0
+  // Rounded to the shown tenth first, so that -0.01 reads 0.0, not -0.0.
+  auto tenth = [](double deg) { return std::round(deg * 10.0) / 10.0 + 0.0; };
+  ImGui::Text("yaw %.1f deg   tilt %.1f deg", tenth(r.yaw_deg), tenth(r.tilt_deg));
   if (driver_->device().source() == ToolSource::kMouse && r.depth_m <= 0.0)
     ImGui::TextDisabled("scroll down to dig; left drag moves the tool");
 }
@@ -233,8 +235,9 @@ void ViewerApp::draw_contact_section() {
   if (l.body_total > 0) {
     ImGui::Text("bodies %d (Bullet)   on the blade %.1f N", l.body_total,
                 double(magnitude(l.body_force_n)));
-    ImGui::Text("  this frame: mean %.1f  max %.1f N; since reset max %.1f N",
-                w.mean(w.body_force_sum_n), w.body_force_max_n, l.body_force_max_n);
+    ImGui::Text("  this frame: mean %.1f  max %.1f N", w.mean(w.body_force_sum_n),
+                w.body_force_max_n);
+    ImGui::Text("  largest since the start or Reset: %.1f N", l.body_force_max_n);
   }
   draw_plots();
 }
