@@ -1127,6 +1127,45 @@ TEST(Stability, HandCuttingThroughDragAndWallLosesEnergy) {
   EXPECT_LT(e.back(), 0.5 * e.front());
 }
 
+TEST(Stability, HandPushedIntoSoilMeetsItsBearingAndLosesEnergy) {
+  // Penetration at the device's damping limit (20 N s/m on the device) over
+  // the floor's wall: the hand, pulled 4 cm below the soil's surface at
+  // y = 0.02, pushes the edge down through the soil onto the rigid floor.
+  ForceModelParams p;
+  p.cutting = CuttingModel::kContactDrag;
+  p.force_scale = 1.0;
+  p.contact_drag.drag_n_per_m = 0.0;
+  p.low_speed_damping_n_s_per_m = 20.0;
+  p.earthmoving.soil = soil_preset(SoilPreset::kLooseSand);
+  p.earthmoving.soil.cohesion_pa = 0.0;  // a few newtons of bearing: the device's range
+  p.surface.stiffness_n_per_m = 3000.0;
+  p.surface.damping_n_s_per_m = 0.25;
+  p.device.inherent_damping_n_s_per_m = 2.0;
+  p.policy = LimitPolicy::kRefuse;
+  ForceModel model(p);
+  HandSim hand;
+  bool pushed = false;
+  auto force = [&](Vec3 x, Vec3 v) {
+    ForceInput in;
+    in.device_point_m = x;
+    in.velocity_m_per_s = v;
+    in.surface_y_m = 0.0;  // the rigid floor
+    in.embedment_depth_m = std::max(0.0, 0.02 - x.y);
+    in.embedded_length_m = in.embedment_depth_m > 0.0 ? 0.5 : 0.0;
+    const ForceOutput out = model.compute(in);
+    if (out.penetration_n.y > 1.0) pushed = true;
+    return out.device_n;
+  };
+  std::vector<double> e = hand.run({0.0, 0.03, 0.0}, 3.0, 3000.0, 0.0, force);
+  EXPECT_TRUE(pushed);  // the bearing was felt on the way down
+  double e_max = 0.0;
+  for (double x : e) e_max = std::max(e_max, x);
+  EXPECT_LE(e_max, e.front() * (1.0 + 1e-4));
+  // It settles on the floor at the energy's minimum (the penetration force,
+  // a resistance to motion, is zero at rest).
+  EXPECT_NEAR(e.back(), hand.resting_energy(3000.0), 1e-3 * e.front());
+}
+
 // The whole chain: wall at the Falcon's limit, then the safety limiter with
 // its default limits (soft start off: a stiffness rising over time is not a
 // fixed wall, and the energy below assumes the full one).
