@@ -370,6 +370,9 @@ void ViewerApp::draw_force_model_params() {
   ImGui::SetNextItemWidth(-110);
   if (ImGui::SliderFloat("rake deg", &rake, 20.0f, 160.0f, "%.0f"))
     fp.earthmoving.rake_angle_rad = rake * kDegToRad;
+  ImGui::Checkbox("push-in resistance", &fp.penetration.enabled);
+  ImGui::SameLine();
+  ImGui::Checkbox("twist resistance", &fp.twist_enabled);
   ImGui::Checkbox("surface spring", &fp.surface_enabled);
   float stiff = float(fp.surface.stiffness_n_per_m);
   ImGui::SetNextItemWidth(-110);
