@@ -97,11 +97,14 @@ def main(argv):
     ax_volume.set_xlabel("time (s)")
     ax_volume.grid(alpha=0.3)
 
-    # Maps: row r of the arrays runs along +Z, so origin="lower".
+    # Maps: row r of the arrays runs along +Z, so origin="lower". Both
+    # colour scales start at zero (a scale starting at the smallest value
+    # would show 0.5 m removed as nothing) and say their unit.
     for ax, layer, label, cmap in ((ax_height, height, "final height (m)", "viridis"),
                                    (ax_removed, removed, "removed material (m)", "magma")):
+        top = float(np.nanmax(layer)) if layer.size else 0.0
         image = ax.imshow(layer, origin="lower", extent=extent, cmap=cmap,
-                          interpolation="nearest")
+                          interpolation="nearest", vmin=0.0, vmax=top if top > 0.0 else 1.0)
         ax.set_xlabel("X (m)")
         ax.set_ylabel("Z (m)")
         ax.set_title(label, fontsize=10)

@@ -44,6 +44,7 @@ Command add_haptics_command(CLI::App& app) {
     std::string python = "/usr/bin/python3";
     std::string tools = TERRACUT_TOOLS_DIR;
     bool quiet = false;
+    bool end_with_device = false;
   };
   auto opt = std::make_shared<Options>();
 
@@ -74,6 +75,10 @@ Command add_haptics_command(CLI::App& app) {
                   "duration plus haptics.settle_s (script, sim), 30 s (udp)")
       ->type_name("S")
       ->check(CLI::Range(1e-6, 86400.0));
+  sub->add_flag("--end-with-device", opt->end_with_device,
+                "End the session when the device stops sending: after its first pose, 0.5 s\n"
+                "without one (udp: the device process's own session ended). --duration still\n"
+                "bounds the session");
   sub->add_option("--clock", opt->clock,
                   "'real': the loop runs on its own thread paced by the wall clock (default for\n"
                   "sim and udp); 'fake': synchronously, no sleeping, t = i / rate, so the same\n"
@@ -113,6 +118,9 @@ Command add_haptics_command(CLI::App& app) {
       "                  clamped,rate_limited,watchdog,ramping,nonfinite  safety flags (0/1)\n"
       "                  bad_sample,silent,missed_deadline                loop flags (0/1)\n"
       "                  period, compute           time since the previous tick, compute (s)\n"
+      "                  f_penetration             the push-in resistance's part of fw_y (N)\n"
+      "                  twist_torque, yaw_rate    torque about +Y on the tool (N m; not\n"
+      "                                            rendered), tool yaw rate (rad/s)\n"
       "  summary.json  settings used, period jitter and compute percentiles (p50, p99, max,\n"
       "                us), missed deadlines, loop and safety counters, rejected packets by\n"
       "                reason (udp), device figures, forces, cutting totals, warnings\n"
@@ -131,7 +139,7 @@ Command add_haptics_command(CLI::App& app) {
       "  terracut haptics scenarios/trench_dry_sand.yaml --out out/trench\n"
       "  terracut haptics scenarios/trench_dry_sand.yaml --device script --out out/trench_script\n"
       "  terracut haptics scenarios/trench_dry_sand.yaml --device udp:127.0.0.1:47000 \\\n"
-      "      --duration 10 --out out/trench_udp    # then run terracut-device in another shell\n"
+      "      --end-with-device --duration 30 --out out/trench_udp   # then terracut-device\n"
       "  terracut haptics scenarios/rock_push.yaml --out out/rock   # the blade hits a rock\n"
       "Docs: docs/haptics.md (what you feel and why), docs/bridge-protocol.md (the bridge),\n"
       "docs/bullet.md (rigid bodies).");
@@ -148,6 +156,7 @@ Command add_haptics_command(CLI::App& app) {
     if (!opt->clock.empty())
       so.clock = opt->clock == "fake" ? session::ClockMode::kFake : session::ClockMode::kReal;
     so.realtime = !opt->no_realtime;
+    so.end_with_device = opt->end_with_device;
     so.log = &std::cerr;
     so.interrupt = &g_interrupt;
     const auto say = [&](const std::string& line) {
@@ -169,8 +178,9 @@ Command add_haptics_command(CLI::App& app) {
     if (session.device_kind() == haptics::DeviceKind::kUdp)
       say("listening for a device on udp " + session.loop().settings().udp.address + ":" +
           std::to_string(session.udp_port()) +
-          " (the session clock runs from now; until poses arrive the force is zero and the "
-          "watchdog counts the silence)");
+          " (the session clock runs from now; the force is zero until poses arrive" +
+          (opt->end_with_device ? std::string("; the session ends when they stop)")
+                                : std::string(")")));
     say("running the " + std::string(to_string(session.device_kind())) + " device for " +
         format_number(session.duration_s()) + " s (" +
         (session.clock() == session::ClockMode::kFake ? "fake" : "real") + " clock)");

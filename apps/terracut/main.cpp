@@ -37,6 +37,18 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    // CLI11 checks the required options before the unknown ones: name an
+    // unknown option first, it is the likelier mistake.
+    if (dynamic_cast<const CLI::RequiredError*>(&e)) {
+      for (const CLI::App* sub : app.get_subcommands()) {
+        const std::vector<std::string> extra = sub->remaining();
+        if (extra.empty()) continue;
+        std::cerr << "terracut " << sub->get_name() << ": unknown option or argument:";
+        for (const std::string& x : extra) std::cerr << " " << x;
+        std::cerr << "\nRun with --help for more information.\n";
+        return 2;
+      }
+    }
     const int code = app.exit(e);
     // CLI11 uses many codes for usage errors; report them all as 2.
     return code == 0 ? 0 : 2;

@@ -130,8 +130,19 @@ Command add_run_command(CLI::App& app) {
                     result.max_sample_error_m, result.volume_error_m3,
                     result.step_timing.p99_us, opt->out.c_str());
       std::cout << line;
-      if (result.realtime)
-        std::cout << "realtime: " << session::realtime_json(*result.realtime) << "\n";
+      if (result.realtime) {
+        // A readable line; the full figures are in summary.json's "realtime".
+        const haptics::LoopStats& rt = *result.realtime;
+        std::snprintf(line, sizeof line,
+                      "realtime at %.0f Hz: %lld ticks, %lld missed deadlines; step p50 %.1f us, "
+                      "p99 %.1f us; period jitter p99 %.1f us, max %.1f us (summary.json: "
+                      "realtime)\n",
+                      rt.rate_hz, static_cast<long long>(rt.ticks),
+                      static_cast<long long>(rt.missed_deadlines), rt.compute.p50_s * 1e6,
+                      rt.compute.p99_s * 1e6, rt.period_jitter.p99_s * 1e6,
+                      rt.period_jitter.max_s * 1e6);
+        std::cout << line;
+      }
     }
     return kExitOk;
   };

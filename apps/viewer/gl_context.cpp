@@ -118,6 +118,13 @@ Framebuffer::~Framebuffer() {
 
 void Framebuffer::bind() const { glBindFramebuffer(GL_FRAMEBUFFER, fbo_); }
 
+void Framebuffer::blit_to_default() const {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+}
+
 RgbImage Framebuffer::read() const {
   GLuint source = fbo_;
   if (samples_ > 0) {

@@ -58,6 +58,10 @@ class Framebuffer {
   void bind() const;
   /// Resolves and reads the pixels back, top row first.
   RgbImage read() const;
+  /// Resolves (when multisampled) and copies the picture into the window's
+  /// default framebuffer of the same size: multisampling in a window whose
+  /// visual has none (a virtual X server).
+  void blit_to_default() const;
 
  private:
   int width_, height_, samples_;

@@ -6,12 +6,25 @@
 #include <limits>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/surface.hpp"
 
 namespace terracut::viewer {
 
 haptics::HapticSettings viewer_settings(haptics::HapticSettings settings) {
   settings.tool_rotation_deg.reset();
   return settings;
+}
+
+double mouse_clearance_m(const GridSpec& spec, double max_height_m) {
+  return std::max(0.02 * max_height_m, 0.5 * std::min(spec.cell_x_m(), spec.cell_z_m()));
+}
+
+DriverOptions reset_options(const DriverOptions& previous, const ViewerDevice& device) {
+  DriverOptions o = previous;
+  o.source = device.source();
+  o.speed = device.speed();
+  o.playing = device.playing();
+  return o;
 }
 
 LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticSettings& settings,
@@ -41,9 +54,15 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
   if (!tour_.empty()) {
     start = tour_.sample(0.0);
   } else {
-    start.position_m = {spec_.origin_m.x + 0.5 * spec_.size_x_m,
-                        spec_.origin_m.y + double(max_h) + 0.1 * extent,
-                        spec_.origin_m.z + 0.5 * spec_.size_z_m};
+    // No script (a bare heightmap): just above the soil in the middle, so
+    // the first scroll down digs.
+    const double x = spec_.origin_m.x + 0.5 * spec_.size_x_m;
+    const double z = spec_.origin_m.z + 0.5 * spec_.size_z_m;
+    start.position_m = {x,
+                        spec_.origin_m.y +
+                            surface_height_m(spec_, initial_.data(), representation_, x, z) +
+                            mouse_clearance_m(spec_, double(max_h)),
+                        z};
   }
 
   {

@@ -122,6 +122,15 @@ class LoopDriver {
   bool started_ = false;
 };
 
+/// How high above the soil the mouse tool is put down, metres: 2 % of the
+/// terrain's tallest height or half a cell, whichever is more.
+double mouse_clearance_m(const GridSpec& spec, double max_height_m);
+
+/// The options a Reset opens the next session with: the same as the
+/// previous ones, with the device's tool source and speed, and playing only
+/// if it was playing (a paused viewer stays paused through a Reset).
+DriverOptions reset_options(const DriverOptions& previous, const ViewerDevice& device);
+
 /// The haptic settings the viewer uses: the scenario's `haptics:` section (or
 /// the defaults), with a fixed tool rotation dropped (the viewer's device
 /// gives the orientation, so the keys can turn the tool).

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -67,20 +68,42 @@ int main(int argc, char** argv) {
                "benchmark: take the frames at 60/s without drawing them (the loop's reference)");
   app.add_option("--mesh-max", opt.mesh_max, "largest terrain mesh side, vertices (default 512)")
       ->check(CLI::Range(2, 8192));
-  app.add_option("--msaa", opt.msaa, "headless multisampling samples (default 4, 0: none)")
+  app.add_option("--msaa", opt.msaa, "multisampling samples, window and headless (default 4, 0: none)")
       ->check(CLI::Range(0, 16));
   app.add_option("--max-fps", opt.max_fps, "window: frame cap (default 60, 0: none)")
       ->check(CLI::Range(0, 1000));
-  app.add_option("--extent", opt.heightmap_size_m, "heightmap input: side of the terrain, metres");
+  app.add_option("--extent", opt.heightmap_size_m, "heightmap input: side of the terrain, metres")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--full-scale", opt.heightmap_full_scale_m,
-                 "heightmap input: height of a white pixel, metres");
+                 "heightmap input: height of a white pixel, metres")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--font", font, "TTF font for the panel (default DejaVu Sans when installed)");
   app.add_flag("--play-script", opt.tool_from_script,
                "window: start by playing the scenario's cuts (default: the mouse drives)");
+  app.add_option("--speed", opt.play_speed,
+                 "window: replay speed of the script (device seconds per second)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 16.0));
+  app.add_flag("--loop", opt.loop_script,
+               "window: replay the script from the initial terrain each time it ends");
+  app.add_option("--window-seconds", opt.window_seconds,
+                 "window: close after this many seconds and print the frame count (measurements)")
+      ->check(CLI::Range(0.0, 86400.0));
+  app.add_flag("--paused", opt.pause_last_frame,
+               "headless: draw the last frame as paused (for screenshots of the panel)");
   bool no_realtime = false;
   app.add_flag("--no-realtime", no_realtime,
                "do not ask for SCHED_FIFO for the haptic loop's thread");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version exit 0; every command-line error exits 2, as
+    // docs/viewer.md says (CLI11's own codes differ by error).
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
   opt.realtime = !no_realtime;
 
   try {
@@ -116,6 +139,10 @@ int main(int argc, char** argv) {
       opt.representation = terracut::parse_representation(representation);
     if (!resolution.empty()) opt.resolution = terracut::io::parse_resolution(resolution);
     if (!opt.screenshot.empty() || opt.benchmark_frames > 0) opt.headless = true;
+    if (std::filesystem::path(input).extension() == ".png" && app.count("--extent") == 0)
+      std::cerr << "terracut-viewer: " << input << " opens as " << opt.heightmap_size_m << " x "
+                << opt.heightmap_size_m << " m with white = " << opt.heightmap_full_scale_m
+                << " m high (the defaults; set --extent and --full-scale)\n";
 
     terracut::viewer::ViewerApp viewer(opt, terracut::viewer::load_input(opt));
     return opt.headless ? viewer.run_headless() : viewer.run_window();

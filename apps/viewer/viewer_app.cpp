@@ -95,6 +95,7 @@ void ViewerApp::open_session(const DriverOptions& driver_options) {
     camera_.mode = mode;
     camera_.yaw_rad = yaw;
     camera_.pitch_rad = pitch;
+    if (!camera_framed_) frame_on_tool_path();
     if (!camera_framed_ && options_.orbit) {
       camera_.yaw_rad = float((*options_.orbit)[0] * kDegToRad);
       camera_.pitch_rad = float((*options_.orbit)[1] * kDegToRad);
@@ -108,16 +109,60 @@ void ViewerApp::open_session(const DriverOptions& driver_options) {
   float extent = float(std::max(spec.size_x_m, spec.size_z_m));
   arrow_length_m_ = 0.25f * extent;
   *live_ = Live{};
+  frame_gate_.reset();
+  redraw_.changed();
+  mouse_placed_ = false;
   consume_frame();  // the starting frame: tool pose
   device_target_ = live_->pose;
   driver_->device().set_target(device_target_);
   driver_->start();
 }
 
+void ViewerApp::frame_on_tool_path() {
+  // The orbit camera turns about the middle of the terrain and of the tool's
+  // scripted path (the blade's ends included), far enough back that a blade
+  // passing near the terrain's edge does not fill the view.
+  const Tour& tour = driver_->tour();
+  if (tour.empty()) return;
+  const GridSpec& spec = driver_->spec();
+  Vec3 lo{spec.origin_m.x, spec.origin_m.y, spec.origin_m.z};
+  Vec3 hi{spec.origin_m.x + spec.size_x_m, spec.origin_m.y + max_initial_height_m_,
+          spec.origin_m.z + spec.size_z_m};
+  const BladeSpec& blade = scenario_.base.blade;
+  constexpr int kSamples = 64;
+  for (int i = 0; i <= kSamples; ++i) {
+    const Segment e = blade_segment(blade, tour.sample(tour.duration_s() * i / kSamples));
+    for (const Vec3& p : {e.a, e.b}) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+  }
+  const Vec3 size = hi - lo;
+  const float radius = 0.5f * float(length(size));
+  camera_.target = to_f((lo + hi) * 0.5);
+  camera_.target.y = float(spec.origin_m.y) + 0.25f * max_initial_height_m_;
+  camera_.scene_radius_m = std::max(camera_.scene_radius_m, radius);
+  camera_.distance_m = std::max(camera_.distance_m, 3.0f * radius);
+}
+
+void ViewerApp::print_realtime_line() {
+  // The loop thread's scheduling, in the words `terracut haptics` uses.
+  std::cerr << "terracut-viewer: " << driver_->loop().realtime_status().message << "\n";
+}
+
 void ViewerApp::close_session() {
   if (driver_) driver_->stop();
   driver_.reset();
   terrain_.reset();
+}
+
+bool ViewerApp::take_frame() {
+  ViewerDevice& dev = driver_->device();
+  if (!frame_gate_.take(dev.playing() || dev.stepping(), dev.clock_s())) {
+    live_->uploaded_last = 0;
+    return false;
+  }
+  return consume_frame();
 }
 
 bool ViewerApp::consume_frame() {
@@ -129,6 +174,23 @@ bool ViewerApp::consume_frame() {
   std::int64_t before = terrain_->uploaded_samples();
   terrain_->upload(f->heights.data(), f->dirty);
   Live& l = *live_;
+  // Does the picture change? A still tool over an unchanged terrain does not
+  // need drawing again.
+  auto same = [](Vec3 a, Vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
+  bool changed = !l.have_frame || !f->dirty.empty() || !same(l.pose.position_m, f->pose.position_m) ||
+                 l.pose.orientation.w != f->pose.orientation.w ||
+                 l.pose.orientation.x != f->pose.orientation.x ||
+                 l.pose.orientation.y != f->pose.orientation.y ||
+                 l.pose.orientation.z != f->pose.orientation.z ||
+                 l.contact.length_m != f->contact.length_m ||
+                 !same(l.force_world_n, f->force_world_n) ||
+                 f->window.force_max_n != l.window.force_max_n || l.body_count != f->body_count;
+  for (int i = 0; !changed && i < f->body_count; ++i) {
+    const haptics::ViewBody& a = l.bodies[std::size_t(i)];
+    const haptics::ViewBody& b = f->bodies[std::size_t(i)];
+    changed = !same(a.position_m, b.position_m) || a.orientation.w != b.orientation.w ||
+              a.orientation.x != b.orientation.x || a.orientation.y != b.orientation.y;
+  }
   l.uploaded_last = terrain_->uploaded_samples() - before;
   l.have_frame = true;
   l.sequence = f->sequence;
@@ -147,13 +209,22 @@ bool ViewerApp::consume_frame() {
   std::copy_n(f->bodies.begin(), f->body_count, l.bodies.begin());
   l.step_time_s = f->step_time_s;
   l.period_s = f->period_s;
-  return true;
+  l.penetration_n = f->penetration_force_n;
+  l.twist_torque_n_m = f->twist_torque_n_m;
+  l.yaw_rate_rad_per_s = f->yaw_rate_rad_per_s;
+  l.window = f->window;
+  l.force_max_n = std::max(l.force_max_n, f->window.force_max_n);
+  l.body_force_max_n = std::max(l.body_force_max_n, f->window.body_force_max_n);
+  l.readout = tool_readout(f->pose, driver_->spec(), f->heights.data(), driver_->representation());
+  if (changed) redraw_.changed();
+  return changed;
 }
 
 void ViewerApp::push_history() {
   Live& l = *live_;
   l.contact_hist[std::size_t(l.hist_next)] = float(l.contact.length_m);
-  l.force_hist[std::size_t(l.hist_next)] = magnitude(l.force_world_n);
+  l.force_hist[std::size_t(l.hist_next)] = float(l.window.force_max_n);
+  l.body_hist[std::size_t(l.hist_next)] = float(l.window.body_force_max_n);
   l.jitter_hist[std::size_t(l.hist_next)] = float(timing_.take_worst_jitter_s() * 1e6);
   l.hist_next = (l.hist_next + 1) % kHistory;
 }
@@ -162,11 +233,9 @@ void ViewerApp::reset_session() {
   // The haptic loop has no reset: a new session starts from the initial
   // terrain, with the same tool source and speed.
   reset_requested_ = false;
-  DriverOptions o = driver_options_;
-  o.source = driver_->device().source();
-  o.speed = driver_->device().speed();
-  o.playing = true;
+  const DriverOptions o = reset_options(driver_options_, driver_->device());
   close_session();
+  timing_.clear();  // the timing statistics and the maxima start afresh
   open_session(o);
 }
 
@@ -229,7 +298,7 @@ GLFWwindow* ViewerApp::open_window() {
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  glfwWindowHint(GLFW_SAMPLES, 4);
+  glfwWindowHint(GLFW_SAMPLES, 0);  // multisampled offscreen instead (window_frame)
   std::string title = "terracut viewer - " + base_scenario_.base.name;
   GLFWwindow* window = glfwCreateWindow(options_.width, options_.height, title.c_str(), nullptr, nullptr);
   if (!window) {
@@ -240,7 +309,15 @@ GLFWwindow* ViewerApp::open_window() {
   glfwMakeContextCurrent(window);
   glfwSwapInterval(1);
   glfwSetWindowUserPointer(window, this);
-  glfwSetScrollCallback(window, scroll_callback);  // ImGui chains to it
+  glfwSetScrollCallback(window, scroll_callback);  // ImGui chains to these
+  glfwSetCursorPosCallback(window, [](GLFWwindow* w, double, double) { event_callback(w); });
+  glfwSetMouseButtonCallback(window, [](GLFWwindow* w, int, int, int) { event_callback(w); });
+  glfwSetKeyCallback(window, [](GLFWwindow* w, int, int, int, int) { event_callback(w); });
+  glfwSetCharCallback(window, [](GLFWwindow* w, unsigned) { event_callback(w); });
+  glfwSetWindowFocusCallback(window, [](GLFWwindow* w, int) { event_callback(w); });
+  glfwSetCursorEnterCallback(window, [](GLFWwindow* w, int) { event_callback(w); });
+  glfwSetFramebufferSizeCallback(window, [](GLFWwindow* w, int, int) { event_callback(w); });
+  glfwSetWindowRefreshCallback(window, [](GLFWwindow* w) { event_callback(w); });
   // Sticky keys and buttons: a tap shorter than a frame is still seen once.
   glfwSetInputMode(window, GLFW_STICKY_KEYS, GLFW_TRUE);
   glfwSetInputMode(window, GLFW_STICKY_MOUSE_BUTTONS, GLFW_TRUE);
@@ -250,7 +327,6 @@ GLFWwindow* ViewerApp::open_window() {
 int ViewerApp::run_window() {
   GLFWwindow* window = open_window();
   if (!window) return kExitNoContext;
-  glEnable(GL_MULTISAMPLE);
   init_gl_objects();
   init_imgui(true, window);
 
@@ -259,23 +335,48 @@ int ViewerApp::run_window() {
   dopt.source = options_.tool_from_script ? ToolSource::kScript : ToolSource::kMouse;
   dopt.realtime = options_.realtime;
   dopt.playing = true;
+  dopt.speed = options_.play_speed;
   open_session(dopt);
-  std::cerr << "terracut-viewer: " << describe_current_context() << "\n";
+  const std::string renderer = describe_current_context();
+  std::cerr << "terracut-viewer: " << renderer << "\n";
+  if (options_.msaa > 0 && (renderer.find("llvmpipe") != std::string::npos ||
+                            renderer.find("softpipe") != std::string::npos))
+    std::cerr << "terracut-viewer: a software renderer: multisampling (--msaa " << options_.msaa
+              << ") takes about 3x the frame time; --msaa 0 draws faster, with jagged edges\n";
+  print_realtime_line();
 
-  Clock::time_point last = Clock::now();
+  // Event-driven: sleep until an event or the next frame time, draw only
+  // when something changed (RedrawGate), and count the frames drawn.
+  const double frame_period = options_.max_fps > 0 ? 1.0 / options_.max_fps : 0.0;
+  const Clock::time_point opened = Clock::now();
+  Clock::time_point last = opened;
+  std::int64_t drawn = 0, iterations = 0;
+  double drawing_s = 0.0;  // wall time of the iterations that drew
   while (!glfwWindowShouldClose(window)) {
-    glfwPollEvents();
-    Clock::time_point now = Clock::now();
-    double dt = std::chrono::duration<double>(now - last).count();
-    last = now;
-    window_frame(window, dt);
-    if (options_.max_fps > 0) {
-      // Pace by wall clock (no vsync under a virtual X server).
-      std::this_thread::sleep_until(now + std::chrono::duration_cast<Clock::duration>(
-                                              std::chrono::duration<double>(1.0 / options_.max_fps)));
-    }
+    const Clock::time_point begin = Clock::now();
+    double dt = std::chrono::duration<double>(begin - last).count();
+    last = begin;
+    ++iterations;
+    const bool drew = window_frame(window, dt);
+    if (drew) ++drawn;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - opened).count();
+    if (options_.window_seconds > 0.0 && elapsed >= options_.window_seconds)
+      glfwSetWindowShouldClose(window, GLFW_TRUE);
+    // Pace by wall clock (no vsync under a virtual X server): wait for
+    // events until the next frame is due.
+    const double spent = std::chrono::duration<double>(Clock::now() - begin).count();
+    const double wait = std::max(frame_period - spent, 0.0);
+    if (drew) drawing_s += std::max(spent, frame_period);
+    if (wait > 0.0) glfwWaitEventsTimeout(wait); else glfwPollEvents();
   }
+  const double open_s = std::chrono::duration<double>(Clock::now() - opened).count();
+  std::fprintf(stderr,
+               "terracut-viewer: window: %lld frames drawn in %.1f s open (%lld iterations); "
+               "%.1f frames/s while drawing\n",
+               static_cast<long long>(drawn), open_s, static_cast<long long>(iterations),
+               drawing_s > 0.0 ? double(drawn) / drawing_s : 0.0);
   close_session();
+  window_fb_.reset();
   shutdown_imgui(true);
   shapes_.reset();
   glfwDestroyWindow(window);
@@ -283,21 +384,46 @@ int ViewerApp::run_window() {
   return 0;
 }
 
-void ViewerApp::window_frame(GLFWwindow* window, double dt_s) {
-  // One frame of the window: a pending reset, the input, the newest frame, the drawing.
-  if (reset_requested_) reset_session();
-  // Slow drawing posts sparse targets: let the tool glide between them.
-  driver_->device().set_lag_s(1.5 * dt_s);
+bool ViewerApp::window_frame(GLFWwindow* window, double dt_s) {
+  // One iteration of the window: a pending reset (or the script's replay),
+  // the input, the newest frame, and the drawing when something changed.
+  if (options_.loop_script && driver_->device().source() == ToolSource::kScript &&
+      driver_->device().script_finished())
+    reset_requested_ = true;
+  if (reset_requested_) {
+    reset_session();
+    if (options_.loop_script) driver_->device().set_playing(true);
+  }
+  // Targets come once a frame: the device ramps to each over one frame
+  // interval, so the tool moves at a steady speed between them.
+  driver_->device().set_frame_interval_s(dt_s);
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   handle_window_input(window, dt_s);
-  consume_frame();
-  push_history();
+  if (take_frame()) push_history();
   int fb_w = 1, fb_h = 1;
   glfwGetFramebufferSize(window, &fb_w, &fb_h);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (!redraw_.draw()) {
+    // Nothing changed: ImGui's frame is begun and ended without drawing.
+    ImGui::NewFrame();
+    ImGui::EndFrame();
+    return false;
+  }
+  // Multisampling in a window too: draw into a multisampled framebuffer of
+  // the window's size and resolve it into the window (a virtual X server's
+  // visual has no samples of its own).
+  if (options_.msaa > 0 && (!window_fb_ || window_fb_->width() != fb_w || window_fb_->height() != fb_h))
+    window_fb_ = std::make_unique<Framebuffer>(fb_w, fb_h, options_.msaa);
+  if (window_fb_) {
+    window_fb_->bind();
+    glEnable(GL_MULTISAMPLE);
+  } else {
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
   render(fb_w, fb_h, true);
+  if (window_fb_) window_fb_->blit_to_default();
   glfwSwapBuffers(window);
+  return true;
 }
 
 }  // namespace terracut::viewer

@@ -13,7 +13,9 @@
 #include <vector>
 
 #include "camera.hpp"
+#include "gl_context.hpp"
 #include "loop_driver.hpp"
+#include "viewer_controls.hpp"
 #include "shape_renderer.hpp"
 #include "terrain_renderer.hpp"
 #include "terracut/session/scenario.hpp"
@@ -52,6 +54,10 @@ struct ViewerOptions {
   double heightmap_full_scale_m = 0.2;  ///< heightmap input: height of white, metres
   std::filesystem::path font;           ///< TTF for the panel; empty: DejaVu Sans if present
   bool tool_from_script = false;        ///< window mode: start playing the script (else mouse)
+  double play_speed = 1.0;              ///< device clock per second, (0, 16]: the script's replay speed
+  bool loop_script = false;             ///< window mode: replay the script (a reset) when it ends
+  double window_seconds = 0.0;          ///< window mode: close after this many seconds (0: never)
+  bool pause_last_frame = false;        ///< headless: draw the last frame paused
   bool realtime = true;                 ///< ask for SCHED_FIFO for the loop thread
 };
 
@@ -83,10 +89,15 @@ class ViewerApp {
   void init_imgui(bool with_glfw, GLFWwindow* window);
   void shutdown_imgui(bool with_glfw);
   void open_session(const DriverOptions& driver_options);
+  /// Widens the orbit camera's framing to the tool's scripted path.
+  void frame_on_tool_path();
   void close_session();
   /// Takes the newest published frame (if any), uploads its dirty rectangle
-  /// and records its values; returns whether one was taken.
+  /// and records its values; returns whether one was taken whose picture
+  /// differs from the previous one.
   bool consume_frame();
+  /// The first frame of a session, or a frame the gate lets through.
+  bool take_frame();
   void push_history();
   void render(int fb_width, int fb_height, bool draw_imgui);
   void draw_scene(int x, int y, int w, int h);
@@ -99,11 +110,18 @@ class ViewerApp {
   void handle_window_input(GLFWwindow* window, double dt_s);
   void begin_mouse_drive();
   float ground_height_at(double x, double z) const;
+  /// Where the cursor's ray first meets the terrain surface (within the
+  /// terrain's extent), world metres; false when it misses.
+  bool terrain_hit(const Pointer& p, Vec3f& hit) const;
+  /// Prints the loop's real-time line (as `terracut haptics` does).
+  void print_realtime_line();
 
   // Window loop (viewer_app.cpp). open_window: nullptr (and a message) when
   // no window can be made.
   GLFWwindow* open_window();
-  void window_frame(GLFWwindow* window, double dt_s);
+  /// One iteration of the window: input, the newest frame and, when
+  /// something changed, the drawing; returns whether it drew.
+  bool window_frame(GLFWwindow* window, double dt_s);
 
   // Headless runs (viewer_headless.cpp).
   void headless_frame(int w, int h, bool with_panel_time);
@@ -127,6 +145,7 @@ class ViewerApp {
   void draw_panel_header();
   void draw_run_section();
   void draw_script_progress();
+  void draw_tool_section();
   void draw_contact_section();
   void draw_plots();
   void draw_timing_section();
@@ -163,6 +182,10 @@ class ViewerApp {
   int panel_width_ = 0;
   bool imgui_ready_ = false;
   bool reset_requested_ = false;
+  FrameGate frame_gate_;
+  RedrawGate redraw_;
+  std::unique_ptr<Framebuffer> window_fb_;  // the window's multisampled target
+  bool mouse_placed_ = false;  // the mouse tool was put down under the cursor this session
 
   std::unique_ptr<Live> live_;
 
@@ -189,6 +212,7 @@ class ViewerApp {
   int scene_x_ = 0, scene_y_ = 0, scene_w_ = 1, scene_h_ = 1;  // window pixels, y down
 
   friend void scroll_callback(GLFWwindow*, double, double);
+  friend void event_callback(GLFWwindow*);
 };
 
 }  // namespace terracut::viewer

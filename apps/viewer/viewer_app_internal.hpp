@@ -24,6 +24,8 @@ inline float magnitude(Vec3 v) { return float(length(v)); }
 /// GLFW scroll callback of the window (viewer_input.cpp): adds the wheel's
 /// motion to the app's scroll_accum_.
 void scroll_callback(GLFWwindow* window, double, double dy);
+/// Marks the window for redrawing (any input event, a resize).
+void event_callback(GLFWwindow* window);
 
 // The latest frame's scalar fields, plot histories and frame timing.
 struct ViewerApp::Live {
@@ -35,6 +37,13 @@ struct ViewerApp::Live {
   Segment edge{};
   ContactResult contact{};
   Vec3 device_m{}, proxy_m{}, force_world_n{}, force_device_n{}, body_force_n{};
+  double penetration_n = 0.0, twist_torque_n_m = 0.0, yaw_rate_rad_per_s = 0.0;
+  /// The ticks since the previously taken frame (max and mean of the forces).
+  haptics::ViewWindow window{};
+  /// Largest |force| and |bodies' force| of any tick since the session (or
+  /// Reset) began, N.
+  double force_max_n = 0.0, body_force_max_n = 0.0;
+  ToolReadout readout{};
   double step_time_s = 0.0, period_s = 0.0;
   // Rigid bodies of the frame (the first body_count are valid).
   int body_count = 0, body_total = 0;
@@ -42,7 +51,10 @@ struct ViewerApp::Live {
   std::int64_t uploaded_last = 0;
 
   std::vector<float> contact_hist = std::vector<float>(kHistory, 0.0f);
+  // Per drawn frame: the largest |force| of the ticks it sums up (so brief
+  // contacts between frames show), and the same for the bodies' force.
   std::vector<float> force_hist = std::vector<float>(kHistory, 0.0f);
+  std::vector<float> body_hist = std::vector<float>(kHistory, 0.0f);
   std::vector<float> jitter_hist = std::vector<float>(kHistory, 0.0f);
   int hist_next = 0;
 

@@ -183,6 +183,7 @@ void LoopTiming::clear() {
   ticks_.store(0, std::memory_order_relaxed);
   period_max_ns_.store(0, std::memory_order_relaxed);
   compute_max_ns_.store(0, std::memory_order_relaxed);
+  worst_jitter_ns_.store(0, std::memory_order_relaxed);
 }
 
 double LoopTiming::take_worst_jitter_s() {
@@ -213,6 +214,16 @@ void ViewerDevice::set_speed(double speed) {
   speed_.store(std::clamp(speed, 0.0, 16.0));
 }
 
+void ViewerDevice::set_frame_interval_s(double interval_s) {
+  if (!std::isfinite(interval_s)) interval_s = 0.0;
+  frame_interval_s_.store(std::clamp(interval_s, 0.0, 0.25), std::memory_order_relaxed);
+}
+
+void ViewerDevice::request_step_s(double step_s) {
+  if (!(step_s > 0.0) || !std::isfinite(step_s)) return;
+  step_budget_s_.fetch_add(step_s, std::memory_order_relaxed);
+}
+
 void ViewerDevice::set_lag_s(double lag_s) {
   if (!std::isfinite(lag_s)) lag_s = kVirtualDeviceLag_s;
   lag_s_.store(std::clamp(lag_s, kVirtualDeviceLag_s, 1.0), std::memory_order_relaxed);
@@ -237,11 +248,25 @@ bool ViewerDevice::read(double t_s, haptics::DeviceSample& out) noexcept {
   // How far the device's own clock moves this tick.
   double advance = playing_.load(std::memory_order_relaxed) ? speed_.load(std::memory_order_relaxed) * dt : 0.0;
   advance += double(step_requests_.exchange(0, std::memory_order_relaxed)) * dt_s_;
+  if (advance == 0.0) {
+    // A timed step while paused: at the device's speed, until its budget is played.
+    const double budget = step_budget_s_.load(std::memory_order_relaxed);
+    if (budget > 0.0) {
+      const double rate = speed_.load(std::memory_order_relaxed);
+      const double a = std::min(budget, (rate > 0.0 ? rate : 1.0) * dt);
+      step_budget_s_.fetch_sub(a, std::memory_order_relaxed);
+      advance = a;
+    }
+  }
+  clock_s_ += advance;
+  clock_published_.store(clock_s_, std::memory_order_relaxed);
 
   const ToolSource wanted = ToolSource(source_.load(std::memory_order_relaxed));
   if (wanted != active_) {
     if (wanted == ToolSource::kMouse) {
       mouse_target_ = pose_;
+      ramp_from_ = pose_;
+      ramp_len_s_ = 0.0;
     } else if (!tour_.empty()) {
       // Back to the script: travel over the terrain to where it left off.
       Tour::transit(transit_, 0.0, pose_, tour_.sample(script_time_s_), clearance_y_m_,
@@ -253,11 +278,25 @@ bool ViewerDevice::read(double t_s, haptics::DeviceSample& out) noexcept {
   }
 
   if (active_ == ToolSource::kMouse) {
-    target_.read(mouse_target_);
+    // The goal ramps from where it was to each new target over one frame.
+    auto goal = [&] {
+      const double u = ramp_len_s_ > 0.0 ? std::min(1.0, ramp_t_s_ / ramp_len_s_) : 1.0;
+      return BladePose{lerp(ramp_from_.position_m, mouse_target_.position_m, u),
+                       normalized(slerp(ramp_from_.orientation, mouse_target_.orientation, u))};
+    };
+    BladePose posted;
+    if (target_.read(posted)) {
+      ramp_from_ = goal();
+      mouse_target_ = posted;
+      ramp_t_s_ = 0.0;
+      ramp_len_s_ = frame_interval_s_.load(std::memory_order_relaxed);
+    }
     if (advance > 0.0) {
+      ramp_t_s_ += advance;
+      const BladePose g = goal();
       const double a = 1.0 - std::exp(-advance / lag_s_.load(std::memory_order_relaxed));
-      pose_.position_m = lerp(pose_.position_m, mouse_target_.position_m, a);
-      pose_.orientation = normalized(slerp(pose_.orientation, mouse_target_.orientation, a));
+      pose_.position_m = lerp(pose_.position_m, g.position_m, a);
+      pose_.orientation = normalized(slerp(pose_.orientation, g.orientation, a));
     }
   } else if (!tour_.empty()) {
     if (in_transit_) {

@@ -7,12 +7,19 @@
 //    the terrain, moves over and descends to the next cut's start (a real
 //    operator lifts the blade; the transit cuts only air);
 //  - mouse source: the tool follows the target pose the drawing thread posts
-//    (mouse and keyboard) with a first-order lag of kVirtualDeviceLag_s, so
-//    60 Hz input becomes a smooth 1 kHz motion.
+//    (mouse and keyboard) once per drawn frame. Each new target is reached by
+//    a ramp over one frame interval (set_frame_interval_s) from where the
+//    previous ramp had got to, and the tool follows that ramp with a
+//    first-order lag of kVirtualDeviceLag_s, so targets posted at 10-60 Hz
+//    become a smooth 1 kHz motion of steady speed. (A lag alone makes the
+//    speed decay within every frame: a saw-tooth at the frame rate that a
+//    speed-dependent force, such as the cutting force below its saturation
+//    speed, renders as a buzz; docs/viewer.md.)
 //
-// Play/pause, single steps and speed act on the device's own clock: paused,
-// the handle holds still (the loop keeps ticking at its rate, as a haptic
-// loop must; a still blade cuts nothing and feels no drag). Speed scales the
+// Play/pause, steps and speed act on the device's own clock: paused, the
+// handle holds still (the loop keeps ticking at its rate, as a haptic loop
+// must; a still blade cuts nothing and feels no drag); a step plays a stated
+// time (request_step_s) and holds again. Speed scales the
 // script's time and the lag. The device also timestamps each read and write
 // with the wall clock, so the viewer sees the loop's period and compute time
 // live (LoopStats) without touching the loop's own records.
@@ -129,6 +136,15 @@ class ViewerDevice final : public haptics::Device {
   void set_speed(double speed);
   double speed() const { return speed_.load(); }
   void request_steps(int n) { step_requests_.fetch_add(n); }
+  /// While paused: play step_s more seconds of device time at the device's
+  /// speed (as if playing, over as many ticks), then hold still again. A
+  /// Step that is seen, unlike one loop period.
+  void request_step_s(double step_s);
+  /// True while a requested step is still being played.
+  bool stepping() const { return step_budget_s_.load(std::memory_order_relaxed) > 0.0; }
+  /// The device's own clock, seconds: the device time played so far (by
+  /// either source); it stands still while paused.
+  double clock_s() const { return clock_published_.load(std::memory_order_relaxed); }
   void set_source(ToolSource source) { source_.store(int(source)); }
   ToolSource source() const { return ToolSource(source_.load()); }
   void set_target(const BladePose& pose) { target_.write(pose); }
@@ -136,6 +152,10 @@ class ViewerDevice final : public haptics::Device {
   /// [kVirtualDeviceLag_s, 1]; the viewer lengthens it when it draws slowly,
   /// so the tool glides between sparse targets instead of stopping and going.
   void set_lag_s(double lag_s);
+  /// The drawing thread's frame interval, seconds: each posted target is
+  /// ramped to over this much device time. Clamped to [0, 0.25]; 0 (the
+  /// default) jumps the goal to each target at once (the lag alone).
+  void set_frame_interval_s(double interval_s);
   /// Script time played so far, seconds, and whether the tour has ended.
   double script_time_s() const { return script_time_published_.load(); }
   bool script_finished() const { return script_finished_.load(); }
@@ -159,7 +179,10 @@ class ViewerDevice final : public haptics::Device {
   bool started_ = false;
   double script_time_s_ = 0.0;
   BladePose pose_{};         // the handle's pose, world
-  BladePose mouse_target_{};
+  BladePose mouse_target_{};  // where the ramp goes
+  BladePose ramp_from_{};     // where the ramp started
+  double ramp_t_s_ = 0.0;     // device time since it started
+  double ramp_len_s_ = 0.0;   // its length
   ToolSource active_ = ToolSource::kScript;
   PoseLeg transit_[3]{};     // a transit back to the script after the mouse
   double transit_time_s_ = 0.0;
@@ -171,7 +194,11 @@ class ViewerDevice final : public haptics::Device {
   std::atomic<bool> playing_{true};
   std::atomic<double> speed_{1.0};
   std::atomic<double> lag_s_{kVirtualDeviceLag_s};
+  std::atomic<double> frame_interval_s_{0.0};
   std::atomic<int> step_requests_{0};
+  std::atomic<double> step_budget_s_{0.0};
+  std::atomic<double> clock_published_{0.0};
+  double clock_s_ = 0.0;  // loop thread
   std::atomic<int> source_{0};
   std::atomic<double> script_time_published_{0.0};
   std::atomic<bool> script_finished_{false};

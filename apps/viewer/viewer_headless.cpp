@@ -158,6 +158,7 @@ void ViewerApp::run_lockstep(int w, int h) {
       std::this_thread::sleep_for(std::chrono::microseconds(100));
     consume_frame();
     push_history();
+    if (k == frames && options_.pause_last_frame) driver_->device().set_playing(false);
     // The panel needs a frame or two to lay itself out; draw only the last three.
     if (k + 3 > frames) headless_frame(w, h, true);
   }

@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "viewer_controls.hpp"
+
 namespace terracut::viewer {
 namespace {
 
@@ -26,17 +28,72 @@ struct ViewerApp::Pointer {
 
 void scroll_callback(GLFWwindow* window, double, double dy) {
   auto* app = static_cast<ViewerApp*>(glfwGetWindowUserPointer(window));
-  if (app) app->scroll_accum_ += dy;
+  if (app) {
+    app->scroll_accum_ += dy;
+    app->redraw_.changed();
+  }
+}
+
+void event_callback(GLFWwindow* window) {
+  auto* app = static_cast<ViewerApp*>(glfwGetWindowUserPointer(window));
+  if (app) app->redraw_.changed();
 }
 
 void ViewerApp::begin_mouse_drive() {
+  // The mouse takes the tool where it is; a paused viewer stays paused (the
+  // tool follows once playing again).
   ViewerDevice& dev = driver_->device();
   if (dev.source() != ToolSource::kMouse) {
     device_target_ = live_->pose;
     dev.set_target(device_target_);
     dev.set_source(ToolSource::kMouse);
+    mouse_placed_ = false;
   }
-  dev.set_playing(true);
+}
+
+bool ViewerApp::terrain_hit(const Pointer& p, Vec3f& hit) const {
+  // March the cursor's ray through the terrain's box in steps of half a
+  // cell, then bisect the step where it passes below the surface.
+  const GridSpec& spec = driver_->spec();
+  const float aspect = float(scene_w_) / float(scene_h_);
+  const Ray ray =
+      camera_.ray(float((p.mx - scene_x_) / scene_w_), float((p.my - scene_y_) / scene_h_), aspect);
+  const float top = float(spec.origin_m.y) + max_initial_height_m_ * 1.05f + 1e-3f;
+  const float ground = float(spec.origin_m.y);
+  // Where the ray enters the slab between the ground and the top.
+  if (std::abs(ray.direction.y) < 1e-6f) return false;
+  const float t_top = (top - ray.origin.y) / ray.direction.y;
+  const float t_ground = (ground - ray.origin.y) / ray.direction.y;
+  float t0 = std::max(0.0f, std::min(t_top, t_ground)), t1 = std::max(t_top, t_ground);
+  if (t1 <= 0.0f) return false;
+  const float step = 0.5f * float(std::min(spec.cell_x_m(), spec.cell_z_m()));
+  auto below = [&](float t) {
+    const Vec3f q = ray.origin + ray.direction * t;
+    return q.y <= ground_height_at(q.x, q.z);
+  };
+  auto on_terrain = [&](float t) {
+    const Vec3f q = ray.origin + ray.direction * t;
+    return q.x >= spec.origin_m.x && q.x <= spec.origin_m.x + spec.size_x_m &&
+           q.z >= spec.origin_m.z && q.z <= spec.origin_m.z + spec.size_z_m;
+  };
+  const int max_steps = 100000;
+  float prev = t0;
+  for (int i = 1; i <= max_steps; ++i) {
+    const float t = std::min(t0 + step * float(i), t1);
+    if (below(t)) {
+      float a = prev, b = t;
+      for (int k = 0; k < 30; ++k) {
+        const float m = 0.5f * (a + b);
+        (below(m) ? b : a) = m;
+      }
+      if (!on_terrain(b)) return false;
+      hit = ray.origin + ray.direction * b;
+      return true;
+    }
+    prev = t;
+    if (t >= t1) break;
+  }
+  return false;
 }
 
 void ViewerApp::handle_window_input(GLFWwindow* window, double dt_s) {
@@ -87,11 +144,22 @@ bool ViewerApp::drag_tool(GLFWwindow* window, const Pointer& p) {
   bool target_changed = false;
   const bool left = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
   if (left && !dragging_tool_ && p.in_scene && !io.WantCaptureMouse) {
+    begin_mouse_drive();
+    Vec3f ground;
+    if (!mouse_placed_ && terrain_hit(p, ground)) {
+      // The first drag puts the tool down just above the soil under the
+      // cursor, so it digs at the first scroll down.
+      device_target_.position_m = {double(ground.x),
+                                   double(ground.y) + mouse_clearance_m(spec, max_initial_height_m_),
+                                   double(ground.z)};
+      mouse_placed_ = true;
+      target_changed = true;
+    }
     Vec3f hit;
     if (plane_hit(p, float(device_target_.position_m.y), hit)) {
-      begin_mouse_drive();
       dragging_tool_ = true;
       grab_offset_ = to_f(device_target_.position_m) - hit;
+      grab_offset_.y = 0.0f;
     }
   } else if (left && dragging_tool_) {
     Vec3f hit;
@@ -169,6 +237,8 @@ bool ViewerApp::turn_tool(GLFWwindow* window, double dt_s) {
   double tilt = (key_held(window, GLFW_KEY_R) ? 1.0 : 0.0) -
                 (key_held(window, GLFW_KEY_F) ? 1.0 : 0.0);
   if (yaw == 0.0 && tilt == 0.0) return false;
+  // Ctrl+Q quits: not a turn.
+  if (key_held(window, GLFW_KEY_LEFT_CONTROL) || key_held(window, GLFW_KEY_RIGHT_CONTROL)) return false;
   begin_mouse_drive();
   Quat q = device_target_.orientation;
   if (yaw != 0.0) q = quat_from_axis_angle({0, 1, 0}, yaw * 90.0 * kDegToRad * dt_s) * q;
@@ -186,18 +256,39 @@ bool ViewerApp::key_pressed(GLFWwindow* window, int key) {
 }
 
 void ViewerApp::key_commands(GLFWwindow* window) {
-  // Single presses.
+  // Single presses (viewer_controls.hpp says which key does what).
   ViewerDevice& dev = driver_->device();
-  if (key_pressed(window, GLFW_KEY_SPACE)) dev.set_playing(!dev.playing());
-  if (key_pressed(window, GLFW_KEY_N)) {
-    dev.set_playing(false);
-    dev.request_steps(1);
+  const int mods = (key_held(window, GLFW_KEY_LEFT_CONTROL) || key_held(window, GLFW_KEY_RIGHT_CONTROL))
+                       ? GLFW_MOD_CONTROL
+                       : 0;
+  for (int key : {GLFW_KEY_ESCAPE, GLFW_KEY_Q, GLFW_KEY_SPACE, GLFW_KEY_N, GLFW_KEY_BACKSPACE,
+                  GLFW_KEY_T, GLFW_KEY_C}) {
+    if (!key_pressed(window, key)) continue;
+    switch (key_command(key, mods)) {
+      case KeyCommand::kQuit:
+        glfwSetWindowShouldClose(window, GLFW_TRUE);
+        break;
+      case KeyCommand::kPlayPause:
+        dev.set_playing(!dev.playing());
+        break;
+      case KeyCommand::kStep:
+        dev.set_playing(false);
+        dev.request_step_s(kStepTime_s);
+        break;
+      case KeyCommand::kReset:
+        reset_requested_ = true;
+        break;
+      case KeyCommand::kTopView:
+        camera_.mode = camera_.mode == CameraMode::kTop ? CameraMode::kOrbit : CameraMode::kTop;
+        break;
+      case KeyCommand::kColour:
+        style_.color =
+            style_.color == ColorMode::kHeight ? ColorMode::kRemoved : ColorMode::kHeight;
+        break;
+      case KeyCommand::kNone:
+        break;
+    }
   }
-  if (key_pressed(window, GLFW_KEY_BACKSPACE)) reset_requested_ = true;
-  if (key_pressed(window, GLFW_KEY_T))
-    camera_.mode = camera_.mode == CameraMode::kTop ? CameraMode::kOrbit : CameraMode::kTop;
-  if (key_pressed(window, GLFW_KEY_C))
-    style_.color = style_.color == ColorMode::kHeight ? ColorMode::kRemoved : ColorMode::kHeight;
 }
 
 }  // namespace terracut::viewer

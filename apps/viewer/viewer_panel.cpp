@@ -10,9 +10,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace terracut::viewer {
 namespace {
@@ -76,8 +78,16 @@ void ViewerApp::draw_labels(int x, int y, int w, int h) {
                 double(magnitude(l.force_world_n)), double(magnitude(l.force_device_n)));
   ImDrawList* dl = ImGui::GetForegroundDrawList();
   ImVec2 size = ImGui::CalcTextSize(text);
-  ImVec2 at(sx + 18.0f, sy - size.y - 14.0f);
-  dl->AddRectFilled(ImVec2(at.x - 5, at.y - 3), ImVec2(at.x + size.x + 5, at.y + size.y + 3),
+  // Beside the tool, clear of the blade's line on the screen, inside the
+  // scene (label_position: a resize never clips it).
+  const Vec3f ea = transform_point(vp, to_f(l.edge.a)), eb = transform_point(vp, to_f(l.edge.b));
+  const float edx = 0.5f * (eb.x - ea.x) * float(w), edy = -0.5f * (eb.y - ea.y) * float(h);
+  const float pad = 6.0f;
+  float lx = 0.0f, ly = 0.0f;
+  label_position(sx, sy, edx, edy, size.x + 2.0f * pad, size.y + 2.0f * pad,
+                 ScreenRect{float(x), float(y), float(w), float(h)}, 22.0f, lx, ly);
+  ImVec2 at(lx + pad, ly + pad);
+  dl->AddRectFilled(ImVec2(lx, ly), ImVec2(lx + size.x + 2.0f * pad, ly + size.y + 2.0f * pad),
                     IM_COL32(20, 22, 28, 190), 4.0f);
   dl->AddText(at, IM_COL32(255, 255, 255, 255), text);
 }
@@ -91,6 +101,7 @@ void ViewerApp::draw_panel(int fb_width, int fb_height) {
                ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
   draw_panel_header();
   draw_run_section();
+  draw_tool_section();
   draw_contact_section();
   draw_timing_section();
   draw_display_section();
@@ -132,9 +143,11 @@ void ViewerApp::draw_run_section() {
   bool playing = dev.playing();
   if (ImGui::Button(playing ? "Pause" : "Play", ImVec2(70, 0))) dev.set_playing(!playing);
   ImGui::SameLine();
-  if (ImGui::Button("Step", ImVec2(60, 0))) {
+  char step_label[32];
+  std::snprintf(step_label, sizeof step_label, "Step %.0f ms", kStepTime_s * 1e3);
+  if (ImGui::Button(step_label, ImVec2(90, 0))) {
     dev.set_playing(false);
-    dev.request_steps(1);
+    dev.request_step_s(kStepTime_s);
   }
   ImGui::SameLine();
   if (ImGui::Button("Reset", ImVec2(60, 0))) reset_requested_ = true;
@@ -153,7 +166,14 @@ void ViewerApp::draw_run_section() {
   if (!driver_options_.paced) {
     ImGui::TextDisabled("headless: lock-step, %.4g s per frame", options_.frame_time_s);
   }
-  ImGui::Text("t = %.3f s   step %lld", l.t_s, static_cast<long long>(l.step));
+  // The device's clock: it stands still while paused (the loop's own time,
+  // which keeps ticking, is the step count's).
+  ImGui::Text("t = %.3f s   step %lld", dev.clock_s(), static_cast<long long>(l.step));
+  if (!playing) {
+    ImGui::SameLine();
+    ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.35f, 1.0f), "%s",
+                       dev.stepping() ? "stepping" : "paused");
+  }
   if (dev.source() == ToolSource::kScript) draw_script_progress();
 }
 
@@ -181,16 +201,44 @@ void ViewerApp::draw_script_progress() {
   }
 }
 
+void ViewerApp::draw_tool_section() {
+  // --- where the tool is ---
+  const Live& l = *live_;
+  const ToolReadout& r = l.readout;
+  section("Tool");
+  ImGui::Text("height %.3f m", r.height_m);
+  ImGui::SameLine();
+  if (r.depth_m > 0.0)
+    ImGui::Text("  depth %.3f m in the soil", r.depth_m);
+  else
+    ImGui::Text("  %.3f m above the soil", -r.depth_m);
+  // Rounded to the shown tenth first, so that -0.01 reads 0.0, not -0.0.
+  auto tenth = [](double deg) { return std::round(deg * 10.0) / 10.0 + 0.0; };
+  ImGui::Text("yaw %.1f deg   tilt %.1f deg", tenth(r.yaw_deg), tenth(r.tilt_deg));
+  if (driver_->device().source() == ToolSource::kMouse && r.depth_m <= 0.0)
+    ImGui::TextDisabled("scroll down to dig; left drag moves the tool");
+}
+
 void ViewerApp::draw_contact_section() {
   // --- live values and plots ---
   const Live& l = *live_;
+  const haptics::ViewWindow& w = l.window;
   section("Contact and force");
-  ImGui::Text("contact %.3f m   depth %.3f m", l.contact.length_m, l.contact.max_depth_m);
+  ImGui::Text("contact %.3f m   deepest %.3f m", l.contact.length_m, l.contact.max_depth_m);
   ImGui::Text("|F| %.1f N world   %.2f N device", double(magnitude(l.force_world_n)),
               double(magnitude(l.force_device_n)));
-  if (l.body_total > 0)
+  // Every tick since the previous drawn frame, so a brief contact shows.
+  ImGui::Text("this frame (%lld ticks): mean %.1f  max %.1f N", static_cast<long long>(w.ticks),
+              w.mean(w.force_sum_n), w.force_max_n);
+  if (std::abs(l.penetration_n) >= 0.05 || std::abs(l.twist_torque_n_m) >= 0.05)
+    ImGui::Text("push-in %.1f N   twist %.1f N m", l.penetration_n, l.twist_torque_n_m);
+  if (l.body_total > 0) {
     ImGui::Text("bodies %d (Bullet)   on the blade %.1f N", l.body_total,
                 double(magnitude(l.body_force_n)));
+    ImGui::Text("  this frame: mean %.1f  max %.1f N", w.mean(w.body_force_sum_n),
+                w.body_force_max_n);
+    ImGui::Text("  largest since the start or Reset: %.1f N", l.body_force_max_n);
+  }
   draw_plots();
 }
 
@@ -204,9 +252,16 @@ void ViewerApp::draw_plots() {
                    float(std::max(driver_->blade_length_m(), 1e-3)), ImVec2(plot_w, 52));
   float fmax = 1.0f;
   for (float v : l.force_hist) fmax = std::max(fmax, v);
-  std::snprintf(overlay, sizeof overlay, "force |F| %.0f N (max %.0f)", double(magnitude(l.force_world_n)), double(fmax));
+  std::snprintf(overlay, sizeof overlay, "|F| per frame max, N (plot max %.0f)", double(fmax));
   ImGui::PlotLines("##force", l.force_hist.data(), kHistory, l.hist_next, overlay, 0.0f,
                    fmax * 1.1f, ImVec2(plot_w, 52));
+  if (l.body_total > 0) {
+    float bmax = 1.0f;
+    for (float v : l.body_hist) bmax = std::max(bmax, v);
+    std::snprintf(overlay, sizeof overlay, "bodies' force per frame max, N (%.0f)", double(bmax));
+    ImGui::PlotLines("##bodies", l.body_hist.data(), kHistory, l.hist_next, overlay, 0.0f,
+                     bmax * 1.1f, ImVec2(plot_w, 44));
+  }
   float jmax = 50.0f;
   for (float v : l.jitter_hist) jmax = std::max(jmax, v);
   std::snprintf(overlay, sizeof overlay, driver_options_.paced ? "loop jitter, worst per frame (max %.0f us)"
@@ -236,12 +291,14 @@ void ViewerApp::draw_timing_section() {
                 l.stats.compute_p99_us, l.stats.compute_max_us);
   }
 
-  const RenderingCheck& check = d.force_model().rendering();
-  if (check.any_limited()) {
-    ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.35f, 1.0f), "device limits lowered:%s%s%s",
-                       check.surface_stiffness_limited ? " stiffness" : "",
-                       check.surface_damping_limited ? " damping" : "",
-                       check.cutting_damping_limited ? " cutting damping" : "");
+  // What the device check lowered, requested -> used.
+  const std::vector<std::string> changes = d.force_model().limit_changes();
+  if (!changes.empty()) {
+    ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.35f, 1.0f), "device limits lowered:");
+    ImGui::PushTextWrapPos(0.0f);
+    for (const std::string& c : changes)
+      ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.35f, 1.0f), "  %s", c.c_str());
+    ImGui::PopTextWrapPos();
   }
 }
 
@@ -313,6 +370,9 @@ void ViewerApp::draw_force_model_params() {
   ImGui::SetNextItemWidth(-110);
   if (ImGui::SliderFloat("rake deg", &rake, 20.0f, 160.0f, "%.0f"))
     fp.earthmoving.rake_angle_rad = rake * kDegToRad;
+  ImGui::Checkbox("push-in resistance", &fp.penetration.enabled);
+  ImGui::SameLine();
+  ImGui::Checkbox("twist resistance", &fp.twist_enabled);
   ImGui::Checkbox("surface spring", &fp.surface_enabled);
   float stiff = float(fp.surface.stiffness_n_per_m);
   ImGui::SetNextItemWidth(-110);
@@ -327,9 +387,11 @@ void ViewerApp::draw_force_model_params() {
 void ViewerApp::draw_help_section() {
   if (ImGui::CollapsingHeader("Mouse and keys")) {
     ImGui::TextWrapped(
-        "Left drag: move the tool in its horizontal plane.  Wheel: tool up/down.  Q/E: turn about "
+        "Left drag: move the tool in its horizontal plane (the first drag puts it down just above "
+        "the soil under the cursor).  Wheel: tool up/down (scroll down to dig).  Q/E: turn about "
         "Y.  R/F: tilt.  Right drag: orbit.  Middle drag: pan.  Shift+wheel: zoom.  Space: "
-        "play/pause.  N: step.  Backspace: reset.  T: top view.  C: colour.");
+        "play/pause.  N: step 20 ms.  Backspace: reset.  T: top view.  C: colour.  Esc or "
+        "Ctrl+Q: quit.");
   }
 }
 

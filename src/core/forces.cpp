@@ -322,6 +322,79 @@ SurfaceForce surface_force(const SurfaceParams& params, Vec3 device_point_m, Vec
 }
 
 // ---------------------------------------------------------------------------
+// Penetration
+// ---------------------------------------------------------------------------
+
+BearingFactors bearing_capacity_factors(double internal_friction_rad) noexcept {
+  const double phi = internal_friction_rad;
+  const double t = std::tan(phi);
+  const double k = std::tan(0.25 * kPi + 0.5 * phi);
+  BearingFactors f;
+  f.n_q = std::exp(kPi * t) * k * k;
+  // (N_q - 1) cot phi is 0/0 at phi = 0; its limit is pi + 2 and the
+  // series N_q - 1 = (pi + 2) phi + O(phi^2) makes it continuous there.
+  f.n_c = phi < 1e-7 ? kPi + 2.0 : (f.n_q - 1.0) / t;
+  f.n_gamma = 2.0 * (f.n_q + 1.0) * t;
+  return f;
+}
+
+std::string validate(const PenetrationParams& params) {
+  return check_positive("edge_thickness_m", params.edge_thickness_m);
+}
+
+PenetrationResult penetration_resistance(const SoilParams& soil, const PenetrationParams& params,
+                                         double length_m, double depth_m,
+                                         double surcharge_pa) noexcept {
+  PenetrationResult out;
+  if (!(length_m > 0.0) || !(depth_m > 0.0)) return out;
+  const double b = params.edge_thickness_m;
+  const double gamma = soil.unit_weight_n_per_m3;
+  const BearingFactors f = bearing_capacity_factors(soil.internal_friction_rad);
+  const double q = gamma * depth_m + soil.surcharge_pa + surcharge_pa;
+  out.bearing_pa = soil.cohesion_pa * f.n_c + q * f.n_q + 0.5 * gamma * b * f.n_gamma;
+  out.tip_n = out.bearing_pa * b * length_m * std::min(1.0, depth_m / b);
+  const double k0 = 1.0 - std::sin(soil.internal_friction_rad);
+  out.side_n = 2.0 * length_m *
+               (0.5 * k0 * gamma * depth_m * depth_m * std::tan(soil.soil_tool_friction_rad) +
+                soil.adhesion_pa * depth_m);
+  return out;
+}
+
+Vec3 penetration_world_force(const PenetrationResult& result, Vec3 velocity_m_per_s,
+                             double low_speed_damping_n_s_per_m) noexcept {
+  const double vy = velocity_m_per_s.y;
+  if (vy < 0.0) return {0.0, saturated_drag_n(result.down_n(), -vy, low_speed_damping_n_s_per_m), 0.0};
+  if (vy > 0.0) return {0.0, -saturated_drag_n(result.up_n(), vy, low_speed_damping_n_s_per_m), 0.0};
+  return {0.0, vy == 0.0 ? 0.0 : vy, 0.0};  // NaN passes through
+}
+
+// ---------------------------------------------------------------------------
+// Twist
+// ---------------------------------------------------------------------------
+
+TwistResult twist_resistance(double resistance_n_per_m, const TwistEngagement& engagement,
+                             double yaw_rate_rad_per_s, double low_speed_damping_n_s_per_m,
+                             double blade_length_m) noexcept {
+  TwistResult out;
+  const double w = yaw_rate_rad_per_s;
+  if (!std::isfinite(w)) {
+    out.torque_n_m = out.net_force_n = w;  // for the safety limiter to catch
+    return out;
+  }
+  const double torque = resistance_n_per_m * engagement.abs_moment_m2;
+  if (w == 0.0 || !(torque > 0.0)) return out;
+  // Every part a damper of beta / blade_length per metre below saturation:
+  // the torque of the whole grows as beta |omega| integral s^2 ds / L_blade.
+  const double rotational_damping =
+      low_speed_damping_n_s_per_m * engagement.second_moment_m3 / blade_length_m;
+  const double scale = saturated_drag_n(torque, std::abs(w), rotational_damping) / torque;
+  const double sense = w > 0.0 ? -1.0 : 1.0;
+  out.torque_n_m = sense * torque * scale;
+  out.net_force_n = sense * resistance_n_per_m * engagement.signed_length_m * scale;
+  return out;
+}
+
+// ---------------------------------------------------------------------------
 // Device limits
 // ---------------------------------------------------------------------------
 
@@ -376,6 +449,7 @@ std::string validate(const ForceModelParams& params) {
   if (auto m = nested("contact_drag", validate(params.contact_drag)); !m.empty()) return m;
   if (auto m = nested("earthmoving", validate(params.earthmoving)); !m.empty()) return m;
   if (auto m = nested("surface", validate(params.surface)); !m.empty()) return m;
+  if (auto m = nested("penetration", validate(params.penetration)); !m.empty()) return m;
   if (auto m = check_positive("low_speed_damping_n_s_per_m", params.low_speed_damping_n_s_per_m);
       !m.empty())
     return m;
@@ -403,6 +477,8 @@ ForceModel::ForceModel(const ForceModelParams& params) : requested_(params), par
   // the device's figure and Colgate & Brown's passivity bound for that damping.
   if (params.surface_enabled) {
     double damping = params.surface.damping_n_s_per_m * gain;
+    check_.requested_surface_damping_n_s_per_m = damping;
+    check_.requested_surface_stiffness_n_per_m = params.surface.stiffness_n_per_m * gain;
     if (damping > dev.max_damping_n_s_per_m) {
       if (refuse) {
         throw InputError("surface.damping_n_s_per_m = " +
@@ -455,12 +531,14 @@ ForceModel::ForceModel(const ForceModelParams& params) : requested_(params), par
   }
 
   // Cutting: the low-speed slope (and the viscous term at the longest
-  // contact) is a virtual damping, within the device's figure.
+  // contact) is a virtual damping, within the device's figure. The same
+  // slope regularises penetration and twist.
   if (params.cutting != CuttingModel::kNone) {
     double viscous = params.cutting == CuttingModel::kContactDrag
                          ? params.contact_drag.viscous_n_s_per_m2 * params.max_contact_length_m
                          : 0.0;
     double damping = (params.low_speed_damping_n_s_per_m + viscous) * gain;
+    check_.requested_cutting_damping_n_s_per_m = damping;
     if (damping > dev.max_damping_n_s_per_m) {
       if (refuse) {
         throw InputError(
@@ -472,14 +550,41 @@ ForceModel::ForceModel(const ForceModelParams& params) : requested_(params), par
             " is " + format_number(damping) + " N s/m on the device" + scaling +
             ", above device.max_damping_n_s_per_m = " + format_number(dev.max_damping_n_s_per_m));
       }
-      double factor = dev.max_damping_n_s_per_m / damping;
-      params_.low_speed_damping_n_s_per_m *= factor;
-      params_.contact_drag.viscous_n_s_per_m2 *= factor;
+      // Scale the whole soil force, not its low-speed slope alone: a lower
+      // slope alone would make the force velocity-bound (min(k L, beta |v|)
+      // = beta |v| at ordinary speeds), flat whatever the contact.
+      check_.cutting_gain = dev.max_damping_n_s_per_m / damping;
       damping = dev.max_damping_n_s_per_m;
       check_.cutting_damping_limited = true;
     }
     check_.cutting_damping_n_s_per_m = damping;
   }
+}
+
+std::vector<std::string> ForceModel::limit_changes() const {
+  std::vector<std::string> out;
+  const RenderingCheck& c = check_;
+  auto line = [](const std::string& what, double world_from, double world_to, double device_from,
+                 double device_to, const std::string& unit) {
+    return what + " " + format_number(world_from) + " -> " + format_number(world_to) + " " + unit +
+           " (world; " + format_number(device_from) + " -> " + format_number(device_to) + " " +
+           unit + " on the device)";
+  };
+  if (c.surface_stiffness_limited)
+    out.push_back(line("surface stiffness", requested_.surface.stiffness_n_per_m,
+                       params_.surface.stiffness_n_per_m, c.requested_surface_stiffness_n_per_m,
+                       c.surface_stiffness_n_per_m, "N/m"));
+  if (c.surface_damping_limited)
+    out.push_back(line("surface damping", requested_.surface.damping_n_s_per_m,
+                       params_.surface.damping_n_s_per_m, c.requested_surface_damping_n_s_per_m,
+                       c.surface_damping_n_s_per_m, "N s/m"));
+  if (c.cutting_damping_limited)
+    out.push_back(line("cutting damping", params_.low_speed_damping_n_s_per_m,
+                       params_.low_speed_damping_n_s_per_m * c.cutting_gain,
+                       c.requested_cutting_damping_n_s_per_m, c.cutting_damping_n_s_per_m,
+                       "N s/m") +
+                  ": the whole soil force x " + format_number(c.cutting_gain));
+  return out;
 }
 
 ForceOutput ForceModel::compute(const ForceInput& input) const noexcept {
@@ -498,7 +603,7 @@ ForceOutput ForceModel::compute(const ForceInput& input) const noexcept {
                                          params_.low_speed_damping_n_s_per_m);
       break;
     case CuttingModel::kEarthmoving: {
-      double width = input.contact_length_m;
+      double width = input.cut_width_m >= 0.0 ? input.cut_width_m : input.contact_length_m;
       // Engaged width across the horizontal motion: L |e x u|.
       double edge_len = length(input.edge_direction);
       double speed_xz = std::hypot(v.x, v.z);
@@ -521,7 +626,41 @@ ForceOutput ForceModel::compute(const ForceInput& input) const noexcept {
       break;
     }
   }
-  out.world_n = out.cutting_n + out.surface_n;
+  if (params_.cutting != CuttingModel::kNone) {
+    const double beta = params_.low_speed_damping_n_s_per_m;
+    const SoilParams& soil = params_.earthmoving.soil;
+    if (params_.penetration.enabled) {
+      out.penetration = penetration_resistance(soil, params_.penetration, input.embedded_length_m,
+                                               input.embedment_depth_m, input.surcharge_pa);
+      out.penetration_n = penetration_world_force(out.penetration, v, beta);
+    }
+    if (params_.twist_enabled && input.yaw_rate_rad_per_s != 0.0 &&
+        input.twist.engaged_length_m > 0.0) {
+      // The soil's resistance per metre of edge: the drag per metre of
+      // contact, or the earthmoving force per metre of width at the depth.
+      const double per_m =
+          params_.cutting == CuttingModel::kContactDrag
+              ? params_.contact_drag.drag_n_per_m
+              : earthmoving_force(params_.earthmoving, 1.0, input.twist_depth_m).horizontal_n;
+      const TwistResult t = twist_resistance(per_m, input.twist, input.yaw_rate_rad_per_s, beta,
+                                             input.blade_length_m);
+      out.twist_torque_n_m = t.torque_n_m;
+      // n = Y x e, the horizontal normal of the edge.
+      const double ex = input.edge_direction.x, ez = input.edge_direction.z;
+      const double eh = std::hypot(ex, ez);
+      if (eh > 0.0) out.twist_n = Vec3{ez / eh, 0.0, -ex / eh} * t.net_force_n;
+    }
+    // A device that cannot render the cutting damping gets the whole soil
+    // force scaled (RenderingCheck::cutting_gain).
+    const double k = check_.cutting_gain;
+    if (k != 1.0) {
+      out.cutting_n = out.cutting_n * k;
+      out.penetration_n = out.penetration_n * k;
+      out.twist_n = out.twist_n * k;
+      out.twist_torque_n_m *= k;
+    }
+  }
+  out.world_n = out.cutting_n + out.penetration_n + out.twist_n + out.surface_n;
   out.device_n = out.world_n * params_.force_scale;
   return out;
 }

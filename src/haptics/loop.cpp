@@ -45,6 +45,9 @@ HapticLoop::HapticLoop(const LoopParams& params, Simulation& sim, Quat default_o
       default_orientation_(normalized(default_orientation)) {
   const HapticSettings& settings = params_.settings();
   if (options_.ticks < 1) throw InputError("haptics: the loop needs at least one tick");
+  if (!(std::isfinite(options_.end_after_silence_s) && options_.end_after_silence_s >= 0.0))
+    throw InputError(must_be("haptics: end_after_silence_s", "finite and >= 0",
+                             options_.end_after_silence_s));
   if (sim_.params().rate_hz != params_.rate_hz())
     throw InputError("haptics: the simulation steps at " + format_number(sim_.params().rate_hz) +
                      " Hz, the loop runs at haptics.rate_hz " + format_number(params_.rate_hz()) +
@@ -83,12 +86,19 @@ void HapticLoop::step1(double t_s) noexcept {
     safety_.restart(t_s);
   }
   const bool bad = !read_device(t_s);
+  // A device that sent and then fell silent long enough has ended its session.
+  if (options_.end_after_silence_s > 0.0 && has_sample_ &&
+      t_s - last_sample_t_s_ > options_.end_after_silence_s && !ended_with_device_) {
+    ended_with_device_ = true;
+    request_stop();
+  }
 
   // Without a usable sample (none yet, or a bad one) the simulation is not
   // stepped: nothing is measured or cut.
   stepped_ = has_sample_ && !bad;
   if (!stepped_) {
     velocity_m_per_s_ = {};
+    yaw_rate_rad_per_s_ = 0.0;
     has_previous_tool_ = false;  // start the estimate afresh
     return;
   }
@@ -118,6 +128,8 @@ bool HapticLoop::read_device(double t_s) noexcept {
   }
   sample_ = fresh;
   device_position_m_ = fresh.position_m;
+  if (!has_sample_) trips_before_first_sample_ = safety_.counters().watchdog_trips;
+  trips_at_newest_sample_ = safety_.counters().watchdog_trips;
   has_sample_ = true;
   last_sample_t_s_ = t_s;
   if (fresh.reconnected) {
@@ -147,14 +159,34 @@ BladePose HapticLoop::tool_pose() const noexcept {
 // (a device slower than the loop does not read as stop-and-go).
 void HapticLoop::estimate_velocity(const BladePose& pose, double t_s) noexcept {
   if (tick_flags_ & kFlagSilent) return;
-  if (has_previous_tool_ && t_s > previous_tool_t_s_) {
-    const double dt = t_s - previous_tool_t_s_;
+  // The interval between the samples: on the device's clock when it gives
+  // one (a late network packet is not a jump in speed), else the loop's.
+  const double device_t = sample_.device_time_s;
+  const bool device_clock = std::isfinite(device_t) && std::isfinite(previous_device_t_s_) &&
+                            device_t > previous_device_t_s_;
+  if (has_previous_tool_ && (device_clock || t_s > previous_tool_t_s_)) {
+    const double dt = device_clock ? device_t - previous_device_t_s_ : t_s - previous_tool_t_s_;
     const Vec3 raw = (pose.position_m - previous_tool_m_) * (1.0 / dt);
     const double alpha = filter_rc_s_ > 0.0 ? 1.0 - std::exp(-dt / filter_rc_s_) : 1.0;
     velocity_m_per_s_ = velocity_m_per_s_ + (raw - velocity_m_per_s_) * alpha;
   } else {
     velocity_m_per_s_ = {};
   }
+  // The yaw rate: the turn of the edge's horizontal direction about +Y
+  // (Ry(a) X = (cos a, 0, -sin a)), filtered as the velocity is.
+  const Vec3 edge_dir = rotate(pose.orientation, Vec3{1.0, 0.0, 0.0});
+  const bool level = std::hypot(edge_dir.x, edge_dir.z) > 1e-6;
+  const double yaw = level ? std::atan2(-edge_dir.z, edge_dir.x) : previous_yaw_rad_;
+  if (has_previous_tool_ && (device_clock || t_s > previous_tool_t_s_)) {
+    const double dt = device_clock ? device_t - previous_device_t_s_ : t_s - previous_tool_t_s_;
+    const double turn = std::remainder(yaw - previous_yaw_rad_, 2.0 * std::numbers::pi);
+    const double alpha = filter_rc_s_ > 0.0 ? 1.0 - std::exp(-dt / filter_rc_s_) : 1.0;
+    yaw_rate_rad_per_s_ += (turn / dt - yaw_rate_rad_per_s_) * alpha;
+  } else {
+    yaw_rate_rad_per_s_ = 0.0;
+  }
+  previous_yaw_rad_ = yaw;
+  previous_device_t_s_ = device_t;
   previous_tool_m_ = pose.position_m;
   previous_tool_t_s_ = t_s;
   has_previous_tool_ = true;
@@ -199,12 +231,31 @@ ForceOutput HapticLoop::world_force(const StepOutput& out, const CutLoad& load) 
   in.contact_length_m = out.contact.length_m;
   in.cut_depth_m = load.depth_m;
   in.surcharge_pa = load.surcharge_pa;
+  in.cut_width_m = load.width_m;
   in.edge_direction = out.edge.b - out.edge.a;
   in.device_point_m = out.pose.position_m;
   in.surface_y_m = settings.surface_reference == SurfaceReference::kGround
                        ? sim_.grid().spec().origin_m.y
                        : surface_y_m(sim_.grid(), sim_.params().representation,
                                      out.pose.position_m.x, out.pose.position_m.z);
+  // What penetration and twist read: how deep the edge sits in the soil
+  // beside it, and which parts of it a turn drives into soil.
+  const ForceModelParams& fp = params_.force_model().params();
+  in.blade_length_m = fp.max_contact_length_m;
+  if (fp.cutting != CuttingModel::kNone) {
+    if (fp.penetration.enabled) {
+      const Embedment emb =
+          embedment(sim_.grid(), sim_.params().representation, out.edge, lookahead_m_);
+      in.embedment_depth_m = emb.depth_m;
+      in.embedded_length_m = emb.length_m;
+    }
+    if (fp.twist_enabled && yaw_rate_rad_per_s_ != 0.0) {
+      in.yaw_rate_rad_per_s = yaw_rate_rad_per_s_;
+      in.twist = twist_engagement(sim_.grid(), sim_.params().representation, out.edge,
+                                  out.pose.position_m, yaw_rate_rad_per_s_, lookahead_m_,
+                                  in.twist_depth_m);
+    }
+  }
   ForceOutput force = params_.force_model().compute(in);
   // The soil a bucket carries weighs on it (unit weight x volume, straight down).
   const double load_n = params_.force_model().params().earthmoving.soil.unit_weight_n_per_m3 *
@@ -232,6 +283,9 @@ LoopRecord& HapticLoop::write_record(const StepOutput& out, const ForceOutput& f
   r.velocity_m_per_s = velocity_m_per_s_;
   r.force_world_n = force.world_n;
   r.body_force_world_n = body_force;
+  r.penetration_force_n = force.penetration_n.y;
+  r.twist_torque_n_m = force.twist_torque_n_m;
+  r.yaw_rate_rad_per_s = yaw_rate_rad_per_s_;
   r.force_device_n = command.force_n;
   r.flags = command.flags;
   r.period_s = period_s;
@@ -260,6 +314,9 @@ void HapticLoop::publish_frame(const StepOutput& out, const ForceOutput& force,
   f.force_world_n = force.world_n;
   f.force_device_n = command.force_n;
   f.body_force_world_n = last_.body_force_world_n;
+  f.penetration_force_n = force.penetration_n.y;
+  f.twist_torque_n_m = force.twist_torque_n_m;
+  f.yaw_rate_rad_per_s = yaw_rate_rad_per_s_;
   f.step_time_s = compute_s;
   f.period_s = period_s;
   fill_bodies(f, options_.bodies);
@@ -269,17 +326,18 @@ void HapticLoop::publish_frame(const StepOutput& out, const ForceOutput& force,
 HapticLoop::CutLoad HapticLoop::cut_load(const StepOutput& out) const noexcept {
   if (out.contact.length_m <= 0.0) return {};
   if (params_.settings().cut_depth == CutDepthMeasure::kSection)
-    return {out.contact.section_area_m2 / out.contact.length_m, 0.0};
-  if (sim_.params().soil.model != SoilModel::kFlow)
-    return {depth_ahead_m(sim_.grid(), sim_.params().representation, out.edge, velocity_m_per_s_,
-                          lookahead_m_),
-            0.0};
+    return {out.contact.section_area_m2 / out.contact.length_m, 0.0, -1.0};
+  if (sim_.params().soil.model != SoilModel::kFlow) {
+    const CutAhead ahead = cut_ahead(sim_.grid(), sim_.params().representation, out.edge,
+                                     velocity_m_per_s_, lookahead_m_);
+    return {ahead.depth_m, 0.0, ahead.width_m};
+  }
   // Soil that flows: the pile the blade pushes is not depth of cut but a
   // surcharge on the failure wedge (q = unit weight x pile height).
   const SoilAhead ahead = soil_ahead(sim_.grid(), sim_.params().representation, out.edge,
                                      velocity_m_per_s_, lookahead_m_);
   const double unit_weight = params_.force_model().params().earthmoving.soil.unit_weight_n_per_m3;
-  return {ahead.depth_m, unit_weight * ahead.pile_m};
+  return {ahead.depth_m, unit_weight * ahead.pile_m, ahead.width_m};
 }
 
 void HapticLoop::record(const LoopRecord& r) noexcept {

@@ -52,6 +52,10 @@ void parse_forces(const yaml::Map& f, ForceModelParams& p) {
   f.read_number("force_scale", p.force_scale);
   f.read_number("low_speed_damping_n_s_per_m", p.low_speed_damping_n_s_per_m);
   f.read_boolean("project_width_on_motion", p.project_width_on_motion);
+  f.read_boolean("twist_enabled", p.twist_enabled);
+  const yaml::Map pen = f.section("penetration", {"enabled", "edge_thickness_m"});
+  pen.read_boolean("enabled", p.penetration.enabled);
+  pen.read_number("edge_thickness_m", p.penetration.edge_thickness_m);
   if (const auto policy = f.get("policy"))
     p.policy = policy->choice({LimitPolicy::kClamp, LimitPolicy::kRefuse});
 
@@ -119,7 +123,8 @@ HapticSettings parse_haptics(const YAML::Node& node, const std::string& file) {
     s.cut_depth = f->choice({CutDepthMeasure::kAhead, CutDepthMeasure::kSection});
 
   parse_forces(top.section("forces", {"cutting", "force_scale", "low_speed_damping_n_s_per_m",
-                                      "project_width_on_motion", "policy", "contact_drag",
+                                      "project_width_on_motion", "twist_enabled", "penetration",
+                                      "policy", "contact_drag",
                                       "earthmoving", "surface", "device"}),
                s.forces);
 

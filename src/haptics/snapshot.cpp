@@ -36,10 +36,22 @@ void SnapshotExchange::publish(const HeightGrid& grid) {
   }
   // If the reader has not taken the previous frame, it will skip it, so this
   // frame's dirty region must also hold the previous one's.
+  // The same for the window of ticks the frame sums up.
+  ViewWindow window;
+  window.ticks = 1;
+  window.force_max_n = window.force_sum_n = length(f.force_world_n);
+  window.body_force_max_n = window.body_force_sum_n = length(f.body_force_world_n);
+  window.device_force_max_n = length(f.force_device_n);
+  window.contact_max_m = window.contact_sum_m = f.contact.length_m;
   Rect dirty = dirty_since_publish_;
-  if (middle_.load(std::memory_order_acquire) & kFresh) dirty.include(last_published_dirty_);
+  if (middle_.load(std::memory_order_acquire) & kFresh) {
+    dirty.include(last_published_dirty_);
+    window.merge(last_published_window_);
+  }
   f.dirty = dirty;
+  f.window = window;
   last_published_dirty_ = dirty;
+  last_published_window_ = window;
   dirty_since_publish_ = {};
   f.sequence = ++sequence_;
   unsigned old = middle_.exchange(back_ | kFresh, std::memory_order_acq_rel);
@@ -51,6 +63,17 @@ const ViewFrame* SnapshotExchange::acquire() {
   unsigned old = middle_.exchange(front_, std::memory_order_acq_rel);
   front_ = old & ~kFresh;
   return &frames_[front_];
+}
+
+void ViewWindow::merge(const ViewWindow& other) {
+  ticks += other.ticks;
+  force_max_n = std::max(force_max_n, other.force_max_n);
+  force_sum_n += other.force_sum_n;
+  body_force_max_n = std::max(body_force_max_n, other.body_force_max_n);
+  body_force_sum_n += other.body_force_sum_n;
+  device_force_max_n = std::max(device_force_max_n, other.device_force_max_n);
+  contact_max_m = std::max(contact_max_m, other.contact_max_m);
+  contact_sum_m += other.contact_sum_m;
 }
 
 void fill_bodies(ViewFrame& frame, const BodySource* source) noexcept {

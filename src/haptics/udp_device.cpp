@@ -80,6 +80,7 @@ struct UdpDevice::Impl {
   std::array<std::uint8_t, kMaxBridgePacketSize> tx{};
   PosePayload newest{};
   std::uint32_t newest_sequence = 0;
+  std::uint64_t newest_timestamp_ns = 0;
 };
 
 UdpDevice::UdpDevice(const std::string& address, int port) : impl_(std::make_unique<Impl>()) {
@@ -118,6 +119,7 @@ bool UdpDevice::read(double t_s, DeviceSample& out) noexcept {
         if (filter_.new_session() && filter_.sessions() > 1) reconnected_ = true;
         impl_->newest = pose;
         impl_->newest_sequence = header.sequence;
+        impl_->newest_timestamp_ns = header.timestamp_ns;
         impl_->peer = impl_->sender;
         impl_->has_peer = true;
         got = true;
@@ -129,6 +131,9 @@ bool UdpDevice::read(double t_s, DeviceSample& out) noexcept {
   out.orientation = out.has_orientation ? p.orientation : Quat{};
   out.buttons = p.buttons;
   out.reconnected = reconnected_;
+  // The sender's clock (nanoseconds, any origin): kept to microseconds in a
+  // double for about 285 years of uptime.
+  out.device_time_s = double(impl_->newest_timestamp_ns) * 1e-9;
   return true;
 }
 

@@ -100,24 +100,7 @@ HapticRig::~HapticRig() {
 }
 
 std::vector<std::string> HapticRig::rendering_changes() const {
-  std::vector<std::string> out;
-  const RenderingCheck& rc = loop_->force_model().rendering();
-  const ForceModelParams& used = loop_->force_model().params();
-  if (rc.surface_stiffness_limited)
-    out.push_back("forces.surface.stiffness_n_per_m lowered to " +
-                  format_number(used.surface.stiffness_n_per_m) + " N/m (world; " +
-                  format_number(rc.surface_stiffness_n_per_m) +
-                  " N/m on the device) to stay passive and within the device");
-  if (rc.surface_damping_limited)
-    out.push_back("forces.surface.damping_n_s_per_m lowered to " +
-                  format_number(used.surface.damping_n_s_per_m) + " N s/m (world; " +
-                  format_number(rc.surface_damping_n_s_per_m) + " N s/m on the device)");
-  if (rc.cutting_damping_limited)
-    out.push_back("forces.low_speed_damping_n_s_per_m lowered to " +
-                  format_number(used.low_speed_damping_n_s_per_m) +
-                  " N s/m (world; cutting damping " +
-                  format_number(rc.cutting_damping_n_s_per_m) + " N s/m on the device, its limit)");
-  return out;
+  return loop_->force_model().limit_changes();
 }
 
 HapticSession::HapticSession(const Scenario& input, const SessionOptions& options)
@@ -193,6 +176,7 @@ HapticSession::HapticSession(const Scenario& input, const SessionOptions& option
   ro.loop.record_capacity = std::min<std::size_t>(options.max_records, std::size_t(ro.loop.ticks));
   ro.loop.realtime = options.realtime;
   ro.loop.snapshot = options.snapshot;
+  if (options.end_with_device) ro.loop.end_after_silence_s = kDeviceEndSilence_s;
   ro.bodies_csv = options.bodies_csv;
   try {
     rig_ = std::make_unique<HapticRig>(input, *params, default_orientation, *device_, ro);
@@ -257,10 +241,13 @@ std::vector<std::string> HapticSession::warnings() const {
   if (c.missed_deadlines > 0)
     w.push_back(std::to_string(c.missed_deadlines) +
                 " ticks started late: the tick before ran past their deadline (see timing_us)");
-  if (s.watchdog_trips > 0)
-    w.push_back("the watchdog ramped the force to zero " + std::to_string(s.watchdog_trips) +
-                " times (no device sample for more than safety.watchdog_timeout_s, counting the "
-                "wait for the first sample)");
+  // The waits before the device's first sample and after its last are
+  // expected (the safety limiter holds zero force then); a silence in between
+  // is not.
+  if (const std::int64_t trips = l.watchdog_trips_while_active(); trips > 0)
+    w.push_back("the watchdog ramped the force to zero " + std::to_string(trips) +
+                " times while the device was sending (no sample for more than "
+                "safety.watchdog_timeout_s)");
   if (c.records_dropped > 0)
     w.push_back(std::to_string(c.records_dropped) +
                 " oldest records were not kept (the session was longer than max_records)");
@@ -303,6 +290,7 @@ std::string HapticSession::summary_json() const {
   j << "  \"rate_hz\": " << json_number(st.rate_hz) << ",\n";
   j << "  \"duration_s\": " << json_number(duration_s_) << ",\n";
   j << "  \"ticks\": " << c.ticks << ",\n";
+  j << "  \"ended_with_device\": " << (l.ended_with_device() ? "true" : "false") << ",\n";
   j << "  \"wall_s\": " << json_number(wall_s_) << ",\n";
   j << "  \"realtime\": {\"fifo\": " << (l.realtime_status().fifo ? "true" : "false")
     << ", \"priority\": " << l.realtime_status().priority
@@ -325,6 +313,7 @@ std::string HapticSession::summary_json() const {
   j << "  \"safety\": {\"samples\": " << s.samples << ", \"clamped\": " << s.clamped
     << ", \"rate_limited\": " << s.rate_limited << ", \"ramping\": " << s.ramping
     << ", \"watchdog\": " << s.watchdog << ", \"watchdog_trips\": " << s.watchdog_trips
+    << ", \"watchdog_trips_while_active\": " << l.watchdog_trips_while_active()
     << ", \"nonfinite\": " << s.nonfinite << ", \"restarts\": " << s.restarts << "},\n";
 
   // Rejected bridge packets by reason (all zero for script and sim).
@@ -359,7 +348,17 @@ std::string HapticSession::summary_json() const {
     << ", \"surface_stiffness_limited\": " << (rc.surface_stiffness_limited ? "true" : "false")
     << ", \"surface_damping_limited\": " << (rc.surface_damping_limited ? "true" : "false")
     << ", \"cutting_damping_limited\": " << (rc.cutting_damping_limited ? "true" : "false")
-    << "},\n";
+    << ", \"requested_surface_stiffness_n_per_m\": "
+    << json_number(rc.requested_surface_stiffness_n_per_m)
+    << ", \"requested_surface_damping_n_s_per_m\": "
+    << json_number(rc.requested_surface_damping_n_s_per_m)
+    << ", \"requested_cutting_damping_n_s_per_m\": "
+    << json_number(rc.requested_cutting_damping_n_s_per_m)
+    << ", \"cutting_gain\": " << json_number(rc.cutting_gain) << ", \"changes\": [";
+  const std::vector<std::string> changes = l.force_model().limit_changes();
+  for (std::size_t i = 0; i < changes.size(); ++i)
+    j << (i ? ", " : "") << json_string(changes[i]);
+  j << "]},\n";
   j << "    \"safety_limits\": {\"max_force_n\": " << json_number(st.safety.max_force_n)
     << ", \"max_force_rate_n_per_s\": " << json_number(st.safety.max_force_rate_n_per_s)
     << ", \"rise_time_s\": " << json_number(st.safety.rise_time_s)

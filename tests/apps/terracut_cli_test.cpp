@@ -258,12 +258,17 @@ TEST_F(CliTest, HapticsWithBodiesFeelsThemAndWritesTheirPoses) {
 TEST_F(CliTest, RealtimeRunReportsStepTimeJitterAndMissedDeadlines) {
   const fs::path out = dir_ / "out";
   const Result r = terracut({"run", scenario("mound_generator.yaml"), "--out", out.string(),
-                             "--resolution", "16", "--realtime", "--quiet"});
+                             "--resolution", "16", "--realtime"});
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string summary = slurp(out / "summary.json");
   for (const char* key : {"\"realtime\"", "\"missed_deadlines\"", "\"period_jitter\"",
                           "\"step_time\"", "\"p50_us\"", "\"p99_us\"", "\"max_us\""})
     EXPECT_NE(summary.find(key), std::string::npos) << key;
+  // A readable line on stdout (the scenario steps at 500 Hz); the JSON only
+  // in summary.json.
+  EXPECT_NE(r.out.find("realtime at 500 Hz:"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("missed deadlines"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find('{'), std::string::npos) << r.out;
 }
 
 TEST_F(CliTest, RunOptionsOverrideTheScenario) {
@@ -327,6 +332,9 @@ TEST_F(CliTest, BadOptionsAreReported) {
                        {"--representation"}, 2);
   expect_clean_failure(terracut({"run", sc}), {"--out"}, 2);
   expect_clean_failure(terracut({}), {"subcommand"}, 2);
+  // An unknown option is named first, before the required ones it hides.
+  expect_clean_failure(terracut({"run", "--bogus"}), {"unknown option", "--bogus"}, 2);
+  expect_clean_failure(terracut({"run", sc, "--bogus"}), {"--bogus"}, 2);
   // An output folder that cannot be made.
   write("file", "x");
   expect_clean_failure(terracut({"run", sc, "--out", (dir_ / "file" / "sub").string()}),

@@ -630,7 +630,7 @@ TEST(ForceModel, ClampFitsTheDefaultsToALargeWorkspaceMapping) {
   // The limited world values render as those device values.
   const double gain = p.force_scale * p.workspace_scale;
   EXPECT_NEAR(model.params().surface.stiffness_n_per_m * gain, 1500.0, 1e-9);
-  EXPECT_NEAR(model.params().low_speed_damping_n_s_per_m * gain, 20.0, 1e-9);
+  EXPECT_NEAR(model.params().low_speed_damping_n_s_per_m * c.cutting_gain * gain, 20.0, 1e-9);
   // Passive by Colgate & Brown's condition.
   EXPECT_LE(c.surface_stiffness_n_per_m * 1e-3 / 2 + c.surface_damping_n_s_per_m,
             p.device.inherent_damping_n_s_per_m + 1e-12);
@@ -679,7 +679,8 @@ TEST(ForceModel, DampingLimits) {
   EXPECT_TRUE(clamped.rendering().cutting_damping_limited);
   EXPECT_NEAR(clamped.rendering().cutting_damping_n_s_per_m, 20.0, 1e-9);
   const ForceModelParams& e = clamped.params();
-  EXPECT_NEAR((e.low_speed_damping_n_s_per_m + e.contact_drag.viscous_n_s_per_m2 * 1.0) * 0.02,
+  EXPECT_NEAR((e.low_speed_damping_n_s_per_m + e.contact_drag.viscous_n_s_per_m2 * 1.0) * 0.02 *
+                  clamped.rendering().cutting_gain,
               20.0, 1e-9);
 }
 
@@ -750,6 +751,257 @@ TEST(ForceModel, EarthmovingWidthAcrossTheMotion) {
   EXPECT_NEAR(length(model.compute(in).world_n), 0.0, 1e-9);
   in.edge_direction = {};  // unknown: the contact length
   EXPECT_NEAR(model.compute(in).engaged_width_m, 0.5, 1e-15);
+}
+
+// ---------------------------------------------------------------------------
+// Penetration: bearing capacity under the edge, friction on its faces
+// ---------------------------------------------------------------------------
+
+TEST(Bearing, FactorsMatchVesicsTable) {
+  // Vesic (1973), as tabulated in Das, Principles of Foundation Engineering
+  // (N_c, N_q, N_gamma to two decimals).
+  struct Row {
+    double phi_deg, n_c, n_q, n_gamma;
+  };
+  for (const Row& r : {Row{0, 5.14, 1.00, 0.00}, Row{10, 8.35, 2.47, 1.22},
+                       Row{20, 14.83, 6.40, 5.39}, Row{30, 30.14, 18.40, 22.40},
+                       Row{40, 75.31, 64.20, 109.41}}) {
+    const BearingFactors f = bearing_capacity_factors(r.phi_deg * kDeg);
+    EXPECT_NEAR(f.n_c, r.n_c, 0.006 * std::max(1.0, r.n_c)) << r.phi_deg;
+    EXPECT_NEAR(f.n_q, r.n_q, 0.006 * std::max(1.0, r.n_q)) << r.phi_deg;
+    EXPECT_NEAR(f.n_gamma, r.n_gamma, 0.006 * std::max(1.0, r.n_gamma)) << r.phi_deg;
+  }
+  // Frictionless: Prandtl's pi + 2, continuous as phi -> 0.
+  EXPECT_EQ(bearing_capacity_factors(0.0).n_c, kPi + 2.0);
+  EXPECT_NEAR(bearing_capacity_factors(1e-6).n_c, kPi + 2.0, 1e-4);
+  EXPECT_NEAR(bearing_capacity_factors(0.0).n_q, 1.0, 1e-15);
+  EXPECT_EQ(bearing_capacity_factors(0.0).n_gamma, 0.0);
+}
+
+SoilParams frictionless_soil(double cohesion_pa) {
+  SoilParams s;
+  s.internal_friction_rad = 0.0;
+  s.soil_tool_friction_rad = 0.0;
+  s.cohesion_pa = cohesion_pa;
+  s.adhesion_pa = 0.0;
+  s.surcharge_pa = 0.0;
+  return s;
+}
+
+TEST(Penetration, ZeroDepthOrLengthGivesZero) {
+  const SoilParams soil = soil_preset(SoilPreset::kClay);  // cohesion and adhesion
+  const PenetrationParams p;
+  for (double d : {0.0, -0.01}) {
+    const PenetrationResult r = penetration_resistance(soil, p, 0.5, d);
+    EXPECT_EQ(r.down_n(), 0.0);
+    EXPECT_EQ(r.up_n(), 0.0);
+  }
+  EXPECT_EQ(penetration_resistance(soil, p, 0.0, 0.1).down_n(), 0.0);
+  // Continuous at zero depth: the tip is mobilised over the first B.
+  const PenetrationResult tiny = penetration_resistance(soil, p, 0.5, 1e-9);
+  EXPECT_LT(tiny.down_n(), 1e-3);
+}
+
+TEST(Penetration, FrictionlessCohesionlessSoilBearsItsOverburden) {
+  // phi = delta = c = c_a = 0: N_q = 1, N_gamma = 0, no face friction: the
+  // edge carries the weight of the soil column over its strip, gamma D B L.
+  const SoilParams soil = frictionless_soil(0.0);
+  PenetrationParams p;
+  p.edge_thickness_m = 0.02;
+  for (double d : {0.02, 0.05, 0.2}) {
+    const PenetrationResult r = penetration_resistance(soil, p, 0.5, d);
+    expect_rel(r.tip_n, soil.unit_weight_n_per_m3 * d * 0.02 * 0.5, kRel, "tip");
+    EXPECT_EQ(r.side_n, 0.0);
+  }
+  // Shallower than B: mobilised in proportion to the depth.
+  const PenetrationResult half = penetration_resistance(soil, p, 0.5, 0.01);
+  expect_rel(half.tip_n, soil.unit_weight_n_per_m3 * 0.01 * 0.02 * 0.5 * 0.5, kRel, "half");
+}
+
+TEST(Penetration, FrictionlessCohesiveSoilIsPrandtlsPunch) {
+  // phi = 0, c > 0: q_ult = (pi + 2) c + gamma D (Prandtl 1921).
+  const SoilParams soil = frictionless_soil(4000.0);
+  const PenetrationParams p;
+  const PenetrationResult r = penetration_resistance(soil, p, 0.4, 0.1);
+  expect_rel(r.bearing_pa, (kPi + 2.0) * 4000.0 + soil.unit_weight_n_per_m3 * 0.1, kRel, "q_ult");
+  expect_rel(r.tip_n, r.bearing_pa * p.edge_thickness_m * 0.4, kRel, "tip");
+}
+
+TEST(Penetration, ScalesWithLengthAndDepth) {
+  const SoilParams soil = soil_preset(SoilPreset::kDrySand);
+  const PenetrationParams p;
+  const PenetrationResult a = penetration_resistance(soil, p, 0.2, 0.1);
+  const PenetrationResult b = penetration_resistance(soil, p, 0.6, 0.1);
+  expect_rel(b.tip_n, 3.0 * a.tip_n, kRel, "tip linear in L");
+  expect_rel(b.side_n, 3.0 * a.side_n, kRel, "side linear in L");
+  // Dry sand has no adhesion: the faces' friction grows as D^2 (K0 gamma z tan delta).
+  const PenetrationResult deep = penetration_resistance(soil, p, 0.2, 0.2);
+  expect_rel(deep.side_n, 4.0 * a.side_n, kRel, "side as D^2");
+  const double k0 = 1.0 - std::sin(soil.internal_friction_rad);
+  expect_rel(a.side_n,
+             2.0 * 0.2 * 0.5 * k0 * soil.unit_weight_n_per_m3 * 0.01 *
+                 std::tan(soil.soil_tool_friction_rad),
+             kRel, "side by hand");
+  // Below B the tip grows with depth through q = gamma D only: linear, with
+  // the slope gamma N_q B L.
+  const BearingFactors f = bearing_capacity_factors(soil.internal_friction_rad);
+  const double slope = (deep.tip_n - a.tip_n) / 0.1;
+  expect_rel(slope, soil.unit_weight_n_per_m3 * f.n_q * p.edge_thickness_m * 0.2, 1e-9, "slope");
+}
+
+TEST(Penetration, WorldForceOpposesVerticalMotionOnly) {
+  const SoilParams soil = soil_preset(SoilPreset::kClay);
+  const PenetrationParams p;
+  const PenetrationResult r = penetration_resistance(soil, p, 0.5, 0.08);
+  ASSERT_GT(r.up_n(), 0.0);
+  ASSERT_GT(r.down_n(), r.up_n());
+  const double beta = 1000.0;
+  // At rest, and sliding horizontally: nothing.
+  EXPECT_EQ(length(penetration_world_force(r, {0, 0, 0}, beta)), 0.0);
+  EXPECT_EQ(length(penetration_world_force(r, {0.7, 0, -0.3}, beta)), 0.0);
+  // Pushed down fast: the whole resistance, up; pulled out: the faces, down.
+  const Vec3 down = penetration_world_force(r, {0.0, -5.0, 0.0}, beta);
+  EXPECT_EQ(down.x, 0.0);
+  EXPECT_EQ(down.z, 0.0);
+  expect_rel(down.y, r.down_n(), kRel, "down");
+  expect_rel(penetration_world_force(r, {0.0, 5.0, 0.0}, beta).y, -r.up_n(), kRel, "up");
+  // The same for any horizontal velocity, either sign (symmetry).
+  expect_rel(penetration_world_force(r, {-3.0, -5.0, 2.0}, beta).y, r.down_n(), kRel, "mirror");
+  // Slowly: a damper of slope beta.
+  expect_rel(penetration_world_force(r, {0.0, -1e-4, 0.0}, beta).y, 0.1, kRel, "damper");
+  EXPECT_TRUE(std::isnan(penetration_world_force(r, {0.0, std::nan(""), 0.0}, beta).y));
+}
+
+TEST(Penetration, ValidateNamesTheField) {
+  ForceModelParams p;
+  p.penetration.edge_thickness_m = 0.0;
+  EXPECT_NE(validate(p).find("penetration.edge_thickness_m"), std::string::npos) << validate(p);
+}
+
+// ---------------------------------------------------------------------------
+// Twist: the cutting resistance of a buried edge turned about the vertical
+// ---------------------------------------------------------------------------
+
+// A straight edge engaged from s0 to s1 (signed distances from the axis).
+TwistEngagement engaged_between(double s0, double s1) {
+  TwistEngagement e;
+  // integral of |s|, sign(s), s^2 over [s0, s1], split at 0.
+  auto part = [&](double a, double b, double sign) {
+    e.engaged_length_m += b - a;
+    e.abs_moment_m2 += sign * 0.5 * (b * b - a * a);
+    e.signed_length_m += sign * (b - a);
+    e.second_moment_m3 += (b * b * b - a * a * a) / 3.0;
+  };
+  if (s0 < 0.0) part(s0, std::min(s1, 0.0), -1.0);
+  if (s1 > 0.0) part(std::max(s0, 0.0), s1, 1.0);
+  return e;
+}
+
+TEST(Twist, CentredBladeFeelsATorqueAndNoNetForce) {
+  const double f = 400.0, L = 0.5, beta = 1000.0;
+  const TwistEngagement e = engaged_between(-0.25, 0.25);
+  // Fast turning: the saturated torque f L^2 / 4 against the yaw rate.
+  const TwistResult t = twist_resistance(f, e, 10.0, beta, L);
+  expect_rel(t.torque_n_m, -f * L * L / 4.0, kRel, "torque");
+  EXPECT_NEAR(t.net_force_n, 0.0, 1e-12);
+  // The other way: the opposite torque.
+  expect_rel(twist_resistance(f, e, -10.0, beta, L).torque_n_m, f * L * L / 4.0, kRel, "sign");
+}
+
+TEST(Twist, ZeroRateOrNoEngagementGivesZero) {
+  const TwistEngagement e = engaged_between(-0.25, 0.25);
+  EXPECT_EQ(twist_resistance(400.0, e, 0.0, 1000.0, 0.5).torque_n_m, 0.0);
+  EXPECT_EQ(twist_resistance(400.0, TwistEngagement{}, 3.0, 1000.0, 0.5).torque_n_m, 0.0);
+  EXPECT_EQ(twist_resistance(0.0, e, 3.0, 1000.0, 0.5).torque_n_m, 0.0);
+  EXPECT_TRUE(std::isnan(twist_resistance(400.0, e, std::nan(""), 1000.0, 0.5).torque_n_m));
+}
+
+TEST(Twist, ScalesWithTheSquareOfTheLengthAndIsADamperWhenSlow) {
+  const double f = 400.0, beta = 1000.0, L = 1.0;
+  const TwistResult a = twist_resistance(f, engaged_between(-0.2, 0.2), 50.0, beta, L);
+  const TwistResult b = twist_resistance(f, engaged_between(-0.4, 0.4), 50.0, beta, L);
+  expect_rel(b.torque_n_m, 4.0 * a.torque_n_m, kRel, "L^2");
+  // Slowly: each metre of edge a damper of beta / L_blade: T = beta w integral s^2 / L.
+  const TwistEngagement e = engaged_between(-0.4, 0.4);
+  const double w = 1e-4;
+  expect_rel(twist_resistance(f, e, w, beta, L).torque_n_m, -beta * w * e.second_moment_m3 / L,
+             kRel, "damper");
+}
+
+TEST(Twist, OneSidedEngagementGivesANetForceAgainstTheMotion) {
+  // Only the +s half in soil: turning at +w moves it along +n, so the soil
+  // pushes it along -n; the net force is f L_half and the torque f L_half^2 / 2.
+  const double f = 300.0;
+  const TwistResult t = twist_resistance(f, engaged_between(0.0, 0.3), 20.0, 1000.0, 0.6);
+  expect_rel(t.net_force_n, -f * 0.3, kRel, "net");
+  expect_rel(t.torque_n_m, -f * 0.09 / 2.0, kRel, "torque");
+  // Mirrored engagement: the mirrored force, the same torque.
+  const TwistResult m = twist_resistance(f, engaged_between(-0.3, 0.0), 20.0, 1000.0, 0.6);
+  expect_rel(m.net_force_n, -t.net_force_n, kRel, "mirror net");
+  expect_rel(m.torque_n_m, t.torque_n_m, kRel, "mirror torque");
+}
+
+TEST(ForceModel, PenetrationAndTwistJoinTheForce) {
+  ForceModelParams p;
+  p.cutting = CuttingModel::kContactDrag;
+  p.surface_enabled = false;
+  ForceModel model(p);
+  ForceInput in;
+  in.velocity_m_per_s = {0.0, -2.0, 0.0};  // plunging, fast (saturated)
+  in.embedment_depth_m = 0.06;
+  in.embedded_length_m = 0.5;
+  in.edge_direction = {1.0, 0.0, 0.0};
+  in.yaw_rate_rad_per_s = 5.0;
+  in.twist = engaged_between(-0.25, 0.25);
+  in.blade_length_m = 0.5;
+  const ForceOutput out = model.compute(in);
+  const PenetrationResult r = penetration_resistance(p.earthmoving.soil, p.penetration, 0.5, 0.06);
+  expect_rel(out.penetration_n.y, r.down_n(), kRel, "penetration");
+  expect_rel(out.world_n.y, r.down_n(), kRel, "sum");
+  expect_rel(out.twist_torque_n_m, -p.contact_drag.drag_n_per_m * 0.25 * 0.25, kRel, "torque");
+  // Twisting the edge along X about +Y: the +X half moves along n = Y x X = -Z.
+  in.twist = engaged_between(0.0, 0.25);
+  const ForceOutput one = model.compute(in);
+  EXPECT_NEAR(one.twist_n.z, p.contact_drag.drag_n_per_m * 0.25, 1e-9);  // against -Z motion
+  EXPECT_NEAR(one.twist_n.x, 0.0, 1e-12);
+  // No cutting model: no soil resistance at all.
+  p.cutting = CuttingModel::kNone;
+  EXPECT_EQ(length(ForceModel(p).compute(in).world_n), 0.0);
+  // Disabled one by one.
+  p.cutting = CuttingModel::kContactDrag;
+  p.penetration.enabled = false;
+  p.twist_enabled = false;
+  EXPECT_EQ(length(ForceModel(p).compute(in).world_n), 0.0);
+}
+
+TEST(ForceModel, ALimitedCuttingDampingScalesTheWholeForce) {
+  // Experiment 1's defaults on a 10x workspace: the cutting damping, 1000 N s/m
+  // x 0.02 x 10 = 200 N s/m on the device, is ten times the Falcon's 20.
+  ForceModelParams p;
+  p.workspace_scale = 10.0;
+  p.surface_enabled = false;
+  ForceModel model(p);
+  const RenderingCheck& c = model.rendering();
+  EXPECT_TRUE(c.cutting_damping_limited);
+  EXPECT_NEAR(c.requested_cutting_damping_n_s_per_m, 200.0, 1e-9);
+  EXPECT_NEAR(c.cutting_damping_n_s_per_m, 20.0, 1e-9);
+  EXPECT_NEAR(c.cutting_gain, 0.1, 1e-12);
+  // The force keeps its shape against the contact length: at 0.6 m/s it is
+  // 0.1 x 400 L, linear in L, not 0.1 x 1000 x 0.6 = 60 N flat.
+  ForceInput in;
+  in.velocity_m_per_s = {0.0, 0.0, 0.6};
+  double previous = 0.0;
+  for (double L : {0.1, 0.3, 0.5, 0.7, 0.9}) {
+    in.contact_length_m = L;
+    const double f = length(model.compute(in).world_n);
+    EXPECT_NEAR(f, 0.1 * 400.0 * L, 1e-9) << L;
+    EXPECT_GT(f, previous);
+    previous = f;
+  }
+  // The damping the device meets at low speed is its limit: 0.1 x 1000 x 0.02 x 10.
+  in.velocity_m_per_s = {0.0, 0.0, 1e-4};
+  const double slope = length(model.compute(in).device_n) / 1e-4 * p.workspace_scale;
+  EXPECT_NEAR(slope, 20.0, 1e-6);
 }
 
 // ---------------------------------------------------------------------------
@@ -873,6 +1125,45 @@ TEST(Stability, HandCuttingThroughDragAndWallLosesEnergy) {
   for (double x : e) e_max = std::max(e_max, x);
   EXPECT_LE(e_max, e.front() * (1.0 + 1e-4));
   EXPECT_LT(e.back(), 0.5 * e.front());
+}
+
+TEST(Stability, HandPushedIntoSoilMeetsItsBearingAndLosesEnergy) {
+  // Penetration at the device's damping limit (20 N s/m on the device) over
+  // the floor's wall: the hand, pulled 4 cm below the soil's surface at
+  // y = 0.02, pushes the edge down through the soil onto the rigid floor.
+  ForceModelParams p;
+  p.cutting = CuttingModel::kContactDrag;
+  p.force_scale = 1.0;
+  p.contact_drag.drag_n_per_m = 0.0;
+  p.low_speed_damping_n_s_per_m = 20.0;
+  p.earthmoving.soil = soil_preset(SoilPreset::kLooseSand);
+  p.earthmoving.soil.cohesion_pa = 0.0;  // a few newtons of bearing: the device's range
+  p.surface.stiffness_n_per_m = 3000.0;
+  p.surface.damping_n_s_per_m = 0.25;
+  p.device.inherent_damping_n_s_per_m = 2.0;
+  p.policy = LimitPolicy::kRefuse;
+  ForceModel model(p);
+  HandSim hand;
+  bool pushed = false;
+  auto force = [&](Vec3 x, Vec3 v) {
+    ForceInput in;
+    in.device_point_m = x;
+    in.velocity_m_per_s = v;
+    in.surface_y_m = 0.0;  // the rigid floor
+    in.embedment_depth_m = std::max(0.0, 0.02 - x.y);
+    in.embedded_length_m = in.embedment_depth_m > 0.0 ? 0.5 : 0.0;
+    const ForceOutput out = model.compute(in);
+    if (out.penetration_n.y > 1.0) pushed = true;
+    return out.device_n;
+  };
+  std::vector<double> e = hand.run({0.0, 0.03, 0.0}, 3.0, 3000.0, 0.0, force);
+  EXPECT_TRUE(pushed);  // the bearing was felt on the way down
+  double e_max = 0.0;
+  for (double x : e) e_max = std::max(e_max, x);
+  EXPECT_LE(e_max, e.front() * (1.0 + 1e-4));
+  // It settles on the floor at the energy's minimum (the penetration force,
+  // a resistance to motion, is zero at rest).
+  EXPECT_NEAR(e.back(), hand.resting_energy(3000.0), 1e-3 * e.front());
 }
 
 // The whole chain: wall at the Falcon's limit, then the safety limiter with

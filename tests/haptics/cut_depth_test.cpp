@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 namespace terracut::haptics {
@@ -41,6 +42,74 @@ TEST(CutDepth, APileAheadIsNotDepthButSurchargeHeight) {
   EXPECT_NEAR(depth_ahead_m(g, Representation::kSurface, edge, v, look), 0.15, 1e-6);
   // No horizontal motion: nothing ahead.
   EXPECT_EQ(soil_ahead(g, Representation::kSurface, edge, {0.0, -1.0, 0.0}, look).depth_m, 0.0);
+}
+
+TEST(Embedment, TheDepthIsReadBesideTheEdgeNotInItsOwnTrench) {
+  // A 0.2 m layer with a one-cell trench cut down to 0.12 m along row 40
+  // (z in [0.40, 0.41)), where a horizontal edge along X sits at y = 0.12.
+  HeightGrid g(grid_of_cells(100, 100, 0.01), std::vector<float>(100 * 100, 0.2f));
+  std::vector<float> row(100, 0.12f);
+  g.set_heights({0, 40, 100, 41}, row.data());
+  const double look = depth_lookahead_m(g.spec());
+  const Segment edge{{0.3, 0.12, 0.405}, {0.7, 0.12, 0.405}};
+  for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
+    const Embedment e = embedment(g, rep, edge, look);
+    EXPECT_NEAR(e.depth_m, 0.08, 1e-6);
+    EXPECT_NEAR(e.length_m, 0.4, 1e-12);
+    // Above the soil beside it: not embedded.
+    const Embedment above = embedment(g, rep, {{0.3, 0.25, 0.405}, {0.7, 0.25, 0.405}}, look);
+    EXPECT_EQ(above.depth_m, 0.0);
+    EXPECT_EQ(above.length_m, 0.0);
+  }
+  // Half the edge off the terrain (x > 1 m reads the rigid ground at 0).
+  const Embedment half = embedment(g, Representation::kColumns, {{0.8, 0.1, 0.405}, {1.2, 0.1, 0.405}}, look);
+  EXPECT_NEAR(half.length_m, 0.2, 1e-12);
+  EXPECT_NEAR(half.depth_m, 0.1, 1e-6);
+  EXPECT_EQ(embedment(g, Representation::kSurface, {{0.3, std::nan(""), 0.4}, {0.7, 0.1, 0.4}}, look).length_m, 0.0);
+}
+
+TEST(TwistEngagement, ACentredBuriedEdgeIsEngagedOnBothSidesSymmetrically) {
+  HeightGrid g(grid_of_cells(100, 100, 0.01), std::vector<float>(100 * 100, 0.2f));
+  const double look = depth_lookahead_m(g.spec());
+  const Segment edge{{0.3, 0.15, 0.5}, {0.7, 0.15, 0.5}};
+  const Vec3 centre{0.5, 0.15, 0.5};
+  double depth = 0.0;
+  const TwistEngagement e =
+      twist_engagement(g, Representation::kSurface, edge, centre, 1.0, look, depth);
+  EXPECT_NEAR(e.engaged_length_m, 0.4, 1e-12);
+  EXPECT_NEAR(e.signed_length_m, 0.0, 1e-12);
+  // integral |s| ds = L^2 / 4 and integral s^2 ds = L^3 / 12, exactly with
+  // the parts' own second moments.
+  EXPECT_NEAR(e.abs_moment_m2, 0.04, 1e-12);
+  EXPECT_NEAR(e.second_moment_m3, 0.064 / 12.0, 1e-12);
+  EXPECT_NEAR(depth, 0.05, 1e-6);
+  // Turning the other way reads the other sides: the same for a flat layer.
+  const TwistEngagement back =
+      twist_engagement(g, Representation::kSurface, edge, centre, -1.0, look, depth);
+  EXPECT_NEAR(back.abs_moment_m2, e.abs_moment_m2, 1e-12);
+  // No turning, or an edge above the soil: nothing.
+  EXPECT_EQ(twist_engagement(g, Representation::kSurface, edge, centre, 0.0, look, depth)
+                .engaged_length_m, 0.0);
+  const Segment high{{0.3, 0.3, 0.5}, {0.7, 0.3, 0.5}};
+  EXPECT_EQ(twist_engagement(g, Representation::kSurface, high, {0.5, 0.3, 0.5}, 1.0, look, depth)
+                .engaged_length_m, 0.0);
+  EXPECT_EQ(depth, 0.0);
+}
+
+TEST(TwistEngagement, OnlyTheSideThatMovesIntoSoilIsEngaged) {
+  // Soil only at x < 0.5 (the -s half of an edge along +X centred at 0.5).
+  std::vector<float> h(100 * 100, 0.0f);
+  for (int r = 0; r < 100; ++r)
+    for (int c = 0; c < 50; ++c) h[std::size_t(r) * 100 + c] = 0.2f;
+  HeightGrid g(grid_of_cells(100, 100, 0.01), h);
+  const double look = depth_lookahead_m(g.spec());
+  double depth = 0.0;
+  const TwistEngagement e = twist_engagement(g, Representation::kColumns,
+                                             {{0.3, 0.15, 0.5}, {0.7, 0.15, 0.5}},
+                                             {0.5, 0.15, 0.5}, 2.0, look, depth);
+  EXPECT_NEAR(e.engaged_length_m, 0.2, 1e-12);
+  EXPECT_NEAR(e.signed_length_m, -0.2, 1e-12);
+  EXPECT_NEAR(e.abs_moment_m2, 0.02, 1e-12);
 }
 
 }  // namespace

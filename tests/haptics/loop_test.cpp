@@ -97,6 +97,121 @@ TEST(HapticLoop, ScriptTrenchForcesFollowTheContact) {
   EXPECT_EQ(loop->safety().counters().nonfinite, 0);
 }
 
+// The trench scenario's blade over the middle of the sand, driven by keyframes.
+Motion trench_motion(std::vector<Keyframe> keyframes) {
+  Motion m;
+  m.name = "test";
+  m.keyframes = std::move(keyframes);
+  return m;
+}
+
+TEST(HapticLoop, PlungingIntoSandMeetsItsBearingCapacity) {
+  // Straight down at 1 m/s from 5 cm above the 0.3 m sand to 8 cm into it.
+  const HapticSettings& s = trench().haptics;
+  const Motion plunge = trench_motion({{0.0, {{0.0, 0.35, 0.0}, {}}},
+                                       {0.2, {{0.0, 0.35, 0.0}, {}}},
+                                       {0.33, {{0.0, 0.22, 0.0}, {}}},
+                                       {0.6, {{0.0, 0.22, 0.0}, {}}}});
+  ScriptDevice device(DevicePath(plunge, Workspace(s.workspace)));
+  auto loop = trench_loop(s, device, 600);
+  loop->run_deterministic();
+  const ForceModelParams& fp = loop->force_model().params();
+  const double beta = fp.low_speed_damping_n_s_per_m * loop->force_model().rendering().cutting_gain;
+  int checked = 0;
+  for (const LoopRecord& r : loop->records()) {
+    const double depth = double(0.3f) - r.tool.position_m.y;  // the grid's float32 sand
+    if (depth <= 0.0) {
+      EXPECT_EQ(r.penetration_force_n, 0.0) << r.t_s;  // above the sand
+      continue;
+    }
+    if (r.t_s > 0.4) {
+      // At rest in the sand (the velocity filter settled): no resistance to
+      // a motion that is not there.
+      EXPECT_NEAR(r.penetration_force_n, 0.0, 1e-9) << r.t_s;
+      continue;
+    }
+    if (r.t_s > 0.33) continue;  // stopping: the filtered velocity decays
+    // Going down: up, the tip's bearing and the faces' friction over the
+    // whole 0.4 m edge at the depth below the sand beside it, regularised.
+    ASSERT_LT(r.velocity_m_per_s.y, 0.0) << r.t_s;
+    const PenetrationResult p =
+        penetration_resistance(fp.earthmoving.soil, fp.penetration, 0.4, depth);
+    const double expected = std::min(p.down_n(), beta * -r.velocity_m_per_s.y);
+    EXPECT_NEAR(r.penetration_force_n, expected, 1e-6 * expected + 1e-9) << r.t_s;
+    EXPECT_NEAR(r.force_world_n.y, r.penetration_force_n, 1e-9) << r.t_s;  // nothing else
+    if (depth > 0.02) {
+      EXPECT_GT(r.penetration_force_n, 100.0) << r.t_s;
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 70);  // 8 cm at 1 m/s
+}
+
+TEST(HapticLoop, TurningTheBuriedBladeMeetsATorque) {
+  // Into the sand, then a quarter turn about +Y in 1 s, then the other way.
+  const HapticSettings& s = trench().haptics;
+  const Motion turn = trench_motion({{0.0, {{0.0, 0.35, 0.0}, {}}},
+                                     {0.2, {{0.0, 0.22, 0.0}, {}}},
+                                     {0.4, {{0.0, 0.22, 0.0}, {}}},
+                                     {1.4, {{0.0, 0.22, 0.0}, quat_from_euler_deg({0, 90, 0})}},
+                                     {2.4, {{0.0, 0.22, 0.0}, {}}}});
+  ScriptDevice device(DevicePath(turn, Workspace(s.workspace)));
+  auto loop = trench_loop(s, device, 2400);
+  loop->run_deterministic();
+  int positive = 0, negative = 0;
+  for (const LoopRecord& r : loop->records()) {
+    if (r.t_s > 0.5 && r.t_s < 1.35) {
+      EXPECT_NEAR(r.yaw_rate_rad_per_s, std::numbers::pi / 2, 1e-3) << r.t_s;
+      EXPECT_LT(r.twist_torque_n_m, 0.0) << r.t_s;  // against the turn
+      ++positive;
+    }
+    if (r.t_s > 1.5 && r.t_s < 2.35) {
+      EXPECT_NEAR(r.yaw_rate_rad_per_s, -std::numbers::pi / 2, 1e-3) << r.t_s;
+      EXPECT_GT(r.twist_torque_n_m, 0.0) << r.t_s;
+      ++negative;
+    }
+    // A centred blade: the two halves' forces cancel to a part of the edge
+    // (f ds against T = f L^2 / 4: |F| <= T 4 ds / L^2 = T / 2 per metre, ds = 2 cm).
+    if (r.t_s > 0.5 && r.t_s < 2.35) {
+      EXPECT_LE(std::hypot(r.force_world_n.x, r.force_world_n.z),
+                0.5 * std::abs(r.twist_torque_n_m) + 1e-9)
+          << r.t_s;
+    }
+  }
+  EXPECT_GT(positive, 800);
+  EXPECT_GT(negative, 800);
+}
+
+TEST(HapticLoop, EndsWhenTheDeviceFallsSilentAndCountsOnlyTheSilencesBetween) {
+  // The device is silent for its first 200 ticks (a bridge not yet sending),
+  // sends, falls silent for 120 ticks in the middle, sends again, and stops
+  // for good at tick 1500.
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice script(trench_path(s));
+  test::FaultyDevice device(script, nullptr, [](std::int64_t tick) {
+    return tick < 200 || (tick >= 800 && tick < 920) || tick >= 1500;
+  });
+  const io::Scenario& sc = trench().scenario;
+  LoopOptions o = test::test_loop_options(5000);
+  o.end_after_silence_s = 0.3;
+  auto loop = test::make_loop_rig(s, sc, sc.cuts[0].keyframes[0].pose.orientation, device, o);
+  loop->run_deterministic();
+  EXPECT_TRUE(loop->ended_with_device());
+  // The last sample at tick 1499, then 0.3 s of silence: about 1800 ticks.
+  EXPECT_NEAR(double(loop->counters().ticks), 1500.0 + 300.0, 2.0);
+  // Three trips (the wait at start, the gap, the end); only the gap counts.
+  EXPECT_EQ(loop->safety().counters().watchdog_trips, 3);
+  EXPECT_EQ(loop->watchdog_trips_while_active(), 1);
+  // Without the option the loop runs its ticks.
+  ScriptDevice script2(trench_path(s));
+  test::FaultyDevice quiet(script2, nullptr, [](std::int64_t tick) { return tick >= 1500; });
+  auto full = trench_loop(s, quiet, 2500);
+  full->run_deterministic();
+  EXPECT_FALSE(full->ended_with_device());
+  EXPECT_EQ(full->counters().ticks, 2500);
+  EXPECT_EQ(full->watchdog_trips_while_active(), 0);
+}
+
 TEST(HapticLoop, DeterministicRunsAreIdentical) {
   for (DeviceKind kind : {DeviceKind::kScript, DeviceKind::kSim}) {
     std::vector<LoopRecord> runs[2];

@@ -96,5 +96,35 @@ TEST(SnapshotExchange, ConcurrentReaderNeverSeesATornFrame) {
   EXPECT_GT(frames_checked.load(), 0);
 }
 
+TEST(SnapshotExchange, AFrameSumsUpTheTicksTheReaderDidNotSee) {
+  // A brief contact between two frames the reader takes is in the window's
+  // maximum, and the mean is over every tick since the reader's last frame.
+  HeightGrid grid(spec(), std::vector<float>(kSide * kSide, 0.0f));
+  SnapshotExchange ex(grid);
+  const double forces[] = {1.0, 50.0, 2.0};
+  for (double f : forces) {
+    ex.back().force_world_n = {0.0, 0.0, f};
+    ex.back().contact.length_m = f / 100.0;
+    ex.publish(grid);
+  }
+  const ViewFrame* a = ex.acquire();
+  ASSERT_NE(a, nullptr);
+  EXPECT_EQ(a->force_world_n.z, 2.0);  // the newest tick
+  EXPECT_EQ(a->window.ticks, 3);
+  EXPECT_EQ(a->window.force_max_n, 50.0);
+  EXPECT_DOUBLE_EQ(a->window.mean(a->window.force_sum_n), 53.0 / 3.0);
+  EXPECT_DOUBLE_EQ(a->window.contact_max_m, 0.5);
+  // The next frame starts afresh.
+  ex.back().force_world_n = {0.0, 3.0, 4.0};
+  ex.back().contact.length_m = 0.0;
+  ex.publish(grid);
+  const ViewFrame* b = ex.acquire();
+  ASSERT_NE(b, nullptr);
+  EXPECT_EQ(b->window.ticks, 1);
+  EXPECT_DOUBLE_EQ(b->window.force_max_n, 5.0);
+  EXPECT_EQ(b->window.contact_max_m, 0.0);
+  EXPECT_EQ(ViewWindow{}.mean(1.0), 0.0);
+}
+
 }  // namespace
 }  // namespace terracut::haptics

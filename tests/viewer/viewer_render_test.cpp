@@ -435,6 +435,28 @@ TEST_F(ViewerRenderTest, RigidBodyIsDrawnWhereItRests) {
   EXPECT_GT(soil[0], soil[2]);
 }
 
+TEST_F(ViewerRenderTest, CommandLineErrorsExitWithTwoAndHelpShowsTheDefaults) {
+  // docs/viewer.md: every command-line error exits 2 (CLI11's own code for
+  // an unknown option is 109).
+  const std::string sc = (fs::path(TERRACUT_SOURCE_DIR) / "scenarios/trench_dry_sand.yaml").string();
+  Result r = run({sc, "--bogus"});
+  ASSERT_TRUE(r.exited);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--bogus"), std::string::npos) << r.err;
+  r = run({sc, "--msaa", "99"});
+  EXPECT_EQ(r.code, 2) << r.err;
+  r = run({sc, "--extent", "-1"});
+  EXPECT_EQ(r.code, 2) << r.err;
+  // --help exits 0 and shows the heightmap defaults.
+  const fs::path out = dir_ / "stdout.txt";
+  r = run({"--help"});
+  EXPECT_EQ(r.code, 0);
+  const std::string help = slurp(out);
+  EXPECT_NE(help.find("--extent"), std::string::npos);
+  EXPECT_NE(help.find("=1 "), std::string::npos) << help;    // --extent's default, metres
+  EXPECT_NE(help.find("=0.2"), std::string::npos) << help;   // --full-scale's
+}
+
 TEST_F(ViewerRenderTest, MissingScenarioIsReportedByName) {
   Result r = run({(dir_ / "no_such.yaml").string(), "--screenshot", (dir_ / "x.png").string()});
   ASSERT_TRUE(r.exited) << "the viewer crashed";

@@ -9,8 +9,13 @@
 //     the passive force of a planar soil wedge ahead of a flat blade;
 //   - surface: a proxy (god-object) kept on the terrain surface and a
 //     spring-damper between the proxy and the device point, so the tool
-//     cannot sink into the soil without resistance.
-// ForceModel combines one cutting model with the surface model, checks once
+//     cannot sink into the soil without resistance;
+//   - penetration: the soil's bearing capacity under an edge pushed down
+//     into it (Terzaghi 1943, with Prandtl's, Reissner's and Vesic's
+//     factors) and the friction on its faces;
+//   - twist: the cutting resistance of every part of a buried edge turned
+//     about the vertical, as a torque and a net force.
+// ForceModel combines one cutting model with the others, checks once
 // at construction that the device can render the result stably (Colgate &
 // Brown 1994) and scales world forces to the device.
 //
@@ -23,6 +28,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "terracut/core/contact.hpp"
 #include "terracut/core/grid.hpp"
@@ -216,6 +222,101 @@ SurfaceForce surface_force(const SurfaceParams& params, Vec3 device_point_m, Vec
                            double surface_y_m) noexcept;
 
 // ---------------------------------------------------------------------------
+// Penetration: a blade edge pushed down into the soil
+// ---------------------------------------------------------------------------
+
+/// Bearing-capacity factors of a strip footing (dimensionless):
+///   N_q     = e^(pi tan phi) tan^2(45 deg + phi/2)   (Prandtl 1921, Reissner 1924)
+///   N_c     = (N_q - 1) cot phi, -> pi + 2 as phi -> 0 (Prandtl)
+///   N_gamma = 2 (N_q + 1) tan phi                     (Vesic 1973)
+/// phi: internal friction angle, rad, [0, pi/2).
+struct BearingFactors {
+  double n_c = 0.0;
+  double n_q = 0.0;
+  double n_gamma = 0.0;
+};
+BearingFactors bearing_capacity_factors(double internal_friction_rad) noexcept;
+
+/// Parameters of the penetration model; read-only during a run.
+struct PenetrationParams {
+  bool enabled = true;  ///< add the resistance to vertical motion
+  /// B: thickness of the cutting edge, the width of the strip the soil bears
+  /// under it, m, finite, > 0. Also the depth over which the bearing is
+  /// mobilised (docs/forces.md). Default: a 2 cm steel cutting edge.
+  double edge_thickness_m = 0.02;
+};
+
+/// Returns an empty string when params are valid, else a message naming the field.
+std::string validate(const PenetrationParams& params);
+
+/// What the soil opposes to an edge of engaged length L at embedment depth D.
+struct PenetrationResult {
+  /// q_ult = c N_c + q N_q + gamma B N_gamma / 2 with q = gamma D + surcharge:
+  /// Terzaghi's (1943) bearing capacity of a strip at depth D, Pa.
+  double bearing_pa = 0.0;
+  /// Tip: q_ult B L min(1, D / B), N (the bearing mobilised over the first B of depth).
+  double tip_n = 0.0;
+  /// Both faces: 2 L (K0 gamma D^2 tan(delta) / 2 + c_a D), K0 = 1 - sin phi
+  /// (Jaky's earth pressure at rest): skin friction and adhesion, N.
+  double side_n = 0.0;
+  /// Resistance to pushing down (tip and faces), N, >= 0.
+  double down_n() const { return tip_n + side_n; }
+  /// Resistance to pulling out (the faces only), N, >= 0.
+  double up_n() const { return side_n; }
+};
+
+/// The resistance of the soil to an edge of engaged length length_m at
+/// embedment depth depth_m (the edge's depth below the soil beside it), with
+/// an extra surcharge_pa on the soil around it. Zero when length or depth is
+/// <= 0. Allocates nothing; parameters are trusted (validate once).
+PenetrationResult penetration_resistance(const SoilParams& soil, const PenetrationParams& params,
+                                         double length_m, double depth_m,
+                                         double surcharge_pa = 0.0) noexcept;
+
+/// World force from a penetration result: moving down (v_y < 0),
+/// +saturated_drag_n(down_n, |v_y|, beta) Y; moving up,
+/// -saturated_drag_n(up_n, v_y, beta) Y; zero at v_y = 0. Horizontal motion
+/// does not enter. low_speed_damping_n_s_per_m > 0.
+Vec3 penetration_world_force(const PenetrationResult& result, Vec3 velocity_m_per_s,
+                             double low_speed_damping_n_s_per_m) noexcept;
+
+// ---------------------------------------------------------------------------
+// Twist: a buried blade turned about the vertical
+// ---------------------------------------------------------------------------
+
+/// The part of the edge in soil, seen from the vertical axis through the
+/// blade's centre. s is the signed horizontal distance of a point of the
+/// edge from the axis along the edge; the integrals run over the engaged parts.
+struct TwistEngagement {
+  double engaged_length_m = 0.0;  ///< integral of ds, m, >= 0
+  double abs_moment_m2 = 0.0;     ///< integral of |s| ds, m^2, >= 0
+  double signed_length_m = 0.0;   ///< integral of sign(s) ds, m
+  double second_moment_m3 = 0.0;  ///< integral of s^2 ds, m^3, >= 0
+};
+
+/// What turning a buried blade meets.
+struct TwistResult {
+  /// Torque on the tool about world +Y, N m: against the yaw rate.
+  double torque_n_m = 0.0;
+  /// Net force along n = Y x e (e: the edge's horizontal direction), N:
+  /// nonzero when more of the edge is engaged on one side of the axis.
+  double net_force_n = 0.0;
+};
+
+/// A point of the edge at s moves at omega s along n; the soil resists it
+/// with f per metre of edge (the cutting model's resistance per width),
+/// against its motion. Summed over the engaged parts:
+///   T = -sign(omega) f integral |s| ds,   F_n = -sign(omega) f integral sign(s) ds,
+/// both scaled by the low-speed regularisation of the whole,
+/// saturated_drag_n(f abs_moment, |omega|, beta second_moment / blade_length)
+/// / (f abs_moment): below that rate each part of the edge is a damper of
+/// beta / blade_length per metre. Zero yaw rate or no engagement gives zeros.
+/// resistance_n_per_m >= 0, low_speed_damping_n_s_per_m > 0, blade_length_m > 0.
+TwistResult twist_resistance(double resistance_n_per_m, const TwistEngagement& engagement,
+                             double yaw_rate_rad_per_s, double low_speed_damping_n_s_per_m,
+                             double blade_length_m) noexcept;
+
+// ---------------------------------------------------------------------------
 // Device limits and the passivity rule
 // ---------------------------------------------------------------------------
 
@@ -282,6 +383,10 @@ struct ForceModelParams {
   /// Slope of the cutting force at low speed (saturated damper), N s/m
   /// (world), finite, > 0. Shared by both cutting models.
   double low_speed_damping_n_s_per_m = 1000.0;
+  PenetrationParams penetration{};
+  /// Add the resistance to turning the blade about the vertical while it is
+  /// in soil (twist_resistance).
+  bool twist_enabled = true;
   /// Earthmoving only: use the engaged width projected across the motion,
   /// width = contact length * |sin(angle between edge and horizontal motion)|,
   /// when the input gives the edge direction. A blade sliding along its own
@@ -313,8 +418,18 @@ struct RenderingCheck {
   double surface_stiffness_n_per_m = 0.0;  ///< K on the device after limiting
   double surface_damping_n_s_per_m = 0.0;  ///< B on the device after limiting
   double passive_stiffness_n_per_m = 0.0;  ///< 2 (b - |B|) / T with the B above
-  /// Low-speed slope plus the viscous term at the longest contact, after limiting.
+  /// Low-speed slope plus the viscous term at the longest contact, after
+  /// limiting (the requested damping times cutting_gain).
   double cutting_damping_n_s_per_m = 0.0;
+  /// The same three as requested, before limiting, device units.
+  double requested_surface_stiffness_n_per_m = 0.0;
+  double requested_surface_damping_n_s_per_m = 0.0;
+  double requested_cutting_damping_n_s_per_m = 0.0;
+  /// Factor on the whole soil-resistance force (cutting, penetration, twist),
+  /// in (0, 1]: when the cutting damping is beyond the device (kClamp), the
+  /// force is scaled down as a whole instead of lowering its low-speed
+  /// slope, so that it keeps its shape against contact length and depth.
+  double cutting_gain = 1.0;
   bool surface_stiffness_limited = false;  ///< K was lowered (kClamp)
   bool surface_damping_limited = false;    ///< B was lowered (kClamp)
   bool cutting_damping_limited = false;    ///< low-speed damping / viscous were lowered (kClamp)
@@ -333,10 +448,24 @@ struct ForceInput {
   /// the blade pushes: unit weight x the pile's height over the failure
   /// wedge), Pa, finite, >= 0; added to the soil's own surcharge_pa.
   double surcharge_pa = 0.0;
+  /// Earthmoving: the length of edge with soil ahead of it, m (>= 0), used
+  /// instead of contact_length_m when given; negative: not given.
+  double cut_width_m = -1.0;
   /// Direction of the cutting edge (any length; zero = unknown, no projection).
   Vec3 edge_direction{};
   Vec3 device_point_m{};     ///< point held on the surface by the proxy, world metres
   double surface_y_m = 0.0;  ///< world Y of the terrain surface below device_point_m
+  /// Penetration: depth of the edge below the soil beside it, m (>= 0), and
+  /// the length of edge that deep in soil, m (>= 0).
+  double embedment_depth_m = 0.0;
+  double embedded_length_m = 0.0;
+  /// Twist: the tool's angular velocity about world +Y, rad/s; the engaged
+  /// parts for that sense of turning, and their mean depth of material, m.
+  double yaw_rate_rad_per_s = 0.0;
+  TwistEngagement twist{};
+  double twist_depth_m = 0.0;
+  /// Length of the blade, m (> 0), for the twist's low-speed damping share.
+  double blade_length_m = 1.0;
 };
 
 /// Outputs of one force sample.
@@ -348,6 +477,10 @@ struct ForceOutput {
   SurfaceForce surface{};           ///< proxy, penetration, contact (zero when disabled)
   EarthmovingResult earthmoving{};  ///< the FEE solution (zero unless kEarthmoving)
   double engaged_width_m = 0.0;     ///< width used by the cutting model, m
+  Vec3 penetration_n{};             ///< penetration model's world force (vertical), N
+  PenetrationResult penetration{};  ///< tip and face resistance (zero when disabled)
+  Vec3 twist_n{};                   ///< twist's net world force (horizontal), N
+  double twist_torque_n_m = 0.0;    ///< twist's torque about world +Y, N m (not rendered by a 3-DOF device)
 };
 
 /// The combined model: validated and device-checked once, then a pure const
@@ -363,6 +496,11 @@ class ForceModel {
   /// Parameters in use (after kClamp limiting).
   const ForceModelParams& params() const { return params_; }
   const RenderingCheck& rendering() const { return check_; }
+
+  /// What the device check lowered, one line each, requested -> used, for
+  /// example "cutting damping 1000 -> 100 N s/m (world; 200 -> 20 N s/m on
+  /// the device): the whole soil force x 0.1". Empty when nothing was.
+  std::vector<std::string> limit_changes() const;
 
   /// One sample: allocates nothing, never throws. Non-finite inputs give
   /// non-finite outputs, for the safety limiter to catch and count.

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -27,6 +28,12 @@ struct DeviceSample {
   /// The device reconnected with this sample (a new bridge session): the
   /// loop begins a new soft start.
   bool reconnected = false;
+  /// When the device measured the sample on its own clock, seconds (any
+  /// origin, never going back within a session); NaN when the device does
+  /// not say. The loop estimates the velocity from these times when it has
+  /// them: a sample that arrives late over a network is then not read as a
+  /// jump in speed.
+  double device_time_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// What the loop sends to the device each tick.

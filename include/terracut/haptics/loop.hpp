@@ -29,6 +29,7 @@
 #include <atomic>
 #include <cstdint>
 #include <future>
+#include <limits>
 #include <memory>
 #include <string>
 #include <thread>
@@ -79,6 +80,12 @@ struct LoopRecord {
   /// the blade's plate: StepOutput::listener_force_world_n), world N; zero
   /// without listeners.
   Vec3 body_force_world_n{};
+  /// The penetration model's part of force_world_n (vertical, +Y up), world N.
+  double penetration_force_n = 0.0;
+  /// Twist torque on the tool about world +Y, N m (not in any force: a 3-DOF
+  /// device cannot render it).
+  double twist_torque_n_m = 0.0;
+  double yaw_rate_rad_per_s = 0.0;  ///< estimated tool yaw rate about world +Y, rad/s
   Vec3 force_device_n{};           ///< force sent, device frame, device N (after safety)
   std::uint32_t flags = 0;         ///< kFlag* bits
   double period_s = 0.0;           ///< time since the previous tick's start, seconds
@@ -140,6 +147,10 @@ struct LoopOptions {
   /// Optional viewer feed, fed every tick from the loop thread (one writer);
   /// must outlive the loop and be built on the same grid size.
   SnapshotExchange* snapshot = nullptr;
+  /// > 0: the loop ends by itself once the device, after its first sample,
+  /// has sent nothing for this long, seconds (a UDP device whose session
+  /// ended). 0: only options.ticks or a stop request end it.
+  double end_after_silence_s = 0.0;
   /// Optional: the rigid bodies simulated with the terrain (a step listener
   /// of the simulation that also says where the bodies are), for the
   /// snapshot's frames; must outlive the loop. Null: frames carry no bodies.
@@ -197,6 +208,8 @@ class HapticLoop {
   const Workspace& workspace() const { return workspace_; }
   const LoopCounters& counters() const { return counters_; }
   const LoopRecord& last() const { return last_; }
+  /// The tool's estimated yaw rate about world +Y, rad/s (filtered as the velocity).
+  double yaw_rate_rad_per_s() const { return yaw_rate_rad_per_s_; }
   /// The kept records, oldest first.
   std::vector<LoopRecord> records() const;
   /// Percentiles over the kept records: the period's deviation from the
@@ -213,6 +226,15 @@ class HapticLoop {
   double max_device_force_n() const { return max_device_force_n_; }
   /// Largest |listeners' force| over the run (every tick, kept or not), world N.
   double max_body_force_n() const { return max_body_force_n_; }
+  /// Watchdog trips between the device's first and its newest sample: the
+  /// silences of a device that was sending. The waits before the first
+  /// sample and after the last are expected and not counted here.
+  std::int64_t watchdog_trips_while_active() const {
+    return trips_at_newest_sample_ - trips_before_first_sample_;
+  }
+  /// True when the loop ended because the device fell silent
+  /// (LoopOptions::end_after_silence_s).
+  bool ended_with_device() const { return ended_with_device_; }
 
  private:
   void thread_main(std::promise<void>& ready);
@@ -230,6 +252,7 @@ class HapticLoop {
   struct CutLoad {
     double depth_m = 0.0;
     double surcharge_pa = 0.0;
+    double width_m = -1.0;  // the edge length with soil ahead; negative: the contact length
   };
   CutLoad cut_load(const StepOutput& out) const noexcept;
   ForceOutput world_force(const StepOutput& out, const CutLoad& load) const noexcept;
@@ -264,6 +287,9 @@ class HapticLoop {
   double previous_tool_t_s_ = 0.0;
   bool has_previous_tool_ = false;
   Vec3 velocity_m_per_s_{};
+  double previous_yaw_rad_ = 0.0;    // the edge's heading at the previous good sample
+  double previous_device_t_s_ = std::numeric_limits<double>::quiet_NaN();  // its device time
+  double yaw_rate_rad_per_s_ = 0.0;  // filtered, about world +Y
   double t_s_ = 0.0;
   std::uint32_t tick_flags_ = 0;
   Vec3 device_position_m_{};
@@ -271,6 +297,9 @@ class HapticLoop {
   LoopRecord last_{};
   double max_device_force_n_ = 0.0;
   double max_body_force_n_ = 0.0;
+  std::int64_t trips_before_first_sample_ = 0;
+  std::int64_t trips_at_newest_sample_ = 0;
+  bool ended_with_device_ = false;
 
   std::vector<LoopRecord> records_;  // ring of options_.record_capacity
   std::size_t next_record_ = 0;

@@ -18,6 +18,8 @@
 //       force_scale: 0.02            # device N per world N
 //       low_speed_damping_n_s_per_m: 60
 //       project_width_on_motion: true
+//       twist_enabled: true            # resistance to turning the buried blade
+//       penetration: {enabled: true, edge_thickness_m: 0.02}
 //       policy: clamp                # clamp | refuse
 //       contact_drag: {drag_n_per_m: 400, viscous_n_s_per_m2: 0}
 //       earthmoving:

@@ -27,6 +27,25 @@ inline constexpr int kMaxViewBodies = 64;
 /// A rigid body's shape and pose in a ViewFrame.
 using ViewBody = BodyView;  // terracut/core/bodies.hpp
 
+/// The ticks a reader has not seen yet, summed up when a frame is published:
+/// every tick since the frame the reader took before (it may count a few
+/// ticks twice when the reader takes a frame during a publish), so brief
+/// contacts between two drawn frames are seen.
+struct ViewWindow {
+  std::int64_t ticks = 0;           ///< ticks summed, >= 1 in a published frame
+  double force_max_n = 0.0;         ///< largest |world force on the tool|, N
+  double force_sum_n = 0.0;         ///< sum of |world force| over the ticks, N
+  double body_force_max_n = 0.0;    ///< largest |rigid bodies' force|, N
+  double body_force_sum_n = 0.0;    ///< sum of |rigid bodies' force|, N
+  double device_force_max_n = 0.0;  ///< largest |force sent to the device|, device N
+  double contact_max_m = 0.0;       ///< longest contact, m
+  double contact_sum_m = 0.0;       ///< sum of the contact lengths, m
+  /// Mean of a sum over the ticks (0 for no ticks).
+  double mean(double sum) const { return ticks > 0 ? sum / double(ticks) : 0.0; }
+  /// Adds the ticks of another window.
+  void merge(const ViewWindow& other);
+};
+
 /// One consistent picture of the simulation.
 struct ViewFrame {
   int cols = 0;
@@ -44,6 +63,13 @@ struct ViewFrame {
   Vec3 force_world_n{};        ///< force on the tool in the world, newtons
   Vec3 force_device_n{};       ///< force sent to the device, newtons
   Vec3 body_force_world_n{};   ///< the step listeners' (rigid bodies') part of force_world_n, newtons
+  double penetration_force_n = 0.0;  ///< the penetration model's part of force_world_n (+Y up), N
+  double twist_torque_n_m = 0.0;     ///< twist torque about world +Y, N m (not in force_world_n)
+  double yaw_rate_rad_per_s = 0.0;   ///< estimated yaw rate of the tool, rad/s
+  /// The ticks since the reader's previous frame; publish() fills it from
+  /// this frame's values (force_world_n, body_force_world_n, force_device_n,
+  /// contact) and those of the frames the reader skipped.
+  ViewWindow window{};
   double step_time_s = 0.0;    ///< compute time of the step, seconds
   double period_s = 0.0;       ///< measured loop period before the step, seconds
   /// Rigid bodies (filled by fill_bodies from the loop's BodySource): the
@@ -90,6 +116,7 @@ class SnapshotExchange {
   Rect pending_[3];  // per frame: samples changed since that frame was last written (writer only)
   Rect dirty_since_publish_{};
   Rect last_published_dirty_{};
+  ViewWindow last_published_window_{};
   std::uint64_t sequence_ = 0;
   unsigned back_ = 0;
   unsigned front_ = 2;

@@ -73,6 +73,10 @@ enum class ClockMode {
 };
 
 /// Command-line choices over the scenario's settings.
+/// Silence after which SessionOptions::end_with_device ends a session, seconds:
+/// well past the watchdog's default 0.05 s and any network hiccup.
+inline constexpr double kDeviceEndSilence_s = 0.5;
+
 struct SessionOptions {
   std::optional<haptics::DeviceKind> device;        ///< overrides haptics.device
   std::optional<std::string> udp_address;  ///< overrides haptics.udp.address
@@ -88,6 +92,10 @@ struct SessionOptions {
   /// Where bodies.csv goes when the scenario has bodies (the folder must
   /// exist); empty: not written.
   std::filesystem::path bodies_csv;
+  /// End the session when the device stops sending: after its first sample,
+  /// kDeviceEndSilence_s without one (a UDP device whose own session ended).
+  /// The duration still bounds the session.
+  bool end_with_device = false;
   /// Polled every 10 ms while a real-time loop runs; true stops it (e.g. set by SIGINT).
   const std::atomic<bool>* interrupt = nullptr;
 };
