@@ -130,6 +130,11 @@ class SoilFlow {
   /// Relaxation only (no blade): e.g. between strokes, or a settling run.
   SoilStepResult relax(HeightGrid& grid);
 
+  /// Marks the cells of `rect` and their neighbours (clipped to the grid)
+  /// for relaxation, after an edit made outside a step; the next step's
+  /// passes examine them.
+  void wake(const Rect& rect);
+
   /// Cells still active (the backlog).
   std::int64_t active_cells() const { return std::int64_t(active_.size()); }
   const SoilFlowParams& params() const { return params_; }
