@@ -29,6 +29,7 @@
 #include <mutex>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -247,69 +248,90 @@ struct StepResult {
   StepOutput out;
 };
 
-// The columns of a batched step, allocated with the GIL held, filled without it.
-class StepColumns {
+// Named numpy columns of n rows, allocated with the GIL held and filled
+// row by row without it (set() makes no Python call). Float64 columns
+// first, then int64 ones, in the order named.
+class Columns {
  public:
-  StepColumns(py::ssize_t n, bool with_cut) : n_(n) {
-    for (const char* name : kDouble) doubles_.emplace_back(name, py::array_t<double>(n));
-    for (const char* name : kInt) ints_.emplace_back(name, py::array_t<std::int64_t>(n));
-    if (with_cut) ints_.emplace_back("cut", py::array_t<std::int64_t>(n));
+  Columns(py::ssize_t n, std::vector<const char*> doubles, std::vector<const char*> ints) {
+    for (const char* name : doubles) doubles_.emplace_back(name, py::array_t<double>(n));
+    for (const char* name : ints) ints_.emplace_back(name, py::array_t<std::int64_t>(n));
     for (auto& [name, a] : doubles_) dptr_.push_back(a.mutable_data());
     for (auto& [name, a] : ints_) iptr_.push_back(a.mutable_data());
   }
 
-  // Row i from a finished step (no Python calls: safe without the GIL).
-  void fill(py::ssize_t i, const StepOutput& o, std::int64_t cut = -1) {
-    const double d[] = {o.t_s,
-                        o.pose.position_m.x,
-                        o.pose.position_m.y,
-                        o.pose.position_m.z,
-                        o.pose.orientation.w,
-                        o.pose.orientation.x,
-                        o.pose.orientation.y,
-                        o.pose.orientation.z,
-                        o.contact.length_m,
-                        o.contact.section_area_m2,
-                        o.contact.max_depth_m,
-                        o.cut.removed_volume_m3,
-                        o.soil.displaced_volume_m3,
-                        o.listener_force_world_n.x,
-                        o.listener_force_world_n.y,
-                        o.listener_force_world_n.z,
-                        o.timers.total_s};
-    static_assert(sizeof d / sizeof d[0] == sizeof kDouble / sizeof kDouble[0]);
+  // Row i: one value per column, in the order they were named.
+  void set(py::ssize_t i, std::span<const double> d, std::span<const std::int64_t> n) {
     for (std::size_t k = 0; k < dptr_.size(); ++k) dptr_[k][i] = d[k];
-    const std::int64_t n[] = {o.step,      o.contact.cells_visited + o.cut.cells_visited,
-                              o.substeps,  o.changed.c0,
-                              o.changed.r0, o.changed.c1,
-                              o.changed.r1};
-    static_assert(sizeof n / sizeof n[0] == sizeof kInt / sizeof kInt[0]);
-    for (std::size_t k = 0; k < sizeof n / sizeof n[0]; ++k) iptr_[k][i] = n[k];
-    if (iptr_.size() > sizeof n / sizeof n[0]) iptr_.back()[i] = cut;
+    for (std::size_t k = 0; k < iptr_.size(); ++k) iptr_[k][i] = n[k];
   }
 
   py::dict dict() const {
     py::dict out;
-    for (const auto& [name, a] : ints_)
-      if (std::string(name) == "step") out[name] = a;
     for (const auto& [name, a] : doubles_) out[name] = a;
-    for (const auto& [name, a] : ints_)
-      if (std::string(name) != "step") out[name] = a;
+    for (const auto& [name, a] : ints_) out[name] = a;
     return out;
   }
 
  private:
-  static constexpr const char* kDouble[] = {
-      "t",  "x",  "y",  "z",  "qw",  "qx",  "qy",  "qz",  "contact_length", "section_area",
-      "max_depth", "removed_volume", "displaced_volume", "listener_fx", "listener_fy",
-      "listener_fz", "step_s"};
-  static constexpr const char* kInt[] = {"step", "cells_visited", "substeps", "changed_c0",
-                                         "changed_r0", "changed_c1", "changed_r1"};
-  py::ssize_t n_;
   std::vector<std::pair<const char*, py::array_t<double>>> doubles_;
   std::vector<std::pair<const char*, py::array_t<std::int64_t>>> ints_;
   std::vector<double*> dptr_;
   std::vector<std::int64_t*> iptr_;
+};
+
+// t, then the pose's 7 numbers: the first columns of every per-step table.
+constexpr std::size_t kTimePose = 8;
+void time_pose(double t_s, const BladePose& p, double* out) {
+  const double v[kTimePose] = {t_s,
+                               p.position_m.x,
+                               p.position_m.y,
+                               p.position_m.z,
+                               p.orientation.w,
+                               p.orientation.x,
+                               p.orientation.y,
+                               p.orientation.z};
+  std::copy(v, v + kTimePose, out);
+}
+
+// The columns of batched steps (Simulation.step(poses), Simulation.run()).
+class StepColumns {
+ public:
+  StepColumns(py::ssize_t n, bool with_cut)
+      : columns_(n,
+                 {"t", "x", "y", "z", "qw", "qx", "qy", "qz", "contact_length", "section_area",
+                  "max_depth", "removed_volume", "displaced_volume", "listener_fx",
+                  "listener_fy", "listener_fz", "step_s"},
+                 int_names(with_cut)) {}
+
+  // Row i from a finished step; cut: the cut's index (with_cut only).
+  void fill(py::ssize_t i, const StepOutput& o, std::int64_t cut = -1) {
+    double d[kTimePose + 9];
+    time_pose(o.t_s, o.pose, d);
+    const double rest[] = {o.contact.length_m,        o.contact.section_area_m2,
+                           o.contact.max_depth_m,     o.cut.removed_volume_m3,
+                           o.soil.displaced_volume_m3, o.listener_force_world_n.x,
+                           o.listener_force_world_n.y, o.listener_force_world_n.z,
+                           o.timers.total_s};
+    std::copy(std::begin(rest), std::end(rest), d + kTimePose);
+    const std::int64_t n[] = {o.step,       o.contact.cells_visited + o.cut.cells_visited,
+                              o.substeps,   o.changed.c0,
+                              o.changed.r0, o.changed.c1,
+                              o.changed.r1, cut};
+    columns_.set(i, d, n);
+  }
+
+  py::dict dict() const { return columns_.dict(); }
+
+ private:
+  static std::vector<const char*> int_names(bool with_cut) {
+    std::vector<const char*> names = {"step",       "cells_visited", "substeps",  "changed_c0",
+                                      "changed_r0", "changed_c1",    "changed_r1"};
+    if (with_cut) names.push_back("cut");
+    return names;
+  }
+
+  Columns columns_;
 };
 
 // ---------------------------------------------------------------------------
@@ -500,36 +522,21 @@ py::dict run_result_dict(const session::RunResult& r, const io::Scenario& sc) {
     out["soil"] = d;
   }
   // The per-step records as columns (contact.csv's, with the cut index).
-  const py::ssize_t n = py::ssize_t(r.records.size());
-  const char* names[] = {"t",  "x",  "y",  "z",  "qw", "qx", "qy", "qz", "contact_length",
-                         "removed_volume", "section_area", "max_depth"};
-  std::vector<py::array_t<double>> cols;
-  for (std::size_t k = 0; k < std::size(names); ++k) cols.emplace_back(n);
-  py::array_t<std::int64_t> cut(n), seq(n);
-  for (py::ssize_t i = 0; i < n; ++i) {
-    const io::StepRecord& rec = r.records[std::size_t(i)];
-    const double v[] = {rec.t_s,
-                        rec.pose.position_m.x,
-                        rec.pose.position_m.y,
-                        rec.pose.position_m.z,
-                        rec.pose.orientation.w,
-                        rec.pose.orientation.x,
-                        rec.pose.orientation.y,
-                        rec.pose.orientation.z,
-                        rec.contact.length_m,
-                        rec.removed_volume_m3,
-                        rec.contact.section_area_m2,
-                        rec.contact.max_depth_m};
-    for (std::size_t k = 0; k < std::size(names); ++k) cols[k].mutable_data()[i] = v[k];
-    cut.mutable_data()[i] = rec.cut;
-    seq.mutable_data()[i] = rec.sequence_index;
+  Columns records(py::ssize_t(r.records.size()),
+                  {"t", "x", "y", "z", "qw", "qx", "qy", "qz", "contact_length", "removed_volume",
+                   "section_area", "max_depth"},
+                  {"cut", "sequence_index"});
+  for (std::size_t i = 0; i < r.records.size(); ++i) {
+    const io::StepRecord& rec = r.records[i];
+    double d[kTimePose + 4];
+    time_pose(rec.t_s, rec.pose, d);
+    const double rest[] = {rec.contact.length_m, rec.removed_volume_m3, rec.contact.section_area_m2,
+                           rec.contact.max_depth_m};
+    std::copy(std::begin(rest), std::end(rest), d + kTimePose);
+    const std::int64_t n[] = {rec.cut, rec.sequence_index};
+    records.set(py::ssize_t(i), d, n);
   }
-  py::dict records;
-  records["t"] = cols[0];
-  records["cut"] = cut;
-  records["sequence_index"] = seq;
-  for (std::size_t k = 1; k < std::size(names); ++k) records[names[k]] = cols[k];
-  out["records"] = records;
+  out["records"] = records.dict();
   py::list cut_names;
   for (const Motion& m : sc.cuts) cut_names.append(m.name);
   out["cut_names"] = cut_names;
@@ -917,7 +924,11 @@ substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
       .def("reset", [](PySimulation& self) {
             auto lock = self.claim();
             self.sim().reset();
-          }, "Restores the initial terrain, time and counters (rigid bodies keep their state).")
+            // Whoever caches heights (the Bullet world) hears of the whole grid.
+            const Rect all{0, 0, self.sim().grid().cols(), self.sim().grid().rows()};
+            for (StepListener* listener : self.sim().listeners()) listener->on_edit(all);
+          }, "Restores the initial terrain, time and counters. Rigid bodies keep their poses and "
+             "are woken over the restored terrain.")
       .def("save", [](PySimulation& self, const std::filesystem::path& dir, std::optional<double> full_scale_m) {
             const HeightGrid& g = self.sim().grid();
             const double fs = full_scale_m.value_or(g.spec().full_scale_m);
