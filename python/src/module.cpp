@@ -403,7 +403,7 @@ py::array layer_view(py::object owner, const float* data, const HeightGrid& grid
   return view;
 }
 
-py::object step_poses(PySimulation& self, py::handle poses) {
+py::object step_poses(PySimulation& self, py::object poses) {
   // One pose: the fast path, then any 7-element array-like.
   BladePose pose;
   bool single = pose_from_sequence(poses, &pose);
@@ -595,7 +595,7 @@ py::dict soil_dict(const SoilParams& s) {
 }
 
 // earthmoving_force over arrays of widths and depths (broadcast by numpy).
-py::dict earthmoving_arrays(py::handle width, py::handle depth, py::handle soil,
+py::dict earthmoving_arrays(py::object width, py::object depth, py::object soil,
                             double rake_angle_deg) {
   EarthmovingParams params;
   params.soil = soil_arg(soil);
@@ -744,7 +744,7 @@ reader's message, "FILE:LINE: field: what".)doc")
       .def_property_readonly("sequence", [](const PyScenario& s) { return s.base().sequence_names(); },
                              "Names of the cuts in the order a run performs them.")
       .def_property_readonly("body_count", [](const PyScenario& s) { return s.s->bodies.size(); })
-      .def("cut_poses", [](const PyScenario& s, py::handle cut, std::optional<double> rate_hz) {
+      .def("cut_poses", [](const PyScenario& s, py::object cut, std::optional<double> rate_hz) {
             const io::Scenario& sc = s.base();
             const double rate = rate_hz.value_or(sc.rate_hz);
             if (!(std::isfinite(rate) && rate > 0.0 && rate <= 1e6))
@@ -815,8 +815,8 @@ one thread at a time.)doc")
            "The scenario's world: terrain, representation, blade, rate and its listeners (the "
            "rigid bodies when it has bodies: and this build has Bullet). bodies_csv: where the "
            "bodies' states go, or None.")
-      .def_static("from_heights", [](py::handle heights, std::pair<double, double> size_m,
-                                     py::handle origin_m, const std::string& representation,
+      .def_static("from_heights", [](py::object heights, std::pair<double, double> size_m,
+                                     py::object origin_m, const std::string& representation,
                                      double rate_hz, double blade_length_m,
                                      const std::string& soil_model, double repose_deg) {
             auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(heights);
@@ -871,7 +871,7 @@ substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
            "Steps the scenario's sequence (or the given cut names / indices) as `terracut "
            "run` does, each cut a separate stroke, and returns the step() columns plus 'cut' "
            "(the cut's index). Writes no files; see terracut.run for that.")
-      .def("contact", [](PySimulation& self, py::handle pose) {
+      .def("contact", [](PySimulation& self, py::object pose) {
             BladePose p;
             if (!pose_from_sequence(pose, &p)) p = pose_from(fixed<7>(pose, "pose").data(), "pose");
             auto lock = self.claim();
@@ -887,7 +887,7 @@ substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
           }, py::arg("pose"),
           "Contact of the blade at pose with the terrain as it is, without cutting or "
           "stepping: length_m (m), section_area_m2 (m^2), max_depth_m (m), cells_visited.")
-      .def("surface_y", [](PySimulation& self, py::handle x, py::handle z) {
+      .def("surface_y", [](PySimulation& self, py::object x, py::object z) {
             py::module_ np = py::module_::import("numpy");
             py::tuple both = np.attr("broadcast_arrays")(doubles(x, "x"), doubles(z, "z"));
             auto xs = doubles(np.attr("ascontiguousarray")(both[0]), "x");
@@ -902,7 +902,7 @@ substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
           }, py::arg("x"), py::arg("z"),
           "World Y of the terrain surface at world (x, z), metres, as the representation "
           "reads the samples (0 above ground level outside the terrain). Scalars or arrays.")
-      .def("edit_heights", [](PySimulation& self, py::handle values, int c0, int r0) {
+      .def("edit_heights", [](PySimulation& self, py::object values, int c0, int r0) {
             auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(values);
             if (!a || a.ndim() != 2)
               throw InputError("edit_heights: expected a 2-D (rows, cols) array of heights in metres");
@@ -1032,8 +1032,8 @@ a pure function of one sample.)doc")
                  haptics::with_derived_fields(s.s->haptics, s.base().blade.length_m);
              return ForceModel(h.forces);
            }), py::arg("scenario"))
-      .def("compute", [](const ForceModel& f, py::handle velocity, double contact_length_m,
-                         double cut_depth_m, py::handle edge_direction, py::handle device_point_m,
+      .def("compute", [](const ForceModel& f, py::object velocity, double contact_length_m,
+                         double cut_depth_m, py::object edge_direction, py::object device_point_m,
                          double surface_y_m, double surcharge_pa) {
             ForceInput in;
             in.velocity_m_per_s = vec3(velocity, "velocity_m_per_s");
@@ -1077,7 +1077,7 @@ non-finite force gives zero and is counted.)doc")
            }), py::arg("max_force_n") = 8.0, py::arg("max_force_rate_n_per_s") = 1000.0,
            py::arg("rise_time_s") = 1.0, py::arg("watchdog_timeout_s") = 0.05,
            py::arg("watchdog_ramp_s") = 0.1)
-      .def("update", [](SafetyLimiter& s, double t_s, py::handle force_n, double last_sample_t_s) {
+      .def("update", [](SafetyLimiter& s, double t_s, py::object force_n, double last_sample_t_s) {
             // Non-finite values pass: the limiter answers them with zero and counts them.
             auto raw = doubles(force_n, "force_n");
             if (raw.ndim() != 1 || raw.size() != 3) throw InputError("force_n: expected 3 numbers");
