@@ -444,7 +444,11 @@ py::object step_poses(PySimulation& self, py::object poses) {
 py::dict run_sequence(PySimulation& self, py::object cuts) {
   const io::Scenario& sc = self.scenario().base;
   std::vector<int> order = sc.sequence;
-  if (!cuts.is_none()) {
+  if (py::isinstance<py::str>(cuts)) {  // "A" or "A,B,C"
+    order.clear();
+    for (const std::string& name : io::parse_name_list(cuts.cast<std::string>(), "cuts"))
+      order.push_back(cut_index(sc, py::str(name)));
+  } else if (!cuts.is_none()) {
     order.clear();
     for (py::handle c : cuts) order.push_back(cut_index(sc, c));
   }
@@ -690,6 +694,11 @@ reader's message, "FILE:LINE: field: what".)doc")
           "resolve against its folder).")
       .def_static("from_image", [](const std::filesystem::path& png, double extent_m,
                                    double full_scale_m) {
+            // Checked here so that the message names this function's arguments.
+            if (!(std::isfinite(extent_m) && extent_m > 0.0))
+              throw InputError(must_be("extent_m", "finite and > 0", extent_m));
+            if (!(std::isfinite(full_scale_m) && full_scale_m > 0.0))
+              throw InputError(must_be("full_scale_m", "finite and > 0", full_scale_m));
             return PyScenario{std::make_shared<const session::Scenario>(
                 session::heightmap_scenario(png, extent_m, full_scale_m))};
           }, py::arg("png"), py::arg("extent_m") = 1.0, py::arg("full_scale_m") = 1.0,
@@ -868,7 +877,7 @@ contact_length (m), section_area (m^2), max_depth (m), removed_volume (m^3),
 displaced_volume (m^3), listener_fx..fz (N), step_s (s), cells_visited,
 substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
       .def("run", &run_sequence, py::arg("cuts") = py::none(),
-           "Steps the scenario's sequence (or the given cut names / indices) as `terracut "
+           "Steps the scenario's sequence (or the given cuts: names or indices, or 'A,B,C') as `terracut "
            "run` does, each cut a separate stroke, and returns the step() columns plus 'cut' "
            "(the cut's index). Writes no files; see terracut.run for that.")
       .def("contact", [](PySimulation& self, py::object pose) {
@@ -906,8 +915,11 @@ substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
             auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(values);
             if (!a || a.ndim() != 2)
               throw InputError("edit_heights: expected a 2-D (rows, cols) array of heights in metres");
-            const Rect rect{c0, r0, int(c0 + std::min<py::ssize_t>(a.shape(1), kMaxGridSide + 1)),
-                            int(r0 + std::min<py::ssize_t>(a.shape(0), kMaxGridSide + 1))};
+            // The far corner in 64 bits, so a huge c0 or r0 is refused, not wrapped.
+            const auto far = [](int start, py::ssize_t size) {
+              return int(std::min<std::int64_t>(std::int64_t(start) + size, std::int64_t(INT32_MAX)));
+            };
+            const Rect rect{c0, r0, far(c0, a.shape(1)), far(r0, a.shape(0))};
             auto lock = self.claim();
             return rect_tuple(self.sim().edit_heights(rect, {a.data(), std::size_t(a.size())}));
           }, py::arg("values"), py::arg("c0") = 0, py::arg("r0") = 0,

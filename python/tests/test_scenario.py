@@ -128,3 +128,4 @@ def test_from_image_is_the_heightmap_at_its_resolution():
     r, c = np.unravel_index(np.argmax(sim.heights), sim.heights.shape)
     assert abs(r - 127.5) <= 1 and abs(c - 127.5) <= 1
     assert "/no/such.png" in error_of(lambda: terracut.Scenario.from_image("/no/such.png"))
+    assert error_of(lambda: terracut.Scenario.from_image("x.png", extent_m=0)).startswith("extent_m must be")

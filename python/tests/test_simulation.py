@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import terracut
-from conftest import SCENARIOS, small_exp1_dict
+from conftest import small_exp1_dict
 
 POSE = [0.5, 0.1, 0.55, 1.0, 0.0, 0.0, 0.0]  # through the centres of row 5 of a 10x10 grid
 
@@ -59,6 +59,8 @@ def test_edit_heights_reports_the_rectangle_and_refuses_bad_values():
         sim.edit_heights(np.array([[-1.0]]))
     with pytest.raises(terracut.InputError, match="2-D"):
         sim.edit_heights(np.zeros(3))
+    with pytest.raises(terracut.InputError, match="inside the 10 x 10 grid"):
+        sim.edit_heights(np.zeros((1, 1)), c0=2**31 - 1)
     assert sim.state_hash == edited  # a refused edit writes nothing
 
 
@@ -98,6 +100,9 @@ def test_run_steps_the_sequence_as_separate_strokes():
     assert sim.conservation_error_m < 1e-6
     only = terracut.Simulation(terracut.Scenario.from_dict(d)).run(["back"])
     assert len(only["t"]) == n2
+    assert len(terracut.Simulation(terracut.Scenario.from_dict(d)).run("back,back")["t"]) == 2 * n2
+    with pytest.raises(terracut.InputError, match="no cut named 'nope'"):
+        terracut.Simulation(terracut.Scenario.from_dict(d)).run(["nope"])
 
 
 def test_contact_query_does_not_cut():

@@ -5,7 +5,6 @@ thread instead of racing."""
 import threading
 
 import numpy as np
-import pytest
 
 import terracut
 
@@ -70,7 +69,7 @@ def test_a_second_thread_on_the_same_simulation_is_refused_not_raced(exp1):
     t.start()
     inside.wait()
     refused = None
-    while not done.is_set() and refused is None:
+    while t.is_alive() and not done.is_set() and refused is None:
         try:
             sim.contact([0.5, 0.1, 0.5, 1, 0, 0, 0])
         except RuntimeError as e:
