@@ -215,7 +215,7 @@ def _run_case(spec: dict) -> dict:
         import terracut
 
         for name, fn in spec.get("extra_overrides", {}).items():
-            OVERRIDES.setdefault(name, fn)
+            OVERRIDES[name] = fn  # the client's, which may be newer than this worker's
         mapping = apply_overrides(spec["mapping"], overrides)
         scenario = from_dict(mapping, base_dir=spec["base_dir"], label=spec["label"])
         os.makedirs(out_dir, exist_ok=True)

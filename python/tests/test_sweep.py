@@ -91,12 +91,18 @@ def test_dask_local_cluster_gives_the_pools_rows(tmp_path):
         from distributed import Client, LocalCluster
     except ImportError as e:  # python3-distributed is in scripts/install-deps.sh
         pytest.skip(f"dask.distributed cannot be imported: {e}")
-    grid = {"resolution": [8, 0, 16]}
-    local = terracut.sweep(small_exp1_dict(), grid=grid, out_dir=tmp_path / "local", processes=1)
+    def blade_height(mapping, value):  # registered here, so it must travel to the workers
+        for k in mapping["cuts"][0]["keyframes"]:
+            k["position_m"][1] = value
+
+    terracut.register_override("dask_test_blade_y_m", blade_height)
+    cases = [{"resolution": 8}, {"resolution": 0}, {"resolution": 16, "dask_test_blade_y_m": 0.05}]
+    local = terracut.sweep(small_exp1_dict(), cases=cases, out_dir=tmp_path / "local", processes=1)
+    assert local.rows[2]["removed_volume_m3"] > local.rows[0]["removed_volume_m3"]
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
             Client(cluster) as client:
         seen = []
-        remote = terracut.sweep(small_exp1_dict(), grid=grid, out_dir=tmp_path / "dask", client=client,
+        remote = terracut.sweep(small_exp1_dict(), cases=cases, out_dir=tmp_path / "dask", client=client,
                                 progress=lambda d, t, r: seen.append(d))
         workers = {w for w in client.run(lambda: __import__("os").getpid()).values()}
     assert len(workers) == 2
