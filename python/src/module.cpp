@@ -78,8 +78,8 @@ py::array_t<double, py::array::c_style | py::array::forcecast> doubles(py::handl
 
 template <std::size_t N>
 std::array<double, N> fixed(py::handle obj, const std::string& what) {
-  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(obj);
-  if (!a || a.ndim() != 1 || a.size() != py::ssize_t(N))
+  const auto a = doubles(obj, what);
+  if (a.ndim() != 1 || a.size() != py::ssize_t(N))
     throw InputError(what + ": expected " + std::to_string(N) + " numbers");
   std::array<double, N> out{};
   for (std::size_t i = 0; i < N; ++i) {

@@ -129,3 +129,15 @@ def test_from_image_is_the_heightmap_at_its_resolution():
     assert abs(r - 127.5) <= 1 and abs(c - 127.5) <= 1
     assert "/no/such.png" in error_of(lambda: terracut.Scenario.from_image("/no/such.png"))
     assert error_of(lambda: terracut.Scenario.from_image("x.png", extent_m=0)).startswith("extent_m must be")
+
+
+def test_yaml_scalars_keep_their_types():
+    text = 'a: 1\nb: -2\nc: 1.5\nd: 1e3\ne: true\nf: ~\ng: "1"\nh: surface\ni: [0.1, x]\nj: .nan\n'
+    m = terracut._terracut._yaml_to_python(text, "t.yaml")
+    assert m["a"] == 1 and type(m["a"]) is int and m["b"] == -2
+    assert m["c"] == 1.5 and m["d"] == 1000.0 and type(m["d"]) is float
+    assert m["e"] is True and m["f"] is None
+    assert m["g"] == "1" and m["h"] == "surface" and m["i"] == [0.1, "x"]
+    assert math.isnan(m["j"])
+    with pytest.raises(terracut.InputError, match="t.yaml:"):
+        terracut._terracut._yaml_to_python("a: [1,", "t.yaml")
