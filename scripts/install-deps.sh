@@ -11,6 +11,7 @@ packages=(
   libglfw3-dev libepoxy-dev libimgui-dev
   libgl1-mesa-dri libegl-mesa0 libegl-dev xvfb xauth
   python3 python3-numpy python3-matplotlib gnuplot-nox
+  pybind11-dev python3-dev python3-pytest python3-scipy python3-distributed python3-dask
 )
 
 missing=()

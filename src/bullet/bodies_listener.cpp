@@ -57,6 +57,8 @@ Vec3 BodiesListener::on_step(const StepOutput& out) noexcept {
 
 void BodiesListener::on_lift() noexcept { world_->lift_tool(); }
 
+void BodiesListener::on_edit(const Rect& changed) noexcept { world_->terrain_changed(changed); }
+
 int BodiesListener::write_bodies(std::span<BodyView> out) const noexcept {
   const int n = std::min(world_->body_count(), int(out.size()));
   for (int i = 0; i < n; ++i) {

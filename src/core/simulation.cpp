@@ -189,4 +189,33 @@ void Simulation::reset() {
   out_ = {};
 }
 
+Rect Simulation::edit_heights(const Rect& rect, std::span<const float> values_m) {
+  if (in_step_) throw std::logic_error("Simulation::edit_heights: not during a step");
+  const Rect grid_rect{0, 0, grid_.cols(), grid_.rows()};
+  if (rect.empty() || rect.c0 < 0 || rect.r0 < 0 || rect.c1 > grid_rect.c1 ||
+      rect.r1 > grid_rect.r1)
+    throw InputError("edit_heights: rectangle [" + std::to_string(rect.c0) + ", " +
+                     std::to_string(rect.c1) + ") x [" + std::to_string(rect.r0) + ", " +
+                     std::to_string(rect.r1) + ") must be non-empty and inside the " +
+                     std::to_string(grid_rect.c1) + " x " + std::to_string(grid_rect.r1) +
+                     " grid (cols x rows)");
+  const int width = rect.c1 - rect.c0;
+  if (std::int64_t(values_m.size()) != rect.area())
+    throw InputError("edit_heights: expected " + std::to_string(rect.r1 - rect.r0) + " x " +
+                     std::to_string(width) + " values (rows x cols), got " +
+                     std::to_string(values_m.size()));
+  for (std::size_t i = 0; i < values_m.size(); ++i) {
+    const float h = values_m[i];
+    if (!(std::isfinite(h) && h >= 0.0f))
+      throw InputError(must_be("edit_heights: height at (col " +
+                                   std::to_string(rect.c0 + int(i) % width) + ", row " +
+                                   std::to_string(rect.r0 + int(i) / width) + ")",
+                               "finite and >= 0 metres", h));
+  }
+  const Rect changed = grid_.set_heights(rect, values_m.data());
+  if (soil_) soil_->wake(changed);
+  for (StepListener* listener : listeners_) listener->on_edit(changed);
+  return changed;
+}
+
 }  // namespace terracut

@@ -205,6 +205,14 @@ void SoilFlow::activate(std::uint32_t cell) {
   active_.push_back(cell);
 }
 
+void SoilFlow::wake(const Rect& rect) {
+  if (rect.empty()) return;
+  const int c0 = std::max(rect.c0 - 1, 0), c1 = std::min(rect.c1 + 1, cols_);
+  const int r0 = std::max(rect.r0 - 1, 0), r1 = std::min(rect.r1 + 1, rows_);
+  for (int r = r0; r < r1; ++r)
+    for (int c = c0; c < c1; ++c) activate(std::uint32_t(std::int64_t(r) * cols_ + c));
+}
+
 void SoilFlow::before_cut(const HeightGrid& grid, const Segment& from, const Segment& to) {
   // The bounding rectangle of the four endpoints, plus a cell.
   const GridSpec& spec = grid.spec();

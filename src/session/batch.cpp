@@ -19,6 +19,11 @@
 #include "terracut/session/world.hpp"
 
 namespace terracut::session {
+
+std::int64_t cut_steps(const Motion& motion, double rate_hz) {
+  return std::llround(motion.duration_s() * rate_hz) + 1;
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -192,12 +197,11 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
   Simulation& sim = world.simulation();
 
   // Steps per cut: samples at t = i / rate for i = 0..n, n = round(duration * rate).
-  std::vector<std::int64_t> cut_steps;
+  std::vector<std::int64_t> steps_of_cut;
   std::int64_t total_steps = 0;
   for (int index : sc.sequence) {
-    const std::int64_t n =
-        std::llround(sc.cuts[std::size_t(index)].duration_s() * sc.rate_hz) + 1;
-    cut_steps.push_back(n);
+    const std::int64_t n = session::cut_steps(sc.cuts[std::size_t(index)], sc.rate_hz);
+    steps_of_cut.push_back(n);
     total_steps += n;
   }
 
@@ -229,12 +233,12 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
     stats.name = motion.name;
     stats.sequence_index = int(k);
     stats.duration_s = motion.duration_s();
-    stats.steps = cut_steps[k];
+    stats.steps = steps_of_cut[k];
     double contact_sum = 0.0;
 
     // Each cut is a separate stroke: nothing is swept from the previous cut's end.
     sim.lift();
-    for (std::int64_t i = 0; i < cut_steps[k]; ++i) {
+    for (std::int64_t i = 0; i < steps_of_cut[k]; ++i) {
       const BladePose pose = motion.sample(double(i) / sc.rate_hz);
       if (pacer) {
         if (done == 0)

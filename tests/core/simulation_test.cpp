@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "terracut/core/error.hpp"
@@ -290,6 +291,96 @@ TEST(Motion, InterpolatesPositionLinearlyAndRotationBySlerp) {
   bad.keyframes[1].t_s = 0.0;
   EXPECT_NE(validate(bad).find("keyframe 1"), std::string::npos);
   EXPECT_EQ(validate(m), "");
+}
+
+// A listener that records what it hears of edits.
+struct EditRecorder final : StepListener {
+  std::vector<Rect> edits;
+  Vec3 on_step(const StepOutput&) noexcept override { return {}; }
+  void on_edit(const Rect& changed) noexcept override { edits.push_back(changed); }
+};
+
+// An edit between steps writes exactly its rectangle, keeps height + removed =
+// initial, reports the rectangle to the caller and to every listener, and is
+// seen by the next step's contact.
+TEST(Simulation, EditHeightsWritesItsRectangleAndTellsTheListeners) {
+  SimParams p;
+  p.grid = test::square_spec(10, 10);
+  p.representation = Representation::kColumns;
+  p.blade.length_m = 2.0;
+  Simulation sim(p, std::vector<float>(100, 0.5f));
+  EditRecorder recorder;
+  sim.add_listener(recorder);
+  const Rect rect{2, 3, 5, 4};  // cols 2..4 of row 3
+  const std::vector<float> values{0.1f, 0.2f, 0.3f};
+  EXPECT_EQ(sim.edit_heights(rect, values), rect);
+  ASSERT_EQ(recorder.edits.size(), 1u);
+  EXPECT_EQ(recorder.edits[0], rect);
+  for (int r = 0; r < 10; ++r) {
+    for (int c = 0; c < 10; ++c) {
+      const bool inside = r == 3 && c >= 2 && c < 5;
+      const float expected = inside ? values[size_t(c - 2)] : 0.5f;
+      EXPECT_EQ(sim.grid().height(c, r), expected) << c << "," << r;
+      const std::int64_t i = sim.grid().index(c, r);
+      EXPECT_EQ(sim.grid().heights()[i] + sim.grid().removed()[i], sim.grid().initial()[i]);
+    }
+  }
+  EXPECT_LE(sim.grid().conservation_error_m(), 1e-7);
+  // A blade along X at y = 0.25 through row 3 (z = 0.35) is inside the
+  // columns taller than that: the 7 untouched ones (0.5 m) and the 0.3 m
+  // one, 8 cells of 0.1 m (the blade spans the grid).
+  const StepOutput& out = sim.step({{0.5, 0.25, 0.35}, Quat{}});
+  EXPECT_NEAR(out.contact.length_m, 0.8, 1e-9);
+}
+
+// Bad edits are refused with a message naming what was wrong, and nothing is
+// written.
+TEST(Simulation, EditHeightsRefusesBadInputAndWritesNothing) {
+  SimParams p;
+  p.grid = test::square_spec(4, 4);
+  Simulation sim(p, std::vector<float>(16, 0.5f));
+  const std::uint64_t start = sim.grid().state_hash();
+  auto message = [&](Rect rect, std::vector<float> v) -> std::string {
+    try {
+      sim.edit_heights(rect, v);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_NE(message({0, 0, 5, 1}, std::vector<float>(5, 0.1f)).find("inside the 4 x 4 grid"),
+            std::string::npos);
+  EXPECT_NE(message({-1, 0, 1, 1}, std::vector<float>(2, 0.1f)).find("inside"), std::string::npos);
+  EXPECT_NE(message({1, 1, 1, 2}, {}).find("non-empty"), std::string::npos);
+  EXPECT_NE(message({0, 0, 2, 2}, std::vector<float>(3, 0.1f)).find("expected 2 x 2 values"),
+            std::string::npos);
+  EXPECT_NE(message({0, 0, 2, 2}, {0.1f, 0.1f, NAN, 0.1f}).find("(col 0, row 1)"),
+            std::string::npos);
+  EXPECT_NE(message({1, 2, 3, 3}, {0.1f, -0.2f}).find("(col 2, row 2)"), std::string::npos);
+  EXPECT_EQ(sim.grid().state_hash(), start);
+}
+
+// With flowing soil, a spike made by an edit slides down to the angle of
+// repose in the following steps (the blade held far above the terrain), and
+// no volume is lost.
+TEST(Simulation, EditHeightsWakesTheSoilFlow) {
+  SimParams p;
+  p.grid = test::square_spec(21, 21);  // cells of 1/21 m
+  p.soil.model = SoilModel::kFlow;
+  p.soil.repose_deg = 34.0;
+  Simulation sim(p, std::vector<float>(21 * 21, 0.0f));
+  const float spike = 0.2f;
+  sim.edit_heights({10, 10, 11, 11}, std::vector<float>{spike});
+  const double volume = sim.grid().volume_m3();
+  for (int i = 0; i < 200; ++i) sim.step({{0.5, 5.0, 0.5}, Quat{}});
+  // Every pair of neighbours along X is within the repose slope (plus the
+  // relaxation tolerance, 2 % of it) of each other.
+  const double limit = std::tan(34.0 * std::numbers::pi / 180.0) * p.grid.cell_x_m() * 1.02 + 1e-6;
+  for (int r = 0; r < 21; ++r)
+    for (int c = 0; c + 1 < 21; ++c)
+      EXPECT_LE(std::abs(sim.grid().height(c, r) - sim.grid().height(c + 1, r)), limit);
+  EXPECT_LT(sim.grid().height(10, 10), spike / 2);
+  EXPECT_NEAR(sim.grid().volume_m3(), volume, 1e-6 * volume);
 }
 
 }  // namespace

@@ -22,4 +22,22 @@ cmake --build "$scratch/sub" -j2 --target consumer >/dev/null
 diff "$scratch/find.txt" "$scratch/sub.txt"
 # Some step is in contact with the mound.
 grep -Eq "contact=0\.[0-9]*[1-9]" "$scratch/find.txt"
+
+# The Python module, when this build has it: installed where Debian's
+# /usr/bin/python3 looks under that prefix, and importable from there.
+if [ -f "$build/python/terracut/__init__.py" ]; then
+  py=/usr/bin/python3
+  site=$(find "$scratch/prefix/lib" -path '*-packages/terracut/__init__.py' | head -n1)
+  [ -n "$site" ] || { echo "the Python package was not installed"; exit 1; }
+  site=$(dirname "$(dirname "$site")")
+  "$py" -c "import site, sys; sys.exit(0 if sys.argv[1] in site.getsitepackages([sys.argv[2]]) else 1)" \
+    "$site" "$scratch/prefix" || { echo "$site is not on $py's path for prefix $scratch/prefix"; exit 1; }
+  (cd "$scratch" && PYTHONPATH="$site" "$py" -c "
+import sys, numpy as np, terracut
+assert terracut.__file__.startswith(sys.argv[1]), terracut.__file__
+sim = terracut.Simulation.from_heights(np.full((8, 8), 0.2), blade_length_m=2.0)
+print('python contact=%.3f' % sim.step([0.5, 0.1, 0.5, 1, 0, 0, 0]).contact_length_m)
+" "$site") | tee "$scratch/python.txt"
+  grep -q "python contact=1.000" "$scratch/python.txt"
+fi
 echo "install test passed"

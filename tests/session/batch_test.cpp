@@ -246,6 +246,9 @@ TEST_F(RunTest, ContactCsvHasOneRowPerStepInSequenceOrder) {
     EXPECT_EQ(c.peak_contact_m, peak) << c.name;
     EXPECT_NEAR(c.removed_volume_m3, volume, 1e-15) << c.name;
     EXPECT_NEAR(c.start_t_s, double(first) / 200.0, 1e-12) << c.name;
+    // cut_steps (what the Python module samples a cut by) says the same.
+    EXPECT_EQ(c.steps, cut_steps(sc.base.cuts[std::size_t(sc.base.find_cut(c.name))], 200.0))
+        << c.name;
     first += c.steps;
   }
   EXPECT_GT(result.cuts[0].peak_contact_m, 0.0);

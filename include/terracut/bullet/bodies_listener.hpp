@@ -68,6 +68,9 @@ class BodiesListener final : public StepListener, public BodySource {
   // StepListener
   Vec3 on_step(const StepOutput& out) noexcept override;
   void on_lift() noexcept override;
+  /// An edit between steps: the Bullet world refreshes the rectangle
+  /// (TerrainWorld::terrain_changed: bounds, wakes the bodies over it).
+  void on_edit(const Rect& changed) noexcept override;
 
   // BodySource
   int body_total() const noexcept override { return world_->body_count(); }

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -118,6 +119,17 @@ class Simulation {
 
   /// Restores the initial terrain, time and counters.
   void reset();
+
+  /// Replaces the heights of a rectangle of samples between steps (an
+  /// excavation made by hand, a terrain loaded from elsewhere): values_m
+  /// holds (r1 - r0) x (c1 - c0) heights, row-major, metres, finite and >= 0;
+  /// the rectangle must lie inside the grid and not be empty. removed is
+  /// updated (initial - height); with SoilModel::kFlow the edited samples
+  /// and their neighbours are relaxed from the next step on; every listener
+  /// hears of it (StepListener::on_edit). Returns the rectangle written.
+  /// Throws InputError naming the bad argument or sample (nothing is
+  /// written then); std::logic_error during a step.
+  Rect edit_heights(const Rect& rect, std::span<const float> values_m);
 
  private:
   SimParams params_;

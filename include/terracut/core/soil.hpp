@@ -178,6 +178,11 @@ class SoilFlow {
   static constexpr int kMaxObstacles = 255;
   /// Soil in the bucket, m^3 (0 without one).
   double bucket_load_m3() const { return load_m3_; }
+  /// Marks the cells of `rect` and their neighbours (clipped to the grid)
+  /// for relaxation, after an edit made outside a step; the next step's
+  /// passes examine them.
+  void wake(const Rect& rect);
+
   /// Cells still active (the backlog).
   std::int64_t active_cells() const { return std::int64_t(active_.size()); }
   const SoilFlowParams& params() const { return params_; }

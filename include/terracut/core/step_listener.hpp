@@ -14,6 +14,7 @@
 // safety).
 #pragma once
 
+#include "terracut/core/grid.hpp"
 #include "terracut/core/math.hpp"
 
 namespace terracut {
@@ -34,6 +35,11 @@ class StepListener {
   /// The blade was lifted (Simulation::lift): the next pose is a jump, not a
   /// sweep.
   virtual void on_lift() noexcept {}
+
+  /// Heights inside `changed` were edited outside a step
+  /// (Simulation::edit_heights): whoever caches them refreshes that
+  /// rectangle. Not called during a step.
+  virtual void on_edit(const Rect& changed) noexcept { (void)changed; }
 };
 
 }  // namespace terracut

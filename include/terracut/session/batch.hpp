@@ -115,6 +115,10 @@ struct RunResult {
   double wall_s = 0.0;               ///< wall-clock time of the simulation loop, seconds
 };
 
+/// Steps a batch run gives a cut at rate_hz: one at t = i / rate_hz (from
+/// the cut's start, Motion::sample) for i = 0..n, n = round(duration * rate_hz).
+std::int64_t cut_steps(const Motion& motion, double rate_hz);
+
 /// Runs the scenario's sequence and writes the outputs into options.out_dir.
 /// Throws terracut::InputError naming the file or folder when an output cannot
 /// be written, or the field when the scenario cannot be simulated.

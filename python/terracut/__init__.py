@@ -1,0 +1,67 @@
+"""terracut: soil cutting for haptic teleoperation, from Python.
+
+SI units throughout (metres, seconds, newtons, kilograms); the world frame
+is right-handed with Y up and the ground plane X-Z. A blade pose is 7
+numbers [x, y, z, qw, qx, qy, qz]: the blade's centre in world metres and
+its orientation as a unit quaternion (the blade lies along its local X).
+
+    import terracut
+    sc = terracut.Scenario.load("scenarios/paper_experiment1.yaml")
+    sim = terracut.Simulation(sc)
+    cols = sim.run()                  # dict of numpy columns, one row per step
+    sim.heights                       # (rows, cols) float32 view of the terrain, metres
+
+Scenarios come from files (Scenario.load), dicts with the same schema
+(Scenario.from_dict) or PNG heightmaps (Scenario.from_image); a Simulation
+also from a numpy array (Simulation.from_heights). terracut.run() is
+`terracut run` (the same files on disk); terracut.sweep() runs many cases,
+locally or on a Dask cluster. Errors are terracut.InputError (a ValueError)
+with the C++ library's messages.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any, Union
+
+from ._terracut import (  # noqa: F401
+    ForceModel,
+    InputError,
+    SafetyLimiter,
+    Scenario,
+    Simulation,
+    StepResult,
+    bodies_available,
+    earthmoving_force,
+    soil_preset,
+)
+from ._scenarios import as_scenario, from_dict, load_mapping  # noqa: F401
+
+Scenario.from_dict = staticmethod(from_dict)
+Scenario.from_dict.__doc__ = from_dict.__doc__
+
+
+def run(scenario, out_dir: Union[str, os.PathLike], realtime: bool = False) -> dict[str, Any]:
+    """Runs a scenario as `terracut run SCENARIO --out OUT_DIR` does.
+
+    scenario: a Scenario, a file path or a dict. Writes the same files
+    (contact.csv, height.npy, removed.npy, PNGs, summary.json, bodies.csv)
+    and returns the run's figures: steps, volumes (m^3), max_sample_error_m,
+    per-cut figures ("cuts"), step timing ("step_timing", microseconds), and
+    "records": contact.csv's columns as numpy arrays (t in s, cut index,
+    x, y, z in m, qw..qz, contact_length m, removed_volume m^3,
+    section_area m^2, max_depth m). The GIL is released during the run.
+    """
+    from ._terracut import _run
+
+    return _run(as_scenario(scenario), Path(out_dir), realtime)
+
+
+from .sweep import SweepResult, register_override, sweep  # noqa: E402,F401
+
+__all__ = [
+    "ForceModel", "InputError", "SafetyLimiter", "Scenario", "Simulation", "StepResult",
+    "SweepResult", "bodies_available", "earthmoving_force", "from_dict", "load_mapping",
+    "register_override", "run", "soil_preset", "sweep",
+]

@@ -1,0 +1,68 @@
+"""Bit-identical to the command line: `terracut run` and the module give the
+same numbers for the same scenario."""
+
+import subprocess
+
+import numpy as np
+
+import terracut
+
+FIELDS = ["t", None, "x", "y", "z", "qw", "qx", "qy", "qz", "contact_length", "removed_volume",
+          "section_area", "max_depth", "cells_visited"]
+
+
+def cli_run(cli, scenario, out, *args):
+    subprocess.run([cli, "run", str(scenario), "--out", str(out), *args], check=True,
+                   capture_output=True)
+    return (out / "contact.csv").read_text().splitlines()
+
+
+def test_simulation_run_matches_the_cli_csv_exactly(cli, exp1, tmp_path):
+    lines = cli_run(cli, exp1, tmp_path / "cli", "--resolution", "30", "--representation", "columns")
+    sc = terracut.Scenario.load(exp1).with_overrides(resolution=30, representation="columns")
+    sim = terracut.Simulation(sc)
+    cols = sim.run()
+    assert lines[0] == "t,cut,x,y,z,qw,qx,qy,qz,contact_length,removed_volume,section_area,max_depth,cells_visited"
+    assert len(lines) - 1 == len(cols["t"])
+    names = sc.cut_names
+    # contact.csv prints every value with %.9g: format the arrays the same way
+    # and the text must be the same, row by row.
+    for i, line in enumerate(lines[1:]):
+        mine = []
+        for f in FIELDS:
+            if f is None:
+                mine.append(names[int(cols["cut"][i])])
+            elif f == "cells_visited":
+                mine.append("%d" % cols[f][i])
+            else:
+                mine.append("%.9g" % cols[f][i])
+        assert ",".join(mine) == line, (i, line)
+    # The final terrain, bitwise.
+    np.testing.assert_array_equal(np.load(tmp_path / "cli" / "height.npy"), sim.heights)
+    np.testing.assert_array_equal(np.load(tmp_path / "cli" / "removed.npy"), sim.removed)
+
+
+def test_terracut_run_writes_the_clis_files(cli, exp1, tmp_path):
+    cli_run(cli, exp1, tmp_path / "cli", "--resolution", "25")
+    result = terracut.run(terracut.Scenario.load(exp1).with_overrides(resolution=25), tmp_path / "py")
+    for name in ["contact.csv", "height.npy", "removed.npy", "height.png", "removed.png"]:
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+    rec = result["records"]
+    assert result["steps"] == len(rec["t"]) == 2001
+    # The records are the CSV's values (before %.9g printing).
+    csv = np.genfromtxt(tmp_path / "cli" / "contact.csv", delimiter=",", names=True, dtype=None,
+                        encoding="utf-8")
+    np.testing.assert_allclose(rec["contact_length"], csv["contact_length"], rtol=1e-8, atol=1e-12)
+    assert result["cuts"][0]["name"] == "horizontal"
+    assert result["removed_volume_m3"] > 0 and abs(result["volume_error_m3"]) < 1e-9
+
+
+def test_run_errors_name_the_output(tmp_path, exp1):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    try:
+        terracut.run(exp1, blocker)
+    except terracut.InputError as e:
+        assert str(blocker) in str(e)
+    else:
+        raise AssertionError("a file as the output folder was accepted")
