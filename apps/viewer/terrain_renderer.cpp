@@ -492,11 +492,15 @@ void TerrainRenderer::update_errors(const float* heights_m, const Rect& samples)
                 return cx + cz <= 1.0f ? h00 + cx * (h10 - h00) + cz * (h01 - h00)
                                        : h11 + (1.0f - cx) * (h01 - h11) + (1.0f - cz) * (h10 - h11);
               };
+              // The top and left edges' middles and the centre; the right
+              // and bottom edges are the next quads' left and top (on a
+              // shared edge both quads interpolate the same line), except
+              // at the node's last column and row.
               worst = std::max(worst, std::fabs(r0[cm] - coarse(x, 0.0f)));
               worst = std::max(worst, std::fabs(rm[ca] - coarse(0.0f, z)));
               worst = std::max(worst, std::fabs(rm[cm] - coarse(x, z)));
-              worst = std::max(worst, std::fabs(rm[cb] - coarse(1.0f, z)));
-              worst = std::max(worst, std::fabs(r1[cm] - coarse(x, 1.0f)));
+              if (i == nu - 1) worst = std::max(worst, std::fabs(rm[cb] - coarse(1.0f, z)));
+              if (j == nv - 1) worst = std::max(worst, std::fabs(r1[cm] - coarse(x, 1.0f)));
             }
           }
           // Plus the children's own errors.
@@ -573,7 +577,7 @@ void TerrainRenderer::select_chunks(const Mat4& vp, float viewport_w, float view
     // from the full-detail one on screen, or its quads larger than
     // kLodQuadPixels (silhouettes), at its nearest point; never into quads
     // smaller than kLodMinQuadPixels / 2 (a cut's wall smeared over a pixel
-    // looks the same as a sharp one).
+    // or so looks the same as a sharp one).
     int level = 0;
     while ((1 << level) < node.step) ++level;
     const float node_error =
