@@ -223,6 +223,26 @@ GLuint make_height_texture(int cols, int rows, const float* data, GLint filter) 
   return t;
 }
 
+// Fills the bound vertex array's buffers with a mesh (static).
+template <class V>
+void upload_mesh(GLuint vbo, GLuint ibo, const std::vector<V>& vertices,
+                 const std::vector<GLuint>& indices) {
+  glBindBuffer(GL_ARRAY_BUFFER, vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(V)), vertices.data(),
+               GL_STATIC_DRAW);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(GLuint)),
+               indices.data(), GL_STATIC_DRAW);
+}
+
+// Float attribute `index` of `count` components at `offset` bytes into V.
+template <class V>
+void float_attribute(GLuint index, GLint count, std::size_t offset) {
+  glEnableVertexAttribArray(index);
+  glVertexAttribPointer(index, count, GL_FLOAT, GL_FALSE, sizeof(V),
+                        reinterpret_cast<void*>(offset));
+}
+
 // The largest height of a set of samples, metres (0 for none).
 float highest(const float* heights_m, int cols, const Rect& r) {
   float top = 0.0f;
@@ -326,20 +346,10 @@ void TerrainRenderer::build_lod_patch() {
   for (int step = 1; step <= root_step_; step *= 2)
     errors_.emplace_back(std::size_t(root_step_ / step) * std::size_t(root_step_ / step), 0.0f);
 
-  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(PatchVertex)),
-               vertices.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(GLuint)),
-               indices.data(), GL_STATIC_DRAW);
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(PatchVertex), nullptr);
-  glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 1, GL_FLOAT, GL_FALSE, sizeof(PatchVertex),
-                        reinterpret_cast<void*>(offsetof(PatchVertex, top)));
-  glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, sizeof(PatchVertex),
-                        reinterpret_cast<void*>(offsetof(PatchVertex, skirt)));
+  upload_mesh(vbo_, ibo_, vertices, indices);
+  float_attribute<PatchVertex>(0, 2, offsetof(PatchVertex, i));
+  float_attribute<PatchVertex>(1, 1, offsetof(PatchVertex, top));
+  float_attribute<PatchVertex>(2, 1, offsetof(PatchVertex, skirt));
   glGenBuffers(1, &instance_vbo_);
   glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
   glEnableVertexAttribArray(3);
@@ -392,20 +402,10 @@ void TerrainRenderer::build_blocky_mesh() {
   box_index_count_ = GLsizei(indices.size());
   triangles_ = std::int64_t(nz - 1) * (nx - 1) * 2;
 
-  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(BoxVertex)), vertices.data(),
-               GL_STATIC_DRAW);
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(GLuint)),
-               indices.data(), GL_STATIC_DRAW);
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(BoxVertex), nullptr);
-  glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, sizeof(BoxVertex),
-                        reinterpret_cast<void*>(offsetof(BoxVertex, sample_u)));
-  glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, sizeof(BoxVertex),
-                        reinterpret_cast<void*>(offsetof(BoxVertex, top)));
+  upload_mesh(vbo_, ibo_, vertices, indices);
+  float_attribute<BoxVertex>(0, 2, offsetof(BoxVertex, pos_u));
+  float_attribute<BoxVertex>(1, 2, offsetof(BoxVertex, sample_u));
+  float_attribute<BoxVertex>(2, 1, offsetof(BoxVertex, top));
 }
 
 void TerrainRenderer::upload(const float* heights_m, const Rect& rect) {
