@@ -9,7 +9,8 @@
 #
 # Environment: BUILD_DIR (default build-bench), JOBS (build jobs, default 2),
 # OUT_DIR (default docs/bench), BENCH_FILTER (a Google Benchmark regex for the
-# step cases). The build is Release with the project's portable flags; pass
+# step cases), BENCH_NO_VIEWER=1 (leave out the viewer's cases, about 4
+# minutes). The build is Release with the project's portable flags; pass
 # CMAKE_ARGS (e.g. -DCMAKE_CXX_FLAGS=-march=native) to change that.
 set -euo pipefail
 
@@ -72,7 +73,7 @@ fi
 echo "== the viewer on the software renderer (llvmpipe, headless EGL)"
 viewer="$build/apps/viewer/terracut-viewer"
 : > "$out/viewer.txt"
-if [ -x "$viewer" ]; then
+if [ -x "$viewer" ] && [ "${BENCH_NO_VIEWER:-0}" != 1 ]; then
   for side in 256 1024 4096 8192; do
     frames=40; [ "$side" = 8192 ] && frames=24
     echo "-- $side" >> "$out/viewer.txt"

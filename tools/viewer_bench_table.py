@@ -40,7 +40,9 @@ def main():
                 fig["fps"], fig["ms"], fig["samples"] = m.group(3), m.group(4), m.group(5)
             if m := PHASES.search(line):
                 fig["upload"], fig["terrain"], fig["triangles"] = m.group(1), m.group(2), m.group(3)
-                fig["panel"] = m.group(5)
+                # The panel is a difference of two timed frames: on a busy
+                # machine it can come out below zero.
+                fig["panel"] = m.group(5) if float(m.group(5)) >= 0 else "< 0 (noise)"
             if (m := LOOP.search(line)) and "loop" not in fig:
                 fig["loop"] = f"{float(m.group(1)):.0f} / {float(m.group(2)):.0f} / {float(m.group(3)):.0f}"
     if side is not None:
