@@ -437,8 +437,8 @@ void TerrainRenderer::update_errors(const float* heights_m, const Rect& samples)
   // level first.
   const int cols = spec_.cols, rows = spec_.rows;
   const int last_u = cols + 1, last_v = rows + 1;
-  // Mesh line 0 and line 1 read sample 0, line k + 1 sample k.
-  // The changed samples' lines, one wider on each side (line 0 shares sample 0).
+  // The changed samples' lines (line 0 and line 1 read sample 0, line k + 1
+  // sample k), one wider on each side.
   const int lu0 = std::max(samples.c0, 0), lu1 = std::min(samples.c1 + 1, last_u);
   const int lv0 = std::max(samples.r0, 0), lv1 = std::min(samples.r1 + 1, last_v);
   if (lu1 < lu0 || lv1 < lv0) return;
