@@ -1,6 +1,11 @@
 #include "terrain_renderer.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <utility>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -12,16 +17,25 @@ namespace {
 
 constexpr GLuint kRestart = 0xFFFFFFFFu;
 
-// One mesh vertex: where it sits (cell coordinates: x = origin.x + pos_u * cell_x),
-// which texel coordinates give its height, and whether it is on the surface (1)
-// or on the ground (0, the skirt's and the outer walls' foot).
-struct Vertex {
+// One vertex of the columns' box mesh: where it sits (cell coordinates:
+// x = origin.x + pos_u * cell_x), which texel gives its height, and whether it
+// is on the surface (1) or on the ground (0, the outer walls' foot).
+struct BoxVertex {
   float pos_u, pos_v;
   float sample_u, sample_v;
   float top;
 };
 
-const char* kVertexShader = R"(#version 330 core
+// One vertex of the level-of-detail patch: its corner (i, j) of the patch's
+// kPatchQuads x kPatchQuads quads, whether it is on the surface (1) or a
+// skirt's foot on the ground (0), and whether it belongs to the skirt.
+struct PatchVertex {
+  float i, j;
+  float top;
+  float skirt;
+};
+
+const char* kBoxVertexShader = R"(#version 330 core
 layout(location = 0) in vec2 a_pos;
 layout(location = 1) in vec2 a_sample;
 layout(location = 2) in float a_top;
@@ -30,16 +44,53 @@ uniform sampler2D u_heights;
 uniform vec2 u_grid;    // cols, rows
 uniform vec2 u_cell;    // cell size along X and Z, metres
 uniform vec3 u_origin;  // world origin corner; y = ground
-uniform int u_blocky;   // 1: one height per cell (texelFetch)
 out vec3 v_world;
 out vec2 v_sample;
+out float v_wall;
 void main() {
-  float h = u_blocky == 1 ? texelFetch(u_heights, ivec2(floor(a_sample)), 0).r
-                          : textureLod(u_heights, a_sample / u_grid, 0.0).r;
+  // One height per cell (texelFetch): flat tops, vertical walls.
+  float h = texelFetch(u_heights, ivec2(floor(a_sample)), 0).r;
   vec3 p = vec3(u_origin.x + a_pos.x * u_cell.x, u_origin.y + a_top * h,
                 u_origin.z + a_pos.y * u_cell.y);
   v_world = p;
   v_sample = a_sample;
+  v_wall = 0.0;
+  gl_Position = u_vp * vec4(p, 1.0);
+}
+)";
+
+// Mesh lines: line 0 is the terrain's outer edge (a flat half-cell border
+// reads the first sample), line k + 1 is sample k's centre, line cols + 1 the
+// far edge. A chunk's vertex (i, j) sits on line chunk.xy + (i, j) * step,
+// clamped to the last line (a chunk reaching past the terrain folds onto its
+// edge: those triangles have no area).
+const char* kLodVertexShader = R"(#version 330 core
+layout(location = 0) in vec2 a_patch;
+layout(location = 1) in float a_top;
+layout(location = 2) in float a_skirt;
+layout(location = 3) in vec3 a_chunk;  // per instance: first lines (u, v), lines per quad
+uniform mat4 u_vp;
+uniform sampler2D u_heights;
+uniform vec2 u_grid;    // cols, rows
+uniform vec2 u_cell;    // cell size along X and Z, metres
+uniform vec3 u_origin;  // world origin corner; y = ground
+uniform vec2 u_lines;   // last mesh line along X and Z: cols + 1, rows + 1
+out vec3 v_world;
+out vec2 v_sample;
+out float v_wall;
+void main() {
+  vec2 line = min(a_chunk.xy + a_patch * a_chunk.z, u_lines);
+  vec2 pos = clamp(line - 0.5, vec2(0.0), u_grid);
+  vec2 s = clamp(line - 0.5, vec2(0.5), u_grid - 0.5);
+  float h = textureLod(u_heights, s / u_grid, 0.0).r;
+  vec3 p = vec3(u_origin.x + pos.x * u_cell.x, u_origin.y + a_top * h,
+                u_origin.z + pos.y * u_cell.y);
+  v_world = p;
+  v_sample = s;
+  // A skirt on the terrain's outer edge is its wall; inside, skirts only fill
+  // the cracks between chunks of different detail and are shaded as soil.
+  bool edge = line.x <= 0.0 || line.y <= 0.0 || line.x >= u_lines.x || line.y >= u_lines.y;
+  v_wall = a_skirt > 0.5 && edge ? 1.0 : 0.0;
   gl_Position = u_vp * vec4(p, 1.0);
 }
 )";
@@ -47,6 +98,7 @@ void main() {
 const char* kFragmentShader = R"(#version 330 core
 in vec3 v_world;
 in vec2 v_sample;
+in float v_wall;  // 1 on the terrain's outer walls
 uniform sampler2D u_heights;
 uniform sampler2D u_initial;
 uniform vec2 u_grid;
@@ -54,7 +106,6 @@ uniform vec2 u_cell;
 uniform vec3 u_origin;
 uniform int u_normal_mode;  // 0: smooth from texture, 1: geometric (box mesh), 2: one per cell
 uniform int u_color_mode;   // 0: height, 1: removed depth
-uniform int u_skirt;        // 1: drawing the skirt (outer walls)
 uniform float u_height_scale;
 uniform float u_removed_scale;
 uniform float u_contour;
@@ -97,7 +148,7 @@ void main() {
   // Geometric normal of the drawn triangle, turned towards the eye.
   vec3 gn = normalize(cross(dFdx(v_world), dFdy(v_world)));
   if (dot(gn, u_eye - v_world) < 0.0) gn = -gn;
-  bool wall = u_skirt == 1 || (u_normal_mode == 1 && abs(gn.y) < 0.5);
+  bool wall = v_wall > 0.99 || (u_normal_mode == 1 && abs(gn.y) < 0.5);
 
   vec3 n;
   float h, h0;
@@ -172,6 +223,36 @@ GLuint make_height_texture(int cols, int rows, const float* data, GLint filter) 
   return t;
 }
 
+// Fills the bound vertex array's buffers with a mesh (static).
+template <class V>
+void upload_mesh(GLuint vbo, GLuint ibo, const std::vector<V>& vertices,
+                 const std::vector<GLuint>& indices) {
+  glBindBuffer(GL_ARRAY_BUFFER, vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(V)), vertices.data(),
+               GL_STATIC_DRAW);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(GLuint)),
+               indices.data(), GL_STATIC_DRAW);
+}
+
+// Float attribute `index` of `count` components at `offset` bytes into V.
+template <class V>
+void float_attribute(GLuint index, GLint count, std::size_t offset) {
+  glEnableVertexAttribArray(index);
+  glVertexAttribPointer(index, count, GL_FLOAT, GL_FALSE, sizeof(V),
+                        reinterpret_cast<void*>(offset));
+}
+
+// The largest height of a set of samples, metres (0 for none).
+float highest(const float* heights_m, int cols, const Rect& r) {
+  float top = 0.0f;
+  for (int row = r.r0; row < r.r1; ++row) {
+    const float* line = heights_m + std::int64_t(row) * cols;
+    for (int c = r.c0; c < r.c1; ++c) top = std::max(top, line[c]);
+  }
+  return top;
+}
+
 }  // namespace
 
 TerrainRenderer::TerrainRenderer(const GridSpec& spec, Representation representation,
@@ -188,10 +269,13 @@ TerrainRenderer::TerrainRenderer(const GridSpec& spec, Representation representa
   mesh_max = std::max(mesh_max, 2);
   blocky_ = representation == Representation::kColumns && 2 * spec.cols <= mesh_max &&
             2 * spec.rows <= mesh_max;
-  program_ = build_program("terrain", kVertexShader, kFragmentShader);
+  program_ = blocky_ ? build_program("terrain (boxes)", kBoxVertexShader, kFragmentShader)
+                     : build_program("terrain", kLodVertexShader, kFragmentShader);
   GLint filter = representation == Representation::kColumns ? GL_NEAREST : GL_LINEAR;
   heights_tex_ = make_height_texture(spec.cols, spec.rows, heights_m, filter);
   initial_tex_ = make_height_texture(spec.cols, spec.rows, initial_m, filter);
+  const Rect all{0, 0, spec.cols, spec.rows};
+  top_m_ = std::max(highest(initial_m, spec.cols, all), highest(heights_m, spec.cols, all));
 
   glGenVertexArrays(1, &vao_);
   glGenBuffers(1, &vbo_);
@@ -200,16 +284,9 @@ TerrainRenderer::TerrainRenderer(const GridSpec& spec, Representation representa
   if (blocky_) {
     build_blocky_mesh();
   } else {
-    build_surface_mesh(mesh_max);
+    build_lod_patch();
+    update_errors(heights_m, all);
   }
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex), nullptr);
-  glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex),
-                        reinterpret_cast<void*>(offsetof(Vertex, sample_u)));
-  glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, sizeof(Vertex),
-                        reinterpret_cast<void*>(offsetof(Vertex, top)));
   glBindVertexArray(0);
   check_gl("creating the terrain mesh and textures");
 }
@@ -218,72 +295,66 @@ TerrainRenderer::~TerrainRenderer() {
   glDeleteProgram(program_);
   glDeleteBuffers(1, &vbo_);
   glDeleteBuffers(1, &ibo_);
+  glDeleteBuffers(1, &instance_vbo_);
   glDeleteVertexArrays(1, &vao_);
   glDeleteTextures(1, &heights_tex_);
   glDeleteTextures(1, &initial_tex_);
 }
 
-void TerrainRenderer::build_surface_mesh(int mesh_max) {
-  // Interior vertices from the first to the last sample centre, plus the outer
-  // edge of the terrain on each side (flat half-cell border).
-  auto axis = [&](int samples, std::vector<float>& pos, std::vector<float>& smp) {
-    int n = std::min(samples, mesh_max);
-    pos.push_back(0.0f);
-    smp.push_back(0.5f);
-    for (int i = 0; i < n; ++i) {
-      float s = n > 1 ? 0.5f + float(i) * float(samples - 1) / float(n - 1) : 0.5f * float(samples);
-      pos.push_back(s);
-      smp.push_back(s);
-    }
-    pos.push_back(float(samples));
-    smp.push_back(float(samples) - 0.5f);
-  };
-  std::vector<float> pu, su, pv, sv;
-  axis(spec_.cols, pu, su);
-  axis(spec_.rows, pv, sv);
-  const int nx = int(pu.size()), nz = int(pv.size());
-  mesh_cols_ = nx;
-  mesh_rows_ = nz;
-
-  std::vector<Vertex> vertices;
-  vertices.reserve(std::size_t(nx) * nz + 2 * std::size_t(nx + nz));
-  for (int j = 0; j < nz; ++j)
-    for (int i = 0; i < nx; ++i) vertices.push_back({pu[i], pv[j], su[i], sv[j], 1.0f});
-
+void TerrainRenderer::build_lod_patch() {
+  // The one patch every chunk draws: kPatchQuads x kPatchQuads quads as
+  // triangle strips split like the surface (from corner (i+1, j) to
+  // (i, j+1)), then a skirt around its perimeter, each edge vertex paired
+  // with one on the ground.
+  const int n = kPatchQuads;
+  std::vector<PatchVertex> vertices;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) vertices.push_back({float(i), float(j), 1.0f, 0.0f});
   std::vector<GLuint> indices;
-  indices.reserve(std::size_t(nz - 1) * (2 * std::size_t(nx) + 1) + 4 * std::size_t(nx + nz));
-  for (int j = 0; j + 1 < nz; ++j) {
-    for (int i = 0; i < nx; ++i) {
-      indices.push_back(GLuint(j * nx + i));
-      indices.push_back(GLuint((j + 1) * nx + i));
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      indices.push_back(GLuint(j * (n + 1) + i));
+      indices.push_back(GLuint((j + 1) * (n + 1) + i));
     }
     indices.push_back(kRestart);
   }
-  top_index_count_ = GLsizei(indices.size());
-  triangles_ = std::int64_t(nz - 1) * (nx - 1) * 2;
-
-  // Skirt: the perimeter of the top grid, each vertex paired with one on the ground.
-  std::vector<GLuint> ring;
-  for (int i = 0; i < nx; ++i) ring.push_back(GLuint(i));
-  for (int j = 1; j < nz; ++j) ring.push_back(GLuint(j * nx + nx - 1));
-  for (int i = nx - 2; i >= 0; --i) ring.push_back(GLuint((nz - 1) * nx + i));
-  for (int j = nz - 2; j >= 0; --j) ring.push_back(GLuint(j * nx));
-  for (GLuint top_index : ring) {
-    Vertex ground = vertices[top_index];
-    ground.top = 0.0f;
-    indices.push_back(top_index);
+  // The perimeter, closed: along j = 0, i = n, j = n backwards, i = 0 backwards.
+  std::vector<std::pair<int, int>> ring;
+  for (int i = 0; i < n; ++i) ring.push_back({i, 0});
+  for (int j = 0; j < n; ++j) ring.push_back({n, j});
+  for (int i = n; i > 0; --i) ring.push_back({i, n});
+  for (int j = n; j > 0; --j) ring.push_back({0, j});
+  ring.push_back(ring.front());
+  for (const auto& [i, j] : ring) {
     indices.push_back(GLuint(vertices.size()));
-    vertices.push_back(ground);
+    vertices.push_back({float(i), float(j), 1.0f, 1.0f});
+    indices.push_back(GLuint(vertices.size()));
+    vertices.push_back({float(i), float(j), 0.0f, 1.0f});
   }
-  skirt_index_count_ = GLsizei(indices.size()) - top_index_count_;
-  triangles_ += std::int64_t(ring.size() - 1) * 2;
+  patch_index_count_ = GLsizei(indices.size());
+  patch_triangles_ = 2 * n * n + 2 * 4 * n;
+  mesh_cols_ = spec_.cols + 2;
+  mesh_rows_ = spec_.rows + 2;
 
-  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(Vertex)), vertices.data(),
-               GL_STATIC_DRAW);
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(GLuint)),
-               indices.data(), GL_STATIC_DRAW);
+  // The quadtree's root: the fewest doublings of a patch that cover every
+  // mesh line along both axes.
+  const int lines = std::max(spec_.cols, spec_.rows) + 1;
+  root_step_ = 1;
+  while (root_step_ * n < lines) root_step_ *= 2;
+  chunks_.reserve(4096);
+  // One error per node and level (level k: step 2^k, (root_step / 2^k)^2 nodes).
+  for (int step = 1; step <= root_step_; step *= 2)
+    errors_.emplace_back(std::size_t(root_step_ / step) * std::size_t(root_step_ / step), 0.0f);
+
+  upload_mesh(vbo_, ibo_, vertices, indices);
+  float_attribute<PatchVertex>(0, 2, offsetof(PatchVertex, i));
+  float_attribute<PatchVertex>(1, 1, offsetof(PatchVertex, top));
+  float_attribute<PatchVertex>(2, 1, offsetof(PatchVertex, skirt));
+  glGenBuffers(1, &instance_vbo_);
+  glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
+  glEnableVertexAttribArray(3);
+  glVertexAttribPointer(3, 3, GL_FLOAT, GL_FALSE, sizeof(Chunk), nullptr);
+  glVertexAttribDivisor(3, 1);
 }
 
 void TerrainRenderer::build_blocky_mesh() {
@@ -314,7 +385,7 @@ void TerrainRenderer::build_blocky_mesh() {
   mesh_cols_ = nx;
   mesh_rows_ = nz;
 
-  std::vector<Vertex> vertices;
+  std::vector<BoxVertex> vertices;
   vertices.reserve(std::size_t(nx) * nz);
   for (int j = 0; j < nz; ++j)
     for (int i = 0; i < nx; ++i)
@@ -328,16 +399,13 @@ void TerrainRenderer::build_blocky_mesh() {
     }
     indices.push_back(kRestart);
   }
-  top_index_count_ = GLsizei(indices.size());
-  skirt_index_count_ = 0;
+  box_index_count_ = GLsizei(indices.size());
   triangles_ = std::int64_t(nz - 1) * (nx - 1) * 2;
 
-  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(Vertex)), vertices.data(),
-               GL_STATIC_DRAW);
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(GLuint)),
-               indices.data(), GL_STATIC_DRAW);
+  upload_mesh(vbo_, ibo_, vertices, indices);
+  float_attribute<BoxVertex>(0, 2, offsetof(BoxVertex, pos_u));
+  float_attribute<BoxVertex>(1, 2, offsetof(BoxVertex, sample_u));
+  float_attribute<BoxVertex>(2, 1, offsetof(BoxVertex, top));
 }
 
 void TerrainRenderer::upload(const float* heights_m, const Rect& rect) {
@@ -354,16 +422,211 @@ void TerrainRenderer::upload(const float* heights_m, const Rect& rect) {
                   heights_m + std::int64_t(r.r0) * spec_.cols + r.c0);
   glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
   uploaded_samples_ += r.area();
+  // Soil can pile above every height seen so far; the chunks' boxes must hold it.
+  top_m_ = std::max(top_m_, highest(heights_m, spec_.cols, r));
+  if (!blocky_) update_errors(heights_m, r);
+}
+
+void TerrainRenderer::update_errors(const float* heights_m, const Rect& samples) {
+  // The error of a node drawn at its step: how far its surface can be from
+  // the full-detail one. Nested (Lindstrom et al. 1996): a node's error is
+  // the largest distance between its own triangles and its children's
+  // vertices (the lines of half its step), plus the largest of its
+  // children's errors; a node of step 1 is the surface itself (error 0).
+  // Only nodes whose lines reach the changed samples are recomputed, finest
+  // level first.
+  const int cols = spec_.cols, rows = spec_.rows;
+  const int last_u = cols + 1, last_v = rows + 1;
+  // The changed samples' lines (line 0 and line 1 read sample 0, line k + 1
+  // sample k), one wider on each side.
+  const int lu0 = std::max(samples.c0, 0), lu1 = std::min(samples.c1 + 1, last_u);
+  const int lv0 = std::max(samples.r0, 0), lv1 = std::min(samples.r1 + 1, last_v);
+  if (lu1 < lu0 || lv1 < lv0) return;
+  const int n = kPatchQuads;
+  for (std::size_t level = 1; level < errors_.size(); ++level) {
+    const int step = 1 << level, half = step / 2, span = n * step;
+    const int side = root_step_ / step;  // nodes per side at this level
+    std::vector<float>& err = errors_[level];
+    const std::vector<float>& finer = errors_[level - 1];
+    // Nodes whose lines (both boundaries included) reach [lu0, lu1] x [lv0, lv1].
+    const int a0 = std::max(0, lu0 / span - 1), a1 = std::min(lu1 / span, side - 1);
+    const int b0 = std::max(0, lv0 / span - 1), b1 = std::min(lv1 / span, side - 1);
+    for (int b = b0; b <= b1; ++b) {
+      for (int a = a0; a <= a1; ++a) {
+        const int u0 = a * span, v0 = b * span;
+        float worst = 0.0f;
+        if (u0 < last_u && v0 < last_v) {
+          // Every line of half the step inside the node, against the node's
+          // own triangles (split from corner (i+1, j) to (i, j+1)). Lattice
+          // point p of the node is line min(start + p * half, last): its
+          // sample index and, per quad, where its middle line falls (0.5,
+          // or elsewhere in the narrower quads at the far edge).
+          std::array<int, 2 * kPatchQuads + 1> cu{}, cv{};
+          std::array<float, kPatchQuads> fx{}, fz{};
+          int nu = 0, nv = 0;  // quads holding lines along X and Z
+          for (int p = 0; p <= 2 * n; ++p) {
+            const int lu = std::min(u0 + p * half, last_u), lv = std::min(v0 + p * half, last_v);
+            cu[std::size_t(p)] = std::clamp(lu - 1, 0, cols - 1);
+            cv[std::size_t(p)] = std::clamp(lv - 1, 0, rows - 1);
+            if (p % 2 == 0 && p < 2 * n) {
+              const int q = p / 2;
+              const int ua = lu, ub = std::min(lu + step, last_u);
+              const int va = lv, vb = std::min(lv + step, last_v);
+              fx[std::size_t(q)] = ub > ua ? float(std::min(ua + half, ub) - ua) / float(ub - ua) : 0.0f;
+              fz[std::size_t(q)] = vb > va ? float(std::min(va + half, vb) - va) / float(vb - va) : 0.0f;
+              nu += ua < last_u ? 1 : 0;
+              nv += va < last_v ? 1 : 0;
+            }
+          }
+          for (int j = 0; j < nv; ++j) {
+            const float* r0 = heights_m + std::int64_t(cv[std::size_t(2 * j)]) * cols;
+            const float* rm = heights_m + std::int64_t(cv[std::size_t(2 * j + 1)]) * cols;
+            const float* r1 = heights_m + std::int64_t(cv[std::size_t(2 * j + 2)]) * cols;
+            const float z = fz[std::size_t(j)];
+            for (int i = 0; i < nu; ++i) {
+              const int ca = cu[std::size_t(2 * i)], cm = cu[std::size_t(2 * i + 1)],
+                        cb = cu[std::size_t(2 * i + 2)];
+              const float x = fx[std::size_t(i)];
+              const float h00 = r0[ca], h10 = r0[cb], h01 = r1[ca], h11 = r1[cb];
+              auto coarse = [&](float cx, float cz) {  // cx, cz in [0, 1] across the quad
+                return cx + cz <= 1.0f ? h00 + cx * (h10 - h00) + cz * (h01 - h00)
+                                       : h11 + (1.0f - cx) * (h01 - h11) + (1.0f - cz) * (h10 - h11);
+              };
+              // The top and left edges' middles and the centre; the right
+              // and bottom edges are the next quads' left and top (on a
+              // shared edge both quads interpolate the same line), except
+              // at the node's last column and row.
+              worst = std::max(worst, std::fabs(r0[cm] - coarse(x, 0.0f)));
+              worst = std::max(worst, std::fabs(rm[ca] - coarse(0.0f, z)));
+              worst = std::max(worst, std::fabs(rm[cm] - coarse(x, z)));
+              if (i == nu - 1) worst = std::max(worst, std::fabs(rm[cb] - coarse(1.0f, z)));
+              if (j == nv - 1) worst = std::max(worst, std::fabs(r1[cm] - coarse(x, 1.0f)));
+            }
+          }
+          // Plus the children's own errors.
+          const int fside = 2 * side;
+          for (int k = 0; k < 4; ++k)
+            worst = std::max(worst, finer[std::size_t(2 * b + (k >> 1)) * std::size_t(fside) +
+                                          std::size_t(2 * a + (k & 1))]);
+        }
+        err[std::size_t(b) * std::size_t(side) + std::size_t(a)] = worst;
+      }
+    }
+  }
+}
+
+int TerrainRenderer::finest_step() const {
+  int finest = 0;
+  for (const Chunk& c : chunks_) finest = finest == 0 ? int(c.step) : std::min(finest, int(c.step));
+  return finest;
+}
+
+void TerrainRenderer::select_chunks(const Mat4& vp, float viewport_w, float viewport_h) {
+  // Walk the quadtree from the root: a node outside the view is dropped; a
+  // node too coarse for its distance (below) is split into its four
+  // children, nearest first (so the nearer soil is drawn first and hides
+  // what is behind it); otherwise it is drawn as one chunk. A quad of `step`
+  // lines spans about step cells.
+  chunks_.clear();
+  const float cell = float(std::max(spec_.cell_x_m(), spec_.cell_z_m()));
+  // Pixels per metre at clip w = 1, along the screen's X and Y.
+  auto row_length = [&](int r) {
+    return std::sqrt(vp.at(r, 0) * vp.at(r, 0) + vp.at(r, 1) * vp.at(r, 1) +
+                     vp.at(r, 2) * vp.at(r, 2));
+  };
+  const float px_per_m = std::max(row_length(0) * 0.5f * viewport_w, row_length(1) * 0.5f * viewport_h);
+  const float last_u = float(spec_.cols + 1), last_v = float(spec_.rows + 1);
+  const float y0 = float(spec_.origin_m.y), y1 = float(spec_.origin_m.y) + std::max(top_m_, 1e-6f);
+  auto world_x = [&](float line) {
+    return float(spec_.origin_m.x) + std::clamp(line - 0.5f, 0.0f, float(spec_.cols)) * float(spec_.cell_x_m());
+  };
+  auto world_z = [&](float line) {
+    return float(spec_.origin_m.z) + std::clamp(line - 0.5f, 0.0f, float(spec_.rows)) * float(spec_.cell_z_m());
+  };
+
+  struct Node {
+    int u0, v0, step;
+  };
+  std::array<Node, 4 * 32> stack{};
+  int top = 0;
+  stack[top++] = {0, 0, root_step_};
+  while (top > 0) {
+    const Node node = stack[--top];
+    const int span = node.step * kPatchQuads;
+    const float xa = world_x(float(node.u0)), xb = world_x(float(node.u0 + span));
+    const float za = world_z(float(node.v0)), zb = world_z(float(node.v0 + span));
+    // The node's box in clip space: outside one clip plane at every corner = not seen.
+    float w_min = std::numeric_limits<float>::max();
+    int outside[6] = {0, 0, 0, 0, 0, 0};
+    for (int k = 0; k < 8; ++k) {
+      const float x = (k & 1) ? xb : xa, y = (k & 2) ? y1 : y0, z = (k & 4) ? zb : za;
+      float clip[4];
+      for (int r = 0; r < 4; ++r)
+        clip[r] = vp.at(r, 0) * x + vp.at(r, 1) * y + vp.at(r, 2) * z + vp.at(r, 3);
+      const float w = clip[3];
+      outside[0] += clip[0] < -w;
+      outside[1] += clip[0] > w;
+      outside[2] += clip[1] < -w;
+      outside[3] += clip[1] > w;
+      outside[4] += clip[2] < -w;
+      outside[5] += clip[2] > w;
+      w_min = std::min(w_min, w);
+    }
+    if (std::any_of(std::begin(outside), std::end(outside), [](int n) { return n == 8; })) continue;
+    // Split while the node's surface could be more than kLodErrorPixels
+    // from the full-detail one on screen, or its quads larger than
+    // kLodQuadPixels (silhouettes), at its nearest point; never into quads
+    // smaller than kLodMinQuadPixels / 2 (a cut's wall smeared over a pixel
+    // or so looks the same as a sharp one).
+    int level = 0;
+    while ((1 << level) < node.step) ++level;
+    const float node_error =
+        errors_[std::size_t(level)][std::size_t(node.v0 / span) * std::size_t(root_step_ / node.step) +
+                                    std::size_t(node.u0 / span)];
+    const float quad_px = w_min <= 1e-6f ? std::numeric_limits<float>::max()
+                                         : float(node.step) * cell * px_per_m / w_min;
+    const bool split = node.step > 1 && quad_px > kLodMinQuadPixels &&
+                       (node_error * px_per_m / w_min > kLodErrorPixels || quad_px > kLodQuadPixels);
+    if (!split) {
+      chunks_.push_back({float(node.u0), float(node.v0), float(node.step)});
+      continue;
+    }
+    // The children that hold mesh lines, farthest pushed first (popped last).
+    const int half = span / 2, child_step = node.step / 2;
+    Node children[4];
+    float dist[4];
+    int count = 0;
+    for (int k = 0; k < 4; ++k) {
+      const Node c{node.u0 + (k & 1) * half, node.v0 + (k >> 1) * half, child_step};
+      if (float(c.u0) >= last_u || float(c.v0) >= last_v) continue;
+      const float cx = 0.5f * (world_x(float(c.u0)) + world_x(float(c.u0 + half)));
+      const float cz = 0.5f * (world_z(float(c.v0)) + world_z(float(c.v0 + half)));
+      children[count] = c;
+      dist[count] = (cx - eye_.x) * (cx - eye_.x) + (cz - eye_.z) * (cz - eye_.z);
+      ++count;
+    }
+    for (int a = 0; a < count; ++a)
+      for (int b = a + 1; b < count; ++b)
+        if (dist[b] > dist[a]) {
+          std::swap(dist[a], dist[b]);
+          std::swap(children[a], children[b]);
+        }
+    if (top + count > int(stack.size())) {  // deeper than any grid a texture can hold
+      chunks_.push_back({float(node.u0), float(node.v0), float(node.step)});
+      continue;
+    }
+    for (int k = 0; k < count; ++k) stack[top++] = children[k];
+  }
 }
 
 void TerrainRenderer::draw(const Mat4& view_projection, Vec3f eye, const TerrainStyle& style) {
   glUseProgram(program_);
   glUniformMatrix4fv(uniform(program_, "u_vp"), 1, GL_FALSE, view_projection.data());
   glUniform2f(uniform(program_, "u_grid"), float(spec_.cols), float(spec_.rows));
+  glUniform2f(uniform(program_, "u_lines"), float(spec_.cols + 1), float(spec_.rows + 1));
   glUniform2f(uniform(program_, "u_cell"), float(spec_.cell_x_m()), float(spec_.cell_z_m()));
   glUniform3f(uniform(program_, "u_origin"), float(spec_.origin_m.x), float(spec_.origin_m.y),
               float(spec_.origin_m.z));
-  glUniform1i(uniform(program_, "u_blocky"), blocky_ ? 1 : 0);
   int normal_mode = blocky_ ? 1 : (representation_ == Representation::kColumns ? 2 : 0);
   glUniform1i(uniform(program_, "u_normal_mode"), normal_mode);
   glUniform1i(uniform(program_, "u_color_mode"), style.color == ColorMode::kRemoved ? 1 : 0);
@@ -383,12 +646,21 @@ void TerrainRenderer::draw(const Mat4& view_projection, Vec3f eye, const Terrain
   glEnable(GL_PRIMITIVE_RESTART);
   glPrimitiveRestartIndex(kRestart);
   glBindVertexArray(vao_);
-  glUniform1i(uniform(program_, "u_skirt"), 0);
-  glDrawElements(GL_TRIANGLE_STRIP, top_index_count_, GL_UNSIGNED_INT, nullptr);
-  if (skirt_index_count_ > 0) {
-    glUniform1i(uniform(program_, "u_skirt"), 1);
-    glDrawElements(GL_TRIANGLE_STRIP, skirt_index_count_, GL_UNSIGNED_INT,
-                   reinterpret_cast<void*>(std::size_t(top_index_count_) * sizeof(GLuint)));
+  if (blocky_) {
+    glDrawElements(GL_TRIANGLE_STRIP, box_index_count_, GL_UNSIGNED_INT, nullptr);
+  } else {
+    GLint viewport[4] = {0, 0, 1, 1};
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    eye_ = eye;
+    select_chunks(view_projection, float(viewport[2]), float(viewport[3]));
+    triangles_ = std::int64_t(chunks_.size()) * patch_triangles_;
+    if (!chunks_.empty()) {
+      glBindBuffer(GL_ARRAY_BUFFER, instance_vbo_);
+      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(chunks_.size() * sizeof(Chunk)), chunks_.data(),
+                   GL_STREAM_DRAW);
+      glDrawElementsInstanced(GL_TRIANGLE_STRIP, patch_index_count_, GL_UNSIGNED_INT, nullptr,
+                              GLsizei(chunks_.size()));
+    }
   }
   glBindVertexArray(0);
   glDisable(GL_PRIMITIVE_RESTART);

@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "gl_context.hpp"
 #include "png_rgb.hpp"
@@ -97,6 +98,49 @@ void ViewerApp::run_benchmark(int w, int h) {
   }
   const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
   print_benchmark(w, h, wall, uploaded, frames_with_upload);
+  if (!options_.benchmark_no_draw) {
+    // Where a frame goes: more frames, phase by phase, each phase ended by
+    // glFinish (llvmpipe rasterises at the flush, so the time is the phase's
+    // own): the terrain upload (taking the newest frame), the terrain alone,
+    // the scene (sky, terrain, tool, bodies) and the whole frame with the
+    // panel. Medians over the frames.
+    std::vector<double> upload_s, terrain_s, scene_s, full_s;
+    std::vector<double> triangles;
+    auto timed = [](auto&& phase) {
+      const Clock::time_point start = Clock::now();
+      phase();
+      glFinish();
+      return std::chrono::duration<double>(Clock::now() - start).count();
+    };
+    const int phase_frames = std::clamp(options_.benchmark_frames / 2, 1, 40);
+    for (int i = 0; i < phase_frames; ++i) {
+      upload_s.push_back(timed([&] { consume_frame(); }));
+      push_history();
+      full_s.push_back(timed([&] { headless_frame(w, h, false); }));
+      scene_s.push_back(timed([&] { render(w, h, false); }));
+      terrain_s.push_back(timed([&] {
+        draw_background(w, h);
+        glViewport(scene_x_, 0, scene_w_, scene_h_);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        draw_terrain(camera_.projection(float(scene_w_) / float(scene_h_)) * camera_.view(),
+                     camera_.eye());
+      }));
+      triangles.push_back(double(terrain_->triangle_count()));
+    }
+    auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v[v.size() / 2];
+    };
+    auto median_ms = [&](const std::vector<double>& v) { return 1000.0 * median(v); };
+    const double full = median_ms(full_s), scene = median_ms(scene_s);
+    std::printf(
+        "  frame phases (median of %d frames, each ended by glFinish): upload %.2f ms, terrain "
+        "%.2f ms (%.0f triangles), scene %.2f ms (sky, terrain, tool, bodies), panel %.2f ms "
+        "(frame %.2f ms less the scene)\n",
+        phase_frames, median_ms(upload_s), median_ms(terrain_s), median(triangles),
+        scene, full - scene, full);
+  }
   print_loop_summary();
 }
 

@@ -9,6 +9,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "merged_heightfield.hpp"
 
 namespace terracut::bullet {
 
@@ -37,6 +38,27 @@ double highest_initial_m(const HeightGrid& grid) {
   return double(top);
 }
 
+// Bullet's sequential-impulse solver with its scratch arrays reserved at
+// construction for the largest contact set the world is expected to reach,
+// so that the first contact of a new kind late in a run (the plate meeting a
+// body, bodies piling up) does not grow them inside a step. Bullet grows
+// them itself, once, past the reserve.
+class ReservedSolver final : public btSequentialImpulseConstraintSolver {
+ public:
+  /// objects: every collision object of the world; manifolds: the contact
+  /// manifolds expected at once (each holds at most 4 points).
+  void reserve(int objects, int manifolds) {
+    const int points = 4 * manifolds;
+    m_tmpSolverBodyPool.reserve(objects + 1);
+    m_kinematicBodyUniqueIdToSolverBodyTable.reserve(objects + 1);
+    m_tmpSolverContactConstraintPool.reserve(points);
+    m_tmpSolverContactFrictionConstraintPool.reserve(2 * points);
+    m_tmpSolverContactRollingFrictionConstraintPool.reserve(3 * points);
+    m_orderTmpConstraintPool.reserve(2 * points);
+    m_orderFrictionConstraintPool.reserve(2 * points);
+  }
+};
+
 const TerrainWorldParams& checked(const TerrainWorldParams& params) {
   if (std::string e = validate(params); !e.empty()) throw InputError(e);
   return params;
@@ -57,6 +79,8 @@ std::string validate(const TerrainWorldParams& p) {
     return must_be("convex_margin_m", "in [0, 0.1]", p.convex_margin_m);
   if (p.solver_iterations < 1 || p.solver_iterations > 1000)
     return must_be("solver_iterations", "in [1, 1000]", p.solver_iterations);
+  if (!in_range(p.merge_tolerance_m, 0.0, 0.001))
+    return must_be("merge_tolerance_m", "in [0, 0.001]", p.merge_tolerance_m);
   if (p.tool.enabled && !(p.tool.height_m > 0.0 && p.tool.height_m <= 100.0))
     return must_be("tool.height_m", "in (0, 100]", p.tool.height_m);
   if (p.tool.enabled && !(p.tool.thickness_m > 0.0 && p.tool.thickness_m <= 100.0))
@@ -72,7 +96,7 @@ struct TerrainWorld::Impl {
   btDefaultCollisionConfiguration config;
   btCollisionDispatcher dispatcher{&config};
   btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
+  ReservedSolver solver;
   btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
 
   std::unique_ptr<btHeightfieldTerrainShape> terrain_shape;
@@ -143,9 +167,11 @@ TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& bl
   // the body sits at the terrain's centre in X-Z and at the middle of the
   // height bounds in Y; then sample (c, r) lands at
   // (sample_x(c), origin.y + height, sample_z(r)).
-  m.terrain_shape = std::make_unique<btHeightfieldTerrainShape>(
+  // Coplanar squares under a body reach the collision query as one rectangle
+  // (merged_heightfield.hpp); the surface and the ray tests are Bullet's own.
+  m.terrain_shape = std::make_unique<detail::MergedHeightfield>(
       grid.cols(), grid.rows(), grid.heights(), btScalar(bounds_.min_height_m),
-      btScalar(bounds_.max_height_m), 1, false);
+      btScalar(bounds_.max_height_m), params_.merge_tolerance_m);
   m.terrain_shape->setLocalScaling(
       btVector3(btScalar(spec.cell_x_m()), btScalar(1.0), btScalar(spec.cell_z_m())));
   btTransform terrain_pose;
@@ -194,6 +220,14 @@ TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& bl
                                    btCollisionObject::CF_NO_CONTACT_RESPONSE);
     m.tool_body->setActivationState(DISABLE_DEACTIVATION);
     m.world.addRigidBody(m.tool_body.get());
+  }
+
+  // Every body may touch the terrain, the floor, the plate and every other
+  // body (up to 64 others each: past that, Bullet grows the arrays itself).
+  {
+    const int n = int(specs_.size());
+    const int objects = n + 3;
+    m.solver.reserve(objects, 3 * n + n * std::min(n - 1, 64) / 2 + 1);
   }
 
   // The loose bodies, in the order given (the order fixes Bullet's results).

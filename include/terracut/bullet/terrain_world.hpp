@@ -82,6 +82,16 @@ struct TerrainWorldParams {
   double convex_margin_m = 0.005;
   /// Constraint solver iterations per step, in [1, 1000].
   int solver_iterations = 10;
+  /// Coplanar merging of the terrain's collision triangles, metres, in
+  /// [0, 0.001]. A body's contacts with the terrain are found triangle by
+  /// triangle (GJK); under a body the squares of samples that lie on one
+  /// plane, every sample within this distance of it, are handed to Bullet as
+  /// rectangles (two triangles each, at most a third of the body's range per
+  /// side) instead of two triangles per square, so a 0.3 m box on 2 cm cells
+  /// of level or evenly sloping soil meets at most 18 triangles instead of
+  /// about 450. The surface is the same to this distance. 0 = Bullet's own
+  /// two triangles per square everywhere.
+  double merge_tolerance_m = 1e-5;
   ToolPlateSpec tool{};
 };
 

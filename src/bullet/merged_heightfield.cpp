@@ -1,0 +1,135 @@
+#include "merged_heightfield.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cmath>
+
+namespace terracut::bullet::detail {
+
+namespace {
+
+// Bullet's rounding of a local coordinate to the nearest grid point.
+int quantized(btScalar v) { return v < 0 ? int(v - btScalar(0.5)) : int(v + btScalar(0.5)); }
+
+// Reports a triangle to the callback unless its height range misses the
+// query box's (the same filter as Bullet 3.24's processAllTriangles).
+bool report(btTriangleCallback* callback, btVector3* v, int part, int index, btScalar y0,
+            btScalar y1) {
+  const btScalar lo = std::min({v[0].y(), v[1].y(), v[2].y()});
+  const btScalar hi = std::max({v[0].y(), v[1].y(), v[2].y()});
+  if (hi < y0 || lo > y1) return false;
+  callback->processTriangle(v, part, index);
+  return true;
+}
+
+}  // namespace
+
+MergedHeightfield::MergedHeightfield(int cols, int rows, const float* heights,
+                                     btScalar min_height, btScalar max_height, double tolerance_m)
+    : btHeightfieldTerrainShape(cols, rows, heights, min_height, max_height, 1, false),
+      heights_(heights),
+      cols_(cols),
+      tolerance_m_(float(tolerance_m)) {}
+
+void MergedHeightfield::processAllTriangles(btTriangleCallback* callback,
+                                            const btVector3& aabb_min,
+                                            const btVector3& aabb_max) const {
+  if (!(tolerance_m_ > 0.0f)) {
+    btHeightfieldTerrainShape::processAllTriangles(callback, aabb_min, aabb_max);
+    return;
+  }
+
+  // The squares Bullet would visit: the box in unscaled grid units, rounded
+  // to the nearest grid points, clamped to the shape and widened by one.
+  const btVector3 inv(1 / m_localScaling.x(), 1 / m_localScaling.y(), 1 / m_localScaling.z());
+  const btVector3 lo = aabb_min * inv + m_localOrigin;
+  const btVector3 hi = aabb_max * inv + m_localOrigin;
+  btVector3 lo_c = lo, hi_c = hi;
+  lo_c.setMax(m_localAabbMin);
+  lo_c.setMin(m_localAabbMax);
+  hi_c.setMax(m_localAabbMin);
+  hi_c.setMin(m_localAabbMax);
+  const int x_begin = std::max(0, quantized(lo_c.x()) - 1);
+  const int x_end = std::min(m_heightStickWidth - 1, quantized(hi_c.x()) + 1);
+  const int j_begin = std::max(0, quantized(lo_c.z()) - 1);
+  const int j_end = std::min(m_heightStickLength - 1, quantized(hi_c.z()) + 1);
+  last_triangles_ = 0;
+  const btScalar y0 = aabb_min.y(), y1 = aabb_max.y();
+  // The largest rectangle: a third of the range along each side, so a body
+  // on a plane still meets about 3 x 3 rectangles (18 triangles) and Bullet's
+  // one GJK point per triangle still spreads over its face (a body landing
+  // flat gets the corners of its face in one step, as with the squares).
+  const int max_x = std::max(1, (x_end - x_begin + kSplits - 1) / kSplits);
+  const int max_j = std::max(1, (j_end - j_begin + kSplits - 1) / kSplits);
+  // Tiles of at most kTile x kTile squares, each merged on its own, so the
+  // marks fit a fixed array (no allocation, whatever the body's size).
+  for (int tj = j_begin; tj < j_end; tj += kTile)
+    for (int tx = x_begin; tx < x_end; tx += kTile)
+      merge_tile(callback, tx, std::min(tx + kTile, x_end), tj, std::min(tj + kTile, j_end),
+                 max_x, max_j, y0, y1);
+}
+
+void MergedHeightfield::merge_tile(btTriangleCallback* callback, int x_begin, int x_end,
+                                   int j_begin, int j_end, int max_x, int max_j, btScalar y0,
+                                   btScalar y1) const {
+  std::array<std::uint8_t, std::size_t(kTile) * kTile> merged{};
+  const int width = x_end - x_begin;
+  auto mark = [&](int x, int j) -> std::uint8_t& {
+    return merged[std::size_t(j - j_begin) * std::size_t(width) + std::size_t(x - x_begin)];
+  };
+  auto height = [&](int x, int j) { return heights_[std::size_t(j) * std::size_t(cols_) + x]; };
+
+  btVector3 v[3];
+  for (int j = j_begin; j < j_end; ++j) {
+    for (int x = x_begin; x < x_end; ++x) {
+      if (mark(x, j)) continue;
+      // The plane through three corners of this square, in grid steps:
+      // h(x', j') = h0 + (x' - x) sx + (j' - j) sj.
+      const float h0 = height(x, j);
+      const float sx = height(x + 1, j) - h0;
+      const float sj = height(x, j + 1) - h0;
+      auto on_plane = [&](int xc, int jc) {
+        return std::fabs(height(xc, jc) - (h0 + float(xc - x) * sx + float(jc - j) * sj)) <=
+               tolerance_m_;
+      };
+      if (!on_plane(x + 1, j + 1)) {
+        // Not planar: Bullet's two triangles of the square, as Bullet reports them.
+        mark(x, j) = 1;
+        getVertex(x, j, v[0]);
+        getVertex(x, j + 1, v[1]);
+        getVertex(x + 1, j, v[2]);
+        last_triangles_ += report(callback, v, 2 * x, j, y0, y1) ? 1 : 0;
+        getVertex(x + 1, j, v[0]);
+        getVertex(x + 1, j + 1, v[2]);
+        last_triangles_ += report(callback, v, 2 * x + 1, j, y0, y1) ? 1 : 0;
+        continue;
+      }
+      // Grow along the row while the next square is free and on the plane,
+      // then down while the whole span of the next row is.
+      const int x_stop = std::min(x_end, x + max_x), j_stop = std::min(j_end, j + max_j);
+      int x1 = x + 1;
+      while (x1 < x_stop && !mark(x1, j) && on_plane(x1 + 1, j) && on_plane(x1 + 1, j + 1)) ++x1;
+      int j1 = j + 1;
+      while (j1 < j_stop) {
+        bool fits = on_plane(x, j1 + 1);
+        for (int xs = x; fits && xs < x1; ++xs) fits = !mark(xs, j1) && on_plane(xs + 1, j1 + 1);
+        if (!fits) break;
+        ++j1;
+      }
+      for (int js = j; js < j1; ++js)
+        for (int xs = x; xs < x1; ++xs) mark(xs, js) = 1;
+      // The rectangle's two triangles, with the corners' own heights, split
+      // and wound as Bullet splits a square.
+      getVertex(x, j, v[0]);
+      getVertex(x, j1, v[1]);
+      getVertex(x1, j, v[2]);
+      last_triangles_ += report(callback, v, 2 * x, j, y0, y1) ? 1 : 0;
+      getVertex(x1, j, v[0]);
+      getVertex(x1, j1, v[2]);
+      last_triangles_ += report(callback, v, 2 * x + 1, j, y0, y1) ? 1 : 0;
+    }
+  }
+}
+
+}  // namespace terracut::bullet::detail
