@@ -35,6 +35,8 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
       spec_(io::grid_spec(scenario.base)),
       representation_(scenario.base.representation),
       blade_length_m_(scenario.base.blade.length_m),
+      bucket_(scenario.base.blade.bucket),
+      repose_deg_(scenario.base.soil.repose_deg),
       initial_(io::build_initial_heights(scenario.base)) {
   // Transits between cuts rise above everything the blade could touch.
   float max_h = 0.0f;

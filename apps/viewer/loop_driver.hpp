@@ -77,6 +77,10 @@ class LoopDriver {
   Representation representation() const { return representation_; }
   double rate_hz() const { return params_.rate_hz(); }
   double blade_length_m() const { return blade_length_m_; }
+  /// The blade's bucket (BucketSpec::enabled() false for a flat blade).
+  const BucketSpec& bucket() const { return bucket_; }
+  /// The soil's angle of repose, degrees (what a tilted bucket holds).
+  double repose_deg() const { return repose_deg_; }
   /// Initial heights, rows x cols, row-major, metres.
   const std::vector<float>& initial_heights() const { return initial_; }
   /// The loop's force model (const after construction).
@@ -108,6 +112,8 @@ class LoopDriver {
   GridSpec spec_;
   Representation representation_;
   double blade_length_m_;
+  BucketSpec bucket_{};
+  double repose_deg_ = 34.0;
   std::vector<float> initial_;
   Tour tour_;
   std::int64_t script_ticks_ = 0;

@@ -210,6 +210,7 @@ bool ViewerApp::consume_frame() {
   l.step_time_s = f->step_time_s;
   l.period_s = f->period_s;
   l.penetration_n = f->penetration_force_n;
+  l.bucket_load_m3 = f->bucket_load_m3;
   l.twist_torque_n_m = f->twist_torque_n_m;
   l.yaw_rate_rad_per_s = f->yaw_rate_rad_per_s;
   l.window = f->window;

@@ -38,6 +38,7 @@ struct ViewerApp::Live {
   ContactResult contact{};
   Vec3 device_m{}, proxy_m{}, force_world_n{}, force_device_n{}, body_force_n{};
   double penetration_n = 0.0, twist_torque_n_m = 0.0, yaw_rate_rad_per_s = 0.0;
+  double bucket_load_m3 = 0.0;  // soil in the bucket
   /// The ticks since the previously taken frame (max and mean of the forces).
   haptics::ViewWindow window{};
   /// Largest |force| and |bodies' force| of any tick since the session (or

@@ -2,6 +2,7 @@
 // panel on the left, one function per section (run controls, contact and
 // force with the plots, timing, display, model parameters, help), and the
 // value labels drawn next to the tool.
+#include "terracut/core/soil.hpp"
 #include "viewer_app_internal.hpp"
 
 #include <backends/imgui_impl_glfw.h>
@@ -215,6 +216,11 @@ void ViewerApp::draw_tool_section() {
   // Rounded to the shown tenth first, so that -0.01 reads 0.0, not -0.0.
   auto tenth = [](double deg) { return std::round(deg * 10.0) / 10.0 + 0.0; };
   ImGui::Text("yaw %.1f deg   tilt %.1f deg", tenth(r.yaw_deg), tenth(r.tilt_deg));
+  if (driver_->bucket().enabled()) {
+    const double holds = bucket_retained_m3({driver_->blade_length_m(), driver_->bucket()}, l.pose.orientation,
+                                            driver_->repose_deg());
+    ImGui::Text("bucket %.2f l of %.2f l it holds now", l.bucket_load_m3 * 1e3, holds * 1e3);
+  }
   if (driver_->device().source() == ToolSource::kMouse && r.depth_m <= 0.0)
     ImGui::TextDisabled("scroll down to dig; left drag moves the tool");
 }

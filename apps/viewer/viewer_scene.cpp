@@ -40,7 +40,11 @@ struct ViewerApp::ToolMarks {
   bool in_contact;      // the edge touches the soil (drawn red)
   float rod;            // the edge rod's radius
   float ground;         // the soil's height under the tool
-  Mat4 plate;           // the plate's model matrix
+  Mat4 plate;           // the plate's model matrix (a flat blade)
+  bool bucket;          // a bucket instead of the plate
+  Mat4 floor, back;     // the bucket's floor and back wall
+  Mat4 load;            // the soil it carries (a box of the load's volume on the floor)
+  bool loaded;
   float r;              // the device point's radius
   Vec3f device, proxy;  // the device point and the proxy
 };
@@ -87,6 +91,11 @@ void ViewerApp::draw_scene(int x, int y, int w, int h) {
   shapes_->begin(vp, eye, style_.light_dir);
   const ToolMarks m = tool_marks();
   draw_blade_edge(m);
+  if (m.bucket) {
+    shapes_->box(m.floor, {0.55f, 0.58f, 0.64f, 1.0f});
+    shapes_->box(m.back, {0.55f, 0.58f, 0.64f, 1.0f});
+    if (m.loaded) shapes_->box(m.load, {0.80f, 0.66f, 0.42f, 1.0f});  // sand
+  }
   draw_bodies();
   draw_device(m);
   draw_force_arrow(m);
@@ -118,6 +127,22 @@ ViewerApp::ToolMarks ViewerApp::tool_marks() const {
   m.plate = translation(to_f(l.pose.position_m)) * rotation(l.pose.orientation) *
             translation({0.0f, 0.5f * plate_h + m.rod, 0.0f}) *
             scaling({blade_len, plate_h, 0.6f * m.rod});
+  // A bucket: its floor from the lip back along the blade frame's +Z and its
+  // back wall (blade.hpp), and the soil it carries as a box of the load's
+  // volume on the floor, as deep as the floor (its section's area / depth high).
+  const BucketSpec& bucket = driver_->bucket();
+  m.bucket = bucket.enabled();
+  m.loaded = false;
+  if (m.bucket) {
+    const Mat4 frame = translation(to_f(l.pose.position_m)) * rotation(l.pose.orientation);
+    const float depth = float(bucket.depth_m), height = float(bucket.height_m), wall = 2.0f * m.rod;
+    m.floor = frame * translation({0.0f, -0.5f * wall, 0.5f * depth}) * scaling({blade_len, wall, depth});
+    m.back = frame * translation({0.0f, 0.5f * height, depth + 0.5f * wall}) * scaling({blade_len, height, wall});
+    const float fill = float(l.bucket_load_m3 / (double(blade_len) * bucket.depth_m));
+    m.loaded = fill > 1e-6f;
+    if (m.loaded)
+      m.load = frame * translation({0.0f, 0.5f * fill, 0.5f * depth}) * scaling({0.98f * blade_len, fill, 0.98f * depth});
+  }
   m.r = 0.012f * extent;
   m.device = to_f(l.device_m);
   m.proxy = to_f(l.proxy_m);
@@ -196,7 +221,7 @@ void ViewerApp::draw_see_through(const ToolMarks& m) {
   glEnable(GL_BLEND);
   glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   glDepthMask(GL_FALSE);
-  shapes_->box(m.plate, {0.70f, 0.74f, 0.80f, 0.35f});
+  if (!m.bucket) shapes_->box(m.plate, {0.70f, 0.74f, 0.80f, 0.35f});
   // The edge and the device point once more, faint and without depth test, so
   // they show through the soil that hides them (a blade deep in a trench).
   glDisable(GL_DEPTH_TEST);

@@ -313,6 +313,7 @@ void HapticLoop::publish_frame(const StepOutput& out, const ForceOutput& force,
   f.proxy_position_m = force.surface.in_contact ? force.surface.proxy_m : out.pose.position_m;
   f.force_world_n = force.world_n;
   f.force_device_n = command.force_n;
+  f.bucket_load_m3 = out.soil.bucket_load_m3;
   f.body_force_world_n = last_.body_force_world_n;
   f.penetration_force_n = force.penetration_n.y;
   f.twist_torque_n_m = force.twist_torque_n_m;

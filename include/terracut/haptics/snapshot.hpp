@@ -66,6 +66,7 @@ struct ViewFrame {
   double penetration_force_n = 0.0;  ///< the penetration model's part of force_world_n (+Y up), N
   double twist_torque_n_m = 0.0;     ///< twist torque about world +Y, N m (not in force_world_n)
   double yaw_rate_rad_per_s = 0.0;   ///< estimated yaw rate of the tool, rad/s
+  double bucket_load_m3 = 0.0;       ///< soil in the bucket (SoilStepResult::bucket_load_m3), m^3
   /// The ticks since the reader's previous frame; publish() fills it from
   /// this frame's values (force_world_n, body_force_world_n, force_device_n,
   /// contact) and those of the frames the reader skipped.
