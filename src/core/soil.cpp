@@ -134,6 +134,17 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   near_blade_.assign(n, 0);
   obstacle_.assign(n, 0);
   obstacles_.reserve(16);
+  // The per-step scratch sized up front for the blade (its swept rectangle
+  // and the cells near it: a square of its length plus a margin of cells)
+  // and for an active set of a large pile, so that the 1 kHz loop's ticks
+  // do not grow them: a haptic loop on flowing soil allocates nothing.
+  const double reach_cells = blade.length_m / std::min(dx_, dz_) + 8.0;
+  const std::size_t footprint = std::size_t(std::min(double(n), reach_cells * reach_cells));
+  before_.reserve(footprint);
+  marked_.reserve(footprint);
+  const std::size_t active = std::min(n, std::max<std::size_t>(std::size_t(1) << 16, 4 * footprint));
+  active_.reserve(active);
+  touched_.reserve(active);
 
   // Every cell of a slope already steeper than the repose angle starts active.
   const float* h = grid.heights();

@@ -23,8 +23,8 @@ namespace {
 // Runs the trench's ticks [0, ticks) by hand and counts allocations during
 // all but the first (the first tick starts the device).
 long allocations_per_run(Device& device, std::int64_t ticks, SnapshotExchange* snapshot,
-                         const std::function<void(std::int64_t)>& before_tick = nullptr) {
-  const test::HapticScenario& in = test::trench();
+                         const std::function<void(std::int64_t)>& before_tick = nullptr,
+                         const test::HapticScenario& in = test::trench()) {
   LoopOptions o;
   o.ticks = ticks;
   o.record_capacity = std::size_t(ticks);
@@ -60,6 +60,16 @@ TEST(LoopAllocation, ScriptAndSimTicksAllocateNothing) {
     SnapshotExchange exchange(probe.grid());
     EXPECT_EQ(allocations_per_run(device, 3000, &exchange), 0);
   }
+}
+
+TEST(LoopAllocation, TicksOnSoilThatFlowsAllocateNothing) {
+  // The trench with soil that flows: the cut is pushed into a pile and the
+  // pile relaxes every tick; its scratch is sized when the loop is built.
+  test::HapticScenario flow = test::trench();
+  flow.scenario.soil.model = SoilModel::kFlow;
+  const DevicePath path(flow.scenario.cuts[0], Workspace(flow.haptics.workspace));
+  ScriptDevice device(path);
+  EXPECT_EQ(allocations_per_run(device, 3000, nullptr, nullptr, flow), 0);
 }
 
 TEST(LoopAllocation, UdpTicksAllocateNothing) {

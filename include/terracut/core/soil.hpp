@@ -147,8 +147,10 @@ struct SoilObstacle {
 double bucket_retained_m3(const BladeSpec& blade, const Quat& orientation, double repose_deg);
 
 /// The soil phase's state (kFlow): the active cells and the scratch of the
-/// passes, sized at construction (7 bytes per sample) so that a step
-/// allocates nothing once its scratch has grown to the blade's footprint.
+/// passes, sized at construction (7 bytes per sample, plus lists for the
+/// blade's footprint and an active set of at least 65536 cells) so that a
+/// step allocates nothing (tested in the haptic loop on flowing soil); only
+/// a backlog larger than that grows them.
 class SoilFlow {
  public:
   /// Builds the state over the grid (which must outlive it) and marks every
