@@ -2,7 +2,8 @@
 # Builds the libFuzzer targets of tests/fuzz/ with clang (build-fuzz/, or
 # $TERRACUT_FUZZ_BUILD_DIR; the library sources they need instrumented with
 # -fsanitize=fuzzer-no-link,address,undefined, nothing else built) and runs
-# each for SECONDS (default 3600), TERRACUT_JOBS at a time, from the
+# each for SECONDS (default 3600), TERRACUT_FUZZ_JOBS (default: the number
+# of processors) at a time, from the
 # repository root. Each run starts from the checked-in seeds
 # (tests/fuzz/corpus/<target>/) and grows its own corpus in
 # build-fuzz/corpus/<target>/; a crash, leak, hang (-timeout, 10 s) or
@@ -19,7 +20,8 @@ shift || true
 targets=("$@")
 [[ ${#targets[@]} -gt 0 ]] || targets=(scenario png npy bridge differential)
 build=${TERRACUT_FUZZ_BUILD_DIR:-$root/build-fuzz}
-jobs=${TERRACUT_JOBS:-$(nproc)}
+jobs=${TERRACUT_JOBS:-$(nproc)}            # for the build
+fuzz_jobs=${TERRACUT_FUZZ_JOBS:-$(nproc)}  # targets run at once
 cc=${TERRACUT_FUZZ_CC:-clang}
 cxx=${TERRACUT_FUZZ_CXX:-clang++}
 flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g"
@@ -50,10 +52,10 @@ report() {
     echo "artifacts: $build/artifacts/$t/ (copy each into tests/fuzz/corpus/$t/ once fixed)"
   fi
 }
-# In batches of $jobs targets at once.
+# In batches of $fuzz_jobs targets at once.
 status=0
-for ((i = 0; i < ${#targets[@]}; i += jobs)); do
-  batch=("${targets[@]:i:jobs}")
+for ((i = 0; i < ${#targets[@]}; i += fuzz_jobs)); do
+  batch=("${targets[@]:i:fuzz_jobs}")
   pids=()
   for t in "${batch[@]}"; do
     run_one "$t" &

@@ -11,6 +11,7 @@ packages=(
   libglfw3-dev libepoxy-dev libimgui-dev
   libgl1-mesa-dri libegl-mesa0 libegl-dev xvfb xauth
   python3 python3-numpy python3-matplotlib gnuplot-nox
+  clang libclang-rt-14-dev
 )
 
 missing=()

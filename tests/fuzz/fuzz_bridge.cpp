@@ -61,7 +61,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (control & 1u) {
       // A well-formed pose: the header from the generator, the payload from the bytes.
       std::uint8_t d[8] = {};
-      std::memcpy(d, datagram.data(), std::min<std::size_t>(8, datagram.size()));
+      if (!datagram.empty()) std::memcpy(d, datagram.data(), std::min<std::size_t>(8, datagram.size()));
       next.session = d[0] % 4 == 0 ? next.session + 1u : next.session;
       next.sequence += std::uint32_t(std::int32_t(std::int8_t(d[1])));
       if (d[2] == 0xFF) next.sequence += 0x80000000u;  // a jump of half the sequence space
