@@ -319,8 +319,18 @@ void scan_scenario(const Context& ctx, const std::string& text, std::span<Sectio
 // checked (a mistake anywhere is reported before a large image is decoded).
 struct PendingImage {
   Field image;
+  Field size;
   std::optional<Resolution> resolution;
 };
+
+// Cells of at least kMinCellM (core/grid.hpp), reported at size_m once the
+// resolution is known.
+void check_cells(const Field& size, const Scenario& sc) {
+  const double cell = std::min(sc.size_x_m / sc.resolution.cols, sc.size_z_m / sc.resolution.rows);
+  if (!(cell >= kMinCellM))
+    size.fail("the cells would be " + format_number(cell) +
+              " m (size_m / resolution); a cell must be at least 1e-6 m");
+}
 
 // The terrain block; a generator terrain is complete on return, an image
 // terrain is returned to read_terrain_image.
@@ -367,6 +377,7 @@ std::optional<PendingImage> parse_terrain(const Context& ctx, const Field& field
       ctx.fail(field.key_mark(), child_path(field.path(), "resolution"),
                "missing required field 'resolution' (required with a generator)");
     sc.resolution = *resolution;
+    check_cells(size, sc);
     Generator gen = default_generator(*kind, grid_spec(sc));
     if (const auto m = terrain.get("mound")) {
       const Map mound(*m, {"centre_m", "radius_m"});
@@ -389,7 +400,7 @@ std::optional<PendingImage> parse_terrain(const Context& ctx, const Field& field
     sc.generator = gen;
     return std::nullopt;
   }
-  return PendingImage{*image, resolution};
+  return PendingImage{*image, size, resolution};
 }
 
 // Why a path's status cannot be read (exists() failed with ec): a
@@ -439,6 +450,7 @@ void read_terrain_image(const PendingImage& pending, const std::filesystem::path
     check_resolution(image, sc.image.cols, sc.image.rows);
     sc.resolution = {sc.image.cols, sc.image.rows};
   }
+  check_cells(pending.size, sc);
 }
 
 // One parsed cut, with the fields that later checks report against.

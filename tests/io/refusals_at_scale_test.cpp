@@ -107,6 +107,24 @@ TEST(RefusalsAtScale, CoreGridsPastTheirCapAreRefusedBeforeAllocating) {
   EXPECT_LT(peak_rss_bytes() - before, small_growth(16));
 }
 
+// Cells of 1e-300 m made every cell coordinate infinite (undefined
+// conversions to int in the traversal; found by the scenario fuzz target):
+// a cell must be at least kMinCellM, in the scenario and in core.
+TEST(RefusalsAtScale, AbsurdlySmallCellsAreRefusedNamingTheLimit) {
+  std::int64_t grew = 0;
+  const std::string m = refusal(
+      scenario_text("  generator: plane\n  size_m: [1e-300, 1]\n  full_scale_m: 0.4\n  resolution: 8\n"), &grew);
+  EXPECT_NE(m.find("big.yaml:5: terrain.size_m:"), std::string::npos) << m;
+  EXPECT_NE(m.find("at least 1e-6 m"), std::string::npos) << m;
+  EXPECT_NO_THROW(parse_scenario(scenario_text("  generator: plane\n  size_m: [8e-6, 1]\n  full_scale_m: 0.4\n"
+                                               "  resolution: 8\n"),
+                                 "micro.yaml"));  // cells of exactly 1e-6 m
+  GridSpec spec = grid_of_cells(4, 4, 1e-7);
+  EXPECT_NE(validate(spec).find(">= 1e-6 m"), std::string::npos) << validate(spec);
+  spec = grid_of_cells(4, 4, kMinCellM);
+  EXPECT_EQ(validate(spec), "");
+}
+
 std::vector<std::uint8_t> chunk(const char* type, const std::vector<std::uint8_t>& data) {
   std::vector<std::uint8_t> out;
   auto be32 = [&](std::uint32_t v) {
