@@ -174,8 +174,10 @@ extern "C" std::size_t LLVMFuzzerCustomMutator(std::uint8_t* data, std::size_t s
     return LLVMFuzzerMutate(data, size, max_size);
   }
   if (!root.IsMap()) return LLVMFuzzerMutate(data, size, max_size);
+  const long nodes = count_nodes(root);
+  if (nodes == 0) return LLVMFuzzerMutate(data, size, max_size);  // {}: nothing to change
   Mutation m{rng, 0, 0, false};
-  m.target = long(rng() % std::uint32_t(count_nodes(root)));
+  m.target = long(rng() % std::uint32_t(nodes));
   YAML::Emitter out;
   try {
     out << m.visit(root);
