@@ -960,8 +960,11 @@ void prefetch_next_sweep(const HeightGrid& grid, const GridFrame& f, const Segme
   Vec3 a = to.a + (to.a - from.a), b = to.b + (to.b - from.b);
   double ua = (a.x - f.x0) * f.inv_cx, va = (a.z - f.z0) * f.inv_cz;
   double ub = (b.x - f.x0) * f.inv_cx, vb = (b.z - f.z0) * f.inv_cz;
-  int points = std::min(kMaxAhead, int(std::max(std::abs(ub - ua) / 8.0, std::abs(vb - va))) + 1);
-  if (!(points >= 1)) return;  // NaN from a far-away edge
+  // Bounded before the conversion to int (a span of 1e300 cells was undefined
+  // behaviour: found by the scenario fuzz target, on cells of 1e-302 m).
+  const double span = std::max(std::abs(ub - ua) / 8.0, std::abs(vb - va));
+  if (!std::isfinite(span)) return;  // NaN or inf from a far-away edge
+  const int points = int(std::min(span, double(kMaxAhead - 1))) + 1;
   const float* height = grid.heights();
   const float* removed = grid.removed();
   const float* initial = grid.initial();

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
 
 namespace terracut {
@@ -96,6 +97,9 @@ double height_at(const Generator& g, double x_m, double z_m) {
 }
 
 std::vector<float> generate_heights(const GridSpec& spec, const Generator& generator) {
+  // Before the allocation: a spec past the caps (or with a negative side,
+  // whose sample count wraps) would ask for gigabytes.
+  if (const std::string problem = validate(spec); !problem.empty()) throw InputError(problem);
   std::vector<float> heights(static_cast<std::size_t>(spec.sample_count()));
   // Sample (c, r) sits at its cell centre, the same point HeightGrid uses.
   for (int r = 0; r < spec.rows; ++r) {

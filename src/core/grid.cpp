@@ -20,6 +20,10 @@ std::string validate(const GridSpec& spec) {
     return must_be("grid.size_x_m", "finite and > 0", spec.size_x_m);
   if (!(std::isfinite(spec.size_z_m) && spec.size_z_m > 0.0))
     return must_be("grid.size_z_m", "finite and > 0", spec.size_z_m);
+  if (!(spec.cell_x_m() >= kMinCellM))
+    return must_be("grid.size_x_m / grid.cols (the cell side along x)", ">= 1e-6 m", spec.cell_x_m());
+  if (!(spec.cell_z_m() >= kMinCellM))
+    return must_be("grid.size_z_m / grid.rows (the cell side along z)", ">= 1e-6 m", spec.cell_z_m());
   if (!is_finite(spec.origin_m)) return "grid.origin_m must be finite";
   if (!(std::isfinite(spec.full_scale_m) && spec.full_scale_m > 0.0))
     return must_be("grid.full_scale_m", "finite and > 0", spec.full_scale_m);

@@ -112,7 +112,10 @@ const StepOutput& Simulation::finish_step() {
   int substeps = 1;
   if (angle > 0.0 && tolerance < half_length) {
     double max_angle = 2.0 * std::acos(1.0 - tolerance / half_length);
-    substeps = std::clamp(int(std::ceil(angle / max_angle)), 1, kMaxSubsteps);
+    // Bounded before the conversion to int: on absurdly small cells max_angle
+    // is 0 and the ratio inf (found by the scenario fuzz target).
+    const double n = std::ceil(angle / max_angle);
+    substeps = n < kMaxSubsteps ? std::max(1, int(n)) : kMaxSubsteps;
   }
   const double overlap_m =
       kSweepOverlapCells * std::min(params_.grid.cell_x_m(), params_.grid.cell_z_m());

@@ -203,7 +203,13 @@ const LoopRecord& HapticLoop::step2(double period_s, double compute_s,
 
   // Safety: a bad sample or no sample yet asks for zero force (shrinking to
   // zero is immediate); the watchdog looks at the last good sample's time.
-  const SafetyOutput safe = safety_.update(t_s_, force.device_n, last_sample_t_s_);
+  SafetyOutput safe = safety_.update(t_s_, force.device_n, last_sample_t_s_);
+  if (tick_flags_ & kFlagBadSample) {
+    // Zero for a bad sample also while the watchdog fades an older force
+    // out (update() would give the fading force; found by terracut-soak).
+    safe.force_n = {};
+    safety_.zero_output();
+  }
   std::uint32_t flags = tick_flags_ | safe.flags.bits();
   if (missed_deadline) {
     flags |= kFlagMissedDeadline;

@@ -15,6 +15,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/io/scenario_ranges.hpp"
 #include "terracut/io/yaml_reader.hpp"
 
 namespace terracut::io {
@@ -43,15 +44,39 @@ double sequence_steps(const Scenario& sc) {
     total += std::round(sc.cuts[std::size_t(index)].duration_s() * sc.rate_hz) + 1.0;
   return total;
 }
-constexpr double kMaxRateHz = 1e6;
+using Ends = yaml::Field::Ends;
+constexpr double kMax = yaml::kMaxMagnitude;
+
+// Every number of the file with a range of its own (scenario_ranges.hpp).
+constexpr yaml::Range kRanges[] = {
+    {"rate_hz", 0.0, 1e6, Ends::kOpenLow},
+    {"blade.length_m", 0.0, kMax, Ends::kOpenLow},
+    {"blade.bucket.depth_m", 0.0, kMax, Ends::kOpenLow},
+    {"blade.bucket.height_m", 0.0, kMax, Ends::kOpenLow},
+    {"terrain.size_m[0]", 0.0, kMax, Ends::kOpenLow},
+    {"terrain.size_m[1]", 0.0, kMax, Ends::kOpenLow},
+    {"terrain.full_scale_m", 0.0, kMax, Ends::kOpenLow},
+    // Each side, of N or [cols, rows]; the total is capped too (kMaxScenarioSamples).
+    {"terrain.resolution", 1, kMaxGridSide, Ends::kClosed, true},
+    {"terrain.mound.radius_m", 0.0, kMax, Ends::kOpenLow},
+    {"terrain.plane.height_m", 0.0, kMax, Ends::kClosed},
+    {"cuts[].keyframes[].t_s", 0.0, kMax, Ends::kClosed},
+    {"soil.repose_deg", 0.0, 80.0, Ends::kOpenLow},
+    {"soil.max_pair_checks_per_step", 1000, 1e9, Ends::kClosed, true},
+    {"reference.mound.radius_m", 0.0, kMax, Ends::kOpenLow},
+    {"reference.mound.height_m", 0.0, kMax, Ends::kOpenLow},
+};
+
+const yaml::Range& range(std::string_view path) { return yaml::find_range(kRanges, path); }
 
 void check_resolution(const Field& f, long long cols, long long rows) {
-  if (cols < 1 || rows < 1)
+  const yaml::Range& side = range("terrain.resolution");
+  if (cols < side.lo || rows < side.lo)
     f.fail("resolution must be at least 1 sample per side, got " + std::to_string(cols) + "x" +
            std::to_string(rows));
-  if (cols > kMaxGridSide || rows > kMaxGridSide)
+  if (cols > side.hi || rows > side.hi)
     f.fail("resolution " + std::to_string(cols) + "x" + std::to_string(rows) +
-           " is absurd: at most " + std::to_string(kMaxGridSide) + " samples per side");
+           " is absurd: each side must be at most " + format_number(side.hi) + " samples");
   if (cols * rows > kMaxScenarioSamples)
     f.fail("resolution " + std::to_string(cols) + "x" + std::to_string(rows) +
            " is absurd: more than 2^28 samples in total");
@@ -296,8 +321,18 @@ void scan_scenario(const Context& ctx, const std::string& text, std::span<Sectio
 // checked (a mistake anywhere is reported before a large image is decoded).
 struct PendingImage {
   Field image;
+  Field size;
   std::optional<Resolution> resolution;
 };
+
+// Cells of at least kMinCellM (core/grid.hpp), reported at size_m once the
+// resolution is known.
+void check_cells(const Field& size, const Scenario& sc) {
+  const double cell = std::min(sc.size_x_m / sc.resolution.cols, sc.size_z_m / sc.resolution.rows);
+  if (!(cell >= kMinCellM))
+    size.fail("the cells would be " + format_number(cell) +
+              " m (size_m / resolution); a cell must be at least 1e-6 m");
+}
 
 // The terrain block; a generator terrain is complete on return, an image
 // terrain is returned to read_terrain_image.
@@ -316,10 +351,10 @@ std::optional<PendingImage> parse_terrain(const Context& ctx, const Field& field
   const Field size = terrain.require("size_m");
   size.numbers(2);  // the shape first: a list of two numbers
   const std::vector<Field> sides = size.elements();
-  sc.size_x_m = sides[0].positive();
-  sc.size_z_m = sides[1].positive();
+  sc.size_x_m = sides[0].in(range("terrain.size_m[0]"));
+  sc.size_z_m = sides[1].in(range("terrain.size_m[1]"));
   if (const auto origin = terrain.get("origin_m")) sc.origin_m = origin->vec3();
-  sc.full_scale_m = terrain.require("full_scale_m").positive();
+  sc.full_scale_m = terrain.require("full_scale_m").in(range("terrain.full_scale_m"));
 
   std::optional<Resolution> resolution;
   if (const auto res = terrain.get("resolution")) resolution = parse_resolution_field(*res);
@@ -344,11 +379,12 @@ std::optional<PendingImage> parse_terrain(const Context& ctx, const Field& field
       ctx.fail(field.key_mark(), child_path(field.path(), "resolution"),
                "missing required field 'resolution' (required with a generator)");
     sc.resolution = *resolution;
+    check_cells(size, sc);
     Generator gen = default_generator(*kind, grid_spec(sc));
     if (const auto m = terrain.get("mound")) {
       const Map mound(*m, {"centre_m", "radius_m"});
       read_xz(mound, "centre_m", gen.mound.centre_x_m, gen.mound.centre_z_m);
-      if (const auto r = mound.get("radius_m")) gen.mound.radius_m = r->positive();
+      if (const auto r = mound.get("radius_m")) gen.mound.radius_m = r->in(range("terrain.mound.radius_m"));
     }
     if (const auto b = terrain.get("box")) {
       const Map box(*b, {"min_m", "max_m"});
@@ -359,14 +395,14 @@ std::optional<PendingImage> parse_terrain(const Context& ctx, const Field& field
     }
     if (const auto p = terrain.get("plane")) {
       const Map plane(*p, {"height_m"});
-      if (const auto h = plane.get("height_m")) gen.plane.height_m = h->non_negative();
+      if (const auto h = plane.get("height_m")) gen.plane.height_m = h->in(range("terrain.plane.height_m"));
     }
     const std::string problem = validate(gen);
     if (!problem.empty()) generator->fail(problem);
     sc.generator = gen;
     return std::nullopt;
   }
-  return PendingImage{*image, resolution};
+  return PendingImage{*image, size, resolution};
 }
 
 // Why a path's status cannot be read (exists() failed with ec): a
@@ -416,6 +452,7 @@ void read_terrain_image(const PendingImage& pending, const std::filesystem::path
     check_resolution(image, sc.image.cols, sc.image.rows);
     sc.resolution = {sc.image.cols, sc.image.rows};
   }
+  check_cells(pending.size, sc);
 }
 
 // One parsed cut, with the fields that later checks report against.
@@ -444,7 +481,7 @@ ParsedCut parse_cut(const Field& field) {
     const Map kf(item, {"t_s", "position_m", "rotation_deg"});
     Keyframe k;
     const Field t = kf.require("t_s");
-    k.t_s = t.non_negative();
+    k.t_s = t.in(range("cuts[].keyframes[].t_s"));
     if (!motion.keyframes.empty() && !(k.t_s > motion.keyframes.back().t_s))
       t.fail("t_s " + format_number(k.t_s) + " is not after the previous keyframe's " +
              format_number(motion.keyframes.back().t_s) + " (times must strictly increase)");
@@ -481,18 +518,17 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     sc.representation =
         f->choice({Representation::kSurface, Representation::kColumns}, "representation");
   if (const auto f = top.get("rate_hz")) {
-    sc.rate_hz = f->positive();
-    if (sc.rate_hz > kMaxRateHz) f->fail(must_be("in (0, 1e6]", sc.rate_hz));
+    sc.rate_hz = f->in(range("rate_hz"));
   }
 
   const Map blade(top.require("blade"), {"length_m", "bucket"});
-  sc.blade.length_m = blade.require("length_m").positive();
+  sc.blade.length_m = blade.require("length_m").in(range("blade.length_m"));
   const std::optional<Field> bucket_field = blade.get("bucket");
   if (const auto& b = bucket_field) {
     // A bucket behind the edge (blade.hpp, BucketSpec): its floor and back.
     const Map bucket(*b, {"depth_m", "height_m"});
-    sc.blade.bucket.depth_m = bucket.require("depth_m").positive();
-    sc.blade.bucket.height_m = bucket.require("height_m").positive();
+    sc.blade.bucket.depth_m = bucket.require("depth_m").in(range("blade.bucket.depth_m"));
+    sc.blade.bucket.height_m = bucket.require("height_m").in(range("blade.bucket.height_m"));
   }
 
   const std::optional<PendingImage> image = parse_terrain(ctx, top.require("terrain"), sc);
@@ -556,9 +592,10 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     const Map soil(*f, {"model", "repose_deg", "max_pair_checks_per_step", "edge"});
     if (const auto m = soil.get("model"))
       sc.soil.model = m->choice({SoilModel::kVanish, SoilModel::kFlow}, "soil model");
-    if (const auto a = soil.get("repose_deg")) sc.soil.repose_deg = a->in_range(0.0, 80.0, yaml::Field::Ends::kOpenLow);
+    if (const auto a = soil.get("repose_deg")) sc.soil.repose_deg = a->in(range("soil.repose_deg"));
     if (const auto w = soil.get("max_pair_checks_per_step"))
-      sc.soil.max_pair_checks_per_step = w->integer_in(1000, 1000000000);
+      sc.soil.max_pair_checks_per_step =
+          static_cast<std::int64_t>(w->in(range("soil.max_pair_checks_per_step")));
     if (const auto e = soil.get("edge"))
       sc.soil.edge = e->choice({SoilEdge::kWall, SoilEdge::kOpen}, "soil edge");
   }
@@ -576,8 +613,8 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     const std::vector<double> c = mound.require("centre_m").numbers(2);
     shape.centre_x_m = c[0];
     shape.centre_z_m = c[1];
-    shape.radius_m = mound.require("radius_m").positive();
-    shape.height_m = mound.require("height_m").positive();
+    shape.radius_m = mound.require("radius_m").in(range("reference.mound.radius_m"));
+    shape.height_m = mound.require("height_m").in(range("reference.mound.height_m"));
     sc.reference_mound = shape;
   }
 
@@ -591,6 +628,8 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
 }
 
 }  // namespace
+
+std::span<const yaml::Range> scenario_ranges() { return kRanges; }
 
 int Scenario::find_cut(std::string_view cut_name) const {
   for (std::size_t i = 0; i < cuts.size(); ++i)

@@ -10,6 +10,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <stdexcept>
 #include <system_error>
 
 #include "terracut/core/error.hpp"
@@ -224,6 +225,20 @@ long long Field::integer_in(long long lo, long long hi) const {
   if (v < lo || v > hi)
     fail(must_be("in [" + format_number(lo) + ", " + format_number(hi) + "]", v));
   return v;
+}
+
+double Field::in(const Range& range) const {
+  if (range.whole) return double(integer_in(std::llround(range.lo), std::llround(range.hi)));
+  if (range.hi == kMaxMagnitude && range.lo == 0.0 && range.ends == Ends::kOpenLow) return positive();
+  if (range.hi == kMaxMagnitude && range.lo == 0.0 && range.ends == Ends::kClosed) return non_negative();
+  if (range.hi == kMaxMagnitude && range.lo == -kMaxMagnitude) return number();
+  return in_range(range.lo, range.hi, range.ends);
+}
+
+const Range& find_range(std::span<const Range> table, std::string_view path) {
+  for (const Range& r : table)
+    if (r.path == path) return r;
+  throw std::logic_error("no range declared for '" + std::string(path) + "'");
 }
 
 std::vector<Field> Field::elements() const {

@@ -285,6 +285,29 @@ TEST(HapticLoop, SilentDeviceTripsTheWatchdogAndSoftStartsOnReturn) {
   EXPECT_EQ(loop->counters().silent_ticks, 300);
 }
 
+// A bad sample while the watchdog fades the force of a silence out still
+// gets zero force (the fade used to go on through it; found by the soak
+// test), and the force then comes back no faster than the rate limit.
+TEST(HapticLoop, BadSampleDuringTheWatchdogFadeGetsZeroForce) {
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice script(trench_path(s));
+  const int timeout = int(std::lround(s.safety.watchdog_timeout_s * s.rate_hz));
+  const std::int64_t bad = 2000 + timeout + 10;  // silent from 2000, tripped by now, fading
+  test::FaultyDevice device(
+      script, [&](std::int64_t tick) { return tick == bad; },
+      [&](std::int64_t tick) { return tick >= 2000 && tick < 2300 && tick != bad; });
+  auto loop = trench_loop(s, device, ticks_of(s));
+  loop->run_deterministic();
+  const std::vector<LoopRecord> rs = loop->records();
+  ASSERT_GT(length(rs[std::size_t(bad - 1)].force_device_n), 0.1);  // fading, not yet zero
+  ASSERT_TRUE(rs[std::size_t(bad - 1)].flags & kFlagWatchdog);
+  EXPECT_TRUE(rs[std::size_t(bad)].flags & kFlagBadSample);
+  EXPECT_EQ(length(rs[std::size_t(bad)].force_device_n), 0.0);
+  const double step_n = s.safety.max_force_rate_n_per_s / s.rate_hz;
+  EXPECT_LE(length(rs[std::size_t(bad + 1)].force_device_n), step_n * (1 + 1e-9));
+  EXPECT_EQ(loop->counters().bad_samples, 1);
+}
+
 // The closed loop with the simulated hand along the trench: it digs, the
 // force stays within the device, and the hand's motion about its target
 // stays within what the rendered force can explain (no instability).

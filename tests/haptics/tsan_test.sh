@@ -1,11 +1,27 @@
 #!/usr/bin/env bash
-# Builds the snapshot-exchange test with ThreadSanitizer and runs it: the
-# exchange between the loop thread and a reader must be free of data races.
+# Builds every test that runs threads with ThreadSanitizer and runs them (a
+# build of its own in SCRATCH, configured with TERRACUT_TSAN: only the
+# libraries those tests need, and the tests of tests/tsan/CMakeLists.txt):
+# the snapshot exchange, the haptic loop, the pacer, the UDP device and
+# bridge, PNG reads from several threads, the viewer's loop driver with a
+# drawing thread, and a short soak (a hostile sender thread against the
+# loop). Any data race fails the test.
 set -euo pipefail
 source=$1 scratch=$2
-mkdir -p "$scratch"
-g++ -std=c++20 -O1 -g -fsanitize=thread -I"$source/include" \
-  "$source/tests/haptics/snapshot_test.cpp" "$source/src/haptics/snapshot.cpp" \
-  "$source/src/core/grid.cpp" "$source/src/core/math.cpp" "$source/src/core/format.cpp" \
-  -lgtest -lgtest_main -pthread -o "$scratch/snapshot_test_tsan"
-TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" "$scratch/snapshot_test_tsan"
+jobs=${TERRACUT_JOBS:-2}
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+CCACHE_BASEDIR=$source cmake -S "$source" -B "$scratch" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" "${launcher[@]}" \
+  -DCMAKE_CXX_FLAGS="-fsanitize=thread -Wno-tsan" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" \
+  -DTERRACUT_TSAN=ON -DTERRACUT_BUILD_TESTS=OFF -DTERRACUT_BUILD_APPS=OFF -DTERRACUT_BUILD_BENCH=OFF >/dev/null
+CCACHE_BASEDIR=$source cmake --build "$scratch" -j"$jobs" --target tsan_all >/dev/null
+export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1"
+bin=$scratch/tests/tsan
+cd "$source"
+for t in snapshot loop pacer udp image loop_driver; do
+  echo "== tsan_$t"
+  "$bin/tsan_$t" --gtest_brief=1
+done
+echo "== tsan_soak"
+"$bin/tsan_soak" --duration 3

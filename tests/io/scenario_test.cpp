@@ -313,7 +313,7 @@ TEST(ScenarioErrors, ZeroAndNegativeSizesAreRefused) {
   const std::string zero_blade = replace(kGood, "length_m: 1.25", "length_m: 0");
   expect_error(zero_blade, line_of(zero_blade, "length_m: 0"), "blade.length_m", "> 0");
   const std::string zero_rate = replace(kGood, "rate_hz: 250", "rate_hz: 0");
-  expect_error(zero_rate, line_of(zero_rate, "rate_hz"), "rate_hz", "> 0");
+  expect_error(zero_rate, line_of(zero_rate, "rate_hz"), "rate_hz", "must be in (0, ");
   const std::string neg_radius = replace(kGood, "radius_m: 0.35}", "radius_m: -0.35}");
   expect_error(neg_radius, line_of(neg_radius, "radius_m: -0.35"), "terrain.mound.radius_m", "> 0");
   const std::string neg_time = replace(kGood, "t_s: 0.0,", "t_s: -1.0,");

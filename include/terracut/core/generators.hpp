@@ -82,8 +82,10 @@ double height_at(const BoxShape& box, double x_m, double z_m);
 double height_at(const Generator& generator, double x_m, double z_m);
 
 /// Samples the generator at the cell centres of the grid: returns rows x cols
-/// heights, row-major, index = r * cols + c, metres. The grid spec must be
-/// valid (validate(spec) empty) and the generator valid.
+/// heights, row-major, index = r * cols + c, metres. The generator must be
+/// valid; an invalid grid spec (validate(spec) not empty: a side outside
+/// [1, 65536], more than 2^30 samples) throws InputError with validate's
+/// message, before anything is allocated.
 std::vector<float> generate_heights(const GridSpec& spec, const Generator& generator);
 
 /// Exact length, metres, of the part of a segment that lies inside the solid

@@ -43,6 +43,10 @@ struct GridSpec {
 inline constexpr int kMaxGridSide = 65536;
 /// Largest accepted sample count (2^30, 12 GiB of layers).
 inline constexpr std::int64_t kMaxGridSamples = std::int64_t(1) << 30;
+/// Smallest accepted cell side, metres (a micrometre): the cell coordinates
+/// of any position within 1e9 m then stay finite (cells of 1e-300 m made
+/// them infinite, and the traversal's conversions to int undefined).
+inline constexpr double kMinCellM = 1e-6;
 
 /// Returns an empty string when spec is valid, else a message naming the bad field.
 std::string validate(const GridSpec& spec);

@@ -105,6 +105,11 @@ class SafetyLimiter {
   /// received; the watchdog compares it with t_s.
   SafetyOutput update(double t_s, Vec3 force_n, double last_device_sample_t_s) noexcept;
 
+  /// Zeroes the output at once, outside update(): for a bad device sample,
+  /// which the haptic loop answers with zero force even while the watchdog
+  /// is fading an older force out. The next update() builds the force up
+  /// from zero under the rate limit. Counts nothing (the caller counts why).
+  void zero_output() noexcept { last_output_ = {}; }
   /// The last output force (zero before the first update).
   Vec3 last_force_n() const { return last_output_; }
   /// Whether the watchdog currently holds the device as silent.

@@ -26,6 +26,7 @@
 #include <initializer_list>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -104,6 +105,8 @@ class Context {
 YAML::Node parse_text(const Context& ctx, const std::string& text,
                       std::string_view malformed = "malformed YAML");
 
+struct Range;
+
 /// One value of the document with its field path (e.g. "cuts[0].keyframes[1].t_s")
 /// and the line errors about it report: its own mark, or the mark of the key
 /// (or list) that introduced it when it has none. Safe to keep and copy.
@@ -161,6 +164,8 @@ class Field {
   long long integer() const;
   /// integer() in [lo, hi].
   long long integer_in(long long lo, long long hi) const;
+  /// The number as its entry of a reader's table of ranges says (see Range).
+  double in(const Range& range) const;
 
   /// The elements of a list, each with its path "path[i]".
   std::vector<Field> elements() const;
@@ -189,6 +194,27 @@ class Field {
   std::string path_;
   YAML::Mark fallback_;
 };
+
+/// The range of one number of a section, declared in its reader's table of
+/// ranges (one table per reader, e.g. io::scenario_ranges()): the reader
+/// reads the field with Field::in(range), and the boundary tests are
+/// generated from the same table (each end, and just beyond it). Reading
+/// follows the toolkit's own checks, so the messages are theirs: whole
+/// numbers by integer_in, (0, 1e9] by positive ("must be > 0"), [0, 1e9] by
+/// non_negative, anything else by in_range ("must be in (0, 1e6]").
+struct Range {
+  /// Where the number is, relative to the section: "rate_hz",
+  /// "terrain.size_m[0]"; "[]" for every element of a list ("cuts[].keyframes[].t_s").
+  std::string_view path;
+  double lo = -kMaxMagnitude;
+  double hi = kMaxMagnitude;
+  Field::Ends ends = Field::Ends::kClosed;
+  bool whole = false;  ///< a whole number (lo and hi whole too)
+};
+
+/// The entry of table for path; a path missing from the table is a
+/// programming error (std::logic_error).
+const Range& find_range(std::span<const Range> table, std::string_view path);
 
 /// A mapping with a fixed set of allowed keys. Unknown keys (the error lists
 /// the allowed ones), repeated keys (the error names the first one's line)
