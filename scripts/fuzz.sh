@@ -29,7 +29,7 @@ launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 CCACHE_BASEDIR=$root cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER="$cc" \
   -DCMAKE_CXX_COMPILER="$cxx" "${launcher[@]}" -DTERRACUT_FUZZ=ON -DTERRACUT_BUILD_TESTS=OFF \
-  -DTERRACUT_BUILD_APPS=OFF -DTERRACUT_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS="$flags" \
+  -DTERRACUT_BUILD_APPS=OFF -DTERRACUT_BUILD_BENCH=OFF -DTERRACUT_BUILD_PYTHON=OFF -DCMAKE_CXX_FLAGS="$flags" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
 CCACHE_BASEDIR=$root cmake --build "$build" -j"$jobs" --target "${targets[@]/#/fuzz_}"
 

@@ -14,7 +14,8 @@ command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 CCACHE_BASEDIR=$source cmake -S "$source" -B "$scratch" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" "${launcher[@]}" \
   -DCMAKE_CXX_FLAGS="-fsanitize=thread -Wno-tsan" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" \
-  -DTERRACUT_TSAN=ON -DTERRACUT_BUILD_TESTS=OFF -DTERRACUT_BUILD_APPS=OFF -DTERRACUT_BUILD_BENCH=OFF >/dev/null
+  -DTERRACUT_TSAN=ON -DTERRACUT_BUILD_TESTS=OFF -DTERRACUT_BUILD_APPS=OFF -DTERRACUT_BUILD_BENCH=OFF \
+  -DTERRACUT_BUILD_PYTHON=OFF >/dev/null
 CCACHE_BASEDIR=$source cmake --build "$scratch" -j"$jobs" --target tsan_all >/dev/null
 export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1"
 bin=$scratch/tests/tsan
