@@ -321,11 +321,7 @@ bool ViewerDevice::read(double t_s, haptics::DeviceSample& out) noexcept {
     script_time_published_.store(script_time_s_, std::memory_order_relaxed);
   }
 
-  out.position_m = workspace_.to_device(pose_.position_m);
-  out.orientation = workspace_.orientation_to_device(pose_.orientation);
-  out.has_orientation = true;
-  out.buttons = 0;
-  out.reconnected = false;
+  workspace_.fill_sample(pose_, out);
   return true;
 }
 

@@ -44,4 +44,12 @@ Quat Workspace::orientation_to_device(Quat world) const {
   return normalized(inverse_ * world * rotation_);
 }
 
+void Workspace::fill_sample(const BladePose& world_pose, DeviceSample& out) const {
+  out.position_m = to_device(world_pose.position_m);
+  out.orientation = orientation_to_device(world_pose.orientation);
+  out.has_orientation = true;
+  out.buttons = 0;
+  out.reconnected = false;
+}
+
 }  // namespace terracut::haptics

@@ -89,11 +89,7 @@ class FollowerDevice final : public haptics::Device {
     if (l > step_m_) d = d * (step_m_ / l);
     pose_.position_m = pose_.position_m + d;
     pose_.orientation = target_.orientation;
-    out.position_m = workspace_.to_device(pose_.position_m);
-    out.orientation = workspace_.orientation_to_device(pose_.orientation);
-    out.has_orientation = true;
-    out.buttons = 0;
-    out.reconnected = false;
+    workspace_.fill_sample(pose_, out);
     return true;
   }
   void write(const haptics::DeviceCommand&) noexcept override {}

@@ -11,6 +11,8 @@
 // about a device axis is a turn about the matching world axis.
 #pragma once
 
+#include "terracut/core/blade.hpp"
+#include "terracut/haptics/device.hpp"
 #include "terracut/haptics/settings.hpp"
 #include "terracut/core/math.hpp"
 
@@ -37,6 +39,10 @@ class Workspace {
   Quat orientation_to_world(Quat device) const;
   /// Inverse of orientation_to_world.
   Quat orientation_to_device(Quat world) const;
+  /// The sample a 6-DOF device holding the tool at this world pose reads:
+  /// position and orientation in the device frame, no buttons, not a
+  /// reconnection (the other fields of out are left as they are).
+  void fill_sample(const BladePose& world_pose, DeviceSample& out) const;
 
  private:
   WorkspaceMapping mapping_;
