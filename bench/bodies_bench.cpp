@@ -77,6 +77,12 @@ RunFigures median_of_three(const session::Scenario& sc, const bullet::TerrainWor
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Optional arguments: the file the table is also written to, and a scenario.
+  if (argc > 3 || (argc >= 2 && argv[1][0] == '-') || (argc == 3 && argv[2][0] == '-')) {
+    std::fprintf(stderr, "usage: terracut_bench_bodies [TABLE.md [SCENARIO.yaml]]\n"
+                         "Times the Bullet world's step over the scenario (default: scenarios/rescue.yaml).\n");
+    return argc == 2 && std::string(argv[1]) == "--help" ? 0 : 2;
+  }
   const std::filesystem::path scenario =
       argc > 2 ? std::filesystem::path(argv[2])
                : std::filesystem::path(TERRACUT_SOURCE_DIR) / "scenarios" / "rescue.yaml";

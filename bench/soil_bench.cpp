@@ -87,6 +87,12 @@ Stats collapse() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // One optional argument: the file the table is also written to.
+  if (argc > 2 || (argc == 2 && argv[1][0] == '-')) {
+    std::fprintf(stderr, "usage: terracut_bench_soil [TABLE.md]\n"
+                         "Runs the soil-phase benchmarks and prints their table (and writes it to TABLE.md).\n");
+    return argc == 2 && std::string(argv[1]) == "--help" ? 0 : 2;
+  }
   std::string table =
       "| soil case (1 cm cells, repose 34 deg) | steps | p50 | p99 | max | largest backlog |\n"
       "|---|---|---|---|---|---|\n";
