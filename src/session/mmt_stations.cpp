@@ -1,5 +1,6 @@
 // The two stations of model-mediated teleoperation (mmt.hpp).
 #include <algorithm>
+#include <span>
 #include <chrono>
 #include <cmath>
 
@@ -560,7 +561,13 @@ void OperatorStation::merge(double t_s) {
         }
         b.scratch[k] = float(b.from[k] + (b.to[k] - b.from[k]) * ramp);
       }
-    grid.set_heights(b.rect, b.scratch.data());
+    // Through the simulation's validated edit, so that its listeners (a
+    // Bullet world) and the soil phase hear of it; a height the patch could
+    // not give (non-finite, below the floor) is the floor, as set_heights has it.
+    const std::size_t n = std::size_t(b.rect.area());
+    for (std::size_t j = 0; j < n; ++j)
+      if (!(b.scratch[j] >= 0.0f) || !std::isfinite(b.scratch[j])) b.scratch[j] = 0.0f;
+    rig_->world().simulation().edit_heights(b.rect, std::span<const float>(b.scratch.data(), n));
     include_rect(worked_, b.rect);
   }
   blends_.erase(std::remove_if(blends_.begin(), blends_.end(), [](const Blend& b) { return b.done; }),
