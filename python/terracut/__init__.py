@@ -58,9 +58,30 @@ def run(scenario, out_dir: Union[str, os.PathLike], realtime: bool = False) -> d
     return _run(as_scenario(scenario), Path(out_dir), realtime)
 
 
+def run_mmt(scenario, out_dir: Union[str, os.PathLike, None] = None, rtt_ms: Union[float, None] = None,
+            loss: Union[float, None] = None, deadband: Union[float, None] = None,
+            seed: Union[int, None] = None) -> dict[str, Any]:
+    """Runs a teleoperation scenario (one with an `mmt:` section) as
+    `terracut mmt SCENARIO [--out OUT_DIR]` does: both stations in one
+    process over the emulated link, with the round trip (rtt_ms,
+    milliseconds), independent loss (a fraction in [0, 1)), the perceptual
+    deadband and the seed overriding the scenario's. Returns the summary's
+    figures: force errors of MMT and of direct force reflection (N, RMS and
+    max), terrain and tracking errors (m), packets per second, update
+    count, passivity (J), the soil estimate. Writes operator.csv,
+    remote.csv, terrain_error.csv and summary.json into out_dir when given.
+    The GIL is released during the run.
+    """
+    from ._terracut import _run_mmt
+
+    return _run_mmt(as_scenario(scenario), None if out_dir is None else Path(out_dir),
+                    None if rtt_ms is None else float(rtt_ms) / 1000.0, loss, deadband, seed)
+
+
 from .sweep import SweepResult, register_override, sweep  # noqa: E402,F401
 
 __all__ = [
+    "run_mmt",
     "ForceModel", "InputError", "SafetyLimiter", "Scenario", "Simulation", "StepResult",
     "SweepResult", "bodies_available", "earthmoving_force", "from_dict", "load_mapping",
     "register_override", "run", "soil_preset", "sweep",

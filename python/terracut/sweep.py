@@ -207,6 +207,12 @@ def _error_row(index: int, overrides: dict, error: str, wall_s: float, out_dir: 
             "wall_s": wall_s, "out_dir": out_dir}
 
 
+# The teleoperation link's conditions: not fields of the scenario but options
+# of its run (`terracut mmt --rtt-ms ... --loss ...`); a case that has one, or
+# a scenario with an `mmt:` section, runs both stations (terracut.run_mmt).
+NETWORK_OVERRIDES = ("rtt_ms", "loss", "deadband", "seed")
+
+
 def _run_case(spec: dict) -> dict:
     """Runs one case (in a worker process or on a Dask worker); never raises."""
     start = time.perf_counter()
@@ -216,11 +222,17 @@ def _run_case(spec: dict) -> dict:
 
         for name, fn in spec.get("extra_overrides", {}).items():
             OVERRIDES[name] = fn  # the client's, which may be newer than this worker's
-        mapping = apply_overrides(spec["mapping"], overrides)
+        network = {k: v for k, v in overrides.items() if k in NETWORK_OVERRIDES}
+        fields = {k: v for k, v in overrides.items() if k not in NETWORK_OVERRIDES}
+        mapping = apply_overrides(spec["mapping"], fields)
         scenario = from_dict(mapping, base_dir=spec["base_dir"], label=spec["label"])
         os.makedirs(out_dir, exist_ok=True)
         with open(os.path.join(out_dir, "case.json"), "w") as f:
             json.dump({"case": index, "overrides": overrides}, f, indent=2, default=str)
+        if network or "mmt" in mapping:
+            figures = terracut.run_mmt(scenario, out_dir, **network)
+            return {"case": index, "status": "ok", "error": "", "overrides": overrides, **figures,
+                    "wall_s": time.perf_counter() - start, "out_dir": out_dir}
         result = terracut.run(scenario, out_dir)
         return _summary_row(index, overrides, result, time.perf_counter() - start, out_dir)
     except Exception as e:  # a failed case is a row, not a lost sweep
@@ -382,7 +394,8 @@ def sweep(scenario: Union[str, os.PathLike, Mapping],
     names: list[str] = []
     for c in case_list:
         for n in c:
-            _override_fn(n)  # an unknown name fails now, not in every case
+            if n not in NETWORK_OVERRIDES:
+                _override_fn(n)  # an unknown name fails now, not in every case
             if n not in names:
                 names.append(n)
     if processes is not None and (not isinstance(processes, int) or processes < 1):
