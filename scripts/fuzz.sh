@@ -11,7 +11,7 @@
 # script. The executions of each target are in build-fuzz/logs/<target>.log.
 #
 #   scripts/fuzz.sh            # an hour per target
-#   scripts/fuzz.sh 30         # the bounded run of scripts/test.sh
+#   scripts/fuzz.sh 30         # the bounded run of scripts/sanitize.sh
 #   scripts/fuzz.sh 60 png     # only the named targets
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)

@@ -1,23 +1,57 @@
 #!/usr/bin/env bash
 # The whole test suite under AddressSanitizer and UndefinedBehaviorSanitizer
-# (leaks included), in its own build: build-asan/ (or $TERRACUT_ASAN_BUILD_DIR).
-# Run by .ci/run after the README's test command. Left out: the viewer and
-# its tests (not built: the Mesa GL driver's own allocations would read as
-# leaks), the install test (it builds a consumer without the sanitizer
-# runtime) and the ThreadSanitizer test (its own build, run by the normal
-# suite). The Python
-# module's tests run with the runtimes preloaded (python/tests/CMakeLists.txt).
+# (leaks included), then every libFuzzer target for a bounded time, from one
+# build: build-asan/ (or $TERRACUT_ASAN_BUILD_DIR). Run by scripts/test.sh
+# after the Release suite (TERRACUT_SANITIZE=0 there skips it).
+#
+# With clang (installed by scripts/install-deps.sh): a clang build, and the
+# fuzz programs in build-fuzz/ (scripts/fuzz.sh: only the library layers
+# they link, also instrumented for libFuzzer's coverage, which would slow
+# the suite's real-time tests about threefold if it shared this build);
+# without clang a gcc build, and the fuzz runs are skipped (the corpus
+# replays still run in CTest). -O1 with line tables only: sanitizer reports
+# keep file:line, and the build costs about half of -O2 -g.
+#
+# Left out of the CTest run: the viewer and its tests (not built: the Mesa GL
+# driver's own allocations would read as leaks), the install test (it builds
+# a consumer without the sanitizer runtime) and the ThreadSanitizer test (its
+# own build, run by the Release suite). The Python module's tests run with
+# the runtime preloaded (python/tests/CMakeLists.txt).
+#
+#   scripts/sanitize.sh          # build, CTest, 30 s per fuzz target
+#   TERRACUT_FUZZ_SECONDS=0 scripts/sanitize.sh   # no fuzz runs
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${TERRACUT_ASAN_BUILD_DIR:-$root/build-asan}
 jobs=${TERRACUT_JOBS:-$(nproc)}
-flags="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
-cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPYTHON_EXECUTABLE=/usr/bin/python3 \
+sanitizers=address,undefined
+compiler=()
+fuzz=OFF
+if command -v clang >/dev/null && command -v clang++ >/dev/null; then
+  compiler=(-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++)
+  fuzz=ON
+  flags="-fsanitize=$sanitizers -gline-tables-only"
+else
+  echo "sanitize.sh: clang not found: a gcc build, and the libFuzzer runs are skipped"
+  flags="-fsanitize=$sanitizers -g1"
+fi
+flags="$flags -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+CCACHE_BASEDIR=$root cmake -S "$root" -B "$build" "${compiler[@]}" "${launcher[@]}" \
+  -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1" -DCMAKE_C_FLAGS_SANITIZE="-O1" \
+  -DPYTHON_EXECUTABLE=/usr/bin/python3 \
   -DTERRACUT_BUILD_BENCH=OFF -DTERRACUT_BUILD_VIEWER=OFF -DCMAKE_CXX_FLAGS="$flags" \
-  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
-  -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" \
-  -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
-cmake --build "$build" -j"$jobs"
+  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=$sanitizers" \
+  -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=$sanitizers" \
+  -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=$sanitizers" >/dev/null
+CCACHE_BASEDIR=$root cmake --build "$build" -j"$jobs"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ctest --test-dir "$build" --output-on-failure -j"$jobs" --timeout 600 -E "Viewer|install|tsan"
+# Every fuzz target for a bounded time (30 s of wall time each, five at once;
+# docs/reliability.md).
+seconds=${TERRACUT_FUZZ_SECONDS:-30}
+if [[ $fuzz == ON && $seconds != 0 ]]; then
+  TERRACUT_FUZZ_JOBS=${TERRACUT_FUZZ_JOBS:-5} "$root/scripts/fuzz.sh" "$seconds"
+fi

@@ -1,6 +1,7 @@
 """Bit-identical to the command line: `terracut run` and the module give the
 same numbers for the same scenario."""
 
+import os
 import subprocess
 
 import numpy as np
@@ -12,8 +13,11 @@ FIELDS = ["t", None, "x", "y", "z", "qw", "qx", "qy", "qz", "contact_length", "r
 
 
 def cli_run(cli, scenario, out, *args):
+    # Under the sanitizers the interpreter has the runtime preloaded; the
+    # program carries its own (clang links it in), and two would abort it.
+    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
     subprocess.run([cli, "run", str(scenario), "--out", str(out), *args], check=True,
-                   capture_output=True)
+                   capture_output=True, env=env)
     return (out / "contact.csv").read_text().splitlines()
 
 

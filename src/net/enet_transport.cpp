@@ -76,6 +76,18 @@ EnetEndpoint::~EnetEndpoint() {
   }
 }
 
+namespace {
+// ENet drops unreliable packets itself ("packet throttling") while the round
+// trip it measures varies more than usual, which the emulated jitter and a
+// busy machine both cause: commands would be lost beyond the loss the link
+// is set to. The throttle stays at its full scale (never decelerates), so
+// the emulator alone decides what is lost. Set on both sides once connected
+// (before, the command would break the handshake).
+void never_throttle(ENetPeer* peer) {
+  enet_peer_throttle_configure(peer, ENET_PEER_PACKET_THROTTLE_INTERVAL, ENET_PEER_PACKET_THROTTLE_SCALE, 0);
+}
+}  // namespace
+
 std::unique_ptr<EnetEndpoint> EnetEndpoint::listen(const std::string& address, int port,
                                                    const LinkConditions& sending) {
   enet_acquire();
@@ -143,6 +155,7 @@ void EnetEndpoint::receive(double now_s, std::vector<std::vector<std::uint8_t>>&
         if (s_->peer && s_->peer != event.peer && s_->connected) enet_peer_reset(s_->peer);
         s_->peer = event.peer;
         s_->connected = true;
+        never_throttle(event.peer);
         ++s_->connections;
         break;
       case ENET_EVENT_TYPE_DISCONNECT:
