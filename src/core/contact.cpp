@@ -452,7 +452,11 @@ std::int64_t surface_columns(const float* h, const Line& l, int p_first, int p_e
                              ContactSums& sums) {
   const double inv_dp = 1.0 / l.dp;
   const double r = l.dq * inv_dp, ky = l.dy * inv_dp;
-  const double inv_1r = 1.0 / (1.0 + r);        // a of the diagonal: (1 - b) / (1 + r)
+  // a of the diagonal: (1 - b) / (1 + r). An edge parallel to the diagonals
+  // (r = -1, a blade at 45 degrees) crosses none: it takes the one-square
+  // branch only on a diagonal itself (b = 1, the surface linear along it),
+  // where a_d = 0 is as good as any point, and the down branch otherwise.
+  const double inv_1r = 1.0 + r > 0.0 ? 1.0 / (1.0 + r) : 0.0;
   const double inv_r = 1.0 / r;                 // a of a minor crossing (unused when r = 0)
   const std::int64_t sp = l.sp, sq = l.sq;
   const double s_first = (p_first - l.p0) * inv_dp;
@@ -641,10 +645,10 @@ ContactResult contact_surface(const HeightGrid& grid, const Segment& edge) {
   // The interior part, where every node of the squares crossed exists: p in
   // [0, np - 1] and q in [0, nq - 1]. Its full columns take the fast walk;
   // the rest (border ring, partial first and last columns) the general one.
-  // An edge parallel to the diagonals (dq = -dp) never crosses them and an
-  // edge with no footprint crosses no column: both take the general walk.
+  // An edge with no footprint crosses no column: it takes the general walk.
+  // (|dq| <= dp: dp + dq >= 0, 0 for an edge parallel to the diagonals.)
   double sa = s0, sb = s1;
-  bool interior = l.dp > 0.0 && l.dp + l.dq > 0.0 && l.np >= 2 && l.nq >= 2 &&
+  bool interior = l.dp > 0.0 && l.dp + l.dq >= 0.0 && l.np >= 2 && l.nq >= 2 &&
                   detail::clip_axis(l.p0, l.dp, 0.0, l.np - 1.0, sa, sb) &&
                   detail::clip_axis(l.q0, l.dq, 0.0, l.nq - 1.0, sa, sb);
   int p_first = 0, p_end = 0;

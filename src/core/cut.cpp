@@ -895,23 +895,34 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
   const HeightGrid::EditLayers layers = grid.edit_layers();
   const ObliqueSweep& b = w.bounds;
   const bool low_end = w.gv >= 0.0;  // Y along a chord is lowest at its lower end
+  // The section's ends at v.
+  auto ends = [&b](double v, double& lo, double& hi) {
+    lo = b.lo_u[0] + (v - b.lo_r[0]) * b.lo_k[0];
+    hi = b.hi_u[0] + (v - b.hi_r[0]) * b.hi_k[0];
+    for (int k = 1; k < ObliqueSweep::kBounds; ++k) {
+      lo = std::max(lo, b.lo_u[k] + (v - b.lo_r[k]) * b.lo_k[k]);
+      hi = std::min(hi, b.hi_u[k] + (v - b.hi_r[k]) * b.hi_k[k]);
+    }
+  };
+  // A row's top line is the next row's bottom line: its ends are carried
+  // over (the same arithmetic on the same v, so the same values).
+  double carried_v = -kInf, carried_lo = 0.0, carried_hi = 0.0;
   for (int r = w.r_lo; r <= w.r_hi; ++r) {
     const double va = std::max(double(r), w.vmin), vb = std::min(double(r) + 1.0, w.vmax);
     if (va > vb) continue;
     // Q's vertices: the section's ends at va and vb, and the
     // parallelogram's vertices strictly between.
     double cand_u[8], cand_v[8];
-    int n = 0;
-    for (double v : {va, vb}) {
-      double lo = b.lo_u[0] + (v - b.lo_r[0]) * b.lo_k[0];
-      double hi = b.hi_u[0] + (v - b.hi_r[0]) * b.hi_k[0];
-      for (int k = 1; k < ObliqueSweep::kBounds; ++k) {
-        lo = std::max(lo, b.lo_u[k] + (v - b.lo_r[k]) * b.lo_k[k]);
-        hi = std::min(hi, b.hi_u[k] + (v - b.hi_r[k]) * b.hi_k[k]);
-      }
-      cand_u[n] = lo, cand_v[n++] = v;
-      cand_u[n] = hi, cand_v[n++] = v;
+    if (va == carried_v) {
+      cand_u[0] = carried_lo, cand_u[1] = carried_hi;
+    } else {
+      ends(va, cand_u[0], cand_u[1]);
     }
+    ends(vb, cand_u[2], cand_u[3]);
+    carried_v = vb, carried_lo = cand_u[2], carried_hi = cand_u[3];
+    cand_v[0] = cand_v[1] = va;
+    cand_v[2] = cand_v[3] = vb;
+    int n = 4;
     for (int k = 0; k < 4; ++k) {
       if (w.vert_v[k] > va && w.vert_v[k] < vb) cand_u[n] = w.vert_u[k], cand_v[n++] = w.vert_v[k];
     }

@@ -2,7 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <new>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
@@ -53,6 +59,50 @@ void Rect::include(const Rect& other) {
   r1 = std::max(r1, other.r1);
 }
 
+namespace detail {
+
+namespace {
+
+constexpr std::size_t kPageBytes = 4096;
+constexpr std::size_t kHugePageBytes = std::size_t(2) << 20;
+
+std::size_t round_up(std::size_t n, std::size_t to) { return (n + to - 1) / to * to; }
+
+}  // namespace
+
+LayerBlock::LayerBlock(std::int64_t samples) : samples_(samples) {
+  const std::size_t bytes = std::size_t(samples) * sizeof(float);
+  // Layers of a huge page or more start on huge-page boundaries (plus their
+  // stagger); smaller ones on pages, so small grids waste little.
+  const std::size_t align = bytes >= kHugePageBytes ? kHugePageBytes : kPageBytes;
+  layer_stride_ = round_up(bytes, align) + kLayerStaggerBytes;
+  block_bytes_ = round_up(2 * layer_stride_ + bytes, align);
+  block_.reset(static_cast<std::byte*>(std::aligned_alloc(align, block_bytes_)));
+  if (!block_) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  // A hint (THP in madvise mode); refused or unsupported, nothing changes.
+  if (align == kHugePageBytes) (void)madvise(block_.get(), block_bytes_, MADV_HUGEPAGE);
+#endif
+  std::memset(block_.get(), 0, block_bytes_);
+}
+
+LayerBlock::LayerBlock(const LayerBlock& other) : LayerBlock() { *this = other; }
+
+LayerBlock& LayerBlock::operator=(const LayerBlock& other) {
+  if (this == &other) return *this;
+  if (other.block_ == nullptr) {
+    *this = LayerBlock();
+    return *this;
+  }
+  if (samples_ != other.samples_ || block_ == nullptr) *this = LayerBlock(other.samples_);
+  std::memcpy(block_.get(), other.block_.get(), block_bytes_);
+  return *this;
+}
+
+void LayerBlock::Free::operator()(std::byte* p) const noexcept { std::free(p); }
+
+}  // namespace detail
+
 HeightGrid::HeightGrid(const GridSpec& spec, std::vector<float> initial_heights_m) : spec_(spec) {
   if (std::string error = validate(spec); !error.empty()) throw InputError(error);
   if (std::int64_t(initial_heights_m.size()) != spec.sample_count()) {
@@ -68,9 +118,10 @@ HeightGrid::HeightGrid(const GridSpec& spec, std::vector<float> initial_heights_
                                "finite and >= 0", h));
     }
   }
-  initial_ = std::move(initial_heights_m);
-  height_ = initial_;
-  removed_.assign(initial_.size(), 0.0f);
+  layers_ = detail::LayerBlock(spec.sample_count());
+  const std::size_t bytes = initial_heights_m.size() * sizeof(float);
+  std::memcpy(initial_(), initial_heights_m.data(), bytes);
+  std::memcpy(height_(), initial_heights_m.data(), bytes);
 }
 
 Rect HeightGrid::set_heights(const Rect& rect, const float* values_m) {
@@ -83,28 +134,31 @@ Rect HeightGrid::set_heights(const Rect& rect, const float* values_m) {
       float h = values_m[std::int64_t(r - rect.r0) * width + (c - rect.c0)];
       if (!std::isfinite(h) || h < 0.0f) h = 0.0f;
       std::int64_t i = index(c, r);
-      height_[size_t(i)] = h;
-      removed_[size_t(i)] = initial_[size_t(i)] - h;
+      height_()[i] = h;
+      removed_()[i] = initial_()[i] - h;
     }
   }
   return clipped;
 }
 
 void HeightGrid::reset() {
-  height_ = initial_;
-  std::fill(removed_.begin(), removed_.end(), 0.0f);
+  const std::size_t n = std::size_t(spec_.sample_count());
+  std::memcpy(height_(), initial_(), n * sizeof(float));
+  std::fill(removed_(), removed_() + n, 0.0f);
 }
 
 double HeightGrid::volume_m3() const {
   double sum = 0.0;
-  for (float h : height_) sum += h;
+  const float* height = height_();
+  for (std::int64_t i = 0; i < spec_.sample_count(); ++i) sum += height[i];
   return sum * spec_.cell_area_m2();
 }
 
 double HeightGrid::conservation_error_m() const {
   double worst = 0.0;
-  for (size_t i = 0; i < height_.size(); ++i) {
-    double e = std::abs(double(height_[i]) + double(removed_[i]) - double(initial_[i]));
+  const float *height = height_(), *removed = removed_(), *initial = initial_();
+  for (std::int64_t i = 0; i < spec_.sample_count(); ++i) {
+    double e = std::abs(double(height[i]) + double(removed[i]) - double(initial[i]));
     worst = std::max(worst, e);
   }
   return worst;
@@ -112,19 +166,20 @@ double HeightGrid::conservation_error_m() const {
 
 std::uint64_t HeightGrid::state_hash() const {
   std::uint64_t hash = 1469598103934665603ull;
-  auto mix = [&hash](const std::vector<float>& layer) {
-    for (float v : layer) {
+  const std::int64_t n = spec_.sample_count();
+  auto mix = [&hash, n](const float* layer) {
+    for (std::int64_t i = 0; i < n; ++i) {
       std::uint32_t bits;
-      std::memcpy(&bits, &v, sizeof bits);
+      std::memcpy(&bits, &layer[i], sizeof bits);
       for (int k = 0; k < 4; ++k) {
         hash ^= (bits >> (8 * k)) & 0xffu;
         hash *= 1099511628211ull;
       }
     }
   };
-  mix(height_);
-  mix(removed_);
-  mix(initial_);
+  mix(height_());
+  mix(removed_());
+  mix(initial_());
   return hash;
 }
 

@@ -16,7 +16,9 @@
 // height * cell_x_m * cell_z_m.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -81,6 +83,48 @@ struct Rect {
   bool operator==(const Rect&) const = default;
 };
 
+namespace detail {
+
+/// The storage of a grid's three float layers, one block. A traversal across
+/// the rows (a blade oblique or transverse to them) touches the same sample
+/// column of each layer in every row, 4 * cols bytes apart: with a
+/// power-of-two side those addresses agree in their low 12 bits, so in
+/// separate allocations (page-aligned by the allocator) the three layers'
+/// lines fall into the same L1 and L2 cache sets and evict one another. Each
+/// layer here starts kLayerStaggerBytes further into its page than the one
+/// before, which puts them in different sets; big layers start on 2 MiB
+/// boundaries and are offered transparent huge pages (Linux, madvise), so a
+/// column of rows costs fewer TLB misses. Copies are deep.
+class LayerBlock {
+ public:
+  /// Offset of layer k's start within its page is k * kLayerStaggerBytes
+  /// (a third of a 4 KiB page, whole cache lines).
+  static constexpr std::size_t kLayerStaggerBytes = 1344;
+
+  LayerBlock() = default;
+  /// Three layers of samples floats each, zeroed.
+  explicit LayerBlock(std::int64_t samples);
+  LayerBlock(const LayerBlock& other);
+  LayerBlock& operator=(const LayerBlock& other);
+  LayerBlock(LayerBlock&&) noexcept = default;
+  LayerBlock& operator=(LayerBlock&&) noexcept = default;
+
+  /// Layer k (0, 1 or 2): samples floats.
+  float* layer(int k) const { return reinterpret_cast<float*>(block_.get() + std::size_t(k) * layer_stride_); }
+  std::int64_t samples() const { return samples_; }
+
+ private:
+  struct Free {
+    void operator()(std::byte* p) const noexcept;
+  };
+  std::unique_ptr<std::byte, Free> block_;
+  std::int64_t samples_ = 0;
+  std::size_t layer_stride_ = 0;  ///< bytes from one layer's start to the next
+  std::size_t block_bytes_ = 0;
+};
+
+}  // namespace detail
+
 /// The soil state: three layers of rows x cols float samples, row-major,
 /// index = r * cols + c, metres. Invariant, per sample and to float rounding:
 /// height + removed = initial.
@@ -97,13 +141,13 @@ class HeightGrid {
 
   /// Current height above ground, rows x cols, metres. The array is stable for
   /// the grid's lifetime, so an engine (Bullet, a renderer) can read it in place.
-  const float* heights() const { return height_.data(); }
+  const float* heights() const { return height_(); }
   /// Material removed so far (initial - height), rows x cols, metres.
-  const float* removed() const { return removed_.data(); }
+  const float* removed() const { return removed_(); }
   /// Heights at construction, rows x cols, metres.
-  const float* initial() const { return initial_.data(); }
+  const float* initial() const { return initial_(); }
 
-  float height(int c, int r) const { return height_[index(c, r)]; }
+  float height(int c, int r) const { return height_()[index(c, r)]; }
 
   /// The layers opened for an in-place edit by a core phase (the cut, later
   /// soil flow): height and removed writable, initial read-only, each
@@ -117,16 +161,17 @@ class HeightGrid {
   };
   /// Opens the layers for an edit (see EditLayers): the one way to write
   /// samples besides lower() and set_heights().
-  EditLayers edit_layers() { return {height_.data(), removed_.data(), initial_.data()}; }
+  EditLayers edit_layers() { return {height_(), removed_(), initial_()}; }
 
   /// Lowers sample i to new_height_m if that is lower than its height (and not
   /// below 0). Returns the height removed, metres (0 when nothing changed).
   float lower(std::int64_t i, float new_height_m) {
-    float old = height_[i];
+    float* height = height_();
+    float old = height[i];
     float h = new_height_m > 0.0f ? new_height_m : 0.0f;
     if (!(h < old)) return 0.0f;
-    height_[i] = h;
-    removed_[i] = initial_[i] - h;
+    height[i] = h;
+    removed_()[i] = initial_()[i] - h;
     return old - h;
   }
 
@@ -153,9 +198,11 @@ class HeightGrid {
 
  private:
   GridSpec spec_;
-  std::vector<float> height_;
-  std::vector<float> removed_;
-  std::vector<float> initial_;
+  detail::LayerBlock layers_;  ///< height, removed, initial
+
+  float* height_() const { return layers_.layer(0); }
+  float* removed_() const { return layers_.layer(1); }
+  float* initial_() const { return layers_.layer(2); }
 };
 
 }  // namespace terracut
