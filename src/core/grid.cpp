@@ -70,7 +70,7 @@ std::size_t round_up(std::size_t n, std::size_t to) { return (n + to - 1) / to *
 
 }  // namespace
 
-LayerBlock::LayerBlock(std::int64_t samples) : samples_(samples) {
+LayerBlock::LayerBlock(std::int64_t samples, bool zero_layers) : samples_(samples) {
   const std::size_t bytes = std::size_t(samples) * sizeof(float);
   // Layers of a huge page or more start on huge-page boundaries (plus their
   // stagger); smaller ones on pages, so small grids waste little.
@@ -83,7 +83,16 @@ LayerBlock::LayerBlock(std::int64_t samples) : samples_(samples) {
   // A hint (THP in madvise mode); refused or unsupported, nothing changes.
   if (align == kHugePageBytes) (void)madvise(block_.get(), block_bytes_, MADV_HUGEPAGE);
 #endif
-  std::memset(block_.get(), 0, block_bytes_);
+  if (zero_layers) {
+    std::memset(block_.get(), 0, block_bytes_);
+  } else {
+    // Only what lies between and after the layers (copies read it).
+    for (int k = 0; k < 3; ++k) {
+      std::byte* end = block_.get() + std::size_t(k) * layer_stride_ + bytes;
+      std::byte* next = k < 2 ? block_.get() + std::size_t(k + 1) * layer_stride_ : block_.get() + block_bytes_;
+      std::memset(end, 0, std::size_t(next - end));
+    }
+  }
 }
 
 LayerBlock::LayerBlock(const LayerBlock& other) : LayerBlock() { *this = other; }
@@ -118,10 +127,14 @@ HeightGrid::HeightGrid(const GridSpec& spec, std::vector<float> initial_heights_
                                "finite and >= 0", h));
     }
   }
-  layers_ = detail::LayerBlock(spec.sample_count());
+  // Filled layer by layer, the caller's heights released as soon as they are
+  // copied: the peak is the heights plus one layer, not plus three.
+  layers_ = detail::LayerBlock(spec.sample_count(), false);
   const std::size_t bytes = initial_heights_m.size() * sizeof(float);
   std::memcpy(initial_(), initial_heights_m.data(), bytes);
-  std::memcpy(height_(), initial_heights_m.data(), bytes);
+  std::vector<float>().swap(initial_heights_m);
+  std::memcpy(height_(), initial_(), bytes);
+  std::memset(removed_(), 0, bytes);
 }
 
 Rect HeightGrid::set_heights(const Rect& rect, const float* values_m) {

@@ -102,8 +102,10 @@ class LayerBlock {
   static constexpr std::size_t kLayerStaggerBytes = 1344;
 
   LayerBlock() = default;
-  /// Three layers of samples floats each, zeroed.
-  explicit LayerBlock(std::int64_t samples);
+  /// Three layers of samples floats each, zeroed; with zero_layers false
+  /// the layers are left for the caller to fill (their pages untouched, so a
+  /// big grid is built without the whole block resident at once).
+  explicit LayerBlock(std::int64_t samples, bool zero_layers = true);
   LayerBlock(const LayerBlock& other);
   LayerBlock& operator=(const LayerBlock& other);
   LayerBlock(LayerBlock&&) noexcept = default;
