@@ -87,7 +87,28 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
   ro.loop.realtime = options.realtime;
   ro.loop.lock_memory = false;  // the viewer's GL driver allocates; locking all memory is not ours
   ro.loop.snapshot = exchange_.get();
-  rig_ = std::make_unique<session::HapticRig>(scenario_, params_, start.orientation, *device_, ro);
+  if (options.mmt) {
+    if (!scenario_.mmt)
+      throw InputError(scenario_.base.source_path.string() +
+                       ": --mmt: the scenario has no mmt: section (docs/teleoperation.md)");
+    // The operator station runs the loop with the viewer's settings; the
+    // remote world is the scenario's mmt.remote.
+    session::Scenario op = scenario_;
+    op.haptics = params_.settings();
+    remote_scenario_ = std::make_unique<session::Scenario>(session::load_remote_scenario(op));
+    const session::MmtSettings& mmt = *scenario_.mmt;
+    link_ = std::make_unique<net::MemoryLink>(mmt.to_remote, mmt.to_operator);
+    session::OperatorOptions oo;
+    oo.snapshot = exchange_.get();
+    oo.keep_records = false;
+    operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, link_->a(), 1u, oo);
+    remote_ = std::make_unique<session::RemoteStation>(
+        *remote_scenario_, mmt, operator_->rig().loop().force_model(),
+        operator_->simulation().grid(), link_->b(), 2u, session::RemoteOptions{false});
+    mmt_live_.emulated_rtt_s.store(mmt.to_remote.delay_s + mmt.to_operator.delay_s);
+  } else {
+    rig_ = std::make_unique<session::HapticRig>(scenario_, params_, start.orientation, *device_, ro);
+  }
 
   // The first frame shows the tool where it starts (the loop is not running
   // yet, so this thread may write).
@@ -96,17 +117,24 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
   f.edge = blade_segment(scenario_.base.blade, start);
   f.device_position_m = start.position_m;
   f.proxy_position_m = start.position_m;
-  haptics::fill_bodies(f, rig_->world().bodies());  // the bodies where they start
+  haptics::fill_bodies(f, (operator_ ? operator_->rig() : *rig_).world().bodies());  // where they start
   HeightGrid grid(spec_, initial_);
   exchange_->publish(grid);
 }
 
 LoopDriver::~LoopDriver() { stop(); }
 
+const haptics::HapticLoop& LoopDriver::loop() const {
+  return operator_ ? operator_->rig().loop() : rig_->loop();
+}
+
 void LoopDriver::start() {
   if (started_) return;
   started_ = true;
-  if (options_.paced) {
+  if (options_.paced && operator_) {
+    lockstep_running_.store(true);
+    lockstep_thread_ = std::thread([this] { paced_mmt_main(); });
+  } else if (options_.paced) {
     rig_->loop().start();
   } else {
     lockstep_running_.store(true);
@@ -116,7 +144,7 @@ void LoopDriver::start() {
 
 void LoopDriver::stop() {
   if (!started_) return;
-  if (options_.paced) {
+  if (options_.paced && !operator_) {
     rig_->loop().request_stop();
     rig_->loop().join();
   } else {
@@ -127,22 +155,77 @@ void LoopDriver::stop() {
 }
 
 void LoopDriver::lockstep_main() {
-  using Clock = std::chrono::steady_clock;
-  const double period = 1.0 / rate_hz();
   std::int64_t i = 0;
   while (lockstep_running_.load(std::memory_order_relaxed)) {
     if (i >= target_ticks_.load()) {
       std::this_thread::sleep_for(std::chrono::microseconds(200));
       continue;
     }
-    // Tick i at t = i / rate exactly, as HapticLoop::run_deterministic does.
-    const Clock::time_point begin = Clock::now();
-    rig_->loop().step1(double(i) * period);
-    const double compute = std::chrono::duration<double>(Clock::now() - begin).count();
-    rig_->loop().step2(i == 0 ? 0.0 : period, compute, false);
+    tick(i);
     ++i;
     ticks_done_.store(i);  // after step2 published the tick's frame
   }
+}
+
+// Tick i at t = i / rate exactly, as HapticLoop::run_deterministic does: the
+// loop, or the operator station and then the remote.
+void LoopDriver::tick(std::int64_t i) {
+  using Clock = std::chrono::steady_clock;
+  const double period = 1.0 / rate_hz();
+  const double t_s = double(i) * period;
+  if (operator_) {
+    operator_->tick(t_s);
+    remote_->tick(t_s);
+    publish_mmt();
+    return;
+  }
+  const Clock::time_point begin = Clock::now();
+  rig_->loop().step1(t_s);
+  const double compute = std::chrono::duration<double>(Clock::now() - begin).count();
+  rig_->loop().step2(i == 0 ? 0.0 : period, compute, false);
+}
+
+// MMT in real time: both stations ticked at the loop rate by absolute
+// deadlines (a late tick is not made up twice: the deadline moves on).
+void LoopDriver::paced_mmt_main() {
+  using Clock = std::chrono::steady_clock;
+  const auto period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / rate_hz()));
+  Clock::time_point deadline = Clock::now();
+  std::int64_t i = 0;
+  while (lockstep_running_.load(std::memory_order_relaxed)) {
+    tick(i);
+    ++i;
+    ticks_done_.store(i);
+    deadline += period;
+    const Clock::time_point now = Clock::now();
+    if (deadline < now - 10 * period) deadline = now;  // far behind: start again from now
+    std::this_thread::sleep_until(deadline);
+  }
+}
+
+void LoopDriver::publish_mmt() {
+  const session::OperatorRecord& r = operator_->last_record();
+  const session::StationCounters& oc = operator_->counters();
+  const session::StationCounters& rc = remote_->counters();
+  MmtLive& m = mmt_live_;
+  const double err = length(r.force_world_n - r.remote_force_world_n);
+  error_ms_n2_ += (err * err - error_ms_n2_) / rate_hz();  // about the last second
+  m.force_error_rms_n.store(std::sqrt(error_ms_n2_), std::memory_order_relaxed);
+  m.remote_force_n.store(length(r.remote_force_world_n), std::memory_order_relaxed);
+  m.rtt_s.store(operator_->rtt_s(), std::memory_order_relaxed);
+  auto loss = [](const net::LinkEmulator& e) {
+    const net::EmulatorCounters& c = e.counters();
+    return c.datagrams > 0 ? double(c.lost) / double(c.datagrams) : 0.0;
+  };
+  m.loss_to_remote.store(loss(link_->a().emulator()), std::memory_order_relaxed);
+  m.loss_to_operator.store(loss(link_->b().emulator()), std::memory_order_relaxed);
+  m.patches.store(oc.patches, std::memory_order_relaxed);
+  m.estimates.store(oc.estimates, std::memory_order_relaxed);
+  m.rejected.store(oc.rejected.total() + rc.rejected.total(), std::memory_order_relaxed);
+  m.scale_applied.store(r.scale_applied, std::memory_order_relaxed);
+  m.scale_target.store(r.scale_target, std::memory_order_relaxed);
+  m.link_silent.store(r.link_silent, std::memory_order_relaxed);
 }
 
 }  // namespace terracut::viewer

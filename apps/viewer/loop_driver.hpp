@@ -16,6 +16,16 @@
 //    drawing thread asks for, then waits; frame k shows exactly the state
 //    after the ticks it asked for, the same on every run.
 //
+// MMT (DriverOptions::mmt, `terracut-viewer --mmt`): the scenario's `mmt:`
+// section runs as teleoperation: the viewer's device drives the operator
+// station (session::OperatorStation) on the local model, the remote station
+// (its own world: soil, terrain and hidden bodies the operator does not
+// know) runs in the same thread over the emulated link (delay, jitter, loss),
+// and the frames show the local model as the remote's patches correct it.
+// Both ways to run tick the two stations in turn on this class's thread
+// (paced: at the loop rate by absolute deadlines). MmtLive carries the
+// link's figures to the panel.
+//
 // A scenario with rigid bodies (`bodies:`) gets the world's Bullet listener
 // (the one `terracut run` and `terracut haptics` use): the bodies are stepped
 // with the terrain, their force on the blade joins the force, and every
@@ -32,7 +42,9 @@
 #include "terracut/haptics/loop.hpp"
 #include "terracut/haptics/snapshot.hpp"
 #include "terracut/io/scenario.hpp"
+#include "terracut/net/transport.hpp"
 #include "terracut/session/haptic.hpp"
+#include "terracut/session/mmt.hpp"
 #include "viewer_device.hpp"
 
 namespace terracut::viewer {
@@ -51,6 +63,29 @@ struct DriverOptions {
   /// The script is the benchmark's plough (plough_tour) instead of the
   /// scenario's cut sequence.
   bool plough = false;
+  /// Teleoperation: run the scenario's `mmt:` section (operator and remote
+  /// stations over the emulated link) instead of the plain haptic loop.
+  bool mmt = false;
+};
+
+/// The teleoperation link as the panel shows it, written by the driver's
+/// thread after every tick, read by the drawing thread.
+struct MmtLive {
+  std::atomic<double> rtt_s{0.0};             ///< newest measured round trip, s
+  std::atomic<double> emulated_rtt_s{0.0};    ///< the emulator's delays, both ways, s
+  std::atomic<double> loss_to_remote{0.0};    ///< datagrams lost / sent, operator -> remote
+  std::atomic<double> loss_to_operator{0.0};  ///< datagrams lost / sent, remote -> operator
+  std::atomic<std::int64_t> patches{0};       ///< patches merged by the operator
+  std::atomic<std::int64_t> estimates{0};     ///< soil estimates applied
+  std::atomic<std::int64_t> rejected{0};      ///< datagrams rejected, both stations
+  /// RMS over the last second of |local model's force - remote's newest
+  /// measured force|, world N (not time-aligned: the live view; the study's
+  /// aligned figure is `terracut mmt`'s).
+  std::atomic<double> force_error_rms_n{0.0};
+  std::atomic<double> remote_force_n{0.0};  ///< |remote's newest measured force|, world N
+  std::atomic<double> scale_applied{1.0};   ///< the soil factor the operator applies
+  std::atomic<double> scale_target{1.0};    ///< the remote's newest estimate
+  std::atomic<bool> link_silent{false};
 };
 
 class LoopDriver {
@@ -93,8 +128,16 @@ class LoopDriver {
 
   haptics::SnapshotExchange& exchange() { return *exchange_; }
   ViewerDevice& device() { return *device_; }
-  /// The loop; its results only after stop().
-  const haptics::HapticLoop& loop() const { return rig_->loop(); }
+  /// The loop (the operator station's in MMT); its results only after stop().
+  const haptics::HapticLoop& loop() const;
+  /// Teleoperation: the stations run (DriverOptions::mmt).
+  bool mmt() const { return operator_ != nullptr; }
+  /// The link's figures (zeros when not mmt()).
+  const MmtLive& mmt_live() const { return mmt_live_; }
+  /// MMT: the stations, for the tests (read them only while stopped, or
+  /// in lock-step after ticks_done() reached the target).
+  const session::OperatorStation* operator_station() const { return operator_.get(); }
+  const session::RemoteStation* remote_station() const { return remote_.get(); }
   /// Rigid bodies of the scenario (simulated by the world's listener).
   int body_count() const { return int(scenario_.bodies.size()); }
 
@@ -105,6 +148,9 @@ class LoopDriver {
 
  private:
   void lockstep_main();
+  void paced_mmt_main();
+  void tick(std::int64_t i);  // tick i (t = i / rate) of the loop or of both stations
+  void publish_mmt();
 
   session::Scenario scenario_;  // the Tour points into its cuts
   haptics::LoopParams params_;
@@ -120,6 +166,13 @@ class LoopDriver {
   std::unique_ptr<haptics::SnapshotExchange> exchange_;
   std::unique_ptr<ViewerDevice> device_;
   std::unique_ptr<session::HapticRig> rig_;  // after the device, which it uses
+  // MMT: the remote world, the link and the two stations (instead of rig_).
+  std::unique_ptr<session::Scenario> remote_scenario_;
+  std::unique_ptr<net::MemoryLink> link_;
+  std::unique_ptr<session::OperatorStation> operator_;
+  std::unique_ptr<session::RemoteStation> remote_;
+  MmtLive mmt_live_;
+  double error_ms_n2_ = 0.0;  // running mean of the squared force error, N^2
 
   std::thread lockstep_thread_;
   std::atomic<bool> lockstep_running_{false};

@@ -93,6 +93,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 86400.0));
   app.add_flag("--paused", opt.pause_last_frame,
                "headless: draw the last frame as paused (for screenshots of the panel)");
+  app.add_flag("--mmt", opt.mmt,
+               "teleoperation: the tool drives the operator station of the scenario's mmt: "
+               "section; the remote station runs in-process over the emulated link");
   bool no_realtime = false;
   app.add_flag("--no-realtime", no_realtime,
                "do not ask for SCHED_FIFO for the haptic loop's thread");

@@ -72,7 +72,8 @@ ViewerApp::~ViewerApp() { close_session(); }
 
 void ViewerApp::open_session(const DriverOptions& driver_options) {
   driver_options_ = driver_options;
-  driver_ = std::make_unique<LoopDriver>(scenario_, haptics_, driver_options, &timing_);
+  driver_options_.mmt = options_.mmt;
+  driver_ = std::make_unique<LoopDriver>(scenario_, haptics_, driver_options_, &timing_);
   const GridSpec& spec = driver_->spec();
   const std::vector<float>& initial = driver_->initial_heights();
   max_initial_height_m_ = 0.0f;

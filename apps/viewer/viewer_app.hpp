@@ -59,6 +59,9 @@ struct ViewerOptions {
   double window_seconds = 0.0;          ///< window mode: close after this many seconds (0: never)
   bool pause_last_frame = false;        ///< headless: draw the last frame paused
   bool realtime = true;                 ///< ask for SCHED_FIFO for the loop thread
+  /// Run the scenario's `mmt:` section: the tool drives the operator
+  /// station, the remote runs in-process over the emulated link.
+  bool mmt = false;
 };
 
 /// Loads the scenario (and its `haptics:` section) or the heightmap named by
@@ -147,6 +150,7 @@ class ViewerApp {
   void draw_script_progress();
   void draw_tool_section();
   void draw_contact_section();
+  void draw_mmt_section();
   void draw_plots();
   void draw_timing_section();
   void draw_display_section();

@@ -104,6 +104,7 @@ void ViewerApp::draw_panel(int fb_width, int fb_height) {
   draw_run_section();
   draw_tool_section();
   draw_contact_section();
+  draw_mmt_section();
   draw_timing_section();
   draw_display_section();
   draw_model_section();
@@ -134,6 +135,26 @@ void ViewerApp::draw_panel_header() {
   ImGui::TextDisabled("mesh %d x %d%s, %lld triangles", terrain_->mesh_cols(), terrain_->mesh_rows(),
                       terrain_->blocky_mesh() ? " (boxes)" : "",
                       static_cast<long long>(terrain_->triangle_count()));
+}
+
+void ViewerApp::draw_mmt_section() {
+  // --- teleoperation: the link and what came back over it ---
+  if (!driver_->mmt()) return;
+  const MmtLive& m = driver_->mmt_live();
+  section("Teleoperation (MMT)");
+  ImGui::Text("RTT %.0f ms measured (%.0f ms emulated)", m.rtt_s.load() * 1e3,
+              m.emulated_rtt_s.load() * 1e3);
+  ImGui::Text("loss %.1f %% to remote, %.1f %% back", m.loss_to_remote.load() * 100.0,
+              m.loss_to_operator.load() * 100.0);
+  ImGui::Text("updates: %lld patches, %lld estimates", static_cast<long long>(m.patches.load()),
+              static_cast<long long>(m.estimates.load()));
+  ImGui::Text("soil factor %.3f (remote says %.3f)", m.scale_applied.load(), m.scale_target.load());
+  ImGui::Text("force error %.1f N RMS (remote %.1f N)", m.force_error_rms_n.load(),
+              m.remote_force_n.load());
+  if (m.rejected.load() > 0)
+    ImGui::TextDisabled("%lld datagrams rejected", static_cast<long long>(m.rejected.load()));
+  if (m.link_silent.load())
+    ImGui::TextColored(ImVec4(1.0f, 0.45f, 0.35f, 1.0f), "link silent: force fading out");
 }
 
 void ViewerApp::draw_run_section() {

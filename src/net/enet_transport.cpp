@@ -4,7 +4,6 @@
 #include <enet/enet.h>
 
 #include <algorithm>
-#include <deque>
 #include <mutex>
 
 #include "terracut/core/error.hpp"
@@ -51,20 +50,13 @@ struct EnetEndpoint::State {
     if (host) enet_host_destroy(host);
     enet_release();
   }
-  struct Held {
-    double release_s;
-    std::int64_t order;
-    Channel channel;
-    std::vector<std::uint8_t> bytes;
-  };
   LinkEmulator emulator;
   ENetHost* host = nullptr;
   ENetPeer* peer = nullptr;  // the connected peer, or null
   bool connected = false;
   std::int64_t connections = 0;
   std::int64_t dropped_unconnected = 0;
-  std::int64_t next_order = 0;
-  std::deque<Held> held;  // sorted by (release_s, order)
+  HeldQueue held;  // tag: the Channel
 };
 
 EnetEndpoint::EnetEndpoint(std::unique_ptr<State> state) : s_(std::move(state)) {}
@@ -118,35 +110,32 @@ void EnetEndpoint::send(Channel channel, const std::uint8_t* data, std::size_t s
   traffic_.sent_bytes += std::int64_t(size);
   const auto release_at = s_->emulator.schedule(now_s, channel == Channel::kReliable);
   if (!release_at) return;
-  State::Held h{*release_at, s_->next_order++, channel, std::vector<std::uint8_t>(data, data + size)};
-  const auto at = std::upper_bound(
-      s_->held.begin(), s_->held.end(), h, [](const State::Held& x, const State::Held& y) {
-        return x.release_s < y.release_s || (x.release_s == y.release_s && x.order < y.order);
-      });
-  s_->held.insert(at, std::move(h));
+  s_->held.hold(*release_at, static_cast<std::uint8_t>(channel), data, size);
   release(now_s);
 }
 
 void EnetEndpoint::release(double now_s) {
-  while (!s_->held.empty() && s_->held.front().release_s <= now_s) {
-    State::Held& h = s_->held.front();
+  HeldQueue& held = s_->held;
+  while (!held.empty() && held.front_s() <= now_s) {
+    const auto channel = static_cast<Channel>(held.front_tag());
     if (!s_->connected) {
       // Nobody to send to: an unreliable datagram is gone; a reliable one waits.
-      if (h.channel == Channel::kReliable) break;
+      if (channel == Channel::kReliable) break;
       ++s_->dropped_unconnected;
-      s_->held.pop_front();
+      held.pop();
       continue;
     }
-    const enet_uint32 flags = h.channel == Channel::kReliable ? ENET_PACKET_FLAG_RELIABLE : 0;
-    ENetPacket* packet = enet_packet_create(h.bytes.data(), h.bytes.size(), flags);
-    if (packet && enet_peer_send(s_->peer, static_cast<enet_uint8>(h.channel), packet) != 0)
+    const enet_uint32 flags = channel == Channel::kReliable ? ENET_PACKET_FLAG_RELIABLE : 0;
+    const std::vector<std::uint8_t>& bytes = held.front_bytes();
+    ENetPacket* packet = enet_packet_create(bytes.data(), bytes.size(), flags);
+    if (packet && enet_peer_send(s_->peer, static_cast<enet_uint8>(channel), packet) != 0)
       enet_packet_destroy(packet);
-    s_->held.pop_front();
+    held.pop();
   }
   enet_host_flush(s_->host);
 }
 
-void EnetEndpoint::receive(double now_s, std::vector<std::vector<std::uint8_t>>& out) {
+void EnetEndpoint::receive(double now_s, Inbox& out) {
   ENetEvent event;
   while (enet_host_service(s_->host, &event, 0) > 0) {
     switch (event.type) {
@@ -165,7 +154,7 @@ void EnetEndpoint::receive(double now_s, std::vector<std::vector<std::uint8_t>>&
         if (event.peer == s_->peer) {
           ++traffic_.received;
           traffic_.received_bytes += std::int64_t(event.packet->dataLength);
-          out.emplace_back(event.packet->data, event.packet->data + event.packet->dataLength);
+          out.push(event.packet->data, event.packet->dataLength);
         }
         enet_packet_destroy(event.packet);
         break;
@@ -177,6 +166,9 @@ void EnetEndpoint::receive(double now_s, std::vector<std::vector<std::uint8_t>>&
 }
 
 const LinkEmulator& EnetEndpoint::emulator() const { return s_->emulator; }
+void EnetEndpoint::reserve_in_flight(std::size_t datagrams, std::size_t bytes) {
+  s_->held.reserve(datagrams, bytes);
+}
 int EnetEndpoint::port() const { return s_->host ? int(s_->host->address.port) : -1; }
 bool EnetEndpoint::connected() const { return s_->connected; }
 std::int64_t EnetEndpoint::connections() const { return s_->connections; }

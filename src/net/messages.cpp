@@ -3,6 +3,7 @@
 
 #include <zstd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <new>
 
@@ -122,18 +123,49 @@ std::size_t encode_estimate(Header header, const Estimate& e, std::uint8_t* out)
   return finish(header, MessageType::kEstimate, kEstimatePayloadSize, out);
 }
 
-std::size_t encode_patch(Header header, const Patch& patch, std::vector<std::uint8_t>& out) {
+struct PatchCodec::Contexts {
+  Contexts() : c(ZSTD_createCCtx()), d(ZSTD_createDCtx()) {
+    if (!c || !d) {
+      ZSTD_freeCCtx(c);
+      ZSTD_freeDCtx(d);
+      throw std::bad_alloc();
+    }
+  }
+  ~Contexts() {
+    ZSTD_freeCCtx(c);
+    ZSTD_freeDCtx(d);
+  }
+  ZSTD_CCtx* c;
+  ZSTD_DCtx* d;
+};
+
+PatchCodec::PatchCodec() : z_(std::make_unique<Contexts>()) {}
+PatchCodec::~PatchCodec() = default;
+
+std::size_t patch_datagram_bound(std::size_t samples) {
+  return kHeaderSize + kPatchFixedSize + ZSTD_compressBound(samples * 4) + kCrcSize;
+}
+
+void PatchCodec::reserve(std::size_t samples) {
+  samples = std::min<std::size_t>(std::max<std::size_t>(samples, 1), kMaxPatchSamples);
+  raw_.assign(samples * 4, 0);
+  // One compression of that size sizes zstd's working memory.
+  std::vector<std::uint8_t> out(ZSTD_compressBound(raw_.size()));
+  (void)ZSTD_compressCCtx(z_->c, out.data(), out.size(), raw_.data(), raw_.size(), 1);
+}
+
+std::size_t PatchCodec::encode(Header header, const Patch& patch, std::vector<std::uint8_t>& out) {
   out.clear();
   const std::int64_t n = patch.rect.area();
   if (n <= 0 || n > kMaxPatchSamples || patch.heights.size() != std::size_t(n)) return 0;
   // The heights as little-endian float32, then compressed.
-  std::vector<std::uint8_t> raw(std::size_t(n) * 4);
-  for (std::int64_t i = 0; i < n; ++i) put_f32(raw.data() + 4 * i, patch.heights[std::size_t(i)]);
-  const std::size_t bound = ZSTD_compressBound(raw.size());
-  out.resize(kHeaderSize + kPatchFixedSize + bound + kCrcSize);
+  raw_.resize(std::size_t(n) * 4);
+  for (std::int64_t i = 0; i < n; ++i) put_f32(raw_.data() + 4 * i, patch.heights[std::size_t(i)]);
+  const std::size_t bound = ZSTD_compressBound(raw_.size());
+  out.resize(patch_datagram_bound(std::size_t(n)));
   std::uint8_t* p = out.data() + kHeaderSize;
   const std::size_t packed =
-      ZSTD_compress(p + kPatchFixedSize, bound, raw.data(), raw.size(), 1);
+      ZSTD_compressCCtx(z_->c, p + kPatchFixedSize, bound, raw_.data(), raw_.size(), 1);
   if (ZSTD_isError(packed)) {
     out.clear();
     return 0;
@@ -143,11 +175,16 @@ std::size_t encode_patch(Header header, const Patch& patch, std::vector<std::uin
   put_u32(p + 12, static_cast<std::uint32_t>(patch.rect.r0));
   put_u32(p + 16, static_cast<std::uint32_t>(patch.rect.c1 - patch.rect.c0));
   put_u32(p + 20, static_cast<std::uint32_t>(patch.rect.r1 - patch.rect.r0));
-  put_u32(p + 24, static_cast<std::uint32_t>(raw.size()));
+  put_u32(p + 24, static_cast<std::uint32_t>(raw_.size()));
   put_u32(p + 28, static_cast<std::uint32_t>(packed));
   const std::size_t size = finish(header, MessageType::kPatch, kPatchFixedSize + packed, out.data());
   out.resize(size);
   return size;
+}
+
+std::size_t encode_patch(Header header, const Patch& patch, std::vector<std::uint8_t>& out) {
+  PatchCodec codec;
+  return codec.encode(header, patch, out);
 }
 
 Reject decode_header(const std::uint8_t* data, std::size_t size, std::uint32_t link,
@@ -208,7 +245,12 @@ Reject decode_estimate(const std::uint8_t* data, std::size_t, Estimate& out) noe
   return Reject::kNone;
 }
 
-Reject decode_patch(const std::uint8_t* data, std::size_t, Patch& out) {
+Reject decode_patch(const std::uint8_t* data, std::size_t size, Patch& out) {
+  PatchCodec codec;
+  return codec.decode(data, size, out);
+}
+
+Reject PatchCodec::decode(const std::uint8_t* data, std::size_t, Patch& out) {
   const std::size_t payload = payload_size(data);
   if (payload < kPatchFixedSize) return Reject::kBadLength;
   const std::uint8_t* p = payload_of(data);
@@ -228,13 +270,13 @@ Reject decode_patch(const std::uint8_t* data, std::size_t, Patch& out) {
   const unsigned long long content = ZSTD_getFrameContentSize(p + kPatchFixedSize, packed);
   if (content != raw_size) return Reject::kBadPayload;
   try {
-    std::vector<std::uint8_t> raw(raw_size);
+    raw_.resize(raw_size);
     const std::size_t got =
-        ZSTD_decompress(raw.data(), raw.size(), p + kPatchFixedSize, packed);
+        ZSTD_decompressDCtx(z_->d, raw_.data(), raw_.size(), p + kPatchFixedSize, packed);
     if (ZSTD_isError(got) || got != raw_size) return Reject::kBadPayload;
     out.heights.resize(std::size_t(n));
     for (std::int64_t i = 0; i < n; ++i) {
-      const float h = get_f32(raw.data() + 4 * i);
+      const float h = get_f32(raw_.data() + 4 * i);
       if (!std::isfinite(h)) return Reject::kBadPayload;
       out.heights[std::size_t(i)] = h;
     }

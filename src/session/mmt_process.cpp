@@ -122,7 +122,7 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
   auto link = net::EnetEndpoint::connect(address, port, s.to_remote);
   // Wait for the connection before the loop starts.
   const auto start = Clock::now();
-  std::vector<std::vector<std::uint8_t>> none;
+  net::Inbox none;
   while (!link->connected()) {
     if (std::chrono::duration<double>(Clock::now() - start).count() > o.connect_timeout_s)
       throw InputError("--connect: no remote station answered at " + address + ":" +

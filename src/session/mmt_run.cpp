@@ -137,6 +137,10 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
   if (!(duration > 0.0) || duration > 3600.0)
     throw InputError(must_be("--duration", "in (0, 3600]", duration));
   total_ticks_ = std::max<std::int64_t>(1, std::llround(duration * rate_hz_));
+  // Every record of the run has its room now: a tick allocates nothing.
+  operator_->reserve_records(std::size_t(total_ticks_));
+  remote_->reserve_records(std::size_t(total_ticks_));
+  terrain_error_.reserve(std::size_t(total_ticks_ / std::max<std::int64_t>(1, std::llround(0.05 * rate_hz_)) + 1));
 }
 
 MmtRun::~MmtRun() = default;

@@ -54,6 +54,25 @@ void include_rect(Rect& into, const Rect& r) {
     into.include(r);
 }
 
+// The working size of a patch, samples: the sensed square and, in a sensing
+// period, as much again of changed samples.
+std::size_t patch_samples(const MmtSettings& s, const GridSpec& g) {
+  const double side = 2.0 * s.sense_radius_m;
+  const std::size_t window =
+      std::size_t(side / g.cell_x_m() + 2.0) * std::size_t(side / g.cell_z_m() + 2.0);
+  return std::min<std::size_t>(
+      {2 * window, std::size_t(g.sample_count()), std::size_t(net::kMaxPatchSamples)});
+}
+
+// How long a datagram sent one way can be held in flight, s: the delay, the
+// jitter, a hold-back and, for a reliable one, three retransmissions.
+double in_flight_s(const net::LinkConditions& c) {
+  const double retransmit_s = c.retransmit_s.value_or(2.0 * c.delay_s + 0.02);
+  return c.delay_s + c.jitter_s + c.reorder_delay_s + 3.0 * retransmit_s;
+}
+
+constexpr std::size_t kInboxSlots = 32;  // datagrams arriving in one tick, made room for
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -187,8 +206,9 @@ class ScaleCorrection final : public StepListener {
 
 RemoteStation::RemoteStation(const Scenario& remote, const MmtSettings& settings,
                              const ForceModel& nominal, const HeightGrid& operator_initial,
-                             net::Endpoint& link, std::uint32_t session)
-    : settings_(settings), nominal_(nominal), link_(link), session_(session) {
+                             net::Endpoint& link, std::uint32_t session,
+                             const RemoteOptions& options)
+    : settings_(settings), nominal_(nominal), link_(link), session_(session), options_(options) {
   const haptics::LoopParams params = loop_params(remote);
   device_ = std::make_unique<FollowerDevice>(params.settings().workspace,
                                              settings_.follower_speed_m_per_s,
@@ -202,6 +222,19 @@ RemoteStation::RemoteStation(const Scenario& remote, const MmtSettings& settings
     throw InputError("mmt.remote.scenario: the remote grid must have the operator's samples");
   mirror_.assign(operator_initial.initial(),
                  operator_initial.initial() + grid.spec().sample_count());
+  // The buffers of the working traffic, made now: patches of their working
+  // size, a measurement every tick and an update every sensing period in
+  // flight, the commands of a tick arriving.
+  const std::size_t samples = patch_samples(settings_, grid.spec());
+  patch_.heights.reserve(samples);
+  buffer_.reserve(net::patch_datagram_bound(samples));
+  codec_.reserve(samples);
+  const double flight_s = in_flight_s(settings_.to_operator);
+  link_.reserve_in_flight(std::size_t(flight_s * params.rate_hz()) + 16,
+                          net::kHeaderSize + net::kMeasurementPayloadSize + net::kCrcSize);
+  link_.reserve_in_flight(2 * std::size_t(flight_s / settings_.sense_period_s) + 8,
+                          net::patch_datagram_bound(samples));
+  inbox_ = net::Inbox(kInboxSlots, net::kHeaderSize + net::kCommandPayloadSize + net::kCrcSize);
 }
 
 RemoteStation::~RemoteStation() = default;
@@ -321,7 +354,7 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
         mirror_[std::size_t(i)] = grid.heights()[i];
       }
     net::Header h{net::MessageType::kPatch, settings_.link_id, session_, seq_patch_++, to_ns(t_s)};
-    if (net::encode_patch(h, patch_, buffer_) > 0) {
+    if (codec_.encode(h, patch_, buffer_) > 0) {
       link_.send(net::Channel::kReliable, buffer_.data(), buffer_.size(), t_s);
       ++counters_.patches;
     }
@@ -363,9 +396,10 @@ void RemoteStation::tick(double t_s) {
   const auto start = std::chrono::steady_clock::now();
   loop.step1(t_s);
   const haptics::LoopRecord& r =
-      loop.step2(records_.empty() ? 0.0 : t_s - previous_t_s_, seconds_since(start), false);
+      loop.step2(ticked_ ? t_s - previous_t_s_ : 0.0, seconds_since(start), false);
   const double compute_s = seconds_since(start);
   previous_t_s_ = t_s;
+  ticked_ = true;
   if (sim.step_count() > steps_before) {
     include_rect(dirty_, sim.last().changed);
     include_rect(worked_, sim.last().changed);
@@ -403,7 +437,7 @@ void RemoteStation::tick(double t_s) {
   rec.holding = holding;
   rec.active = has_command_;
   rec.compute_s = compute_s;
-  records_.push_back(rec);
+  if (options_.keep_records) records_.push_back(rec);
 }
 
 // ---------------------------------------------------------------------------
@@ -412,13 +446,16 @@ void RemoteStation::tick(double t_s) {
 
 OperatorStation::OperatorStation(const Scenario& op, const MmtSettings& settings,
                                  haptics::Device& device, net::Endpoint& link,
-                                 std::uint32_t session)
-    : settings_(settings), link_(link), session_(session) {
+                                 std::uint32_t session, const OperatorOptions& options)
+    : settings_(settings), link_(link), session_(session), options_(options) {
   const haptics::LoopParams params = loop_params(op);
   guard_ = std::make_unique<LinkGuardDevice>(device);
   RigOptions ro;
   ro.loop.record_capacity = 0;
   ro.loop.realtime = false;
+  ro.loop.snapshot = options_.snapshot;
+  // Round trips of up to 8 s at 1 kHz are measured.
+  command_sent_s_.assign(std::size_t(8.0 * params.rate_hz()) + 1, 0.0);
   rig_ = std::make_unique<HapticRig>(op, params, first_orientation(op), *guard_, ro);
   correction_ = std::make_unique<ScaleCorrection>(rig_->loop(), settings_.max_update_step_n);
   rig_->world().simulation().add_listener(*correction_);
@@ -432,6 +469,24 @@ OperatorStation::OperatorStation(const Scenario& op, const MmtSettings& settings
   const std::size_t window = std::size_t(std::llround(params.rate_hz()));  // 1 s
   power_.assign(window, 0.0);
   power_dfr_.assign(window, 0.0);
+  // The buffers of the working traffic, made now: a command every tick in
+  // flight, the datagrams of a tick arriving (any may be a patch), and the
+  // blends of the patches merging at once (a blend waits while protected
+  // or under the tool: a round trip, a blend and a second of cutting).
+  const std::size_t samples = patch_samples(settings_, g);
+  link_.reserve_in_flight(std::size_t(in_flight_s(settings_.to_remote) * params.rate_hz()) + 16,
+                          net::kHeaderSize + net::kCommandPayloadSize + net::kCrcSize);
+  inbox_ = net::Inbox(kInboxSlots, net::patch_datagram_bound(samples));
+  patch_.heights.reserve(samples);
+  codec_.reserve(samples);
+  blends_.resize(std::min<std::size_t>(
+      std::size_t((protect_s_ + settings_.blend_s + 1.0) / settings_.sense_period_s) + 8, 256));
+  for (Blend& b : blends_) {
+    b.t0_s.reserve(samples);
+    b.from.reserve(samples);
+    b.to.reserve(samples);
+    b.scratch.reserve(samples);
+  }
 }
 
 OperatorStation::~OperatorStation() {
@@ -458,7 +513,7 @@ void OperatorStation::receive(double t_s) {
           filter = &measurements_;
           break;
         case net::MessageType::kPatch:
-          r = net::decode_patch(d.data(), d.size(), patch_);
+          r = codec_.decode(d.data(), d.size(), patch_);
           if (r == net::Reject::kNone && (patch_.rect.c1 > g.cols || patch_.rect.r1 > g.rows))
             r = net::Reject::kBadPayload;  // outside the grid
           filter = &patches_;
@@ -482,15 +537,27 @@ void OperatorStation::receive(double t_s) {
     last_heard_s_ = t_s;
     counters_.sessions = std::max(counters_.sessions, measurements_.sessions());
     switch (h.type) {
-      case net::MessageType::kMeasurement:
+      case net::MessageType::kMeasurement: {
         remote_force_ = m.force_world_n;
+        // The round trip of the first measurement that follows a newer command.
+        const std::uint32_t age = seq_command_ - m.command_sequence;
+        if (age > 0 && age < command_sent_s_.size() &&
+            (!rtt_known_ || std::int32_t(m.command_sequence - rtt_sequence_) > 0)) {
+          rtt_s_ = t_s - command_sent_s_[m.command_sequence % command_sent_s_.size()];
+          rtt_sequence_ = m.command_sequence;
+          rtt_known_ = true;
+        }
         break;
+      }
       case net::MessageType::kPatch: {
         ++counters_.patches;
-        // A new blend from the heights as they are now to the remote's.
-        Blend b;
+        // A new blend from the heights as they are now to the remote's, in
+        // a pooled blend (its buffers reused) after those merging.
+        if (active_blends_ == blends_.size()) blends_.emplace_back();
+        Blend& b = blends_[active_blends_++];
         b.rect = patch_.rect;
-        b.to = patch_.heights;
+        b.done = false;
+        b.to.assign(patch_.heights.begin(), patch_.heights.end());
         b.from.resize(b.to.size());
         const HeightGrid& grid = simulation().grid();
         std::size_t k = 0;
@@ -499,7 +566,6 @@ void OperatorStation::receive(double t_s) {
             b.from[k++] = grid.heights()[grid.index(col, row)];
         b.scratch.resize(b.to.size());
         b.t0_s.assign(b.to.size(), float(t_s));
-        blends_.push_back(std::move(b));
         break;
       }
       case net::MessageType::kEstimate:
@@ -528,7 +594,8 @@ void OperatorStation::merge(double t_s) {
   const double ex = settings_.exclusion_m;
   const double x0 = std::min(edge.a.x, edge.b.x) - ex, x1 = std::max(edge.a.x, edge.b.x) + ex;
   const double z0 = std::min(edge.a.z, edge.b.z) - ex, z1 = std::max(edge.a.z, edge.b.z) + ex;
-  for (Blend& b : blends_) {
+  for (std::size_t bi = 0; bi < active_blends_; ++bi) {
+    Blend& b = blends_[bi];
     b.done = true;
     std::size_t k = 0;
     for (int row = b.rect.r0; row < b.rect.r1; ++row)
@@ -567,17 +634,26 @@ void OperatorStation::merge(double t_s) {
     const std::size_t n = std::size_t(b.rect.area());
     for (std::size_t j = 0; j < n; ++j)
       if (!(b.scratch[j] >= 0.0f) || !std::isfinite(b.scratch[j])) b.scratch[j] = 0.0f;
-    rig_->world().simulation().edit_heights(b.rect, std::span<const float>(b.scratch.data(), n));
+    const Rect changed =
+        rig_->world().simulation().edit_heights(b.rect, std::span<const float>(b.scratch.data(), n));
+    if (options_.snapshot) options_.snapshot->note_changed(changed);
     include_rect(worked_, b.rect);
   }
-  blends_.erase(std::remove_if(blends_.begin(), blends_.end(), [](const Blend& b) { return b.done; }),
-                blends_.end());
+  // The finished blends go back to the pool; the others keep their order
+  // (a later patch lands over an earlier one).
+  std::size_t kept = 0;
+  for (std::size_t bi = 0; bi < active_blends_; ++bi)
+    if (!blends_[bi].done) {
+      if (bi != kept) std::swap(blends_[kept], blends_[bi]);
+      ++kept;
+    }
+  active_blends_ = kept;
 }
 
 void OperatorStation::tick(double t_s) {
   const auto start = std::chrono::steady_clock::now();
   receive(t_s);
-  const bool updating_terrain = !blends_.empty();
+  const bool updating_terrain = active_blends_ > 0;
   merge(t_s);
   const bool silent = heard_ && t_s - last_heard_s_ > settings_.timeout_s;
   guard_->set_silent(silent);
@@ -587,7 +663,7 @@ void OperatorStation::tick(double t_s) {
   Simulation& sim = rig_->world().simulation();
   const std::int64_t steps_before = sim.step_count();
   loop.step1(t_s);
-  const double period = records_.empty() ? 0.0 : t_s - previous_t_s_;
+  const double period = ticks_ == 0 ? 0.0 : t_s - previous_t_s_;
   const haptics::LoopRecord& r = loop.step2(period, seconds_since(start), false);
   if (sim.step_count() > steps_before) {
     const Rect c = sim.last().changed;
@@ -603,6 +679,7 @@ void OperatorStation::tick(double t_s) {
   cmd.pose = r.tool;
   cmd.flags = (r.flags & haptics::kFlagReconnected) ? net::kCommandLifted : 0u;
   std::uint8_t out[net::kHeaderSize + net::kCommandPayloadSize + net::kCrcSize];
+  command_sent_s_[seq_command_ % command_sent_s_.size()] = t_s;
   net::Header h{net::MessageType::kCommand, settings_.link_id, session_, seq_command_++,
                 to_ns(t_s)};
   const std::size_t n = net::encode_command(h, cmd, out);
@@ -655,7 +732,8 @@ void OperatorStation::tick(double t_s) {
   rec.passivity_j = window_j_;
   rec.passivity_dfr_j = window_dfr_j_;
   rec.compute_s = seconds_since(start);
-  records_.push_back(rec);
+  last_ = rec;
+  if (options_.keep_records) records_.push_back(rec);
 }
 
 }  // namespace terracut::session

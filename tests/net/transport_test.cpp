@@ -23,6 +23,51 @@ std::vector<std::uint8_t> bytes(std::uint8_t tag, std::size_t n = 16) {
   return std::vector<std::uint8_t>(n, tag);
 }
 
+TEST(HeldQueue, HandsOutInTimeOrderTiesInHoldingOrderAlsoAfterPopping) {
+  HeldQueue q(2, 8);
+  const auto a = bytes(1, 4), b = bytes(2, 100), c = bytes(3, 4), d = bytes(4, 4);
+  q.hold(0.3, 10, a.data(), a.size());
+  q.hold(0.1, 11, b.data(), b.size());
+  q.hold(0.3, 12, c.data(), c.size());  // a tie with a: after it
+  q.hold(0.2, 13, d.data(), d.size());
+  ASSERT_EQ(q.size(), 4u);
+  const double times[] = {0.1, 0.2, 0.3, 0.3};
+  const std::uint8_t tags[] = {11, 13, 10, 12};
+  const std::vector<std::uint8_t>* contents[] = {&b, &d, &a, &c};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(q.front_s(), times[i]);
+    EXPECT_EQ(q.front_tag(), tags[i]);
+    EXPECT_EQ(q.front_bytes(), *contents[i]);
+    q.pop();
+  }
+  EXPECT_TRUE(q.empty());
+  // Again, in the popped slots: the order holds and the contents are whole.
+  q.hold(0.5, 20, b.data(), b.size());
+  q.hold(0.4, 21, a.data(), a.size());
+  EXPECT_EQ(q.front_tag(), 21);
+  q.pop();
+  EXPECT_EQ(q.front_bytes(), b);
+}
+
+TEST(Inbox, KeepsItsBuffersAcrossClear) {
+  Inbox in(1, 4);
+  const auto a = bytes(1, 3), b = bytes(2, 40);
+  in.push(a.data(), a.size());
+  in.push(b.data(), b.size());
+  ASSERT_EQ(in.size(), 2u);
+  EXPECT_EQ(in[0], a);
+  EXPECT_EQ(in[1], b);
+  const std::uint8_t* kept = in[1].data();
+  in.clear();
+  EXPECT_TRUE(in.empty());
+  in.push(a.data(), a.size());
+  in.push(b.data(), b.size());
+  EXPECT_EQ(in[1].data(), kept);  // the same buffer, not a new one
+  std::size_t n = 0;
+  for (const auto& d : in) n += d.size();
+  EXPECT_EQ(n, a.size() + b.size());
+}
+
 TEST(MemoryLink, DeliversAtTheArrivalTime) {
   LinkConditions ab;
   ab.delay_s = 0.05;

@@ -6,7 +6,9 @@
 // arrival time (on the wall clock the caller passes as now_s) and then handed
 // to ENet, so the conditions add to what the real network does. The remote
 // side serves one operator at a time: a new connection (a restarted
-// operator) replaces the old one.
+// operator) replaces the old one. Held datagrams live in a pooled queue;
+// ENet itself allocates each packet it sends and receives (enet_packet_create,
+// through its malloc), which this side cannot avoid.
 #pragma once
 
 #include <memory>
@@ -31,8 +33,10 @@ class EnetEndpoint final : public Endpoint {
   void send(Channel channel, const std::uint8_t* data, std::size_t size, double now_s) override;
   /// Services ENet (without waiting), hands over what arrived and sends what
   /// the emulator has released by now_s.
-  void receive(double now_s, std::vector<std::vector<std::uint8_t>>& out) override;
+  void receive(double now_s, Inbox& out) override;
+  using Endpoint::receive;
   const LinkEmulator& emulator() const override;
+  void reserve_in_flight(std::size_t datagrams, std::size_t bytes) override;
 
   /// The bound UDP port.
   int port() const;

@@ -18,14 +18,16 @@
 //   40     N    ...   payload (per type, below)
 //   40+N   4    u32   crc32 (IEEE 802.3 / zlib) of bytes [0, 40+N)
 //
-// The codec works on caller buffers and allocates nothing except a patch's
-// heights (a std::vector the caller owns and reuses); it never throws,
-// whatever the bytes.
+// The codec works on caller buffers; the patch codec (PatchCodec) keeps its
+// zstd contexts and scratch, so that once reserved it allocates nothing (the
+// free encode_patch / decode_patch make fresh ones per call); it never
+// throws, whatever the bytes.
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string_view>
 #include <vector>
 
@@ -159,7 +161,8 @@ struct RejectCounts {
 std::size_t encode_command(Header header, const Command& command, std::uint8_t* out) noexcept;
 std::size_t encode_measurement(Header header, const Measurement& m, std::uint8_t* out) noexcept;
 std::size_t encode_estimate(Header header, const Estimate& e, std::uint8_t* out) noexcept;
-/// patch.heights must hold rect.area() values. zstd level 1. Returns 0 (and
+/// patch.heights must hold rect.area() values. zstd level 1 (PatchCodec
+/// below: the same without allocating per call). Returns 0 (and
 /// leaves out empty) when the rectangle is empty or too large.
 std::size_t encode_patch(Header header, const Patch& patch, std::vector<std::uint8_t>& out);
 
@@ -179,5 +182,31 @@ Reject decode_estimate(const std::uint8_t* data, std::size_t size, Estimate& out
 /// decompress to exactly raw_size bytes, or a non-finite height. out.heights
 /// is resized (reused across calls).
 Reject decode_patch(const std::uint8_t* data, std::size_t size, Patch& out);
+
+/// Size of the largest patch datagram of `samples` heights, bytes (what an
+/// encoder's buffer needs).
+std::size_t patch_datagram_bound(std::size_t samples);
+
+/// encode_patch and decode_patch with their zstd contexts and scratch kept
+/// between calls (the free functions make fresh ones each call): a station
+/// that reserved its working patch size encodes and decodes without
+/// allocating. Same rules and results as the free functions.
+class PatchCodec {
+ public:
+  PatchCodec();
+  ~PatchCodec();
+  PatchCodec(const PatchCodec&) = delete;
+  PatchCodec& operator=(const PatchCodec&) = delete;
+  /// Makes room now for patches of up to `samples` heights (the scratch and
+  /// zstd's working memory for that size), samples <= kMaxPatchSamples.
+  void reserve(std::size_t samples);
+  std::size_t encode(Header header, const Patch& patch, std::vector<std::uint8_t>& out);
+  Reject decode(const std::uint8_t* data, std::size_t size, Patch& out);
+
+ private:
+  struct Contexts;
+  std::unique_ptr<Contexts> z_;
+  std::vector<std::uint8_t> raw_;
+};
 
 }  // namespace terracut::net

@@ -95,6 +95,13 @@ class FollowerDevice;
 class LinkGuardDevice;
 class ScaleCorrection;
 
+/// What a remote station does beyond its settings.
+struct RemoteOptions {
+  /// One record per tick (records()); false: none kept, for a session
+  /// without a set end (the viewer's).
+  bool keep_records = true;
+};
+
 class RemoteStation {
  public:
   /// remote: the remote world (load_remote_scenario); nominal: the
@@ -103,10 +110,14 @@ class RemoteStation {
   /// Throws InputError naming the field.
   RemoteStation(const Scenario& remote, const MmtSettings& settings,
                 const ForceModel& nominal, const HeightGrid& operator_initial,
-                net::Endpoint& link, std::uint32_t session);
+                net::Endpoint& link, std::uint32_t session, const RemoteOptions& options = {});
   ~RemoteStation();
-  /// One tick at station time t_s.
+  /// One tick at station time t_s. Allocates nothing in steady state once
+  /// the records have room (reserve_records) and the link's buffers have
+  /// met their working sizes.
   void tick(double t_s);
+  /// Room for `ticks` records, made now.
+  void reserve_records(std::size_t ticks) { records_.reserve(ticks); }
 
   const std::vector<RemoteRecord>& records() const { return records_; }
   const StationCounters& counters() const { return counters_; }
@@ -145,11 +156,25 @@ class RemoteStation {
   std::int64_t rls_samples_ = 0;
   bool estimate_sent_ = false;
   double previous_t_s_ = 0.0;
+  bool ticked_ = false;
   std::vector<RemoteRecord> records_;
+  RemoteOptions options_;
   StationCounters counters_{};
-  std::vector<std::vector<std::uint8_t>> inbox_;
+  net::Inbox inbox_;
   std::vector<std::uint8_t> buffer_;
   net::Patch patch_;
+  net::PatchCodec codec_;
+};
+
+/// What an operator station does beyond its settings.
+struct OperatorOptions {
+  /// The viewer's frame exchange: the loop publishes every tick's frame
+  /// there, and each merged patch notes its rectangle, so that a drawing
+  /// thread sees the remote's updates; nullptr: none.
+  haptics::SnapshotExchange* snapshot = nullptr;
+  /// One record per tick (records()); false: only the newest (last_record()),
+  /// for a session without a set end (the viewer's).
+  bool keep_records = true;
 };
 
 class OperatorStation {
@@ -157,11 +182,21 @@ class OperatorStation {
   /// The operator's haptic loop over op's world with device (which must
   /// outlive the station). Throws InputError naming the field.
   OperatorStation(const Scenario& op, const MmtSettings& settings, haptics::Device& device,
-                  net::Endpoint& link, std::uint32_t session);
+                  net::Endpoint& link, std::uint32_t session, const OperatorOptions& options = {});
   ~OperatorStation();
+  /// One tick at station time t_s. Allocates nothing in steady state once
+  /// the records have room (reserve_records) and the link's buffers and
+  /// the pool of blends have met their working sizes.
   void tick(double t_s);
+  /// Room for `ticks` records, made now.
+  void reserve_records(std::size_t ticks) { records_.reserve(ticks); }
 
   const std::vector<OperatorRecord>& records() const { return records_; }
+  /// The newest tick's record.
+  const OperatorRecord& last_record() const { return last_; }
+  /// The newest measured round trip: from sending a command to receiving
+  /// the first measurement of the remote following it, s; 0 before one.
+  double rtt_s() const { return rtt_s_; }
   const StationCounters& counters() const { return counters_; }
   const HapticRig& rig() const { return *rig_; }
   const Simulation& simulation() const;
@@ -195,7 +230,10 @@ class OperatorStation {
   std::unique_ptr<ScaleCorrection> correction_;
   std::vector<float> stamp_s_;  // time each sample was last changed by the local tool
   double protect_s_ = 0.0;
+  // The blends in arrival order: [0, active_blends_) are merging, the rest
+  // are kept (with their buffers) for the next patches.
   std::vector<Blend> blends_;
+  std::size_t active_blends_ = 0;
   wire::SequenceFilter measurements_, patches_, estimates_;
   std::uint32_t seq_command_ = 0;
   Vec3 remote_force_{};
@@ -214,10 +252,17 @@ class OperatorStation {
   double max_update_step_n_ = 0.0;
   double max_step_while_updating_n_ = 0.0;
   std::vector<OperatorRecord> records_;
+  OperatorRecord last_{};
+  OperatorOptions options_;
+  // When each command was sent, s, by sequence modulo the ring's size.
+  std::vector<double> command_sent_s_;
+  std::uint32_t rtt_sequence_ = 0;  // the command the newest round trip is of
+  double rtt_s_ = 0.0;
+  bool rtt_known_ = false;
   StationCounters counters_{};
-  std::vector<std::vector<std::uint8_t>> inbox_;
-  std::vector<std::uint8_t> buffer_;
+  net::Inbox inbox_;
   net::Patch patch_;
+  net::PatchCodec codec_;
 };
 
 /// Command-line choices over the `mmt:` section.
