@@ -1,6 +1,7 @@
 // Loading a scenario with all its sections. See scenario.hpp.
 #include "terracut/session/scenario.hpp"
 
+#include <cmath>
 #include <deque>
 #include <numbers>
 
@@ -44,8 +45,11 @@ struct RangeTable {
       std::string path = std::string(prefix) + std::string(r.path);
       if (path.ends_with("_rad")) {
         path.replace(path.size() - 4, 4, "_deg");
-        r.lo *= 180.0 / std::numbers::pi;
-        r.hi *= 180.0 / std::numbers::pi;
+        // Degrees as written (90, not 90.00000000000001); the struct's check,
+        // in radians, keeps the ends open or closed as declared.
+        const auto degrees = [](double rad) { return std::round(rad * 180.0 / std::numbers::pi * 1e9) / 1e9; };
+        r.lo = degrees(r.lo);
+        r.hi = degrees(r.hi);
       }
       r.path = paths.emplace_back(std::move(path));
       entries.push_back(r);

@@ -14,6 +14,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -259,6 +263,45 @@ TEST(ScenarioRanges, AnglesAreInDegreesInTheFile) {
   EXPECT_NEAR(phi.hi, 90.0, 1e-12);
   EXPECT_THROW(find_range(scenario_ranges(), "haptics.forces.earthmoving.soil.internal_friction_rad"),
                std::logic_error);
+}
+
+// The table as docs/scenario-format.md shows it.
+std::string markdown_table() {
+  std::string out = "| field | range | kind |\n|---|---|---|\n";
+  for (const Range& r : scenario_ranges()) {
+    std::string range;
+    const bool open_low = r.ends == RangeEnds::kOpenLow || r.ends == RangeEnds::kOpen;
+    if (r.hi >= kRangeMax && r.lo == 0.0)
+      range = open_low ? "> 0" : ">= 0";
+    else
+      range = range_text(r.lo, r.hi, r.ends);
+    out += "| `" + std::string(r.path) + "` | " + range + " | " + (r.whole ? "whole number" : "number") + " |\n";
+  }
+  return out;
+}
+
+// docs/scenario-format.md's table of ranges is generated from the table: it
+// must be the table, as it is now. TERRACUT_UPDATE_DOCS=1 rewrites it.
+TEST(ScenarioRanges, TheDocsTableIsTheTable) {
+  const std::filesystem::path doc = std::filesystem::path(TERRACUT_SOURCE_DIR) / "docs/scenario-format.md";
+  std::ifstream in(doc);
+  ASSERT_TRUE(in) << doc;
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  const std::string begin = "<!-- ranges:begin (generated from session::scenario_ranges()) -->\n";
+  const std::string end = "<!-- ranges:end -->";
+  const std::size_t b = s.find(begin), e = s.find(end);
+  ASSERT_NE(b, std::string::npos) << "no " << begin << " in " << doc;
+  ASSERT_NE(e, std::string::npos);
+  const std::string shown = s.substr(b + begin.size(), e - b - begin.size());
+  const std::string table = markdown_table();
+  if (shown != table && std::getenv("TERRACUT_UPDATE_DOCS")) {
+    s.replace(b + begin.size(), e - b - begin.size(), table);
+    std::ofstream(doc) << s;
+    return;
+  }
+  EXPECT_EQ(shown, table) << "run this test with TERRACUT_UPDATE_DOCS=1 to regenerate the table";
 }
 
 TEST(ScenarioRanges, AMissingEntryIsAProgrammingError) {
