@@ -1,4 +1,4 @@
-// The soak tests' checker of the force a device receives (docs/reliability.md):
+// The soak tests' helpers: resident memory, and the checker of the force a device receives (docs/reliability.md):
 // a Device between a device and the haptic loop that sees every sample the
 // loop reads and every command it writes, and checks the limiter's promises
 // on each: the force limit, the rate limit, zero force on a non-finite
@@ -6,10 +6,13 @@
 // soak (soak.cpp) and the teleoperation soak (mmt_soak.cpp).
 #pragma once
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <fstream>
 #include <vector>
 
 #include "terracut/core/safety.hpp"
@@ -20,6 +23,14 @@ namespace terracut::soak {
 using haptics::Device;
 using haptics::DeviceCommand;
 using haptics::DeviceSample;
+
+/// The process's resident memory, bytes (/proc/self/statm).
+inline std::int64_t rss_bytes() {
+  std::ifstream in("/proc/self/statm");
+  std::int64_t pages = 0, resident = 0;
+  in >> pages >> resident;
+  return resident * std::int64_t(::sysconf(_SC_PAGESIZE));
+}
 
 // Runs on the loop's thread; read its figures after the loop has stopped.
 class CheckingDevice final : public Device {

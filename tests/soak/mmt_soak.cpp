@@ -62,13 +62,6 @@
 namespace terracut::soak {
 namespace {
 
-std::int64_t rss_bytes() {
-  std::ifstream in("/proc/self/statm");
-  std::int64_t pages = 0, resident = 0;
-  in >> pages >> resident;
-  return resident * std::int64_t(::sysconf(_SC_PAGESIZE));
-}
-
 double wall_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }

@@ -65,13 +65,7 @@ namespace {
 using namespace terracut;
 using namespace terracut::haptics;
 using soak::CheckingDevice;
-
-std::int64_t rss_bytes() {
-  std::ifstream in("/proc/self/statm");
-  std::int64_t pages = 0, resident = 0;
-  in >> pages >> resident;
-  return resident * std::int64_t(::sysconf(_SC_PAGESIZE));
-}
+using soak::rss_bytes;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
