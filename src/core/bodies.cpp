@@ -37,10 +37,20 @@ bool valid_name(const std::string& name) {
   return true;
 }
 
-// "FIELD must be in (0, max] metres, got V" when v is not a valid dimension, else "".
-std::string check_dimension(const char* field, double v) {
-  if (std::isfinite(v) && v > 0.0 && v <= kMaxBodyDimensionM) return {};
-  return must_be(field, "in (0, " + format_number(kMaxBodyDimensionM) + "] metres", v);
+constexpr Range kRanges[] = {
+    {"size_m[0]", 0.0, kMaxBodyDimensionM, RangeEnds::kOpenLow},
+    {"size_m[1]", 0.0, kMaxBodyDimensionM, RangeEnds::kOpenLow},
+    {"size_m[2]", 0.0, kMaxBodyDimensionM, RangeEnds::kOpenLow},
+    {"radius_m", 0.0, kMaxBodyDimensionM, RangeEnds::kOpenLow},
+    {"height_m", 0.0, kMaxBodyDimensionM, RangeEnds::kOpenLow},
+    {"mass_kg", 0.0, kRangeMax, RangeEnds::kClosed},  // 0: static
+    {"friction", 0.0, 10.0, RangeEnds::kClosed},
+    {"restitution", 0.0, 1.0, RangeEnds::kClosed},
+};
+
+// "FIELD must be ..." when v is outside its entry of kRanges, else "".
+std::string check_number(std::string_view field, double v) {
+  return check(find_range(kRanges, field), v);
 }
 
 }  // namespace
@@ -52,32 +62,30 @@ std::string validate(const BodySpec& spec) {
   std::string m;
   switch (spec.shape) {
     case BodyShape::kBox:
-      if (!(m = check_dimension("size_m[0]", spec.size_m.x)).empty() ||
-          !(m = check_dimension("size_m[1]", spec.size_m.y)).empty() ||
-          !(m = check_dimension("size_m[2]", spec.size_m.z)).empty())
+      if (!(m = check_number("size_m[0]", spec.size_m.x)).empty() ||
+          !(m = check_number("size_m[1]", spec.size_m.y)).empty() ||
+          !(m = check_number("size_m[2]", spec.size_m.z)).empty())
         return m;
       break;
     case BodyShape::kSphere:
-      if (!(m = check_dimension("radius_m", spec.radius_m)).empty()) return m;
+      if (!(m = check_number("radius_m", spec.radius_m)).empty()) return m;
       break;
     case BodyShape::kCylinder:
-      if (!(m = check_dimension("radius_m", spec.radius_m)).empty() ||
-          !(m = check_dimension("height_m", spec.height_m)).empty())
+      if (!(m = check_number("radius_m", spec.radius_m)).empty() ||
+          !(m = check_number("height_m", spec.height_m)).empty())
         return m;
       break;
     default:
       return "shape must be box, sphere or cylinder";
   }
-  if (!(std::isfinite(spec.mass_kg) && spec.mass_kg >= 0.0))
-    return must_be("mass_kg", "finite and >= 0 (0 = static)", spec.mass_kg);
+  if (auto m = check_number("mass_kg", spec.mass_kg); !m.empty()) return m;
   if (!is_finite(spec.position_m)) return "position_m must be finite";
   if (!is_finite(spec.rotation_deg)) return "rotation_deg must be finite";
-  if (!(spec.friction >= 0.0 && spec.friction <= 10.0))
-    return must_be("friction", "in [0, 10]", spec.friction);
-  if (!(spec.restitution >= 0.0 && spec.restitution <= 1.0))
-    return must_be("restitution", "in [0, 1]", spec.restitution);
-  return {};
+  if (auto m = check_number("friction", spec.friction); !m.empty()) return m;
+  return check_number("restitution", spec.restitution);
 }
+
+std::span<const Range> body_ranges() { return kRanges; }
 
 std::string validate(const std::vector<BodySpec>& bodies) {
   for (std::size_t i = 0; i < bodies.size(); ++i) {

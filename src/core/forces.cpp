@@ -18,23 +18,44 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
 
-// "FIELD must be ..., got VALUE" checks, returning the message or "".
-std::string check_nonnegative(const std::string& field, double value) {
-  if (std::isfinite(value) && value >= 0.0) return {};
-  return must_be(field, "finite and >= 0", value);
-}
+// "FIELD must be ..., got VALUE" for the derived fields, or "".
 std::string check_positive(const std::string& field, double value) {
   if (std::isfinite(value) && value > 0.0) return {};
   return must_be(field, "finite and > 0", value);
 }
-std::string check_angle(const std::string& field, double value_rad, double hi_rad,
-                        bool include_zero) {
-  bool ok = std::isfinite(value_rad) && (include_zero ? value_rad >= 0.0 : value_rad > 0.0) &&
-            value_rad < hi_rad;
-  if (ok) return {};
-  return must_be(field, (include_zero ? "in [0, " : "in (0, ") + format_number(hi_rad) + ") rad",
-                 value_rad) +
-         " rad = " + format_number(value_rad / kDeg) + " deg";
+
+// The ranges of the fields a scenario's haptics.forces sets (the derived
+// ones, set by the session, are checked by validate(ForceModelParams) alone).
+constexpr Range kRanges[] = {
+    {"force_scale", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"low_speed_damping_n_s_per_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"penetration.edge_thickness_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"contact_drag.drag_n_per_m", 0.0, kRangeMax, RangeEnds::kClosed},
+    {"contact_drag.viscous_n_s_per_m2", 0.0, kRangeMax, RangeEnds::kClosed},
+    {"earthmoving.soil.unit_weight_n_per_m3", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"earthmoving.soil.cohesion_pa", 0.0, kRangeMax, RangeEnds::kClosed},
+    {"earthmoving.soil.adhesion_pa", 0.0, kRangeMax, RangeEnds::kClosed},
+    {"earthmoving.soil.internal_friction_rad", 0.0, kPi / 2, RangeEnds::kOpenHigh},
+    {"earthmoving.soil.soil_tool_friction_rad", 0.0, kPi / 2, RangeEnds::kOpenHigh},
+    {"earthmoving.soil.surcharge_pa", 0.0, kRangeMax, RangeEnds::kClosed},
+    {"earthmoving.rake_angle_rad", 0.0, kPi, RangeEnds::kOpen},
+    {"surface.stiffness_n_per_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"surface.damping_n_s_per_m", 0.0, kRangeMax, RangeEnds::kClosed},
+    {"device.max_force_n", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"device.max_stiffness_n_per_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"device.max_damping_n_s_per_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"device.inherent_damping_n_s_per_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+};
+
+// The check of field (its name in its own struct) by its entry at
+// struct_path + field: "FIELD must be ..., got VALUE" or "". An angle's
+// message gives it in degrees too.
+std::string check_entry(std::string_view struct_path, std::string_view field, double value) {
+  const Range& r = find_range(kRanges, std::string(struct_path) + std::string(field));
+  std::string m = check(r, value, field);
+  if (!m.empty() && field.ends_with("_rad"))
+    m += " rad = " + format_number(value / kDeg) + " deg";
+  return m;
 }
 
 // Prefixes a sub-structure's message with its field name.
@@ -92,8 +113,9 @@ double saturated_drag_n(double force_n, double speed_m_per_s,
 }
 
 std::string validate(const ContactDragParams& params) {
-  if (auto m = check_nonnegative("drag_n_per_m", params.drag_n_per_m); !m.empty()) return m;
-  return check_nonnegative("viscous_n_s_per_m2", params.viscous_n_s_per_m2);
+  if (auto m = check_entry("contact_drag.", "drag_n_per_m", params.drag_n_per_m); !m.empty())
+    return m;
+  return check_entry("contact_drag.", "viscous_n_s_per_m2", params.viscous_n_s_per_m2);
 }
 
 Vec3 contact_drag_force(const ContactDragParams& params, double contact_length_m,
@@ -164,22 +186,21 @@ std::optional<SoilPreset> parse_soil_preset(std::string_view name) {
 }
 
 std::string validate(const SoilParams& soil) {
-  if (auto m = check_positive("unit_weight_n_per_m3", soil.unit_weight_n_per_m3); !m.empty())
+  constexpr std::string_view at = "earthmoving.soil.";
+  if (auto m = check_entry(at, "unit_weight_n_per_m3", soil.unit_weight_n_per_m3); !m.empty())
     return m;
-  if (auto m = check_nonnegative("cohesion_pa", soil.cohesion_pa); !m.empty()) return m;
-  if (auto m = check_nonnegative("adhesion_pa", soil.adhesion_pa); !m.empty()) return m;
-  if (auto m = check_angle("internal_friction_rad", soil.internal_friction_rad, kPi / 2, true);
-      !m.empty())
+  if (auto m = check_entry(at, "cohesion_pa", soil.cohesion_pa); !m.empty()) return m;
+  if (auto m = check_entry(at, "adhesion_pa", soil.adhesion_pa); !m.empty()) return m;
+  if (auto m = check_entry(at, "internal_friction_rad", soil.internal_friction_rad); !m.empty())
     return m;
-  if (auto m = check_angle("soil_tool_friction_rad", soil.soil_tool_friction_rad, kPi / 2, true);
-      !m.empty())
+  if (auto m = check_entry(at, "soil_tool_friction_rad", soil.soil_tool_friction_rad); !m.empty())
     return m;
-  return check_nonnegative("surcharge_pa", soil.surcharge_pa);
+  return check_entry(at, "surcharge_pa", soil.surcharge_pa);
 }
 
 std::string validate(const EarthmovingParams& params) {
   if (auto m = nested("soil", validate(params.soil)); !m.empty()) return m;
-  if (auto m = check_angle("rake_angle_rad", params.rake_angle_rad, kPi, false); !m.empty())
+  if (auto m = check_entry("earthmoving.", "rake_angle_rad", params.rake_angle_rad); !m.empty())
     return m;
   // A planar wedge needs a failure-plane angle with D > 0: beta < pi - alpha - delta - phi.
   // Ask for at least one degree of room.
@@ -301,8 +322,9 @@ Vec3 earthmoving_world_force(const EarthmovingResult& result, Vec3 velocity_m_pe
 // ---------------------------------------------------------------------------
 
 std::string validate(const SurfaceParams& params) {
-  if (auto m = check_positive("stiffness_n_per_m", params.stiffness_n_per_m); !m.empty()) return m;
-  return check_nonnegative("damping_n_s_per_m", params.damping_n_s_per_m);
+  if (auto m = check_entry("surface.", "stiffness_n_per_m", params.stiffness_n_per_m); !m.empty())
+    return m;
+  return check_entry("surface.", "damping_n_s_per_m", params.damping_n_s_per_m);
 }
 
 SurfaceForce surface_force(const SurfaceParams& params, Vec3 device_point_m, Vec3 velocity_m_per_s,
@@ -339,7 +361,7 @@ BearingFactors bearing_capacity_factors(double internal_friction_rad) noexcept {
 }
 
 std::string validate(const PenetrationParams& params) {
-  return check_positive("edge_thickness_m", params.edge_thickness_m);
+  return check_entry("penetration.", "edge_thickness_m", params.edge_thickness_m);
 }
 
 PenetrationResult penetration_resistance(const SoilParams& soil, const PenetrationParams& params,
@@ -399,12 +421,13 @@ TwistResult twist_resistance(double resistance_n_per_m, const TwistEngagement& e
 // ---------------------------------------------------------------------------
 
 std::string validate(const DeviceLimits& limits) {
-  if (auto m = check_positive("max_force_n", limits.max_force_n); !m.empty()) return m;
-  if (auto m = check_positive("max_stiffness_n_per_m", limits.max_stiffness_n_per_m); !m.empty())
+  constexpr std::string_view at = "device.";
+  if (auto m = check_entry(at, "max_force_n", limits.max_force_n); !m.empty()) return m;
+  if (auto m = check_entry(at, "max_stiffness_n_per_m", limits.max_stiffness_n_per_m); !m.empty())
     return m;
-  if (auto m = check_positive("max_damping_n_s_per_m", limits.max_damping_n_s_per_m); !m.empty())
+  if (auto m = check_entry(at, "max_damping_n_s_per_m", limits.max_damping_n_s_per_m); !m.empty())
     return m;
-  return check_positive("inherent_damping_n_s_per_m", limits.inherent_damping_n_s_per_m);
+  return check_entry(at, "inherent_damping_n_s_per_m", limits.inherent_damping_n_s_per_m);
 }
 
 double passive_stiffness_limit_n_per_m(double inherent_damping_n_s_per_m,
@@ -450,10 +473,10 @@ std::string validate(const ForceModelParams& params) {
   if (auto m = nested("earthmoving", validate(params.earthmoving)); !m.empty()) return m;
   if (auto m = nested("surface", validate(params.surface)); !m.empty()) return m;
   if (auto m = nested("penetration", validate(params.penetration)); !m.empty()) return m;
-  if (auto m = check_positive("low_speed_damping_n_s_per_m", params.low_speed_damping_n_s_per_m);
+  if (auto m = check_entry("", "low_speed_damping_n_s_per_m", params.low_speed_damping_n_s_per_m);
       !m.empty())
     return m;
-  if (auto m = check_positive("force_scale", params.force_scale); !m.empty()) return m;
+  if (auto m = check_entry("", "force_scale", params.force_scale); !m.empty()) return m;
   if (auto m = check_positive("workspace_scale", params.workspace_scale); !m.empty()) return m;
   if (auto m = check_positive("max_contact_length_m", params.max_contact_length_m); !m.empty())
     return m;
@@ -463,6 +486,8 @@ std::string validate(const ForceModelParams& params) {
   }
   return nested("device", validate(params.device));
 }
+
+std::span<const Range> force_ranges() { return kRanges; }
 
 ForceModel::ForceModel(const ForceModelParams& params) : requested_(params), params_(params) {
   if (auto m = validate(params); !m.empty()) throw InputError(m);

@@ -12,9 +12,16 @@ namespace terracut {
 
 namespace {
 
-std::string check(const char* field, double value, bool allow_zero) {
-  if (std::isfinite(value) && (allow_zero ? value >= 0.0 : value > 0.0)) return {};
-  return must_be(field, allow_zero ? "finite and >= 0" : "finite and > 0", value);
+constexpr Range kRanges[] = {
+    {"max_force_n", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"max_force_rate_n_per_s", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"rise_time_s", 0.0, kRangeMax, RangeEnds::kClosed},
+    {"watchdog_timeout_s", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"watchdog_ramp_s", 0.0, kRangeMax, RangeEnds::kClosed},
+};
+
+std::string check(std::string_view field, double value) {
+  return terracut::check(find_range(kRanges, field), value);
 }
 
 // The point of `target` reachable from `previous` in one sample: anything
@@ -34,13 +41,15 @@ Vec3 rate_limit(Vec3 previous, Vec3 target, double radius, bool& limited) {
 }  // namespace
 
 std::string validate(const SafetyParams& params) {
-  if (auto m = check("max_force_n", params.max_force_n, false); !m.empty()) return m;
-  if (auto m = check("max_force_rate_n_per_s", params.max_force_rate_n_per_s, false); !m.empty())
+  if (auto m = check("max_force_n", params.max_force_n); !m.empty()) return m;
+  if (auto m = check("max_force_rate_n_per_s", params.max_force_rate_n_per_s); !m.empty())
     return m;
-  if (auto m = check("rise_time_s", params.rise_time_s, true); !m.empty()) return m;
-  if (auto m = check("watchdog_timeout_s", params.watchdog_timeout_s, false); !m.empty()) return m;
-  return check("watchdog_ramp_s", params.watchdog_ramp_s, true);
+  if (auto m = check("rise_time_s", params.rise_time_s); !m.empty()) return m;
+  if (auto m = check("watchdog_timeout_s", params.watchdog_timeout_s); !m.empty()) return m;
+  return check("watchdog_ramp_s", params.watchdog_ramp_s);
 }
+
+std::span<const Range> safety_ranges() { return kRanges; }
 
 SafetyLimiter::SafetyLimiter(const SafetyParams& params) : params_(params) {
   if (auto m = validate(params); !m.empty()) throw InputError(m);

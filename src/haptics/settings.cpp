@@ -47,50 +47,47 @@ std::optional<CutDepthMeasure> parse_cut_depth_measure(std::string_view name) {
 }
 
 namespace {
-// "FIELD must be WHAT, got VALUE" when ok is false, else "".
-template <MessageNumber T>
-std::string haptic_check(bool ok, const char* field, const char* what, T value) {
-  if (ok) return {};
-  return must_be(field, what, value);
+
+// The ranges of HapticSettings' own numbers (forces and safety have theirs,
+// core/forces.hpp and core/safety.hpp). velocity_cutoff_hz must also be
+// below rate_hz / 2, a check across fields.
+constexpr Range kRanges[] = {
+    {"rate_hz", 10.0, 10000.0, RangeEnds::kClosed},
+    {"duration_s", 0.0, 86400.0, RangeEnds::kOpenLow},
+    {"settle_s", 0.0, 3600.0, RangeEnds::kClosed},
+    {"workspace.scale", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"workspace.yaw_deg", -360.0, 360.0, RangeEnds::kClosed},
+    {"velocity_cutoff_hz", 0.0, 5000.0, RangeEnds::kOpenHigh},
+    {"hand.mass_kg", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"hand.stiffness_n_per_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"hand.damping_n_s_per_m", 0.0, kRangeMax, RangeEnds::kClosed},
+    {"hand.substeps", 1, 1000, RangeEnds::kClosed, true},
+    {"udp.port", 1, 65535, RangeEnds::kClosed, true},
+};
+
+std::string check(std::string_view field, double value) {
+  return terracut::check(find_range(kRanges, field), value);
 }
+
 }  // namespace
 
 std::string validate(const HapticSettings& s) {
-  const auto finite = [](double v) { return std::isfinite(v); };
   std::string m;
-  if (!(m = haptic_check(finite(s.rate_hz) && s.rate_hz >= 10.0 && s.rate_hz <= 10000.0, "rate_hz",
-                         "finite and in [10, 10000]", s.rate_hz))
-           .empty())
-    return m;
+  if (!(m = check("rate_hz", s.rate_hz)).empty()) return m;
   if (s.device != DeviceKind::kScript && s.device != DeviceKind::kSim &&
       s.device != DeviceKind::kUdp)
     return "device must be script, sim or udp";
-  if (s.duration_s &&
-      !(m = haptic_check(finite(*s.duration_s) && *s.duration_s > 0.0 && *s.duration_s <= 86400.0,
-                         "duration_s", "finite and in (0, 86400]", *s.duration_s))
-           .empty())
-    return m;
-  if (!(m = haptic_check(finite(s.settle_s) && s.settle_s >= 0.0 && s.settle_s <= 3600.0,
-                         "settle_s", "finite and in [0, 3600]", s.settle_s))
-           .empty())
-    return m;
-  if (!(m = haptic_check(finite(s.workspace.scale) && s.workspace.scale > 0.0, "workspace.scale",
-                         "finite and > 0", s.workspace.scale))
-           .empty())
-    return m;
+  if (s.duration_s && !(m = check("duration_s", *s.duration_s)).empty()) return m;
+  if (!(m = check("settle_s", s.settle_s)).empty()) return m;
+  if (!(m = check("workspace.scale", s.workspace.scale)).empty()) return m;
   if (!is_finite(s.workspace.offset_m)) return "workspace.offset_m must be finite";
-  if (!(m = haptic_check(finite(s.workspace.yaw_deg) && std::abs(s.workspace.yaw_deg) <= 360.0,
-                         "workspace.yaw_deg", "finite and in [-360, 360]", s.workspace.yaw_deg))
-           .empty())
-    return m;
+  if (!(m = check("workspace.yaw_deg", s.workspace.yaw_deg)).empty()) return m;
   if (s.tool_rotation_deg && !is_finite(*s.tool_rotation_deg))
     return "tool.rotation_deg must be finite";
-  if (!(m = haptic_check(finite(s.velocity_cutoff_hz) && s.velocity_cutoff_hz >= 0.0 &&
-                             s.velocity_cutoff_hz < s.rate_hz / 2.0,
-                         "velocity_cutoff_hz", "finite, >= 0 and below rate_hz / 2",
-                         s.velocity_cutoff_hz))
-           .empty())
-    return m;
+  if (!(m = check("velocity_cutoff_hz", s.velocity_cutoff_hz)).empty()) return m;
+  if (!(s.velocity_cutoff_hz < s.rate_hz / 2.0))
+    return must_be("velocity_cutoff_hz", "below rate_hz / 2 = " + format_number(s.rate_hz / 2.0),
+                   s.velocity_cutoff_hz);
   if (s.surface_reference != SurfaceReference::kGround &&
       s.surface_reference != SurfaceReference::kTerrain)
     return "surface_reference must be ground or terrain";
@@ -103,30 +100,17 @@ std::string validate(const HapticSettings& s) {
            format_number(s.forces.device.max_force_n) + ", got " +
            format_number(s.safety.max_force_n);
   const SimHandParams& h = s.hand;
-  if (!(m = haptic_check(finite(h.mass_kg) && h.mass_kg > 0.0, "hand.mass_kg", "finite and > 0",
-                         h.mass_kg))
-           .empty())
-    return m;
-  if (!(m = haptic_check(finite(h.stiffness_n_per_m) && h.stiffness_n_per_m > 0.0,
-                         "hand.stiffness_n_per_m", "finite and > 0", h.stiffness_n_per_m))
-           .empty())
-    return m;
-  if (!(m = haptic_check(finite(h.damping_n_s_per_m) && h.damping_n_s_per_m >= 0.0,
-                         "hand.damping_n_s_per_m", "finite and >= 0", h.damping_n_s_per_m))
-           .empty())
-    return m;
-  if (!(m = haptic_check(h.substeps >= 1 && h.substeps <= 1000, "hand.substeps", "in [1, 1000]",
-                         h.substeps))
-           .empty())
-    return m;
+  if (!(m = check("hand.mass_kg", h.mass_kg)).empty()) return m;
+  if (!(m = check("hand.stiffness_n_per_m", h.stiffness_n_per_m)).empty()) return m;
+  if (!(m = check("hand.damping_n_s_per_m", h.damping_n_s_per_m)).empty()) return m;
+  if (!(m = check("hand.substeps", h.substeps)).empty()) return m;
   if (!is_finite(h.start_offset_m)) return "hand.start_offset_m must be finite";
   if (s.udp.address.empty()) return "udp.address must not be empty";
-  if (!(m = haptic_check(s.udp.port >= 1 && s.udp.port <= 65535, "udp.port", "in [1, 65535]",
-                         s.udp.port))
-           .empty())
-    return m;
+  if (!(m = check("udp.port", s.udp.port)).empty()) return m;
   return {};
 }
+
+std::span<const Range> haptic_settings_ranges() { return kRanges; }
 
 HapticSettings with_derived_fields(HapticSettings settings, double blade_length_m) {
   settings.forces.workspace_scale = settings.workspace.scale;

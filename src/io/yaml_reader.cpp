@@ -22,13 +22,6 @@ namespace {
 constexpr long long kMaxWhole = 1'000'000'000;
 static_assert(double(kMaxWhole) == kMaxMagnitude);
 
-// The range [lo, hi] written with its ends: "(0, 1000]".
-std::string range_text(const std::string& lo, const std::string& hi, Field::Ends ends) {
-  const bool open_low = ends == Field::Ends::kOpenLow || ends == Field::Ends::kOpen;
-  const bool open_high = ends == Field::Ends::kOpenHigh || ends == Field::Ends::kOpen;
-  return (open_low ? "(" : "[") + lo + ", " + hi + (open_high ? ")" : "]");
-}
-
 // The body of Map's read_* functions: out = read(value) when key is given.
 template <typename T, typename Read>
 bool read_if_given(const Map& map, std::string_view key, T& out, Read read) {
@@ -199,7 +192,7 @@ double Field::in_range(double lo, double hi, Ends ends) const {
   const bool above_low = (ends == Ends::kOpenLow || ends == Ends::kOpen) ? v > lo : v >= lo;
   const bool below_high = (ends == Ends::kOpenHigh || ends == Ends::kOpen) ? v < hi : v <= hi;
   if (!above_low || !below_high)
-    fail(must_be("in " + range_text(format_number(lo), format_number(hi), ends), v));
+    fail(must_be("in " + range_text(lo, hi, ends), v));
   return v;
 }
 
@@ -233,12 +226,6 @@ double Field::in(const Range& range) const {
   if (range.hi == kMaxMagnitude && range.lo == 0.0 && range.ends == Ends::kClosed) return non_negative();
   if (range.hi == kMaxMagnitude && range.lo == -kMaxMagnitude) return number();
   return in_range(range.lo, range.hi, range.ends);
-}
-
-const Range& find_range(std::span<const Range> table, std::string_view path) {
-  for (const Range& r : table)
-    if (r.path == path) return r;
-  throw std::logic_error("no range declared for '" + std::string(path) + "'");
 }
 
 std::vector<Field> Field::elements() const {

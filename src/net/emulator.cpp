@@ -10,29 +10,41 @@
 namespace terracut::net {
 namespace {
 
-bool in(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
+constexpr Range kRanges[] = {
+    {"delay_s", 0.0, 10.0, RangeEnds::kClosed},
+    {"jitter_s", 0.0, 10.0, RangeEnds::kClosed},
+    {"loss", 0.0, 1.0, RangeEnds::kOpenHigh},
+    {"burst.p_good_to_bad", 0.0, 1.0, RangeEnds::kClosed},
+    {"burst.p_bad_to_good", 0.0, 1.0, RangeEnds::kOpenLow},
+    {"burst.loss_good", 0.0, 1.0, RangeEnds::kClosed},
+    {"burst.loss_bad", 0.0, 1.0, RangeEnds::kClosed},
+    {"reorder", 0.0, 1.0, RangeEnds::kClosed},
+    {"reorder_delay_s", 0.0, 10.0, RangeEnds::kClosed},
+    {"retransmit_s", 0.0, 60.0, RangeEnds::kOpenLow},
+};
+
+std::string check(std::string_view field, double value) {
+  return terracut::check(find_range(kRanges, field), value);
+}
 
 }  // namespace
 
 std::string validate(const LinkConditions& c) {
-  if (!in(c.delay_s, 0.0, 10.0)) return must_be("delay_s", "in [0, 10]", c.delay_s);
-  if (!in(c.jitter_s, 0.0, 10.0)) return must_be("jitter_s", "in [0, 10]", c.jitter_s);
-  if (!in(c.loss, 0.0, 1.0) || c.loss >= 1.0) return must_be("loss", "in [0, 1)", c.loss);
-  if (!in(c.burst.p_good_to_bad, 0.0, 1.0))
-    return must_be("burst.p_good_to_bad", "in [0, 1]", c.burst.p_good_to_bad);
-  if (!in(c.burst.p_bad_to_good, 0.0, 1.0) || c.burst.p_bad_to_good <= 0.0)
-    return must_be("burst.p_bad_to_good", "in (0, 1]", c.burst.p_bad_to_good);
-  if (!in(c.burst.loss_good, 0.0, 1.0))
-    return must_be("burst.loss_good", "in [0, 1]", c.burst.loss_good);
-  if (!in(c.burst.loss_bad, 0.0, 1.0))
-    return must_be("burst.loss_bad", "in [0, 1]", c.burst.loss_bad);
-  if (!in(c.reorder, 0.0, 1.0)) return must_be("reorder", "in [0, 1]", c.reorder);
-  if (!in(c.reorder_delay_s, 0.0, 10.0))
-    return must_be("reorder_delay_s", "in [0, 10]", c.reorder_delay_s);
-  if (c.retransmit_s && (!in(*c.retransmit_s, 0.0, 60.0) || *c.retransmit_s <= 0.0))
-    return must_be("retransmit_s", "in (0, 60]", *c.retransmit_s);
+  std::string m;
+  if (!(m = check("delay_s", c.delay_s)).empty()) return m;
+  if (!(m = check("jitter_s", c.jitter_s)).empty()) return m;
+  if (!(m = check("loss", c.loss)).empty()) return m;
+  if (!(m = check("burst.p_good_to_bad", c.burst.p_good_to_bad)).empty()) return m;
+  if (!(m = check("burst.p_bad_to_good", c.burst.p_bad_to_good)).empty()) return m;
+  if (!(m = check("burst.loss_good", c.burst.loss_good)).empty()) return m;
+  if (!(m = check("burst.loss_bad", c.burst.loss_bad)).empty()) return m;
+  if (!(m = check("reorder", c.reorder)).empty()) return m;
+  if (!(m = check("reorder_delay_s", c.reorder_delay_s)).empty()) return m;
+  if (c.retransmit_s && !(m = check("retransmit_s", *c.retransmit_s)).empty()) return m;
   return {};
 }
+
+std::span<const Range> link_ranges() { return kRanges; }
 
 LinkEmulator::LinkEmulator(const LinkConditions& conditions)
     : c_(conditions), rng_(conditions.seed) {

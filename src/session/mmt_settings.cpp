@@ -17,6 +17,27 @@ namespace yaml = io::yaml;
 
 bool in(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
 
+// The ranges of the section's own numbers (link: net::link_ranges()).
+// link.seed and link_id are the reader's alone (whole numbers).
+constexpr Range kRanges[] = {
+    {"remote.follower_speed_m_per_s", 0.0, 100.0, RangeEnds::kOpenLow},
+    {"remote.follower_time_constant_s", 0.0, 10.0, RangeEnds::kClosed},
+    {"remote.sense_period_s", 0.0, 10.0, RangeEnds::kOpenLow},
+    {"remote.sense_radius_m", 0.0, 100.0, RangeEnds::kOpenLow},
+    {"remote.forgetting", 0.0, 1.0, RangeEnds::kOpenLow},
+    {"link.seed", 0, 1e9, RangeEnds::kClosed, true},
+    {"operator.blend_s", 0.0, 10.0, RangeEnds::kClosed},
+    {"operator.max_update_step_n", 0.0, 100.0, RangeEnds::kOpenLow},
+    {"operator.exclusion_m", 0.0, 100.0, RangeEnds::kClosed},
+    {"operator.deadband", 0.0, 1.0, RangeEnds::kOpenHigh},
+    {"timeout_s", 0.0, 60.0, RangeEnds::kOpenLow},
+    {"udp.port", 1, 65535, RangeEnds::kClosed, true},
+    {"link_id", 0, 1e9, RangeEnds::kClosed, true},
+};
+
+const Range& range(std::string_view path) { return find_range(kRanges, path); }
+std::string check(std::string_view path, double value) { return terracut::check(range(path), value); }
+
 // One direction's conditions from `link:`.
 void read_link(const yaml::Map& link, net::LinkConditions& c) {
   link.read_number("delay_s", c.delay_s);
@@ -25,7 +46,7 @@ void read_link(const yaml::Map& link, net::LinkConditions& c) {
   link.read_number("reorder", c.reorder);
   link.read_number("reorder_delay_s", c.reorder_delay_s);
   if (const auto f = link.get("retransmit_s")) c.retransmit_s = f->number();
-  if (const auto f = link.get("seed")) c.seed = std::uint64_t(f->integer_in(0, 1000000000));
+  if (const auto f = link.get("seed")) c.seed = std::uint64_t(f->in(range("link.seed")));
   const yaml::Map burst =
       link.section("burst", {"p_good_to_bad", "p_bad_to_good", "loss_good", "loss_bad"});
   burst.read_number("p_good_to_bad", c.burst.p_good_to_bad);
@@ -37,30 +58,24 @@ void read_link(const yaml::Map& link, net::LinkConditions& c) {
 }  // namespace
 
 std::string validate(const MmtSettings& s) {
-  if (!in(s.follower_speed_m_per_s, 0.0, 100.0) || s.follower_speed_m_per_s <= 0.0)
-    return must_be("remote.follower_speed_m_per_s", "in (0, 100]", s.follower_speed_m_per_s);
-  if (!in(s.follower_time_constant_s, 0.0, 10.0))
-    return must_be("remote.follower_time_constant_s", "in [0, 10]", s.follower_time_constant_s);
-  if (!in(s.sense_period_s, 0.0, 10.0) || s.sense_period_s <= 0.0)
-    return must_be("remote.sense_period_s", "in (0, 10]", s.sense_period_s);
-  if (!in(s.sense_radius_m, 0.0, 100.0) || s.sense_radius_m <= 0.0)
-    return must_be("remote.sense_radius_m", "in (0, 100]", s.sense_radius_m);
-  if (!in(s.forgetting, 0.0, 1.0) || s.forgetting <= 0.0)
-    return must_be("remote.forgetting", "in (0, 1]", s.forgetting);
+  std::string m;
+  if (!(m = check("remote.follower_speed_m_per_s", s.follower_speed_m_per_s)).empty()) return m;
+  if (!(m = check("remote.follower_time_constant_s", s.follower_time_constant_s)).empty()) return m;
+  if (!(m = check("remote.sense_period_s", s.sense_period_s)).empty()) return m;
+  if (!(m = check("remote.sense_radius_m", s.sense_radius_m)).empty()) return m;
+  if (!(m = check("remote.forgetting", s.forgetting)).empty()) return m;
   if (std::string p = net::validate(s.to_remote); !p.empty()) return "link." + p;
   if (std::string p = net::validate(s.to_operator); !p.empty()) return "link." + p;
-  if (!in(s.blend_s, 0.0, 10.0)) return must_be("operator.blend_s", "in [0, 10]", s.blend_s);
-  if (!in(s.max_update_step_n, 0.0, 100.0) || s.max_update_step_n <= 0.0)
-    return must_be("operator.max_update_step_n", "in (0, 100]", s.max_update_step_n);
-  if (!in(s.exclusion_m, 0.0, 100.0))
-    return must_be("operator.exclusion_m", "in [0, 100]", s.exclusion_m);
-  if (!in(s.deadband, 0.0, 1.0) || s.deadband >= 1.0)
-    return must_be("operator.deadband", "in [0, 1)", s.deadband);
-  if (!in(s.timeout_s, 0.0, 60.0) || s.timeout_s <= 0.0)
-    return must_be("timeout_s", "in (0, 60]", s.timeout_s);
-  if (s.port < 1 || s.port > 65535) return must_be("udp.port", "in [1, 65535]", s.port);
+  if (!(m = check("operator.blend_s", s.blend_s)).empty()) return m;
+  if (!(m = check("operator.max_update_step_n", s.max_update_step_n)).empty()) return m;
+  if (!(m = check("operator.exclusion_m", s.exclusion_m)).empty()) return m;
+  if (!(m = check("operator.deadband", s.deadband)).empty()) return m;
+  if (!(m = check("timeout_s", s.timeout_s)).empty()) return m;
+  if (!(m = check("udp.port", s.port)).empty()) return m;
   return {};
 }
+
+std::span<const Range> mmt_ranges() { return kRanges; }
 
 void MmtReader::read(const YAML::Node& value, const std::string& file) {
   MmtSettings s;
@@ -103,7 +118,7 @@ void MmtReader::read(const YAML::Node& value, const std::string& file) {
   const yaml::Map udp = top.section("udp", {"address", "port"});
   udp.read_text("address", s.address);
   udp.read_integer("port", s.port);
-  if (const auto f = top.get("link_id")) s.link_id = std::uint32_t(f->integer_in(0, 1000000000));
+  if (const auto f = top.get("link_id")) s.link_id = std::uint32_t(f->in(range("link_id")));
   if (const std::string problem = validate(s); !problem.empty()) {
     const yaml::Problem p = yaml::split_problem(problem);
     root.fail_at(p.path, p.what);
@@ -117,7 +132,8 @@ MmtSettings apply_overrides(MmtSettings s, const MmtOverrides& o) {
     s.to_remote.delay_s = s.to_operator.delay_s = 0.5 * *o.rtt_s;
   }
   if (o.loss) {
-    if (!in(*o.loss, 0.0, 1.0) || *o.loss >= 1.0) throw InputError(must_be("--loss", "in [0, 1)", *o.loss));
+    if (auto m = terracut::check(find_range(net::link_ranges(), "loss"), *o.loss, "--loss"); !m.empty())
+      throw InputError(m);
     s.to_remote.loss = s.to_operator.loss = *o.loss;
   }
   if (o.jitter_s) {
@@ -129,12 +145,13 @@ MmtSettings apply_overrides(MmtSettings s, const MmtOverrides& o) {
     s.to_operator.seed = *o.seed + 1;
   }
   if (o.deadband) {
-    if (!in(*o.deadband, 0.0, 1.0) || *o.deadband >= 1.0)
-      throw InputError(must_be("--deadband", "in [0, 1)", *o.deadband));
+    if (auto m = terracut::check(range("operator.deadband"), *o.deadband, "--deadband"); !m.empty())
+      throw InputError(m);
     s.deadband = *o.deadband;
   }
   if (o.blend_s) {
-    if (!in(*o.blend_s, 0.0, 10.0)) throw InputError(must_be("--blend", "in [0, 10]", *o.blend_s));
+    if (auto m = terracut::check(range("operator.blend_s"), *o.blend_s, "--blend"); !m.empty())
+      throw InputError(m);
     s.blend_s = *o.blend_s;
   }
   if (const std::string problem = validate(s); !problem.empty()) throw InputError("mmt." + problem);

@@ -1,11 +1,17 @@
 // Loading a scenario with all its sections. See scenario.hpp.
 #include "terracut/session/scenario.hpp"
 
+#include <cmath>
+#include <deque>
+#include <numbers>
+
 #include "terracut/bullet/bodies_yaml.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
 #include "terracut/haptics/settings_yaml.hpp"
 #include "terracut/io/image.hpp"
+#include "terracut/io/scenario_ranges.hpp"
+#include "terracut/net/emulator.hpp"
 
 namespace terracut::session {
 
@@ -27,7 +33,46 @@ Scenario read_with_sections(Load&& load) {
   return out;
 }
 
+// The gathered table: its paths are owned here (a deque keeps them in place).
+struct RangeTable {
+  std::deque<std::string> paths;
+  std::vector<Range> entries;
+
+  // The entries of a struct's table under prefix. Angles, radians in the
+  // structs ("_rad"), are degrees in the file ("_deg").
+  void add(std::string_view prefix, std::span<const Range> table) {
+    for (Range r : table) {
+      std::string path = std::string(prefix) + std::string(r.path);
+      if (path.ends_with("_rad")) {
+        path.replace(path.size() - 4, 4, "_deg");
+        // Degrees as written (90, not 90.00000000000001); the struct's check,
+        // in radians, keeps the ends open or closed as declared.
+        const auto degrees = [](double rad) { return std::round(rad * 180.0 / std::numbers::pi * 1e9) / 1e9; };
+        r.lo = degrees(r.lo);
+        r.hi = degrees(r.hi);
+      }
+      r.path = paths.emplace_back(std::move(path));
+      entries.push_back(r);
+    }
+  }
+};
+
 }  // namespace
+
+std::span<const Range> scenario_ranges() {
+  static const RangeTable table = [] {
+    RangeTable t;
+    t.add("", io::scenario_ranges());
+    t.add("haptics.", haptics::haptic_settings_ranges());
+    t.add("haptics.forces.", force_ranges());
+    t.add("haptics.safety.", safety_ranges());
+    t.add("bodies[].", body_ranges());
+    t.add("mmt.", mmt_ranges());
+    t.add("mmt.link.", net::link_ranges());
+    return t;
+  }();
+  return table.entries;
+}
 
 Scenario load_scenario(const std::filesystem::path& path) {
   return read_with_sections(

@@ -124,7 +124,7 @@ TEST(ParseBodies, ErrorsNameFileLineAndField) {
   // Line numbers are 1-based lines of the text (line 1 is "bodies:").
   EXPECT_EQ(error_of("bodies:\n  - shape: box\n    size_m: [0.1, -0.2, 0.1]\n    mass_kg: 1\n"
                      "    position_m: [0, 0, 0]\n"),
-            "scene.yaml:3: bodies[0].size_m[1]: must be in (0, 1000] metres, got -0.2");
+            "scene.yaml:3: bodies[0].size_m[1]: must be in (0, 1000], got -0.2");
   EXPECT_EQ(error_of("bodies:\n  - shape: cube\n"),
             "scene.yaml:2: bodies[0].shape: unknown shape 'cube'; allowed: box, sphere, cylinder");
   EXPECT_EQ(error_of("bodies:\n  - shape: sphere\n    radius_m: 0.1\n    size_m: [1, 1, 1]\n"

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "terracut/core/math.hpp"
+#include "terracut/core/ranges.hpp"
 
 namespace terracut {
 
@@ -65,6 +66,9 @@ struct BodySpec {
 /// Returns an empty string when spec is valid, else a message naming the bad
 /// field, e.g. "radius_m must be > 0, got -1" (the caller adds which body).
 std::string validate(const BodySpec& spec);
+/// The ranges of BodySpec's numbers, which validate() checks (core/ranges.hpp);
+/// size_m[i] for each edge of a box.
+std::span<const Range> body_ranges();
 
 /// Checks a list of bodies: each one (validate above) and that names are
 /// unique. Returns an empty string when valid, else a message naming the body

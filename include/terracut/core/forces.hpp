@@ -26,6 +26,7 @@
 
 #include <numbers>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -33,6 +34,7 @@
 #include "terracut/core/contact.hpp"
 #include "terracut/core/grid.hpp"
 #include "terracut/core/math.hpp"
+#include "terracut/core/ranges.hpp"
 #include "terracut/core/surface.hpp"
 
 namespace terracut {
@@ -412,6 +414,12 @@ struct ForceModelParams {
 /// check, which the ForceModel constructor applies), else a message naming
 /// the field.
 std::string validate(const ForceModelParams& params);
+/// The ranges of ForceModelParams' settable fields, by their paths in it
+/// ("surface.stiffness_n_per_m", "earthmoving.soil.cohesion_pa"), which the
+/// validate() functions of these structs check (core/ranges.hpp). Angles in
+/// radians. The fields the session derives (workspace_scale, loop_rate_hz,
+/// max_contact_length_m) are not in it.
+std::span<const Range> force_ranges();
 
 /// The device check made at construction, all in device units.
 struct RenderingCheck {

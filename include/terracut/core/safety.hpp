@@ -20,9 +20,11 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 
 #include "terracut/core/math.hpp"
+#include "terracut/core/ranges.hpp"
 
 namespace terracut {
 
@@ -49,6 +51,8 @@ struct SafetyParams {
 
 /// Returns an empty string when params are valid, else a message naming the field.
 std::string validate(const SafetyParams& params);
+/// The ranges of SafetyParams' fields, which validate() checks (core/ranges.hpp).
+std::span<const Range> safety_ranges();
 
 /// What the limiter did to one sample (for a recorder to log).
 struct SafetyFlags {

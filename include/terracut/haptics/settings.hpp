@@ -25,11 +25,13 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
 #include "terracut/core/forces.hpp"
 #include "terracut/core/math.hpp"
+#include "terracut/core/ranges.hpp"
 #include "terracut/core/safety.hpp"
 
 namespace terracut::haptics {
@@ -156,6 +158,9 @@ struct HapticSettings {
 /// every field, including forces and safety (not the device-rendering check,
 /// which the ForceModel constructor makes).
 std::string validate(const HapticSettings& s);
+/// The ranges of HapticSettings' own numbers, which validate() checks
+/// (core/ranges.hpp; forces and safety: force_ranges(), safety_ranges()).
+std::span<const Range> haptic_settings_ranges();
 
 /// The settings with the derived force fields filled in: forces.workspace_scale
 /// = workspace.scale, forces.loop_rate_hz = rate_hz and

@@ -33,6 +33,7 @@
 
 #include "terracut/core/format.hpp"
 #include "terracut/core/math.hpp"
+#include "terracut/core/ranges.hpp"
 
 namespace terracut::io::yaml {
 
@@ -40,7 +41,7 @@ namespace terracut::io::yaml {
 /// time, rate, force or stiffness of a scenario comes near it in SI units,
 /// and larger values would overflow float heights or volumes. It also keeps
 /// every whole number inside an int.
-inline constexpr double kMaxMagnitude = 1e9;
+inline constexpr double kMaxMagnitude = kRangeMax;
 
 /// A node for messages: "'text'" for a scalar, "a list", "a mapping",
 /// "nothing" for null, "an undefined value" otherwise.
@@ -105,7 +106,8 @@ class Context {
 YAML::Node parse_text(const Context& ctx, const std::string& text,
                       std::string_view malformed = "malformed YAML");
 
-struct Range;
+/// An entry of a table of ranges (core/ranges.hpp).
+using Range = terracut::Range;
 
 /// One value of the document with its field path (e.g. "cuts[0].keyframes[1].t_s")
 /// and the line errors about it report: its own mark, or the mark of the key
@@ -154,7 +156,7 @@ class Field {
   /// number(), >= 0.
   double non_negative() const;
   /// Whether the ends of a range belong to it.
-  enum class Ends { kClosed, kOpenLow, kOpenHigh, kOpen };
+  using Ends = RangeEnds;
   /// number() in the range from lo to hi: [lo, hi] (kClosed), (lo, hi]
   /// (kOpenLow), [lo, hi) (kOpenHigh) or (lo, hi) (kOpen). The error writes
   /// the range that way: "must be in (0, 1000], got 1500".
@@ -195,26 +197,15 @@ class Field {
   YAML::Mark fallback_;
 };
 
-/// The range of one number of a section, declared in its reader's table of
-/// ranges (one table per reader, e.g. io::scenario_ranges()): the reader
-/// reads the field with Field::in(range), and the boundary tests are
-/// generated from the same table (each end, and just beyond it). Reading
-/// follows the toolkit's own checks, so the messages are theirs: whole
-/// numbers by integer_in, (0, 1e9] by positive ("must be > 0"), [0, 1e9] by
-/// non_negative, anything else by in_range ("must be in (0, 1e6]").
-struct Range {
-  /// Where the number is, relative to the section: "rate_hz",
-  /// "terrain.size_m[0]"; "[]" for every element of a list ("cuts[].keyframes[].t_s").
-  std::string_view path;
-  double lo = -kMaxMagnitude;
-  double hi = kMaxMagnitude;
-  Field::Ends ends = Field::Ends::kClosed;
-  bool whole = false;  ///< a whole number (lo and hi whole too)
-};
+// A Range (core/ranges.hpp) read from a file: the reader reads the field with
+// Field::in(range), and the boundary tests are generated from the same table
+// (each end, and just beyond it). Reading follows the toolkit's own checks,
+// so the messages are theirs: whole numbers by integer_in, (0, 1e9] by
+// positive ("must be > 0"), [0, 1e9] by non_negative, anything else by
+// in_range ("must be in (0, 1e6]").
 
-/// The entry of table for path; a path missing from the table is a
-/// programming error (std::logic_error).
-const Range& find_range(std::span<const Range> table, std::string_view path);
+/// The entry of table for path (core's find_range).
+using terracut::find_range;
 
 /// A mapping with a fixed set of allowed keys. Unknown keys (the error lists
 /// the allowed ones), repeated keys (the error names the first one's line)

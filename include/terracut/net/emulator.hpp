@@ -22,7 +22,10 @@
 #include <cstdint>
 #include <optional>
 #include <random>
+#include <span>
 #include <string>
+
+#include "terracut/core/ranges.hpp"
 
 namespace terracut::net {
 
@@ -50,6 +53,8 @@ struct LinkConditions {
 
 /// Empty when valid, else a message naming the field ("delay_s must be ...").
 std::string validate(const LinkConditions& c);
+/// The ranges of LinkConditions' numbers, which validate() checks (core/ranges.hpp).
+std::span<const Range> link_ranges();
 
 /// Counters of one direction.
 struct EmulatorCounters {

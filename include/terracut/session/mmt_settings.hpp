@@ -5,9 +5,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "terracut/core/forces.hpp"
+#include "terracut/core/ranges.hpp"
 #include "terracut/io/scenario.hpp"
 #include "terracut/net/emulator.hpp"
 
@@ -59,6 +61,10 @@ struct MmtSettings {
 
 /// Empty when valid, else a message starting with the field's path.
 std::string validate(const MmtSettings& s);
+/// The ranges of the `mmt:` section's own numbers, by their paths in it
+/// (core/ranges.hpp): validate() checks them, the reader reads link.seed and
+/// link_id through them. link:'s conditions: net::link_ranges().
+std::span<const Range> mmt_ranges();
 
 /// Reads `mmt:` (registered by load_scenario).
 class MmtReader final : public io::SectionReader {

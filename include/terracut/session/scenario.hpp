@@ -6,6 +6,7 @@
 #pragma once
 
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,15 @@ Scenario load_scenario(const std::filesystem::path& path);
 /// source_name (used in messages; relative image paths are resolved against
 /// its folder). Throws InputError as load_scenario.
 Scenario parse_scenario(const std::string& text, const std::filesystem::path& source_name);
+
+/// Every ranged number of a scenario file, by its path from the file's top
+/// level, in the file's units (angles in degrees): the io reader's table
+/// (io::scenario_ranges()) and the tables of the structs the `haptics:`,
+/// `bodies:` and `mmt:` sections fill ("haptics.safety.max_force_n",
+/// "bodies[].mass_kg", "mmt.link.loss"), gathered from the layers that
+/// declare them. The boundary tests and docs/scenarios.md's table of ranges
+/// are generated from it.
+std::span<const Range> scenario_ranges();
 
 /// A bare heightmap as a scenario (the viewer's PNG input): the image at its
 /// own resolution over extent_m x extent_m, a white pixel full_scale_m high,
