@@ -272,7 +272,8 @@ void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
         const double s = std::clamp(((x - edge.a.x) * d.x + (z - edge.a.z) * d.z) /
                                         (plan_length * plan_length),
                                     0.0, 1.0);
-        if (std::hypot(x - (edge.a.x + d.x * s), z - (edge.a.z + d.z * s)) > radius) continue;
+        const double ex = x - (edge.a.x + d.x * s), ez = z - (edge.a.z + d.z * s);
+        if (ex * ex + ez * ez > radius * radius) continue;
         near_blade_[i] = 1;
         marked_.push_back(i);
       }
@@ -504,7 +505,19 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   const float tol = tolerance_m_;
   const bool blade = blade_.present;
   const bool open_edge = params_.edge == SoilEdge::kOpen;
+  const bool obstacles = !obstacles_.empty();
   const double cell_area = dx_ * dz_;
+  const std::uint32_t cols = std::uint32_t(cols_);
+  // The neighbours as index offsets and their limits, in kNeighbours' order.
+  std::int64_t offset[8];
+  float limit[8];
+  for (int k = 0; k < 8; ++k) {
+    offset[k] = std::int64_t(kNeighbours[k].dr) * cols_ + kNeighbours[k].dc;
+    limit[k] = float(limit_[kNeighbours[k].kind]);
+  }
+  // A cell off the grid's border has all 8 neighbours on the grid.
+  const auto interior = [&](int c, int r) { return c > 0 && r > 0 && c < cols_ - 1 && r < rows_ - 1; };
+  int changed_c0 = cols_, changed_c1 = -1, changed_r0 = rows_, changed_r1 = -1;
   while (!active_.empty()) {
     double left_m = 0.0;  // height that slid off the grid in this pass
     // A pass is run whole or not at all (its fluxes come from one frozen
@@ -513,39 +526,51 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
     const std::int64_t pass_checks = 8 * std::int64_t(active_.size());
     if (out.passes > 0 && out.pair_checks + pass_checks > params_.max_pair_checks_per_step) break;
     ++out.passes;
+    out.pair_checks += pass_checks;
     // Each active cell sheds half of its steepest excess, shared among its
     // lower neighbours in proportion to their excess (from the heights
     // frozen at the pass's start).
     for (std::uint32_t a : active_) {
       queued_[a] = 0;
-      const int ca = int(a % std::uint32_t(cols_)), ra = int(a / std::uint32_t(cols_));
+      const int ca = int(a % cols), ra = int(a / cols);
+      const bool inside = interior(ca, ra);
       const float ha = h[a];
       std::uint32_t lower[8];
       float excess[8];
       int n = 0;
       float max_excess = 0.0f, sum_excess = 0.0f;
-      for (const Neighbour& nb : kNeighbours) {
-        const int cb = ca + nb.dc, rb = ra + nb.dr;
-        const bool outside = cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_;
-        // Beyond an open edge lies bare ground (height 0) that takes what
-        // slides onto it; a wall takes nothing.
-        if (outside && !open_edge) continue;
-        const std::uint32_t b = outside ? kOutside : std::uint32_t(std::int64_t(rb) * cols_ + cb);
-        const float e = ha - (outside ? 0.0f : h[b]) - float(limit_[nb.kind]);
+      for (int k = 0; k < 8; ++k) {
+        std::uint32_t b = std::uint32_t(std::int64_t(a) + offset[k]);
+        float hb = 0.0f;
+        if (inside) {
+          hb = h[b];
+        } else {
+          const int cb = ca + kNeighbours[k].dc, rb = ra + kNeighbours[k].dr;
+          // Beyond an open edge lies bare ground (height 0) that takes what
+          // slides onto it; a wall takes nothing.
+          if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_) {
+            if (!open_edge) continue;
+            b = kOutside;
+          } else {
+            hb = h[b];
+          }
+        }
+        const float e = ha - hb - limit[k];
         if (!(e > tol)) continue;
-        // The blade is a wall between the cells on its two sides, and soil
-        // does not flow into the cells it passes through.
-        if (blade && !outside && near_blade_[a] && near_blade_[b] && blade_blocks(a, b, ha)) continue;
-        // Nor into a rigid body: not once the receiving cell's soil would
-        // rise (by at most half the excess) into its underside.
-        if (!outside && obstructed(b, h[b] + kShedFraction * e)) continue;
+        if (b != kOutside) {
+          // The blade is a wall between the cells on its two sides, and soil
+          // does not flow into the cells it passes through.
+          if (blade && near_blade_[a] && near_blade_[b] && blade_blocks(a, b, ha)) continue;
+          // Nor into a rigid body: not once the receiving cell's soil would
+          // rise (by at most half the excess) into its underside.
+          if (obstacles && obstructed(b, hb + kShedFraction * e)) continue;
+        }
         lower[n] = b;
         excess[n] = e;
         ++n;
         max_excess = std::max(max_excess, e);
         sum_excess += e;
       }
-      out.pair_checks += 8;
       if (n == 0) continue;
       const float share = kShedFraction * max_excess / sum_excess;
       if (delta_[a] == 0.0f) touched_.push_back(a);
@@ -562,9 +587,11 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       out.moved_pairs += n;
     }
     active_.clear();
-    // Apply the pass. A cell that rose may now be too steep toward its
-    // lower neighbours; one that fell may have made its higher neighbours
-    // too steep toward it: they are examined in the next pass.
+    // Apply the pass. A cell that changed is examined in the next pass; a
+    // neighbour of one that fell, when the pair between them is now too
+    // steep. That is exact: only that pair of the neighbour changed (a
+    // neighbour that changed itself is examined anyway), and a cell not
+    // active had no excess above the tolerance toward any neighbour.
     // The fluxes cancel exactly; the float heights do not quite: what the
     // pass gained or lost by rounding is measured in double and given back
     // to the highest cell it changed, so no bias builds up over a run.
@@ -576,22 +603,31 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       delta_[t] = 0.0f;
       if (d == 0.0f) continue;  // fluxes that cancelled
       const float old = h[t];
-      h[t] = std::max(0.0f, h[t] + d);
-      gained += double(h[t]) - double(old);
-      if (h[t] > highest_h) {
-        highest_h = h[t];
+      const float now = std::max(0.0f, old + d);
+      h[t] = now;
+      gained += double(now) - double(old);
+      if (now > highest_h) {
+        highest_h = now;
         highest = t;
       }
-      layers.removed_m[t] = layers.initial_m[t] - h[t];
-      const int ct = int(t % std::uint32_t(cols_)), rt = int(t / std::uint32_t(cols_));
-      out.changed.include(ct, rt);
+      layers.removed_m[t] = layers.initial_m[t] - now;
+      const int ct = int(t % cols), rt = int(t / cols);
+      changed_c0 = std::min(changed_c0, ct);
+      changed_c1 = std::max(changed_c1, ct);
+      changed_r0 = std::min(changed_r0, rt);
+      changed_r1 = std::max(changed_r1, rt);
       activate(t);
-      if (d < 0.0f)
-        for (const Neighbour& nb : kNeighbours) {
-          const int c = ct + nb.dc, r = rt + nb.dr;
-          if (c >= 0 && r >= 0 && c < cols_ && r < rows_)
-            activate(std::uint32_t(std::int64_t(r) * cols_ + c));
+      if (!(d < 0.0f)) continue;
+      const bool inside = interior(ct, rt);
+      for (int k = 0; k < 8; ++k) {
+        if (!inside) {
+          const int c = ct + kNeighbours[k].dc, r = rt + kNeighbours[k].dr;
+          if (c < 0 || r < 0 || c >= cols_ || r >= rows_) continue;
         }
+        const std::uint32_t b = std::uint32_t(std::int64_t(t) + offset[k]);
+        // The pair's limit is the same both ways (offsets come in opposite pairs).
+        if (h[b] - now - limit[k] > tol) activate(b);
+      }
     }
     if (gained != 0.0 && highest_h > 0.0f) {
       h[highest] = float(std::max(0.0, double(h[highest]) - gained));
@@ -600,13 +636,16 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
     out.left_over_edge_m3 += left_m * cell_area;
     touched_.clear();
   }
+  if (changed_c1 >= 0) {
+    out.changed.include(changed_c0, changed_r0);
+    out.changed.include(changed_c1, changed_r1);
+  }
   out.backlog_cells = std::int64_t(active_.size());
 }
 
 SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const Segment& to,
                                    const Quat& orientation) {
   SoilStepResult out;
-  mark_blade(grid, to);
   double room = 0.0, holds = 0.0;
   if (blade_spec_.bucket.enabled()) {
     holds = bucket_retained_m3(blade_spec_, orientation, params_.repose_deg);
@@ -624,8 +663,12 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     load_m3_ = holds;
   }
   out.bucket_load_m3 = load_m3_;
-  run_passes(grid, out);
-  clear_blade();
+  // The blade's wall matters only to a pass: marked only when one runs.
+  if (!active_.empty()) {
+    mark_blade(grid, to);
+    run_passes(grid, out);
+    clear_blade();
+  }
   return out;
 }
 
