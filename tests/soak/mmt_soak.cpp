@@ -95,7 +95,8 @@ class HostileEndpoint final : public net::Endpoint {
   }
   const net::LinkEmulator& emulator() const override { return inner_.emulator(); }
 
-  void receive(double now_s, std::vector<std::vector<std::uint8_t>>& out) override {
+  using net::Endpoint::receive;
+  void receive(double now_s, net::Inbox& out) override {
     real_.clear();
     inner_.receive(now_s, real_);
     const bool outage = outage_.active(now_s);
@@ -107,7 +108,7 @@ class HostileEndpoint final : public net::Endpoint {
       net::Header h;
       if (net::decode_header(d.data(), d.size(), link_, h) == net::Reject::kNone) remember(h, d);
       ++delivered;
-      out.push_back(std::move(d));
+      out.push(d.data(), d.size());
     }
     if (uniform() < 0.3) {
       const int n = uniform() < 0.05 ? 1 + int(uniform() * 64) : 1;  // a flood, now and then
@@ -209,16 +210,16 @@ class HostileEndpoint final : public net::Endpoint {
     return kinds[pick(3)];
   }
 
-  void inject(Bytes d, net::Reject expect, std::vector<std::vector<std::uint8_t>>& out) {
+  void inject(Bytes d, net::Reject expect, net::Inbox& out) {
     ++hostile;
     if (expect == net::Reject::kNone)
       ++forged;
     else
       expected.add(expect);
-    out.push_back(std::move(d));
+    out.push(d.data(), d.size());
   }
 
-  void attack(double now_s, bool outage, std::vector<std::vector<std::uint8_t>>& out) {
+  void attack(double now_s, bool outage, net::Inbox& out) {
     const net::MessageType t = received_kind();
     const Last& last = last_[std::size_t(t)];
     // A valid datagram to damage: the last accepted one, or a forged one.
