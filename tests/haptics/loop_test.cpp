@@ -204,7 +204,8 @@ TEST(HapticLoop, ScriptTrenchForcesFollowTheContact) {
         top_h = h(row, col);
         top_z = z;
       }
-      for (const auto [dr, dc] : {std::pair{0, 1}, std::pair{1, 0}, std::pair{1, 1}, std::pair{1, -1}}) {
+      for (const auto& [dr, dc] :
+           {std::pair{0, 1}, std::pair{1, 0}, std::pair{1, 1}, std::pair{1, -1}}) {
         const int r2 = row + dr, c2 = col + dc;
         if (r2 >= spec.rows || c2 < 0 || c2 >= spec.cols) continue;
         const double dist = std::hypot(dr * spec.cell_z_m(), dc * spec.cell_x_m());
