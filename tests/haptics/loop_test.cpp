@@ -10,9 +10,11 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <utility>
 
 #include "haptics_fixture.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/haptics/cut_depth.hpp"
 #include "terracut/haptics/script_device.hpp"
 #include "terracut/haptics/sim_hand.hpp"
 #include "terracut/io/scenario.hpp"
@@ -40,21 +42,67 @@ std::int64_t ticks_of(const HapticSettings& s) {
   return std::llround((trench_cut().duration_s() + s.settle_s) * s.rate_hz);
 }
 
+// The trench's soil flows: after each step, what the loop's earthmoving
+// model is given (the depth ahead and the pile over the failure wedge,
+// read from the same grid the loop reads).
+// The highest soil on a grid, world metres: at the end of the trench, the
+// pile's top, above which the rising blade has left all soil.
+double soil_top_m(const HeightGrid& grid) {
+  const std::size_t n = std::size_t(grid.spec().rows) * std::size_t(grid.spec().cols);
+  return grid.spec().origin_m.y + *std::max_element(grid.heights(), grid.heights() + n);
+}
+
+// Out of the soil: no contact, above the floor, and before the plunge or
+// above the pile's top as the blade rises out (rising through the pile,
+// the pile's sides still rub on the blade's faces: the penetration model's
+// friction, with no contact of the edge).
+bool out_of_soil(const LoopRecord& r, double top_m) {
+  return r.contact_length_m == 0.0 && r.tool.position_m.y > 0.0 &&
+         (r.t_s < 1.0 || r.tool.position_m.y > top_m);
+}
+
+class PileProbe final : public StepListener {
+ public:
+  explicit PileProbe(std::size_t steps) { ahead.reserve(steps); }
+  Vec3 on_step(const StepOutput& out) noexcept override {
+    // The script device moves along -Z while cutting; soil_ahead only uses
+    // the direction of the velocity.
+    ahead.push_back(soil_ahead(sim->grid(), sim->params().representation, out.edge,
+                               Vec3{0.0, 0.0, -1.0}, depth_lookahead_m(sim->grid().spec())));
+    return {};
+  }
+  const Simulation* sim = nullptr;
+  std::vector<SoilAhead> ahead;
+};
+
 TEST(HapticLoop, ScriptTrenchForcesFollowTheContact) {
   const HapticSettings& s = trench().haptics;
+  const io::Scenario& sc = trench().scenario;
+  ASSERT_EQ(sc.soil.model, SoilModel::kFlow);  // the trench's sand flows
   ScriptDevice device(trench_path(s));
-  auto loop = trench_loop(s, device, ticks_of(s));
+  PileProbe probe(std::size_t(ticks_of(s)));
+  auto loop = test::make_loop_rig(s, sc, sc.cuts[0].keyframes[0].pose.orientation, device,
+                                  test::test_loop_options(ticks_of(s)), {&probe});
+  probe.sim = loop.sim.get();
   loop->run_deterministic();
   const std::vector<LoopRecord> rs = loop->records();
   ASSERT_EQ(std::int64_t(rs.size()), ticks_of(s));
+  ASSERT_EQ(probe.ahead.size(), rs.size());  // one step per tick
 
   const SoilParams soil = s.forces.earthmoving.soil;
   const double cell = 2.0 / 100;  // the scenario's cell size, metres
+  const double gamma = soil.unit_weight_n_per_m3;
+  const double tan_repose = std::tan(sc.soil.repose_deg * std::numbers::pi / 180.0);
+  const HeightGrid& grid = loop->simulation().grid();
+  const std::size_t samples = std::size_t(grid.spec().rows) * std::size_t(grid.spec().cols);
+  const double top = soil_top_m(grid);
   int cutting = 0, outside = 0;
-  for (const LoopRecord& r : rs) {
+  double first_pile = -1.0, last_pile = 0.0, first_h = 0.0, last_h = 0.0;
+  for (std::size_t i = 0; i < rs.size(); ++i) {
+    const LoopRecord& r = rs[i];
     // Never more than the Falcon's maximum.
     ASSERT_LE(length(r.force_device_n), s.safety.max_force_n * (1 + 1e-12)) << r.t_s;
-    if (r.contact_length_m == 0.0 && r.tool.position_m.y > 0.0) {
+    if (out_of_soil(r, top)) {
       // Out of the soil and above the floor: exactly no force.
       ++outside;
       EXPECT_EQ(length(r.force_world_n), 0.0) << r.t_s;
@@ -63,19 +111,39 @@ TEST(HapticLoop, ScriptTrenchForcesFollowTheContact) {
     // Steady cutting along -Z at 1 m/s, 8 cm deep, after the soft start.
     if (r.t_s > 1.8 && r.t_s < 2.6) {
       ++cutting;
+      const SoilAhead& a = probe.ahead[i];
       EXPECT_NEAR(r.contact_length_m, 0.4, 1e-9) << r.t_s;    // the whole blade is in the sand
       EXPECT_NEAR(r.cut_depth_m, 0.08, 0.5 * cell) << r.t_s;  // sand at 0.3, edge at 0.22
+      EXPECT_NEAR(a.depth_m, 0.08, 0.5 * cell) << r.t_s;      // the pile is not depth of cut
       EXPECT_NEAR(r.velocity_m_per_s.z, -1.0, 1e-6) << r.t_s;
+      // The pile ahead stands above the sand, and no higher than the 2-D
+      // bulldozing balance allows: all the cut soil (w d x, x pushed since
+      // the plunge began at z = 0.75) in a wedge at the repose angle,
+      // h = sqrt(2 d x tan(repose)), plus a cell's rise.
+      const double pushed = 0.75 - r.tool.position_m.z;
+      EXPECT_GT(a.pile_m, 0.0) << r.t_s;
+      EXPECT_LT(a.pile_m, std::sqrt(2.0 * 0.08 * pushed * tan_repose) + cell * tan_repose)
+          << r.t_s;
       // The soil resists the motion (+Z on the tool) and lifts the vertical
-      // plate (McKyes: V < 0 for alpha = 90 deg): the FEE at this width and depth.
+      // plate (McKyes: V < 0 for alpha = 90 deg): the FEE at this width and
+      // depth with the pile's weight on the failure wedge as its surcharge.
       EarthmovingParams ep;
       ep.soil = soil;
+      ep.soil.surcharge_pa += gamma * a.pile_m;
       ep.rake_angle_rad = s.forces.earthmoving.rake_angle_rad;
-      const EarthmovingResult fee = earthmoving_force(ep, 0.4, r.cut_depth_m);
+      const EarthmovingResult fee = earthmoving_force(ep, a.width_m, a.depth_m);
       EXPECT_GT(fee.horizontal_n, 0.0);
+      // Below the low-speed damper's cap (beta |v|): the operator feels the pile.
+      EXPECT_LT(fee.horizontal_n, s.forces.low_speed_damping_n_s_per_m * 1.0) << r.t_s;
       EXPECT_NEAR(r.force_world_n.z, fee.horizontal_n, 1e-6 * fee.horizontal_n) << r.t_s;
       EXPECT_NEAR(r.force_world_n.y, -fee.vertical_n, 1e-6 * fee.horizontal_n) << r.t_s;
       EXPECT_NEAR(r.force_world_n.x, 0.0, 1e-9);
+      if (first_pile < 0.0) {
+        first_pile = a.pile_m;
+        first_h = r.force_world_n.z;
+      }
+      last_pile = a.pile_m;
+      last_h = r.force_world_n.z;
       // On the device: scaled by force_scale and turned into the device frame
       // (world +Z is "toward the operator", device +x; world +Y is device +z).
       if (r.flags == 0) {
@@ -87,12 +155,66 @@ TEST(HapticLoop, ScriptTrenchForcesFollowTheContact) {
   }
   EXPECT_GT(outside, 1000);
   EXPECT_EQ(cutting, 799);
+  // The pile grows as the blade pushes, and the force with it: more than
+  // without any pile (the FEE of the bare cut) and more at the end than at
+  // the start of the steady cut.
+  EarthmovingParams bare;
+  bare.soil = soil;
+  bare.rake_angle_rad = s.forces.earthmoving.rake_angle_rad;
+  const double h0 = earthmoving_force(bare, 0.4, 0.08).horizontal_n;
+  EXPECT_GT(first_h, h0);
+  EXPECT_GT(last_pile, first_pile + cell * tan_repose);
+  EXPECT_GT(last_h, first_h);
 
-  // The trench: the region below the sand that the edge swept, times the
-  // blade's width: a 1.2 m x 8 cm floor plus two triangles where the blade
-  // goes in and out (each 0.092 m x 8 cm / 2). A cell's worth at each end.
-  const double area = 1.2 * 0.08 + 2 * 0.5 * (0.15 * 0.08 / 0.13) * 0.08;
-  EXPECT_NEAR(loop->simulation().removed_volume_m3(), 0.4 * area, 0.4 * 2 * cell * 0.08);
+  // Nothing vanishes: the soil's volume is the initial volume, to float32
+  // rounding of each sample (half an ulp of 0.5 m per sample, per cell area).
+  double initial = 0.0, now = 0.0;
+  for (std::size_t k = 0; k < samples; ++k) {
+    initial += grid.initial()[k];
+    now += grid.heights()[k];
+  }
+  const double cell_area = cell * cell;
+  EXPECT_NEAR(now * cell_area, initial * cell_area, double(samples) * 3e-8 * cell_area);
+  // The trench: its floor on the centre line stays at the cut level (the
+  // edge went to 0.22 m and nothing digs deeper; the toes of the walls that
+  // slumped at the repose angle reach the middle by at most one cell's rise
+  // at that angle), the pile's top is ahead of where the cut ended
+  // (z < -0.6), windrows stand beside the trench (soil spilled round the
+  // blade's ends), and every slope has relaxed to the repose angle
+  // (within the relaxation's stated tolerance, 2 % of the repose slope).
+  const GridSpec& spec = grid.spec();
+  const auto h = [&](int row, int col) { return double(grid.height(col, row)); };
+  const int mid_col = spec.cols / 2;
+  double top_z = 0.0, top_h = 0.0;
+  for (int row = 0; row < spec.rows; ++row) {
+    const double z = spec.origin_m.z + (row + 0.5) * spec.cell_z_m();
+    if (std::abs(z) < 0.4) {
+      EXPECT_GE(h(row, mid_col), 0.22 - 1e-6) << "z = " << z;
+      EXPECT_LE(h(row, mid_col), 0.22 + cell * tan_repose) << "z = " << z;
+      // Beside the trench (|x| in 0.2 .. 0.4 m), higher than the sand was.
+      double berm = 0.0;
+      for (int col = 0; col < spec.cols; ++col) {
+        const double x = spec.origin_m.x + (col + 0.5) * spec.cell_x_m();
+        if (std::abs(x) > 0.2 && std::abs(x) < 0.4) berm = std::max(berm, h(row, col));
+      }
+      EXPECT_GT(berm, 0.3 + cell * tan_repose) << "z = " << z;
+    }
+    for (int col = 0; col < spec.cols; ++col) {
+      if (h(row, col) > top_h) {
+        top_h = h(row, col);
+        top_z = z;
+      }
+      for (const auto& [dr, dc] :
+           {std::pair{0, 1}, std::pair{1, 0}, std::pair{1, 1}, std::pair{1, -1}}) {
+        const int r2 = row + dr, c2 = col + dc;
+        if (r2 >= spec.rows || c2 < 0 || c2 >= spec.cols) continue;
+        const double dist = std::hypot(dr * spec.cell_z_m(), dc * spec.cell_x_m());
+        EXPECT_LE(std::abs(h(r2, c2) - h(row, col)), 1.02 * tan_repose * dist)
+            << row << "," << col << " to " << r2 << "," << c2;
+      }
+    }
+  }
+  EXPECT_LT(top_z, -0.6);
   EXPECT_EQ(loop->counters().bad_samples, 0);
   EXPECT_EQ(loop->safety().counters().nonfinite, 0);
 }
@@ -321,13 +443,14 @@ TEST(HapticLoop, SimHandTrenchStaysBoundedAndDigs) {
 
   double max_force = 0.0;
   int cutting_with_force = 0, cutting = 0;
+  const double top = soil_top_m(loop->simulation().grid());
   for (const LoopRecord& r : rs) {
     max_force = std::max(max_force, length(r.force_device_n));
     if (r.contact_length_m > 0.2 && r.t_s > 1.8 && r.t_s < 2.6) {
       ++cutting;
       if (r.force_device_n.x > 0.1) ++cutting_with_force;  // resists the push along -x
     }
-    if (r.contact_length_m == 0.0 && r.tool.position_m.y > 0.0) {
+    if (out_of_soil(r, top)) {
       EXPECT_EQ(length(r.force_device_n), 0.0) << r.t_s;
     }
   }

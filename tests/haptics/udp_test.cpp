@@ -155,7 +155,13 @@ TEST(UdpBridge, BindErrorsNameTheSetting) {
 // The running loop (its own thread) and a device-player thread exchanging
 // poses and forces over loopback until the loop's ticks are done.
 TEST(UdpBridge, RoundTripBetweenAPlayerThreadAndTheLoop) {
-  const test::HapticScenario& in = test::trench();
+  // The bridge's round trip on the paper's soil model: the player follows
+  // the path in real time and the checks below need the loop's 300 ticks
+  // done before the path leaves the cutting part (1.1 s of wall time);
+  // flowing soil's relaxation, much slower under ThreadSanitizer, made
+  // the loop miss that window there. The soil is not what this test is about.
+  test::HapticScenario in = test::trench();
+  in.scenario.soil.model = SoilModel::kVanish;
   HapticSettings s = in.haptics;
   s.device = DeviceKind::kUdp;
   UdpDevice device("127.0.0.1", 0);

@@ -24,9 +24,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-TEST(BodiesEngineAllocation, TicksAllocateNothingOnceBulletIsWarm) {
+// The rock session with the given soil model: allocations are counted after
+// the plate's first touch, to the end.
+void expect_no_allocation_once_warm(SoilModel model) {
   ASSERT_TRUE(g_installed);
-  const Scenario in = load_scenario(fs::path(TERRACUT_SOURCE_DIR) / "scenarios/rock_push.yaml");
+  Scenario in = load_scenario(fs::path(TERRACUT_SOURCE_DIR) / "scenarios/rock_push.yaml");
+  in.base.soil.model = model;
   const fs::path dir = fs::temp_directory_path() / ("terracut_bodies_alloc_" + std::to_string(getpid()));
   fs::create_directories(dir);
   const io::Scenario& sc = in.base;
@@ -77,6 +80,16 @@ TEST(BodiesEngineAllocation, TicksAllocateNothingOnceBulletIsWarm) {
                        << " ticks of pushing the rock and leaving it";
   EXPECT_GT(peak, 0.0);
   fs::remove_all(dir);
+}
+
+TEST(BodiesEngineAllocation, TicksAllocateNothingOnceBulletIsWarm) {
+  expect_no_allocation_once_warm(SoilModel::kVanish);
+}
+
+// Soil that flows, banking against the rock (its obstacle set every step
+// by the bodies' listener) and sliding from under it: no allocation either.
+TEST(BodiesEngineAllocation, TicksWithFlowingSoilAllocateNothingOnceBulletIsWarm) {
+  expect_no_allocation_once_warm(SoilModel::kFlow);
 }
 
 }  // namespace
