@@ -587,11 +587,12 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       out.moved_pairs += n;
     }
     active_.clear();
-    // Apply the pass. A cell that changed is examined in the next pass; a
-    // neighbour of one that fell, when the pair between them is now too
-    // steep. That is exact: only that pair of the neighbour changed (a
-    // neighbour that changed itself is examined anyway), and a cell not
-    // active had no excess above the tolerance toward any neighbour.
+    // Apply the pass. A cell that changed is examined in the next pass, and
+    // so are all the neighbours of one that fell. (Waking only those whose
+    // pair with it became too steep would be exact if a cell left inactive
+    // never kept an excess; but soil the blade or a body holds up does, and
+    // is woken this way as the pile around it moves: with the narrower rule,
+    // the trench's walls stayed steeper than the repose angle.)
     // The fluxes cancel exactly; the float heights do not quite: what the
     // pass gained or lost by rounding is measured in double and given back
     // to the highest cell it changed, so no bias builds up over a run.
@@ -624,9 +625,7 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
           const int c = ct + kNeighbours[k].dc, r = rt + kNeighbours[k].dr;
           if (c < 0 || r < 0 || c >= cols_ || r >= rows_) continue;
         }
-        const std::uint32_t b = std::uint32_t(std::int64_t(t) + offset[k]);
-        // The pair's limit is the same both ways (offsets come in opposite pairs).
-        if (h[b] - now - limit[k] > tol) activate(b);
+        activate(std::uint32_t(std::int64_t(t) + offset[k]));
       }
     }
     if (gained != 0.0 && highest_h > 0.0f) {

@@ -37,8 +37,8 @@
 //
 // Cost follows activity: only cells whose height changed (and, once, at
 // construction, every cell steeper than the repose angle) are examined, and
-// a pass examines each active cell's 8 pairs; a cell that changed, and a neighbour of one that
-// fell whose pair with it is now too steep, are examined in the next pass. A step runs whole
+// a pass examines each active cell's 8 pairs; a cell that changed, and the neighbours of one
+// that fell, are examined in the next pass. A step runs whole
 // passes while the next fits in max_pair_checks_per_step (the first always runs); what is left
 // active is carried to the next step (the backlog), so a large collapse is spread over ticks.
 // A step with nothing active costs microseconds: the blade is marked only when a pass runs.
