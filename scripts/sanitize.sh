@@ -49,9 +49,9 @@ CCACHE_BASEDIR=$root cmake --build "$build" -j"$jobs"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ctest --test-dir "$build" --output-on-failure -j"$jobs" --timeout 600 -E "Viewer|install|tsan"
-# Every fuzz target for a bounded time (30 s of wall time each, five at once;
+# Every fuzz target for a bounded time (30 s of wall time, all six at once;
 # docs/reliability.md).
 seconds=${TERRACUT_FUZZ_SECONDS:-30}
 if [[ $fuzz == ON && $seconds != 0 ]]; then
-  TERRACUT_FUZZ_JOBS=${TERRACUT_FUZZ_JOBS:-5} "$root/scripts/fuzz.sh" "$seconds"
+  TERRACUT_FUZZ_JOBS=${TERRACUT_FUZZ_JOBS:-6} "$root/scripts/fuzz.sh" "$seconds"
 fi
