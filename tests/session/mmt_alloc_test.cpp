@@ -18,10 +18,16 @@
 #include "../support/counting_new.hpp"
 
 // Under AddressSanitizer malloc is the sanitizer's: only operator new is
-// counted there.
+// counted there (gcc says so with __SANITIZE_ADDRESS__, clang with
+// __has_feature).
 #if defined(__SANITIZE_ADDRESS__)
 #define TERRACUT_COUNT_MALLOC 0
-#else
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define TERRACUT_COUNT_MALLOC 0
+#endif
+#endif
+#ifndef TERRACUT_COUNT_MALLOC
 #define TERRACUT_COUNT_MALLOC 1
 #endif
 
