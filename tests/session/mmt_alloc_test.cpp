@@ -16,16 +16,12 @@
 #include "terracut/session/scenario.hpp"
 
 #include "../support/counting_new.hpp"
+#include "../support/peak_memory.hpp"
 
-// Under AddressSanitizer malloc is the sanitizer's: only operator new is
-// counted there (gcc says so with __SANITIZE_ADDRESS__, clang with
-// __has_feature).
-#if defined(__SANITIZE_ADDRESS__)
+// Under a sanitizer malloc is the sanitizer's: only operator new is counted
+// there (TERRACUT_TEST_SANITIZED, peak_memory.hpp).
+#if defined(TERRACUT_TEST_SANITIZED)
 #define TERRACUT_COUNT_MALLOC 0
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define TERRACUT_COUNT_MALLOC 0
-#endif
 #endif
 #ifndef TERRACUT_COUNT_MALLOC
 #define TERRACUT_COUNT_MALLOC 1

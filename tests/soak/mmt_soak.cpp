@@ -50,6 +50,7 @@
 #include <thread>
 #include <vector>
 
+#include "../support/peak_memory.hpp"
 #include "checking_device.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/core/wire.hpp"
@@ -68,14 +69,7 @@ namespace {
 // default) before they are reused, so resident memory there is no measure
 // of a leak: the slack is that quarantine, and LeakSanitizer checks leaks
 // at exit instead.
-#if defined(__SANITIZE_ADDRESS__)
-#define TERRACUT_SOAK_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define TERRACUT_SOAK_ASAN 1
-#endif
-#endif
-#ifdef TERRACUT_SOAK_ASAN
+#ifdef TERRACUT_TEST_SANITIZED
 constexpr std::int64_t kRssSlackBytes = std::int64_t(256) << 20;
 #else
 constexpr std::int64_t kRssSlackBytes = std::int64_t(4) << 20;
