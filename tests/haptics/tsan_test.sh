@@ -12,7 +12,7 @@ jobs=${TERRACUT_JOBS:-2}
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 CCACHE_BASEDIR=$source cmake -S "$source" -B "$scratch" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" "${launcher[@]}" \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" "${launcher[@]}" \
   -DCMAKE_CXX_FLAGS="-fsanitize=thread -Wno-tsan" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" \
   -DTERRACUT_TSAN=ON -DTERRACUT_BUILD_TESTS=OFF -DTERRACUT_BUILD_APPS=OFF -DTERRACUT_BUILD_BENCH=OFF \
   -DTERRACUT_BUILD_PYTHON=OFF >/dev/null
