@@ -54,7 +54,6 @@ inline void lower_one(const HeightGrid::EditLayers& layers, std::int64_t row, in
   float old = layers.height_m[row + c];
   if (!(h < old)) return;
   layers.height_m[row + c] = h;
-  layers.removed_m[row + c] = layers.initial_m[row + c] - h;
   change.removed_m += double(old - h);
   if (change.first < 0) change.first = c;
   change.last = c;
@@ -109,11 +108,11 @@ struct SpanResult {
 };
 
 /// HeightGrid::lower applied to the n samples from height[0] with targets
-/// t[0..n): each sample goes down to max(t, 0) when that is lower, and its
-/// removed layer to initial - height. Same values, bit for bit, as calling
-/// HeightGrid::lower per sample (only the order of the removed-height sum
-/// differs), four samples at a time with SSE2 where available.
-SpanResult lower_span(float* height, float* removed, const float* initial, const float* t, int n) {
+/// t[0..n): each sample goes down to max(t, 0) when that is lower. Same
+/// values, bit for bit, as calling HeightGrid::lower per sample (only the
+/// order of the removed-height sum differs), four samples at a time with
+/// SSE2 where available.
+SpanResult lower_span(float* height, const float* t, int n) {
   SpanResult out;
   int k = 0;
 #if defined(__SSE2__) && defined(__GNUC__)
@@ -126,11 +125,7 @@ SpanResult lower_span(float* height, float* removed, const float* initial, const
     __m128 changed = _mm_cmplt_ps(lowered, old);
     int mask = _mm_movemask_ps(changed);
     if (mask == 0) continue;
-    _mm_storeu_ps(height + k, lowered);
-    // removed = initial - height where the height changed, else as it was.
-    __m128 fresh = _mm_sub_ps(_mm_loadu_ps(initial + k), lowered);
-    __m128 kept = _mm_loadu_ps(removed + k);
-    _mm_storeu_ps(removed + k, _mm_or_ps(_mm_and_ps(changed, fresh), _mm_andnot_ps(changed, kept)));
+    _mm_storeu_ps(height + k, lowered);  // unchanged lanes keep their bits (min returns old)
     __m128 drop = _mm_sub_ps(old, lowered);  // 0 where unchanged
     sum_lo = _mm_add_pd(sum_lo, _mm_cvtps_pd(drop));
     sum_hi = _mm_add_pd(sum_hi, _mm_cvtps_pd(_mm_movehl_ps(drop, drop)));
@@ -145,7 +140,6 @@ SpanResult lower_span(float* height, float* removed, const float* initial, const
     float old = height[k];
     if (!(h < old)) continue;
     height[k] = h;
-    removed[k] = initial[k] - h;
     out.removed_m += double(old - h);
     if (out.first < 0) out.first = k;
     out.last = k;
@@ -173,15 +167,14 @@ inline void prefetch(const float* p) {
 /// Lowers samples c in [c_lo, c_hi] of row r to the targets that
 /// fill(c, n, t) writes for samples c .. c + n - 1 (metres above the ground,
 /// float; +inf leaves a sample as it is), kBatch at a time, and returns the
-/// change. The layers are written in place through HeightGrid::edit_layers
-/// (grid.hpp), exactly as HeightGrid::lower would write them.
+/// change. The height layer is written in place through
+/// HeightGrid::edit_layers (grid.hpp), exactly as HeightGrid::lower would
+/// write it.
 template <class Fill>
 inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& fill) {
   const std::int64_t row = grid.index(0, r);
   const HeightGrid::EditLayers layers = grid.edit_layers();
   float* height = layers.height_m + row;
-  float* removed = layers.removed_m + row;
-  const float* initial = layers.initial_m + row;
   RowChange change;
   change.visited = c_hi - c_lo + 1;
   if (change.visited <= kSmallSpan) {
@@ -192,20 +185,15 @@ inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& f
     for (int k = 0; k < change.visited; ++k) lower_one(layers, row, c_lo + k, t[k], change);
     return change;
   }
-  // Ask for the row's first cache lines in the three layers at once, so that
-  // on a terrain larger than the caches their misses overlap instead of
-  // queueing one after the other (the hardware prefetcher takes long rows
-  // from there).
-  for (int c = c_lo; c <= std::min(c_hi, c_lo + kPrimeSamples - 1); c += 16) {
-    prefetch(height + c);
-    prefetch(initial + c);
-    prefetch(removed + c);
-  }
+  // Ask for the row's first cache lines at once, so that on a terrain
+  // larger than the caches their misses overlap instead of queueing one
+  // after the other (the hardware prefetcher takes long rows from there).
+  for (int c = c_lo; c <= std::min(c_hi, c_lo + kPrimeSamples - 1); c += 16) prefetch(height + c);
   float t[kBatch];
   for (int c = c_lo; c <= c_hi; c += kBatch) {
     int n = std::min(kBatch, c_hi - c + 1);
     fill(c, n, t);
-    SpanResult span = lower_span(height + c, removed + c, initial + c, t, n);
+    SpanResult span = lower_span(height + c, t, n);
     if (span.last >= 0) {
       change.removed_m += span.removed_m;
       if (change.first < 0) change.first = c + span.first;
@@ -218,17 +206,10 @@ inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& f
 /// lower_row with the targets already computed: targets[k] for sample c_lo + k.
 inline RowChange lower_row_targets(HeightGrid& grid, int r, int c_lo, int c_hi, const float* targets) {
   const std::int64_t row = grid.index(0, r) + c_lo;
-  const HeightGrid::EditLayers layers = grid.edit_layers();
-  float* height = layers.height_m + row;
-  float* removed = layers.removed_m + row;
-  const float* initial = layers.initial_m + row;
+  float* height = grid.edit_layers().height_m + row;
   int n = c_hi - c_lo + 1;
-  for (int k = 0; k < std::min(n, kPrimeSamples); k += 16) {
-    prefetch(height + k);
-    prefetch(initial + k);
-    prefetch(removed + k);
-  }
-  SpanResult span = lower_span(height, removed, initial, targets, n);
+  for (int k = 0; k < std::min(n, kPrimeSamples); k += 16) prefetch(height + k);
+  SpanResult span = lower_span(height, targets, n);
   RowChange change;
   change.visited = n;
   if (span.last >= 0) {
@@ -977,16 +958,11 @@ void prefetch_next_sweep(const HeightGrid& grid, const GridFrame& f, const Segme
   if (!std::isfinite(span)) return;  // NaN or inf from a far-away edge
   const int points = int(std::min(span, double(kMaxAhead - 1))) + 1;
   const float* height = grid.heights();
-  const float* removed = grid.removed();
-  const float* initial = grid.initial();
   for (int k = 0; k <= points; ++k) {
     double t = double(k) / points;
     int c = floor_clamped(ua + t * (ub - ua), 0, f.cols - 1);
     int r = floor_clamped(va + t * (vb - va), 0, f.rows - 1);
-    std::int64_t i = grid.index(c, r);
-    prefetch(height + i);
-    prefetch(removed + i);
-    prefetch(initial + i);
+    prefetch(height + grid.index(c, r));
   }
 }
 
