@@ -995,7 +995,8 @@ substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
             return s.sim().grid().conservation_error_m();
           }, "Largest |height + removed - initial| over the samples, m.")
       .def_property_readonly("state_hash", [](const PySimulation& s) { return s.sim().grid().state_hash(); },
-                             "64-bit hash of the three layers (bitwise), for determinism checks.")
+                             "64-bit hash of the height, removed and initial layers (bitwise), for "
+                             "determinism checks.")
       .def_property_readonly("shape", [](const PySimulation& s) {
             return py::make_tuple(s.sim().grid().rows(), s.sim().grid().cols());
           }, "(rows, cols) of the layers.")
