@@ -279,10 +279,10 @@ void bm_memory(benchmark::State& state, Case c) {
     Rss after = read_rss();
     double samples = double(c.side) * double(c.side);
     state.counters["bytes_per_sample"] = (after.current - before.current) / samples;
-    state.counters["grid_bytes_per_sample"] = 3.0 * sizeof(float);
+    state.counters["grid_bytes_per_sample"] = 2.0 * sizeof(float);  // height, initial
     state.counters["rss_mib"] = after.current / (1024.0 * 1024.0);
     state.counters["peak_rss_mib"] = after.peak / (1024.0 * 1024.0);
-    state.counters["constant_mib"] = (after.current - 12.0 * samples) / (1024.0 * 1024.0);
+    state.counters["constant_mib"] = (after.current - 2.0 * sizeof(float) * samples) / (1024.0 * 1024.0);
     state.counters["side"] = c.side;
   }
 }

@@ -860,10 +860,16 @@ one thread at a time.)doc")
             auto& s = self.cast<PySimulation&>();
             return layer_view(self, s.sim().grid().heights(), s.sim().grid());
           }, "Current heights above ground, (rows, cols) float32, metres; read-only view.")
-      .def_property_readonly("removed", [](py::object self) {
-            auto& s = self.cast<PySimulation&>();
-            return layer_view(self, s.sim().grid().removed(), s.sim().grid());
-          }, "Material removed (initial - height), (rows, cols) float32, metres; read-only view.")
+      .def_property_readonly("removed", [](const PySimulation& s) {
+            // The grid derives removed from the two stored layers, so this is
+            // a copy, taken now (later steps do not show in it).
+            const HeightGrid& g = s.sim().grid();
+            py::array_t<float> out({py::ssize_t(g.rows()), py::ssize_t(g.cols())});
+            g.copy_removed(out.mutable_data());
+            py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+            return out;
+          }, "Material removed (initial - height), (rows, cols) float32, metres; a read-only copy "
+             "taken when read (not a view: later steps do not show in it).")
       .def_property_readonly("initial", [](py::object self) {
             auto& s = self.cast<PySimulation&>();
             return layer_view(self, s.sim().grid().initial(), s.sim().grid());
@@ -947,9 +953,11 @@ substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
             const double fs = full_scale_m.value_or(g.spec().full_scale_m);
             io::make_output_folder(dir);
             io::write_npy(dir / "height.npy", g.heights(), g.rows(), g.cols());
-            io::write_npy(dir / "removed.npy", g.removed(), g.rows(), g.cols());
+            std::vector<float> removed(std::size_t(g.spec().sample_count()));
+            g.copy_removed(removed.data());
+            io::write_npy(dir / "removed.npy", removed.data(), g.rows(), g.cols());
             io::write_png16(dir / "height.png", g.heights(), g.cols(), g.rows(), fs);
-            io::write_png16(dir / "removed.png", g.removed(), g.cols(), g.rows(), fs);
+            io::write_png16(dir / "removed.png", removed.data(), g.cols(), g.rows(), fs);
           }, py::arg("out_dir"), py::arg("full_scale_m") = py::none(),
           "Writes height.npy and removed.npy (float32 (rows, cols), metres) and height.png, "
           "removed.png (16-bit, pixel = value / full_scale_m) into out_dir (created).")
@@ -987,7 +995,8 @@ substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
             return s.sim().grid().conservation_error_m();
           }, "Largest |height + removed - initial| over the samples, m.")
       .def_property_readonly("state_hash", [](const PySimulation& s) { return s.sim().grid().state_hash(); },
-                             "64-bit hash of the three layers (bitwise), for determinism checks.")
+                             "64-bit hash of the height, removed and initial layers (bitwise), for "
+                             "determinism checks.")
       .def_property_readonly("shape", [](const PySimulation& s) {
             return py::make_tuple(s.sim().grid().rows(), s.sim().grid().cols());
           }, "(rows, cols) of the layers.")

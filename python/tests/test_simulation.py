@@ -29,9 +29,15 @@ def test_layers_share_memory_with_the_grid_and_are_read_only():
     with pytest.raises(ValueError):
         h.flags.writeable = True
     # The view sees the cut as it happens: one step across row 5 at y = 0.2.
+    before = sim.removed
     sim.step([0.5, 0.2, 0.55, 1, 0, 0, 0])
     assert h[5].max() <= 0.2 + 1e-6 and h[0].min() == 0.5
     np.testing.assert_array_equal(sim.heights + sim.removed, sim.initial)
+    # removed is derived by the grid, so it is a read-only copy taken when
+    # read: one read before the step still shows nothing removed.
+    assert not before.flags.writeable and before.shape == (10, 10) and before.dtype == np.float32
+    assert not np.shares_memory(before, sim.removed)
+    assert before.max() == 0.0 and sim.removed[5].min() >= 0.3 - 1e-6
 
 
 def test_a_view_keeps_the_simulation_alive():

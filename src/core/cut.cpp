@@ -54,7 +54,6 @@ inline void lower_one(const HeightGrid::EditLayers& layers, std::int64_t row, in
   float old = layers.height_m[row + c];
   if (!(h < old)) return;
   layers.height_m[row + c] = h;
-  layers.removed_m[row + c] = layers.initial_m[row + c] - h;
   change.removed_m += double(old - h);
   if (change.first < 0) change.first = c;
   change.last = c;
@@ -109,11 +108,11 @@ struct SpanResult {
 };
 
 /// HeightGrid::lower applied to the n samples from height[0] with targets
-/// t[0..n): each sample goes down to max(t, 0) when that is lower, and its
-/// removed layer to initial - height. Same values, bit for bit, as calling
-/// HeightGrid::lower per sample (only the order of the removed-height sum
-/// differs), four samples at a time with SSE2 where available.
-SpanResult lower_span(float* height, float* removed, const float* initial, const float* t, int n) {
+/// t[0..n): each sample goes down to max(t, 0) when that is lower. Same
+/// values, bit for bit, as calling HeightGrid::lower per sample (only the
+/// order of the removed-height sum differs), four samples at a time with
+/// SSE2 where available.
+SpanResult lower_span(float* height, const float* t, int n) {
   SpanResult out;
   int k = 0;
 #if defined(__SSE2__) && defined(__GNUC__)
@@ -126,11 +125,7 @@ SpanResult lower_span(float* height, float* removed, const float* initial, const
     __m128 changed = _mm_cmplt_ps(lowered, old);
     int mask = _mm_movemask_ps(changed);
     if (mask == 0) continue;
-    _mm_storeu_ps(height + k, lowered);
-    // removed = initial - height where the height changed, else as it was.
-    __m128 fresh = _mm_sub_ps(_mm_loadu_ps(initial + k), lowered);
-    __m128 kept = _mm_loadu_ps(removed + k);
-    _mm_storeu_ps(removed + k, _mm_or_ps(_mm_and_ps(changed, fresh), _mm_andnot_ps(changed, kept)));
+    _mm_storeu_ps(height + k, lowered);  // unchanged lanes keep their bits (min returns old)
     __m128 drop = _mm_sub_ps(old, lowered);  // 0 where unchanged
     sum_lo = _mm_add_pd(sum_lo, _mm_cvtps_pd(drop));
     sum_hi = _mm_add_pd(sum_hi, _mm_cvtps_pd(_mm_movehl_ps(drop, drop)));
@@ -145,7 +140,6 @@ SpanResult lower_span(float* height, float* removed, const float* initial, const
     float old = height[k];
     if (!(h < old)) continue;
     height[k] = h;
-    removed[k] = initial[k] - h;
     out.removed_m += double(old - h);
     if (out.first < 0) out.first = k;
     out.last = k;
@@ -173,15 +167,14 @@ inline void prefetch(const float* p) {
 /// Lowers samples c in [c_lo, c_hi] of row r to the targets that
 /// fill(c, n, t) writes for samples c .. c + n - 1 (metres above the ground,
 /// float; +inf leaves a sample as it is), kBatch at a time, and returns the
-/// change. The layers are written in place through HeightGrid::edit_layers
-/// (grid.hpp), exactly as HeightGrid::lower would write them.
+/// change. The height layer is written in place through
+/// HeightGrid::edit_layers (grid.hpp), exactly as HeightGrid::lower would
+/// write it.
 template <class Fill>
 inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& fill) {
   const std::int64_t row = grid.index(0, r);
   const HeightGrid::EditLayers layers = grid.edit_layers();
   float* height = layers.height_m + row;
-  float* removed = layers.removed_m + row;
-  const float* initial = layers.initial_m + row;
   RowChange change;
   change.visited = c_hi - c_lo + 1;
   if (change.visited <= kSmallSpan) {
@@ -192,20 +185,15 @@ inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& f
     for (int k = 0; k < change.visited; ++k) lower_one(layers, row, c_lo + k, t[k], change);
     return change;
   }
-  // Ask for the row's first cache lines in the three layers at once, so that
-  // on a terrain larger than the caches their misses overlap instead of
-  // queueing one after the other (the hardware prefetcher takes long rows
-  // from there).
-  for (int c = c_lo; c <= std::min(c_hi, c_lo + kPrimeSamples - 1); c += 16) {
-    prefetch(height + c);
-    prefetch(initial + c);
-    prefetch(removed + c);
-  }
+  // Ask for the row's first cache lines at once, so that on a terrain
+  // larger than the caches their misses overlap instead of queueing one
+  // after the other (the hardware prefetcher takes long rows from there).
+  for (int c = c_lo; c <= std::min(c_hi, c_lo + kPrimeSamples - 1); c += 16) prefetch(height + c);
   float t[kBatch];
   for (int c = c_lo; c <= c_hi; c += kBatch) {
     int n = std::min(kBatch, c_hi - c + 1);
     fill(c, n, t);
-    SpanResult span = lower_span(height + c, removed + c, initial + c, t, n);
+    SpanResult span = lower_span(height + c, t, n);
     if (span.last >= 0) {
       change.removed_m += span.removed_m;
       if (change.first < 0) change.first = c + span.first;
@@ -218,17 +206,10 @@ inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& f
 /// lower_row with the targets already computed: targets[k] for sample c_lo + k.
 inline RowChange lower_row_targets(HeightGrid& grid, int r, int c_lo, int c_hi, const float* targets) {
   const std::int64_t row = grid.index(0, r) + c_lo;
-  const HeightGrid::EditLayers layers = grid.edit_layers();
-  float* height = layers.height_m + row;
-  float* removed = layers.removed_m + row;
-  const float* initial = layers.initial_m + row;
+  float* height = grid.edit_layers().height_m + row;
   int n = c_hi - c_lo + 1;
-  for (int k = 0; k < std::min(n, kPrimeSamples); k += 16) {
-    prefetch(height + k);
-    prefetch(initial + k);
-    prefetch(removed + k);
-  }
-  SpanResult span = lower_span(height, removed, initial, targets, n);
+  for (int k = 0; k < std::min(n, kPrimeSamples); k += 16) prefetch(height + k);
+  SpanResult span = lower_span(height, targets, n);
   RowChange change;
   change.visited = n;
   if (span.last >= 0) {
@@ -488,7 +469,83 @@ struct ObliqueSweep {
   double hi_u[kBounds], hi_r[kBounds], hi_k[kBounds];
   double base0 = 0.0, base_k = 0.0, step = 0.0;  // y = base0 + rd * base_k + c * step
   int r_lo = 0, r_hi = -1;
+  /// The band of rows [band_r0, band_r1] whose bounds are each one line,
+  /// lo_*[band_lo] and hi_*[band_hi] (see straight_band); empty when none.
+  int band_r0 = 0, band_r1 = -1, band_lo = 0, band_hi = 0;
 };
+
+/// The value at x of the line through (at, base) with the given slope, as
+/// every bound and chain of the parallelogram walks evaluates it.
+inline double line_at(double base, double at, double slope, double x) { return base + (x - at) * slope; }
+
+/// The line a among n (base[a] + (x - at[a]) * slope[a]) such that over x in
+/// [x0, x1] every other line lies below max(line a, clip) (largest true;
+/// else above min(line a, clip)) by more than rounding: a maximum (minimum)
+/// of clip and the n lines anywhere in [x0, x1] is then that of clip and
+/// line a, bit for bit. With clip -inf (+inf) that is the line that is the
+/// maximum (minimum) itself; with a row's line as clip, a chain's envelope
+/// clipped to the row. The gap to each line is piecewise linear with one
+/// kink (where line a crosses clip), so it is checked at x0, x1 and there.
+/// Lines at +-inf (padding) are never a and always lie beyond. -1 when no
+/// line is such.
+int dominant_line(const double* base, const double* at, const double* slope, int n, double x0, double x1,
+                  bool largest, double clip) {
+  for (int a = 0; a < n; ++a) {
+    if (!std::isfinite(base[a])) continue;
+    double points[3] = {x0, x1, x0};
+    if (slope[a] != 0.0) {
+      const double kink = at[a] + (clip - base[a]) / slope[a];
+      if (kink > x0 && kink < x1) points[2] = kink;
+    }
+    bool wins = true;
+    for (double x : points) {
+      const double line_a = line_at(base[a], at[a], slope[a], x);
+      if (!std::isfinite(line_a)) wins = false;
+      const double envelope = largest ? std::max(line_a, clip) : std::min(line_a, clip);
+      for (int i = 0; i < n && wins; ++i) {
+        if (i == a) continue;
+        const double vi = line_at(base[i], at[i], slope[i], x);
+        if (!std::isfinite(vi)) {
+          wins = largest ? vi < 0.0 : vi > 0.0;
+          continue;
+        }
+        const double margin = 1e-9 * (1.0 + std::abs(line_a) + std::abs(base[a]) + std::abs((x - at[a]) * slope[a]) +
+                                      std::abs(base[i]) + std::abs((x - at[i]) * slope[i]));
+        wins = largest ? envelope - vi > margin : vi - envelope > margin;
+      }
+    }
+    if (wins) return a;
+  }
+  return -1;
+}
+
+/// The second and third smallest of four values (a sorting network: of
+/// the two pairs' minima the larger, of their maxima the smaller).
+inline void middle_two(const double (&v)[4], double& second, double& third) {
+  const double a = std::min(v[0], v[1]), b = std::max(v[0], v[1]);
+  const double c = std::min(v[2], v[3]), d = std::max(v[2], v[3]);
+  const double x = std::max(a, c), y = std::min(b, d);
+  second = std::min(x, y);
+  third = std::max(x, y);
+}
+
+/// The rows strictly between the parallelogram's second and third vertex
+/// (in row units, vert_rd) hold no vertex, so each of their section bounds
+/// is one side's line: finds those lines over rows [r0, r1] (r1 + reach the
+/// last row coordinate evaluated) and sets w.band_*; the band stays empty
+/// when a bound has no single line there (lines too close to call).
+void straight_band(ObliqueSweep& w, const double (&vert_rd)[4], int rows, int reach) {
+  double second = 0.0, third = 0.0;
+  middle_two(vert_rd, second, third);
+  const int r0 = floor_clamped(second, -1, rows) + 1;
+  const int r1 = ceil_clamped(third, 0, rows + 1) - 1 - reach;
+  w.band_r0 = 0, w.band_r1 = -1;
+  if (r0 > r1) return;
+  const int lo = dominant_line(w.lo_u, w.lo_r, w.lo_k, ObliqueSweep::kBounds, r0, r1 + reach, true, -kInf);
+  const int hi = dominant_line(w.hi_u, w.hi_r, w.hi_k, ObliqueSweep::kBounds, r0, r1 + reach, false, kInf);
+  if (lo < 0 || hi < 0) return;
+  w.band_r0 = r0, w.band_r1 = r1, w.band_lo = lo, w.band_hi = hi;
+}
 
 /// Rows crossed from which a translation takes the parallelogram walk.
 constexpr double kObliqueMinRows = 8.0;
@@ -575,6 +632,9 @@ bool setup_oblique(const GridFrame& f, const Parallelogram& p, ObliqueSweep& w) 
   w.step = p.slope_x * f.cx;
   w.r_lo = ceil_clamped((p.zmin - f.z0) * f.inv_cz - 0.5, 0, f.rows);
   w.r_hi = floor_clamped((p.zmax - f.z0) * f.inv_cz - 0.5, -1, f.rows - 1);
+  double vert_rd[4];
+  for (int k = 0; k < 4; ++k) vert_rd[k] = (p.v[k].z - f.z0) * f.inv_cz - 0.5;
+  straight_band(w, vert_rd, f.rows, 0);
   return std::isfinite(w.base0) && std::isfinite(w.base_k) && std::isfinite(w.step);
 }
 
@@ -584,23 +644,15 @@ void cut_oblique_points(HeightGrid& grid, const GridFrame& f, const ObliqueSweep
   CutBook rows;  // a local, so that its fields stay in registers
   const HeightGrid::EditLayers layers = grid.edit_layers();
   const double step = w.step;
-  for (int r = w.r_lo; r <= w.r_hi; ++r) {
-    double rd = r;
-    double lo = w.lo_u[0] + (rd - w.lo_r[0]) * w.lo_k[0];
-    double hi = w.hi_u[0] + (rd - w.hi_r[0]) * w.hi_k[0];
-    for (int k = 1; k < ObliqueSweep::kBounds; ++k) {
-      double l = w.lo_u[k] + (rd - w.lo_r[k]) * w.lo_k[k];
-      double h = w.hi_u[k] + (rd - w.hi_r[k]) * w.hi_k[k];
-      lo = l > lo ? l : lo;
-      hi = h < hi ? h : hi;
-    }
+  // Row r's samples between its section bounds lo and hi (column units).
+  auto cut_row = [&](int r, double rd, double lo, double hi) {
     int c_lo = ceil_clamped(lo, 0, f.cols);
     int c_hi = floor_clamped(hi, -1, f.cols - 1);
     double base = w.base0 + rd * w.base_k;
-    if (c_lo > c_hi) continue;
+    if (c_lo > c_hi) return;
     if (c_hi - c_lo >= kSmallSpan) {
       rows.add(r, lower_row(grid, r, c_lo, c_hi, linear_targets(base, step)));
-      continue;
+      return;
     }
     // A few samples: inline, as lower_row's small path.
     const std::int64_t row = grid.index(0, r);
@@ -608,6 +660,36 @@ void cut_oblique_points(HeightGrid& grid, const GridFrame& f, const ObliqueSweep
     change.visited = c_hi - c_lo + 1;
     for (int c = c_lo; c <= c_hi; ++c) lower_one(layers, row, c, float(base + double(c) * step), change);
     rows.add(r, change);
+  };
+  // Rows with any of the sides bounding them: the lowest and highest bound.
+  auto cut_rows = [&](int from, int to) {
+    for (int r = from; r <= to; ++r) {
+      double rd = r;
+      double lo = w.lo_u[0] + (rd - w.lo_r[0]) * w.lo_k[0];
+      double hi = w.hi_u[0] + (rd - w.hi_r[0]) * w.hi_k[0];
+      for (int k = 1; k < ObliqueSweep::kBounds; ++k) {
+        double l = w.lo_u[k] + (rd - w.lo_r[k]) * w.lo_k[k];
+        double h = w.hi_u[k] + (rd - w.hi_r[k]) * w.hi_k[k];
+        lo = l > lo ? l : lo;
+        hi = h < hi ? h : hi;
+      }
+      cut_row(r, rd, lo, hi);
+    }
+  };
+  const int band_r0 = std::max(w.band_r0, w.r_lo), band_r1 = std::min(w.band_r1, w.r_hi);
+  if (band_r0 > band_r1) {
+    cut_rows(w.r_lo, w.r_hi);
+  } else {
+    cut_rows(w.r_lo, band_r0 - 1);
+    // The band: each bound one line (the others below or above it by more
+    // than rounding, so the same values as the maximum and minimum above).
+    const double lo_u = w.lo_u[w.band_lo], lo_r = w.lo_r[w.band_lo], lo_k = w.lo_k[w.band_lo];
+    const double hi_u = w.hi_u[w.band_hi], hi_r = w.hi_r[w.band_hi], hi_k = w.hi_k[w.band_hi];
+    for (int r = band_r0; r <= band_r1; ++r) {
+      double rd = r;
+      cut_row(r, rd, lo_u + (rd - lo_r) * lo_k, hi_u + (rd - hi_r) * hi_k);
+    }
+    cut_rows(band_r1 + 1, w.r_hi);
   }
   book.add(rows);
 }
@@ -852,7 +934,47 @@ struct ColumnsOblique {
   double y0 = 0.0, gu = 0.0, gv = 0.0;
   double vmin = 0.0, vmax = 0.0;
   int r_lo = 0, r_hi = -1;
+  /// In the band of rows (bounds.band_r0 .. band_r1, see straight_band) the
+  /// chord's chain is one line too: band_chain of the chain Y is lowest on.
+  int band_chain = 0;
 };
+
+/// Q's lowest vertex (the first of the lowest, u_star and y_min) among its
+/// n candidates, and its extent in u.
+inline void lowest_vertex(const ColumnsOblique& w, const double* cand_u, const double* cand_v, int n, double& umin,
+                          double& umax, double& u_star, double& y_min) {
+  umin = cand_u[0], umax = cand_u[0], u_star = cand_u[0];
+  y_min = w.y0 + w.gu * cand_u[0] + w.gv * cand_v[0];
+  for (int k = 1; k < n; ++k) {
+    umin = std::min(umin, cand_u[k]);
+    umax = std::max(umax, cand_u[k]);
+    double y = w.y0 + w.gu * cand_u[k] + w.gv * cand_v[k];
+    if (y < y_min) y_min = y, u_star = cand_u[k];
+  }
+}
+
+/// Sets the columns walk's band (w.bounds.band_*, band_chain): the rows
+/// between the parallelogram's second and third vertex, when in all of them
+/// the section bounds and the chain the chords end on are each one line (by
+/// more than rounding, so the band's rows get the values of the general
+/// walk bit for bit); otherwise the band is left empty.
+void columns_band(ColumnsOblique& w, int rows) {
+  ObliqueSweep& b = w.bounds;
+  straight_band(b, w.vert_v, rows, 1);
+  if (b.band_r0 > b.band_r1) return;
+  const double r0 = b.band_r0, r1 = b.band_r1;
+  auto lo = [&b](double v) { return line_at(b.lo_u[b.band_lo], b.lo_r[b.band_lo], b.lo_k[b.band_lo], v); };
+  auto hi = [&b](double v) { return line_at(b.hi_u[b.band_hi], b.hi_r[b.band_hi], b.hi_k[b.band_hi], v); };
+  // Q's extent in u over the band is that of its first and last rows'
+  // corners (the bounds are straight there).
+  const double u0 = std::min(lo(r0), lo(r1 + 1.0)), u1 = std::max(hi(r0), hi(r1 + 1.0));
+  // A chord's end is on the chain or on the row's line (va >= r0 below,
+  // vb <= r1 + 1 above), whichever is inside.
+  w.band_chain = w.gv >= 0.0
+                     ? dominant_line(w.low_v, w.low_u, w.low_k, ColumnsOblique::kChains, u0, u1, true, r0)
+                     : dominant_line(w.up_v, w.up_u, w.up_k, ColumnsOblique::kChains, u0, u1, false, r1 + 1.0);
+  if (w.band_chain < 0) b.band_r0 = 0, b.band_r1 = -1;
+}
 
 bool setup_oblique_columns(const GridFrame& f, const Parallelogram& p, ColumnsOblique& w) {
   if (!set_section_bounds(f, p, 0.0, w.bounds)) return false;
@@ -887,7 +1009,9 @@ bool setup_oblique_columns(const GridFrame& f, const Parallelogram& p, ColumnsOb
   w.vmax = (p.zmax - f.z0) * f.inv_cz;
   w.r_lo = std::max(0, ceil_clamped(w.vmin, 0, f.rows + 1) - 1);
   w.r_hi = floor_clamped(w.vmax, -1, f.rows - 1);
-  return std::isfinite(w.y0) && std::isfinite(w.gu) && std::isfinite(w.gv);
+  if (!(std::isfinite(w.y0) && std::isfinite(w.gu) && std::isfinite(w.gv))) return false;
+  columns_band(w, f.rows);
+  return true;
 }
 
 void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsOblique& w, CutBook& book) {
@@ -904,51 +1028,14 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
       hi = std::min(hi, b.hi_u[k] + (v - b.hi_r[k]) * b.hi_k[k]);
     }
   };
-  // A row's top line is the next row's bottom line: its ends are carried
-  // over (the same arithmetic on the same v, so the same values).
-  double carried_v = -kInf, carried_lo = 0.0, carried_hi = 0.0;
-  for (int r = w.r_lo; r <= w.r_hi; ++r) {
-    const double va = std::max(double(r), w.vmin), vb = std::min(double(r) + 1.0, w.vmax);
-    if (va > vb) continue;
-    // Q's vertices: the section's ends at va and vb, and the
-    // parallelogram's vertices strictly between.
-    double cand_u[8], cand_v[8];
-    if (va == carried_v) {
-      cand_u[0] = carried_lo, cand_u[1] = carried_hi;
-    } else {
-      ends(va, cand_u[0], cand_u[1]);
-    }
-    ends(vb, cand_u[2], cand_u[3]);
-    carried_v = vb, carried_lo = cand_u[2], carried_hi = cand_u[3];
-    cand_v[0] = cand_v[1] = va;
-    cand_v[2] = cand_v[3] = vb;
-    int n = 4;
-    for (int k = 0; k < 4; ++k) {
-      if (w.vert_v[k] > va && w.vert_v[k] < vb) cand_u[n] = w.vert_u[k], cand_v[n++] = w.vert_v[k];
-    }
-    double umin = cand_u[0], umax = cand_u[0], u_star = cand_u[0];
-    double y_min = w.y0 + w.gu * cand_u[0] + w.gv * cand_v[0];
-    for (int k = 1; k < n; ++k) {
-      umin = std::min(umin, cand_u[k]);
-      umax = std::max(umax, cand_u[k]);
-      double y = w.y0 + w.gu * cand_u[k] + w.gv * cand_v[k];
-      if (y < y_min) y_min = y, u_star = cand_u[k];
-    }
+  // Lowers row r's cells [c_lo, c_hi] spanned by Q (u in [umin, umax]) to
+  // Q's lowest point over each: the vertex (u_star, y_min) when it lies in
+  // the cell, else the lowest point of the chord on the side line nearer to
+  // it (chord_min(U)).
+  auto cut_cells = [&](int r, double umin, double umax, double u_star, double y_min, auto&& chord_min) {
     const int c_lo = std::max(0, ceil_clamped(umin, 0, f.cols + 1) - 1);
     const int c_hi = floor_clamped(umax, -1, f.cols - 1);
-    if (c_lo > c_hi) continue;
-    // The lowest Y on the chord of Q at u = U (U within Q's extent).
-    auto chord_min = [&](double U) {
-      double v;
-      if (low_end) {
-        v = va;
-        for (int k = 0; k < ColumnsOblique::kChains; ++k) v = std::max(v, w.low_v[k] + (U - w.low_u[k]) * w.low_k[k]);
-      } else {
-        v = vb;
-        for (int k = 0; k < ColumnsOblique::kChains; ++k) v = std::min(v, w.up_v[k] + (U - w.up_u[k]) * w.up_k[k]);
-      }
-      return w.y0 + w.gu * U + w.gv * v;
-    };
+    if (c_lo > c_hi) return;
     const std::int64_t row = grid.index(0, r);
     RowChange change;
     change.visited = c_hi - c_lo + 1;
@@ -957,7 +1044,88 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
       lower_one(layers, row, c, float(lowest), change);
     }
     rows.add(r, change);
+  };
+  // A row's top line is the next row's bottom line: its ends are carried
+  // over (the same arithmetic on the same v, so the same values).
+  double carried_v = -kInf, carried_lo = 0.0, carried_hi = 0.0;
+  // Any row: Q's corners and the parallelogram's vertices inside the row,
+  // chords against every line of the chain.
+  auto cut_rows = [&](int from, int to) {
+    for (int r = from; r <= to; ++r) {
+      const double va = std::max(double(r), w.vmin), vb = std::min(double(r) + 1.0, w.vmax);
+      if (va > vb) continue;
+      // Q's vertices: the section's ends at va and vb, and the
+      // parallelogram's vertices strictly between.
+      double cand_u[8], cand_v[8];
+      if (va == carried_v) {
+        cand_u[0] = carried_lo, cand_u[1] = carried_hi;
+      } else {
+        ends(va, cand_u[0], cand_u[1]);
+      }
+      ends(vb, cand_u[2], cand_u[3]);
+      carried_v = vb, carried_lo = cand_u[2], carried_hi = cand_u[3];
+      cand_v[0] = cand_v[1] = va;
+      cand_v[2] = cand_v[3] = vb;
+      int n = 4;
+      for (int k = 0; k < 4; ++k) {
+        if (w.vert_v[k] > va && w.vert_v[k] < vb) cand_u[n] = w.vert_u[k], cand_v[n++] = w.vert_v[k];
+      }
+      double umin, umax, u_star, y_min;
+      lowest_vertex(w, cand_u, cand_v, n, umin, umax, u_star, y_min);
+      // The lowest Y on the chord of Q at u = U (U within Q's extent).
+      cut_cells(r, umin, umax, u_star, y_min, [&](double U) {
+        double v;
+        if (low_end) {
+          v = va;
+          for (int k = 0; k < ColumnsOblique::kChains; ++k) v = std::max(v, w.low_v[k] + (U - w.low_u[k]) * w.low_k[k]);
+        } else {
+          v = vb;
+          for (int k = 0; k < ColumnsOblique::kChains; ++k) v = std::min(v, w.up_v[k] + (U - w.up_u[k]) * w.up_k[k]);
+        }
+        return w.y0 + w.gu * U + w.gv * v;
+      });
+    }
+  };
+  const int band_r0 = std::max(b.band_r0, w.r_lo), band_r1 = std::min(b.band_r1, w.r_hi);
+  if (band_r0 > band_r1) {
+    cut_rows(w.r_lo, w.r_hi);
+    book.add(rows);
+    return;
   }
+  cut_rows(w.r_lo, band_r0 - 1);
+  // The band (columns_band): no vertex inside a row, each bound and the
+  // chain one line; the same values as cut_rows (the lines left out lie
+  // beyond the kept ones by more than rounding).
+  const double lo_u = b.lo_u[b.band_lo], lo_r = b.lo_r[b.band_lo], lo_k = b.lo_k[b.band_lo];
+  const double hi_u = b.hi_u[b.band_hi], hi_r = b.hi_r[b.band_hi], hi_k = b.hi_k[b.band_hi];
+  const int chain = w.band_chain;
+  const double chain_v = low_end ? w.low_v[chain] : w.up_v[chain];
+  const double chain_u = low_end ? w.low_u[chain] : w.up_u[chain];
+  const double chain_k = low_end ? w.low_k[chain] : w.up_k[chain];
+  for (int r = band_r0; r <= band_r1; ++r) {
+    const double va = double(r), vb = double(r) + 1.0;  // inside [vmin, vmax]
+    double cand_u[4];
+    if (va == carried_v) {
+      cand_u[0] = carried_lo, cand_u[1] = carried_hi;
+    } else {
+      cand_u[0] = lo_u + (va - lo_r) * lo_k, cand_u[1] = hi_u + (va - hi_r) * hi_k;
+    }
+    cand_u[2] = lo_u + (vb - lo_r) * lo_k, cand_u[3] = hi_u + (vb - hi_r) * hi_k;
+    carried_v = vb, carried_lo = cand_u[2], carried_hi = cand_u[3];
+    const double cand_v[4] = {va, va, vb, vb};
+    double umin, umax, u_star, y_min;
+    lowest_vertex(w, cand_u, cand_v, 4, umin, umax, u_star, y_min);
+    if (low_end) {
+      cut_cells(r, umin, umax, u_star, y_min, [&](double U) {
+        return w.y0 + w.gu * U + w.gv * std::max(va, chain_v + (U - chain_u) * chain_k);
+      });
+    } else {
+      cut_cells(r, umin, umax, u_star, y_min, [&](double U) {
+        return w.y0 + w.gu * U + w.gv * std::min(vb, chain_v + (U - chain_u) * chain_k);
+      });
+    }
+  }
+  cut_rows(band_r1 + 1, w.r_hi);
   book.add(rows);
 }
 
@@ -977,16 +1145,11 @@ void prefetch_next_sweep(const HeightGrid& grid, const GridFrame& f, const Segme
   if (!std::isfinite(span)) return;  // NaN or inf from a far-away edge
   const int points = int(std::min(span, double(kMaxAhead - 1))) + 1;
   const float* height = grid.heights();
-  const float* removed = grid.removed();
-  const float* initial = grid.initial();
   for (int k = 0; k <= points; ++k) {
     double t = double(k) / points;
     int c = floor_clamped(ua + t * (ub - ua), 0, f.cols - 1);
     int r = floor_clamped(va + t * (vb - va), 0, f.rows - 1);
-    std::int64_t i = grid.index(c, r);
-    prefetch(height + i);
-    prefetch(removed + i);
-    prefetch(initial + i);
+    prefetch(height + grid.index(c, r));
   }
 }
 

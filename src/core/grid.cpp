@@ -76,7 +76,7 @@ LayerBlock::LayerBlock(std::int64_t samples, bool zero_layers) : samples_(sample
   // stagger); smaller ones on pages, so small grids waste little.
   const std::size_t align = bytes >= kHugePageBytes ? kHugePageBytes : kPageBytes;
   layer_stride_ = round_up(bytes, align) + kLayerStaggerBytes;
-  block_bytes_ = round_up(2 * layer_stride_ + bytes, align);
+  block_bytes_ = round_up((kLayers - 1) * layer_stride_ + bytes, align);
   block_.reset(static_cast<std::byte*>(std::aligned_alloc(align, block_bytes_)));
   if (!block_) throw std::bad_alloc();
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
@@ -87,9 +87,10 @@ LayerBlock::LayerBlock(std::int64_t samples, bool zero_layers) : samples_(sample
     std::memset(block_.get(), 0, block_bytes_);
   } else {
     // Only what lies between and after the layers (copies read it).
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < kLayers; ++k) {
       std::byte* end = block_.get() + std::size_t(k) * layer_stride_ + bytes;
-      std::byte* next = k < 2 ? block_.get() + std::size_t(k + 1) * layer_stride_ : block_.get() + block_bytes_;
+      std::byte* next =
+          k < kLayers - 1 ? block_.get() + std::size_t(k + 1) * layer_stride_ : block_.get() + block_bytes_;
       std::memset(end, 0, std::size_t(next - end));
     }
   }
@@ -128,13 +129,17 @@ HeightGrid::HeightGrid(const GridSpec& spec, std::vector<float> initial_heights_
     }
   }
   // Filled layer by layer, the caller's heights released as soon as they are
-  // copied: the peak is the heights plus one layer, not plus three.
+  // copied: the peak is the heights plus one layer, not plus two.
   layers_ = detail::LayerBlock(spec.sample_count(), false);
   const std::size_t bytes = initial_heights_m.size() * sizeof(float);
   std::memcpy(initial_(), initial_heights_m.data(), bytes);
   std::vector<float>().swap(initial_heights_m);
   std::memcpy(height_(), initial_(), bytes);
-  std::memset(removed_(), 0, bytes);
+}
+
+void HeightGrid::copy_removed(float* out) const {
+  const float *height = height_(), *initial = initial_();
+  for (std::int64_t i = 0; i < spec_.sample_count(); ++i) out[i] = initial[i] - height[i];
 }
 
 Rect HeightGrid::set_heights(const Rect& rect, const float* values_m) {
@@ -146,9 +151,7 @@ Rect HeightGrid::set_heights(const Rect& rect, const float* values_m) {
     for (int c = clipped.c0; c < clipped.c1; ++c) {
       float h = values_m[std::int64_t(r - rect.r0) * width + (c - rect.c0)];
       if (!std::isfinite(h) || h < 0.0f) h = 0.0f;
-      std::int64_t i = index(c, r);
-      height_()[i] = h;
-      removed_()[i] = initial_()[i] - h;
+      height_()[index(c, r)] = h;
     }
   }
   return clipped;
@@ -157,7 +160,6 @@ Rect HeightGrid::set_heights(const Rect& rect, const float* values_m) {
 void HeightGrid::reset() {
   const std::size_t n = std::size_t(spec_.sample_count());
   std::memcpy(height_(), initial_(), n * sizeof(float));
-  std::fill(removed_(), removed_() + n, 0.0f);
 }
 
 double HeightGrid::volume_m3() const {
@@ -169,9 +171,10 @@ double HeightGrid::volume_m3() const {
 
 double HeightGrid::conservation_error_m() const {
   double worst = 0.0;
-  const float *height = height_(), *removed = removed_(), *initial = initial_();
+  const float *height = height_(), *initial = initial_();
   for (std::int64_t i = 0; i < spec_.sample_count(); ++i) {
-    double e = std::abs(double(height[i]) + double(removed[i]) - double(initial[i]));
+    const float removed = initial[i] - height[i];  // removed_at(i)
+    double e = std::abs(double(height[i]) + double(removed) - double(initial[i]));
     worst = std::max(worst, e);
   }
   return worst;
@@ -180,19 +183,20 @@ double HeightGrid::conservation_error_m() const {
 std::uint64_t HeightGrid::state_hash() const {
   std::uint64_t hash = 1469598103934665603ull;
   const std::int64_t n = spec_.sample_count();
-  auto mix = [&hash, n](const float* layer) {
-    for (std::int64_t i = 0; i < n; ++i) {
-      std::uint32_t bits;
-      std::memcpy(&bits, &layer[i], sizeof bits);
-      for (int k = 0; k < 4; ++k) {
-        hash ^= (bits >> (8 * k)) & 0xffu;
-        hash *= 1099511628211ull;
-      }
+  auto mix = [&hash](float value) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    for (int k = 0; k < 4; ++k) {
+      hash ^= (bits >> (8 * k)) & 0xffu;
+      hash *= 1099511628211ull;
     }
   };
-  mix(height_());
-  mix(removed_());
-  mix(initial_());
+  // The derived removed layer is hashed as the stored one was, so a state
+  // hashes as it did when all three were stored.
+  const float *height = height_(), *initial = initial_();
+  for (std::int64_t i = 0; i < n; ++i) mix(height[i]);
+  for (std::int64_t i = 0; i < n; ++i) mix(initial[i] - height[i]);
+  for (std::int64_t i = 0; i < n; ++i) mix(initial[i]);
   return hash;
 }
 

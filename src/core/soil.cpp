@@ -360,7 +360,6 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   const auto write = [&](std::int64_t cell, float value) {
     put += double(value) - double(layers.height_m[cell]);
     layers.height_m[cell] = value;
-    layers.removed_m[cell] = layers.initial_m[cell] - value;
     last_put = cell;
   };
   // The share of each sample's cut that goes into the bucket: all of it
@@ -495,7 +494,6 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   if (last_put >= 0 && put != taken) {
     const float corrected = float(std::max(0.0, double(layers.height_m[last_put]) + (taken - put)));
     layers.height_m[last_put] = corrected;
-    layers.removed_m[last_put] = layers.initial_m[last_put] - corrected;
   }
 }
 
@@ -611,7 +609,6 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
         highest_h = now;
         highest = t;
       }
-      layers.removed_m[t] = layers.initial_m[t] - now;
       const int ct = int(t % cols), rt = int(t / cols);
       changed_c0 = std::min(changed_c0, ct);
       changed_c1 = std::max(changed_c1, ct);
@@ -630,7 +627,6 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
     }
     if (gained != 0.0 && highest_h > 0.0f) {
       h[highest] = float(std::max(0.0, double(h[highest]) - gained));
-      layers.removed_m[highest] = layers.initial_m[highest] - h[highest];
     }
     out.left_over_edge_m3 += left_m * cell_area;
     touched_.clear();
@@ -695,7 +691,6 @@ void SoilFlow::pour(HeightGrid& grid, const Segment& lip, double volume_m3, Soil
     put += double(now) - double(layers.height_m[i]);
     wanted += share_m;
     layers.height_m[i] = now;
-    layers.removed_m[i] = layers.initial_m[i] - now;
     last = i;
     out.changed.include(c, r);
     activate(std::uint32_t(i));
@@ -704,7 +699,6 @@ void SoilFlow::pour(HeightGrid& grid, const Segment& lip, double volume_m3, Soil
   if (last >= 0 && put != wanted) {
     const float corrected = float(std::max(0.0, double(layers.height_m[last]) + (wanted - put)));
     layers.height_m[last] = corrected;
-    layers.removed_m[last] = layers.initial_m[last] - corrected;
   }
   out.poured_m3 += volume_m3;
 }

@@ -310,16 +310,19 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
 
   io::write_npy(dir / "height.npy", grid.heights(), grid.rows(), grid.cols());
   io::write_png16(dir / "height.png", grid.heights(), grid.cols(), grid.rows(), sc.full_scale_m);
+  // The removed layer is derived (initial - height), so it is written from a copy.
+  std::vector<float> removed(std::size_t(grid.spec().sample_count()));
+  grid.copy_removed(removed.data());
   if (!flow) {
-    io::write_npy(dir / "removed.npy", grid.removed(), grid.rows(), grid.cols());
-    io::write_png16(dir / "removed.png", grid.removed(), grid.cols(), grid.rows(), sc.full_scale_m);
+    io::write_npy(dir / "removed.npy", removed.data(), grid.rows(), grid.cols());
+    io::write_png16(dir / "removed.png", removed.data(), grid.cols(), grid.rows(), sc.full_scale_m);
   } else {
     // The signed removed layer as its two parts: taken from, put down on.
-    std::vector<float> taken(std::size_t(grid.spec().sample_count()));
+    std::vector<float> taken(removed.size());
     std::vector<float> put(taken.size());
     for (std::size_t i = 0; i < taken.size(); ++i) {
-      taken[i] = std::max(0.0f, grid.removed()[i]);
-      put[i] = std::max(0.0f, -grid.removed()[i]);
+      taken[i] = std::max(0.0f, removed[i]);
+      put[i] = std::max(0.0f, -removed[i]);
     }
     io::write_npy(dir / "removed.npy", taken.data(), grid.rows(), grid.cols());
     io::write_png16(dir / "removed.png", taken.data(), grid.cols(), grid.rows(), sc.full_scale_m);

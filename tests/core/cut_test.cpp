@@ -176,10 +176,6 @@ TEST(Cut, ConservationAfterRandomCuts) {
       Segment b{a.a + Vec3{0.05, 0.0, 0.05} * (unit(rng) - 0.5), a.b + Vec3{0.03, -0.02, 0.08} * (unit(rng) - 0.5)};
       booked += cut_sweep(grid, rep, a, b).removed_volume_m3;
     }
-    for (std::int64_t i = 0; i < s.sample_count(); ++i) {
-      double sum = double(grid.heights()[i]) + double(grid.removed()[i]);
-      ASSERT_NEAR(sum, grid.initial()[i], kFloatTol) << to_string(rep) << " sample " << i;
-    }
     EXPECT_LE(grid.conservation_error_m(), kFloatTol);
     EXPECT_NEAR(initial_volume - grid.volume_m3(), booked, 1e-9 * initial_volume + 1e-12) << to_string(rep);
     EXPECT_GT(booked, 0.0);

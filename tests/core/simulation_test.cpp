@@ -322,7 +322,7 @@ TEST(Simulation, EditHeightsWritesItsRectangleAndTellsTheListeners) {
       const float expected = inside ? values[size_t(c - 2)] : 0.5f;
       EXPECT_EQ(sim.grid().height(c, r), expected) << c << "," << r;
       const std::int64_t i = sim.grid().index(c, r);
-      EXPECT_EQ(sim.grid().heights()[i] + sim.grid().removed()[i], sim.grid().initial()[i]);
+      EXPECT_EQ(sim.grid().heights()[i] + sim.grid().removed_at(i), sim.grid().initial()[i]);
     }
   }
   EXPECT_LE(sim.grid().conservation_error_m(), 1e-7);

@@ -347,7 +347,7 @@ TEST(SoilDisplacement, SoilLayersKeepTheirIdentity) {
   EXPECT_LT(g.conservation_error_m(), 1e-6);
   int deposited = 0;
   for (std::int64_t i = 0; i < g.spec().sample_count(); ++i)
-    if (g.removed()[i] < 0.0f) ++deposited;
+    if (g.removed_at(i) < 0.0f) ++deposited;
   EXPECT_GT(deposited, 100);
 }
 

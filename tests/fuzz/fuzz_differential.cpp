@@ -59,7 +59,7 @@ double distance(LatticePoint a, LatticePoint b, double px, double pz) {
 void check_layers(const HeightGrid& g, const char* what) {
   for (std::int64_t i = 0; i < g.spec().sample_count(); ++i) {
     check(g.heights()[i] <= g.initial()[i], "fuzz_differential", what);
-    check(std::abs(g.heights()[i] + g.removed()[i] - g.initial()[i]) <= 1e-6f, "fuzz_differential", what);
+    check(std::abs(g.heights()[i] + g.removed_at(i) - g.initial()[i]) <= 1e-6f, "fuzz_differential", what);
   }
 }
 

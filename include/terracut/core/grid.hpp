@@ -1,6 +1,6 @@
 // The height grid: cols x rows samples of a soil surface over a rectangle of
-// the ground plane (X-Z), with three layers: current height, removed material
-// and initial height.
+// the ground plane (X-Z), with two stored layers, current height and initial
+// height, and the removed material derived from them (initial - height).
 //
 // Sample placement (cell-centred): the terrain covers
 //   x in [origin.x, origin.x + size_x_m],  z in [origin.z, origin.z + size_z_m]
@@ -43,7 +43,7 @@ struct GridSpec {
 
 /// Largest accepted grid side (65536 samples); larger grids are refused as absurd.
 inline constexpr int kMaxGridSide = 65536;
-/// Largest accepted sample count (2^30, 12 GiB of layers).
+/// Largest accepted sample count (2^30, 8 GiB of layers).
 inline constexpr std::int64_t kMaxGridSamples = std::int64_t(1) << 30;
 /// Smallest accepted cell side, metres (a micrometre): the cell coordinates
 /// of any position within 1e9 m then stay finite (cells of 1e-300 m made
@@ -85,24 +85,26 @@ struct Rect {
 
 namespace detail {
 
-/// The storage of a grid's three float layers, one block. A traversal across
-/// the rows (a blade oblique or transverse to them) touches the same sample
-/// column of each layer in every row, 4 * cols bytes apart: with a
-/// power-of-two side those addresses agree in their low 12 bits, so in
-/// separate allocations (page-aligned by the allocator) the three layers'
-/// lines fall into the same L1 and L2 cache sets and evict one another. Each
-/// layer here starts kLayerStaggerBytes further into its page than the one
-/// before, which puts them in different sets; big layers start on 2 MiB
-/// boundaries and are offered transparent huge pages (Linux, madvise), so a
-/// column of rows costs fewer TLB misses. Copies are deep.
+/// The storage of a grid's two float layers (height, initial), one block. A
+/// traversal across the rows (a blade oblique or transverse to them) touches
+/// the same sample column of each layer in every row, 4 * cols bytes apart:
+/// with a power-of-two side those addresses agree in their low 12 bits, so
+/// in separate allocations (page-aligned by the allocator) the layers' lines
+/// fall into the same L1 and L2 cache sets and evict one another. Each layer
+/// here starts kLayerStaggerBytes further into its page than the one before,
+/// which puts them in different sets; big layers start on 2 MiB boundaries
+/// and are offered transparent huge pages (Linux, madvise), so a column of
+/// rows costs fewer TLB misses. Copies are deep.
 class LayerBlock {
  public:
+  /// Layers in the block.
+  static constexpr int kLayers = 2;
   /// Offset of layer k's start within its page is k * kLayerStaggerBytes
   /// (a third of a 4 KiB page, whole cache lines).
   static constexpr std::size_t kLayerStaggerBytes = 1344;
 
   LayerBlock() = default;
-  /// Three layers of samples floats each, zeroed; with zero_layers false
+  /// kLayers layers of samples floats each, zeroed; with zero_layers false
   /// the layers are left for the caller to fill (their pages untouched, so a
   /// big grid is built without the whole block resident at once).
   explicit LayerBlock(std::int64_t samples, bool zero_layers = true);
@@ -111,7 +113,7 @@ class LayerBlock {
   LayerBlock(LayerBlock&&) noexcept = default;
   LayerBlock& operator=(LayerBlock&&) noexcept = default;
 
-  /// Layer k (0, 1 or 2): samples floats.
+  /// Layer k (0 .. kLayers - 1): samples floats.
   float* layer(int k) const { return reinterpret_cast<float*>(block_.get() + std::size_t(k) * layer_stride_); }
   std::int64_t samples() const { return samples_; }
 
@@ -127,9 +129,11 @@ class LayerBlock {
 
 }  // namespace detail
 
-/// The soil state: three layers of rows x cols float samples, row-major,
-/// index = r * cols + c, metres. Invariant, per sample and to float rounding:
-/// height + removed = initial.
+/// The soil state: rows x cols float samples, row-major, index = r * cols + c,
+/// metres: the current height and the initial height are stored; the
+/// removed material is initial - height, computed in float on read
+/// (removed_at, copy_removed), so it is exactly what a stored layer kept as
+/// initial - height would hold, and a cut writes the height layer alone.
 class HeightGrid {
  public:
   /// Builds a grid from initial heights (rows x cols, metres >= 0, finite).
@@ -144,26 +148,29 @@ class HeightGrid {
   /// Current height above ground, rows x cols, metres. The array is stable for
   /// the grid's lifetime, so an engine (Bullet, a renderer) can read it in place.
   const float* heights() const { return height_(); }
-  /// Material removed so far (initial - height), rows x cols, metres.
-  const float* removed() const { return removed_(); }
   /// Heights at construction, rows x cols, metres.
   const float* initial() const { return initial_(); }
+  /// Material removed so far at sample i, metres: initial - height (float;
+  /// negative where material was put down).
+  float removed_at(std::int64_t i) const { return initial_()[i] - height_()[i]; }
+  /// Writes the removed layer (removed_at of every sample, rows x cols,
+  /// row-major) to out, which must hold sample_count() floats.
+  void copy_removed(float* out) const;
 
   float height(int c, int r) const { return height_()[index(c, r)]; }
 
-  /// The layers opened for an in-place edit by a core phase (the cut, later
-  /// soil flow): height and removed writable, initial read-only, each
-  /// rows x cols, row-major. The editor must keep height + removed = initial
-  /// per sample and report the rectangle it changed (StepOutput), which is
-  /// how everyone caching the heights (Bullet, the viewer) learns of it.
+  /// The layers opened for an in-place edit by a core phase (the cut, soil
+  /// flow): height writable, initial read-only, each rows x cols, row-major.
+  /// The removed material follows from the two. The editor must report the
+  /// rectangle it changed (StepOutput), which is how everyone caching the
+  /// heights (Bullet, the viewer) learns of it.
   struct EditLayers {
     float* height_m;         ///< rows x cols, metres
-    float* removed_m;        ///< rows x cols, metres
     const float* initial_m;  ///< rows x cols, metres
   };
   /// Opens the layers for an edit (see EditLayers): the one way to write
   /// samples besides lower() and set_heights().
-  EditLayers edit_layers() { return {height_(), removed_(), initial_()}; }
+  EditLayers edit_layers() { return {height_(), initial_()}; }
 
   /// Lowers sample i to new_height_m if that is lower than its height (and not
   /// below 0). Returns the height removed, metres (0 when nothing changed).
@@ -173,12 +180,11 @@ class HeightGrid {
     float h = new_height_m > 0.0f ? new_height_m : 0.0f;
     if (!(h < old)) return 0.0f;
     height[i] = h;
-    removed_()[i] = initial_()[i] - h;
     return old - h;
   }
 
   /// Replaces the heights of a rectangle (values rows-of-rect x cols-of-rect,
-  /// row-major) and returns the rectangle that changed. removed is updated.
+  /// row-major) and returns the rectangle that changed.
   Rect set_heights(const Rect& rect, const float* values_m);
 
   /// Restores every sample to its initial height.
@@ -193,18 +199,20 @@ class HeightGrid {
 
   /// Total material volume above ground, cubic metres (sum of height * cell area).
   double volume_m3() const;
-  /// Largest |height + removed - initial| over all samples, metres.
+  /// Largest |height + removed - initial| over all samples, metres (in
+  /// double, removed being removed_at: what is left is the rounding of
+  /// initial - height to float).
   double conservation_error_m() const;
-  /// A 64-bit FNV-1a hash of the three layers (bitwise), for determinism checks.
+  /// A 64-bit FNV-1a hash of the height, removed and initial layers
+  /// (bitwise, in that order), for determinism checks.
   std::uint64_t state_hash() const;
 
  private:
   GridSpec spec_;
-  detail::LayerBlock layers_;  ///< height, removed, initial
+  detail::LayerBlock layers_;  ///< height, initial
 
   float* height_() const { return layers_.layer(0); }
-  float* removed_() const { return layers_.layer(1); }
-  float* initial_() const { return layers_.layer(2); }
+  float* initial_() const { return layers_.layer(1); }
 };
 
 }  // namespace terracut
