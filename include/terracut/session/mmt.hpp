@@ -134,6 +134,7 @@ class RemoteStation {
   void receive(double t_s);
   void update_estimate(const haptics::LoopRecord& r);
   void sense(double t_s, const haptics::LoopRecord& r);
+  void send_estimate(double t_s);
   Rect window_around(Vec3 p) const;
 
   MmtSettings settings_;
@@ -143,6 +144,7 @@ class RemoteStation {
   std::unique_ptr<FollowerDevice> device_;
   std::unique_ptr<HapticRig> rig_;
   std::vector<float> mirror_;  // what the operator was sent (starts as its initial heights)
+  std::vector<float> sensed_;  // the sensed rectangle: soil, or a body's top over it
   wire::SequenceFilter commands_;
   std::uint32_t command_sequence_ = 0;
   Vec3 commanded_m_{};
@@ -345,6 +347,7 @@ class MmtRun {
   std::int64_t tick_ = 0, total_ticks_ = 0;
   double rate_hz_ = 1000.0;
   std::vector<std::pair<double, double>> terrain_error_;
+  mutable std::vector<float> sensed_;  // terrain_rms's remote surface, reserved for the grid
 };
 
 /// The per-tick files (docs/teleoperation.md lists the columns). Throw
