@@ -605,7 +605,9 @@ void OperatorStation::merge(double t_s) {
   HeightGrid& grid = rig_->world().simulation().grid();
   const haptics::LoopRecord& last = rig_->loop().last();
   const bool in_contact = last.contact_length_m > 0.0;
-  const Segment edge = simulation().last().edge;
+  // The edge where the tool is now (the loop steps the simulation only
+  // near the terrain, so its last step's edge can be old).
+  const Segment edge = blade_segment(simulation().params().blade, last.tool);
   const double ex = settings_.exclusion_m;
   const double x0 = std::min(edge.a.x, edge.b.x) - ex, x1 = std::max(edge.a.x, edge.b.x) + ex;
   const double z0 = std::min(edge.a.z, edge.b.z) - ex, z1 = std::max(edge.a.z, edge.b.z) + ex;
