@@ -310,6 +310,16 @@ void RemoteStation::update_estimate(const haptics::LoopRecord& r) {
   const double x = length(horizontal(nominal_.compute(in).cutting_n)) / 100.0;
   const double y = length(horizontal(r.force_world_n)) / 100.0;
   if (!(x > 0.01) || !std::isfinite(y)) return;  // below 1 N the ratio says little
+  // Once it has settled, a sample more than kOutlier times off the estimate
+  // is something no soil does (the plate striking a rock: Bullet's impact
+  // is a hundred times the cut): left out, or it would be carried into the
+  // operator's soil for the next second.
+  constexpr double kOutlier = 4.0;
+  constexpr std::int64_t kSettled = 200;
+  if (rls_samples_ >= kSettled && (y > kOutlier * theta_ * x || kOutlier * y < theta_ * x)) {
+    ++rls_outliers_;
+    return;
+  }
   const double lambda = settings_.forgetting;
   const double k = p_ * x / (lambda + x * p_ * x);
   theta_ = std::clamp(theta_ + k * (y - theta_ * x), 0.02, 50.0);
