@@ -7,6 +7,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/surface.hpp"
+#include "terracut/session/mmt_process.hpp"
 
 namespace terracut::viewer {
 
@@ -95,16 +96,25 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
     // remote world is the scenario's mmt.remote.
     session::Scenario op = scenario_;
     op.haptics = params_.settings();
-    remote_scenario_ = std::make_unique<session::Scenario>(session::load_remote_scenario(op));
     const session::MmtSettings& mmt = *scenario_.mmt;
-    link_ = std::make_unique<net::MemoryLink>(mmt.to_remote, mmt.to_operator);
     session::OperatorOptions oo;
     oo.snapshot = exchange_.get();
     oo.keep_records = false;
-    operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, link_->a(), 1u, oo);
-    remote_ = std::make_unique<session::RemoteStation>(
-        *remote_scenario_, mmt, operator_->rig().loop().force_model(),
-        operator_->simulation().grid(), link_->b(), 2u, session::RemoteOptions{false});
+    if (!options.remote.empty()) {
+      // The remote is another process; a new session id each start, as
+      // `terracut mmt --role operator` has it.
+      udp_ = session::connect_operator_link(mmt, options.remote, "--remote",
+                                            options.connect_timeout_s);
+      const auto id = std::uint32_t(std::chrono::steady_clock::now().time_since_epoch().count());
+      operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, *udp_, id, oo);
+    } else {
+      remote_scenario_ = std::make_unique<session::Scenario>(session::load_remote_scenario(op));
+      link_ = std::make_unique<net::MemoryLink>(mmt.to_remote, mmt.to_operator);
+      operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, link_->a(), 1u, oo);
+      remote_ = std::make_unique<session::RemoteStation>(
+          *remote_scenario_, mmt, operator_->rig().loop().force_model(),
+          operator_->simulation().grid(), link_->b(), 2u, session::RemoteOptions{false});
+    }
     mmt_live_.emulated_rtt_s.store(mmt.to_remote.delay_s + mmt.to_operator.delay_s);
   } else {
     rig_ = std::make_unique<session::HapticRig>(scenario_, params_, start.orientation, *device_, ro);
@@ -155,12 +165,19 @@ void LoopDriver::stop() {
 }
 
 void LoopDriver::lockstep_main() {
+  // A remote in another process runs on the wall clock: each tick waits for
+  // its time (t = i / rate from the start), or the operator would run ahead.
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
   std::int64_t i = 0;
   while (lockstep_running_.load(std::memory_order_relaxed)) {
     if (i >= target_ticks_.load()) {
       std::this_thread::sleep_for(std::chrono::microseconds(200));
       continue;
     }
+    if (udp_)
+      std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
+                                                std::chrono::duration<double>(double(i) / rate_hz())));
     tick(i);
     ++i;
     ticks_done_.store(i);  // after step2 published the tick's frame
@@ -175,7 +192,7 @@ void LoopDriver::tick(std::int64_t i) {
   const double t_s = double(i) * period;
   if (operator_) {
     operator_->tick(t_s);
-    remote_->tick(t_s);
+    if (remote_) remote_->tick(t_s);
     publish_mmt();
     return;
   }
@@ -207,7 +224,6 @@ void LoopDriver::paced_mmt_main() {
 void LoopDriver::publish_mmt() {
   const session::OperatorRecord& r = operator_->last_record();
   const session::StationCounters& oc = operator_->counters();
-  const session::StationCounters& rc = remote_->counters();
   MmtLive& m = mmt_live_;
   const double err = length(r.force_world_n - r.remote_force_world_n);
   error_ms_n2_ += (err * err - error_ms_n2_) / rate_hz();  // about the last second
@@ -218,11 +234,14 @@ void LoopDriver::publish_mmt() {
     const net::EmulatorCounters& c = e.counters();
     return c.datagrams > 0 ? double(c.lost) / double(c.datagrams) : 0.0;
   };
-  m.loss_to_remote.store(loss(link_->a().emulator()), std::memory_order_relaxed);
-  m.loss_to_operator.store(loss(link_->b().emulator()), std::memory_order_relaxed);
+  // With the remote in another process, its sender's losses are its own.
+  m.loss_to_remote.store(loss(udp_ ? udp_->emulator() : link_->a().emulator()),
+                         std::memory_order_relaxed);
+  m.loss_to_operator.store(link_ ? loss(link_->b().emulator()) : 0.0, std::memory_order_relaxed);
   m.patches.store(oc.patches, std::memory_order_relaxed);
   m.estimates.store(oc.estimates, std::memory_order_relaxed);
-  m.rejected.store(oc.rejected.total() + rc.rejected.total(), std::memory_order_relaxed);
+  m.rejected.store(oc.rejected.total() + (remote_ ? remote_->counters().rejected.total() : 0),
+                  std::memory_order_relaxed);
   m.scale_applied.store(r.scale_applied, std::memory_order_relaxed);
   m.scale_target.store(r.scale_target, std::memory_order_relaxed);
   m.link_silent.store(r.link_silent, std::memory_order_relaxed);

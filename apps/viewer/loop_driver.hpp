@@ -24,7 +24,11 @@
 // and the frames show the local model as the remote's patches correct it.
 // Both ways to run tick the two stations in turn on this class's thread
 // (paced: at the loop rate by absolute deadlines). MmtLive carries the
-// link's figures to the panel.
+// link's figures to the panel. With DriverOptions::remote the remote station
+// is another process (`terracut mmt --role remote`) over UDP: only the
+// operator station ticks here, on the wall clock in both ways to run (the
+// remote does not wait for lock-step), and the panel's loss and rejections
+// are the operator's side's.
 //
 // A scenario with rigid bodies (`bodies:`) gets the world's Bullet listener
 // (the one `terracut run` and `terracut haptics` use): the bodies are stepped
@@ -35,6 +39,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -66,6 +71,13 @@ struct DriverOptions {
   /// Teleoperation: run the scenario's `mmt:` section (operator and remote
   /// stations over the emulated link) instead of the plain haptic loop.
   bool mmt = false;
+  /// With mmt: the remote station is another process (`terracut mmt
+  /// --role remote`) at this "ADDR:PORT" or "PORT" (IPv4), reached over UDP
+  /// with the scenario's mmt.link conditions at this sender; empty: the
+  /// remote runs here over the emulated in-memory link.
+  std::string remote;
+  /// How long to wait for that remote station to answer, s.
+  double connect_timeout_s = 5.0;
 };
 
 /// The teleoperation link as the panel shows it, written by the driver's
@@ -169,6 +181,7 @@ class LoopDriver {
   // MMT: the remote world, the link and the two stations (instead of rig_).
   std::unique_ptr<session::Scenario> remote_scenario_;
   std::unique_ptr<net::MemoryLink> link_;
+  std::unique_ptr<net::Endpoint> udp_;  // DriverOptions::remote: the link to the other process
   std::unique_ptr<session::OperatorStation> operator_;
   std::unique_ptr<session::RemoteStation> remote_;
   MmtLive mmt_live_;

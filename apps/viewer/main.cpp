@@ -11,6 +11,7 @@
 
 #include "gl_context.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/session/mmt_process.hpp"
 #include "viewer_app.hpp"
 
 namespace {
@@ -96,6 +97,9 @@ int main(int argc, char** argv) {
   app.add_flag("--mmt", opt.mmt,
                "teleoperation: the tool drives the operator station of the scenario's mmt: "
                "section; the remote station runs in-process over the emulated link");
+  app.add_option("--remote", opt.remote,
+                 "with --mmt: the remote station is another process (`terracut mmt --role "
+                 "remote`) at ADDR:PORT or PORT (UDP, IPv4), not in-process");
   bool no_realtime = false;
   app.add_flag("--no-realtime", no_realtime,
                "do not ask for SCHED_FIFO for the haptic loop's thread");
@@ -110,6 +114,11 @@ int main(int argc, char** argv) {
   opt.realtime = !no_realtime;
 
   try {
+    if (!opt.remote.empty()) {
+      if (!opt.mmt)
+        throw terracut::InputError("--remote: needs --mmt (the viewer is then the operator station)");
+      terracut::session::parse_endpoint(opt.remote, "--remote", "127.0.0.1");  // refused here if bad
+    }
     opt.input = input;
     opt.screenshot = screenshot;
     opt.font = font;

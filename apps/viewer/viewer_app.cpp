@@ -73,6 +73,7 @@ ViewerApp::~ViewerApp() { close_session(); }
 void ViewerApp::open_session(const DriverOptions& driver_options) {
   driver_options_ = driver_options;
   driver_options_.mmt = options_.mmt;
+  driver_options_.remote = options_.remote;
   driver_ = std::make_unique<LoopDriver>(scenario_, haptics_, driver_options_, &timing_);
   const GridSpec& spec = driver_->spec();
   const std::vector<float>& initial = driver_->initial_heights();

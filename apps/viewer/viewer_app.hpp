@@ -62,6 +62,9 @@ struct ViewerOptions {
   /// Run the scenario's `mmt:` section: the tool drives the operator
   /// station, the remote runs in-process over the emulated link.
   bool mmt = false;
+  /// With mmt: the remote station is `terracut mmt --role remote` at this
+  /// "ADDR:PORT" or "PORT" (UDP) instead of in-process.
+  std::string remote;
 };
 
 /// Loads the scenario (and its `haptics:` section) or the heightmap named by

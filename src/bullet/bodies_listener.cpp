@@ -28,6 +28,8 @@ Vec3 BodiesListener::on_step(const StepOutput& out) noexcept {
   world_->step(out);
   if (csv_) csv_->write_step(*world_);
   const WorldStepInfo& info = world_->last();
+  // A released buried body lowered the soil it stood in: part of this step's change.
+  if (info.bodies_released > 0) sim_.include_changed(info.released_rect);
   peak_tool_force_n_ = std::max(peak_tool_force_n_, length(info.tool_force_n));
   if (info.tool_contact_points > 0) ++steps_touching_;
   ++steps_;

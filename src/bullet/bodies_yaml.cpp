@@ -20,9 +20,9 @@ bool field_belongs(BodyShape shape, std::string_view key) {
   return true;
 }
 
-BodySpec parse_body(const yaml::Field& field, std::size_t index) {
+BodySpec parse_body(const yaml::Field& field, std::size_t index, std::string& buried_where) {
   const yaml::Map map(field, {"name", "shape", "size_m", "radius_m", "height_m", "mass_kg",
-                              "position_m", "rotation_deg", "friction", "restitution"});
+                              "position_m", "rotation_deg", "friction", "restitution", "buried"});
   BodySpec spec;
   spec.name = "body" + std::to_string(index);
   map.read_text("name", spec.name);
@@ -50,6 +50,8 @@ BodySpec parse_body(const yaml::Field& field, std::size_t index) {
   map.read_vec3("rotation_deg", spec.rotation_deg);
   map.read_number("friction", spec.friction);
   map.read_number("restitution", spec.restitution);
+  if (map.read_boolean("buried", spec.buried) && spec.buried)
+    buried_where = field.context().where(map.get("buried")->mark()) + ": " + field.path() + ".buried";
 
   // Range checks, reported against the field they concern: validate's
   // messages start with the field ("size_m[1] must be ...").
@@ -62,7 +64,9 @@ BodySpec parse_body(const yaml::Field& field, std::size_t index) {
 
 }  // namespace
 
-std::vector<BodySpec> parse_bodies(const YAML::Node& node, const std::string& file) {
+std::vector<BodySpec> parse_bodies(const YAML::Node& node, const std::string& file,
+                                   std::vector<std::string>* buried_where) {
+  if (buried_where) buried_where->clear();
   if (node.IsNull()) return {};  // "bodies:" with nothing under it: no bodies
   const yaml::Field list(yaml::Context(file), node, "bodies", node.Mark());
   if (!list.is_sequence()) list.fail("expected a list of bodies, got " + yaml::describe(node));
@@ -71,7 +75,9 @@ std::vector<BodySpec> parse_bodies(const YAML::Node& node, const std::string& fi
   std::vector<yaml::Field> names;  // where each body's name is given (or the body itself)
   const std::vector<yaml::Field> items = list.elements();
   for (std::size_t i = 0; i < items.size(); ++i) {
-    BodySpec spec = parse_body(items[i], i);
+    std::string where;
+    BodySpec spec = parse_body(items[i], i, where);
+    if (buried_where) buried_where->push_back(std::move(where));
     const yaml::Field name = items[i].lookup("name").value_or(items[i]);
     for (std::size_t j = 0; j < bodies.size(); ++j)
       if (bodies[j].name == spec.name)

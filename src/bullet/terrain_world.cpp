@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
@@ -26,6 +27,61 @@ btQuaternion to_bt(Quat q) {
   return btQuaternion(btScalar(q.x), btScalar(q.y), btScalar(q.z), btScalar(q.w));
 }
 Quat from_bt(const btQuaternion& q) { return {double(q.w()), double(q.x()), double(q.y()), double(q.z())}; }
+
+// Where a ray from `from` along the unit `d` (both in the body's frame)
+// enters the body's shape, as the distance along it; NaN when it misses.
+// Exact for the shapes' outer surfaces (a box's edges are Bullet's rounded
+// by its margin: up to the margin lower there).
+double ray_entry(const BodySpec& b, Vec3 from, Vec3 d) {
+  constexpr double kMiss = std::numeric_limits<double>::quiet_NaN();
+  const Vec3 h = half_extents_m(b);
+  switch (b.shape) {
+    case BodyShape::kBox: {
+      double enter = -1e300, leave = 1e300;
+      const double o[3] = {from.x, from.y, from.z}, v[3] = {d.x, d.y, d.z}, e[3] = {h.x, h.y, h.z};
+      for (int k = 0; k < 3; ++k) {
+        if (std::fabs(v[k]) < 1e-12) {
+          if (std::fabs(o[k]) > e[k]) return kMiss;
+          continue;
+        }
+        const double t0 = (-e[k] - o[k]) / v[k], t1 = (e[k] - o[k]) / v[k];
+        enter = std::max(enter, std::min(t0, t1));
+        leave = std::min(leave, std::max(t0, t1));
+      }
+      return enter <= leave && enter >= 0.0 ? enter : kMiss;
+    }
+    case BodyShape::kSphere: {
+      const double bb = dot(from, d), c = dot(from, from) - b.radius_m * b.radius_m;
+      const double disc = bb * bb - c;
+      return disc >= 0.0 ? -bb - std::sqrt(disc) : kMiss;
+    }
+    case BodyShape::kCylinder: {
+      // The side (radius r about local Y, |y| <= h.y) and the two caps.
+      double best = kMiss;
+      const auto take = [&](double t) {
+        if (t >= 0.0 && !(t >= best)) best = t;
+      };
+      const double a = d.x * d.x + d.z * d.z;
+      if (a > 1e-12) {
+        const double bb = from.x * d.x + from.z * d.z;
+        const double c = from.x * from.x + from.z * from.z - b.radius_m * b.radius_m;
+        const double disc = bb * bb - a * c;
+        if (disc >= 0.0) {
+          const double t = (-bb - std::sqrt(disc)) / a;
+          if (std::fabs(from.y + t * d.y) <= h.y) take(t);
+        }
+      }
+      if (std::fabs(d.y) > 1e-12)
+        for (double cap : {-h.y, h.y}) {
+          const double t = (cap - from.y) / d.y;
+          const double x = from.x + t * d.x, z = from.z + t * d.z;
+          if (x * x + z * z <= b.radius_m * b.radius_m) take(t);
+        }
+      return best;
+    }
+  }
+  return kMiss;
+}
 
 // The range check shared by the friction-like fields.
 bool in_range(double v, double lo, double hi) { return v >= lo && v <= hi; }
@@ -108,6 +164,8 @@ struct TerrainWorld::Impl {
   std::unique_ptr<btRigidBody> tool_body;
   std::vector<std::unique_ptr<btCollisionShape>> body_shapes;
   std::vector<std::unique_ptr<btRigidBody>> bodies;
+  std::vector<btVector3> inertia;  // per body, for a held one's release
+  std::vector<char> held;          // per body: buried, not yet reached
 
   ~Impl() {
     for (auto& b : bodies) world.removeRigidBody(b.get());
@@ -134,6 +192,9 @@ TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& bl
     throw InputError("the Bullet heightfield needs at least 2 x 2 samples, the grid has " +
                      format_number(grid.cols()) + " x " + format_number(grid.rows()));
   if (std::string e = validate(specs_); !e.empty()) throw InputError(e);
+  for (std::size_t i = 0; i < specs_.size(); ++i)
+    if (std::string e = buried_problem(specs_[i], grid.spec(), grid.heights()); !e.empty())
+      throw InputError("bodies[" + format_number(i) + "] (" + specs_[i].name + "): " + e);
   dt_s_ = 1.0 / rate_hz;
 
   // Height bounds: [0, max] with room for piles above the initial terrain.
@@ -258,7 +319,13 @@ TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& bl
     info.m_friction = btScalar(b.friction);
     info.m_restitution = btScalar(b.restitution);
     auto body = std::make_unique<btRigidBody>(info);
+    // A buried body is held: static (no gravity, no integration) and, as
+    // static, in no pair with the terrain, the floor or the plate.
+    const bool held = b.buried && b.mass_kg > 0.0;
+    if (held) body->setMassProps(0, btVector3(0, 0, 0));
     m.world.addRigidBody(body.get());
+    m.inertia.push_back(inertia);
+    m.held.push_back(held ? 1 : 0);
     m.body_shapes.push_back(std::move(shape));
     m.bodies.push_back(std::move(body));
   }
@@ -270,6 +337,7 @@ void TerrainWorld::step(const StepOutput& out) {
   const double start = now_s();
   terrain_changed(out.changed);
   set_tool_pose(out.pose);
+  release_reached(out.changed);
   advance();
   info_.total_s = now_s() - start;
 }
@@ -377,6 +445,10 @@ void TerrainWorld::advance() {
   info_.tool_contact_points = points;
   info_.bodies_woken = pending_woken_;
   pending_woken_ = 0;
+  info_.bodies_released = pending_released_;
+  info_.released_rect = pending_released_rect_;
+  pending_released_ = 0;
+  pending_released_rect_ = {};
   bounds_.clamped_last_step = pending_clamped_;
   pending_clamped_ = 0;
   info_.step = steps_;
@@ -394,7 +466,126 @@ BodyState TerrainWorld::body_state(int i) const {
   s.velocity_m_s = from_bt(b.getLinearVelocity());
   s.angular_velocity_rad_s = from_bt(b.getAngularVelocity());
   s.active = b.isActive();
+  s.held = impl_->held[std::size_t(i)] != 0;
   return s;
+}
+
+int TerrainWorld::held_count() const {
+  return int(std::count(impl_->held.begin(), impl_->held.end(), char(1)));
+}
+
+void TerrainWorld::release_reached(const Rect& changed) {
+  Impl& m = *impl_;
+  const float* h = grid_.heights();
+  const double ground = grid_.spec().origin_m.y;
+  btVector3 tool_lo(0, 0, 0), tool_hi(0, 0, 0);
+  // The plate takes part once it has a pose (its contacts are on).
+  const bool tool = m.tool_body && !(m.tool_body->getCollisionFlags() &
+                                     btCollisionObject::CF_NO_CONTACT_RESPONSE);
+  if (tool) m.tool_body->getAabb(tool_lo, tool_hi);
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    if (!m.held[i]) continue;
+    btVector3 lo, hi;
+    m.bodies[i]->getAabb(lo, hi);
+    bool reached = tool && tool_lo.x() <= hi.x() && tool_hi.x() >= lo.x() &&
+                   tool_lo.y() <= hi.y() && tool_hi.y() >= lo.y() && tool_lo.z() <= hi.z() &&
+                   tool_hi.z() >= lo.z();
+    // Or the cut took the soil over its footprint down to its top.
+    const Rect f = samples_under(lo, hi);
+    const Rect c{std::max(f.c0, changed.c0), std::max(f.r0, changed.r0),
+                 std::min(f.c1, changed.c1), std::min(f.r1, changed.r1)};
+    const float top = float(double(hi.y()) - ground);
+    for (int row = c.r0; row < c.r1 && !reached; ++row)
+      for (int col = c.c0; col < c.c1 && !reached; ++col)
+        reached = h[grid_.index(col, row)] <= top;
+    if (reached) release(int(i));
+  }
+}
+
+Rect TerrainWorld::samples_under(const btVector3& lo, const btVector3& hi) const {
+  // A sample on the box's side counts as under it (Bullet's float box
+  // reaches it within a micrometre).
+  const GridSpec& g = grid_.spec();
+  constexpr double kOn = 1e-6;
+  const auto first = [](double v, double origin, double cell) {
+    return int(std::ceil((v - kOn - origin) / cell - 0.5));
+  };
+  const auto end = [](double v, double origin, double cell) {
+    return int(std::floor((v + kOn - origin) / cell - 0.5)) + 1;
+  };
+  return {std::clamp(first(lo.x(), g.origin_m.x, g.cell_x_m()), 0, g.cols),
+          std::clamp(first(lo.z(), g.origin_m.z, g.cell_z_m()), 0, g.rows),
+          std::clamp(end(hi.x(), g.origin_m.x, g.cell_x_m()), 0, g.cols),
+          std::clamp(end(hi.z(), g.origin_m.z, g.cell_z_m()), 0, g.rows)};
+}
+
+void TerrainWorld::release(int i) {
+  Impl& m = *impl_;
+  btRigidBody& b = *m.bodies[std::size_t(i)];
+  btVector3 lo, hi;
+  b.getAabb(lo, hi);
+  // The soil it stood in: the samples under its box and one more all round
+  // go down to its lowest point (lower() only lowers: a deeper cut stays),
+  // so it rests on a level floor and no terrain triangle reaches into it.
+  Rect pit = samples_under(lo, hi);
+  pit = {std::max(pit.c0 - 1, 0), std::max(pit.r0 - 1, 0), std::min(pit.c1 + 1, grid_.cols()),
+         std::min(pit.r1 + 1, grid_.rows())};
+  const float floor_h = float(double(lo.y()) - grid_.spec().origin_m.y);
+  for (int row = pit.r0; row < pit.r1; ++row)
+    for (int col = pit.c0; col < pit.c1; ++col) grid_.lower(grid_.index(col, row), floor_h);
+  // Dynamic from now on: out of the world and back, so that the broadphase
+  // gives it the dynamic body's collision groups (Bullet allocates its new
+  // pairs here, once per release).
+  m.world.removeRigidBody(&b);
+  b.setMassProps(btScalar(specs_[std::size_t(i)].mass_kg), m.inertia[std::size_t(i)]);
+  b.updateInertiaTensor();
+  b.setLinearVelocity(btVector3(0, 0, 0));
+  b.setAngularVelocity(btVector3(0, 0, 0));
+  m.world.addRigidBody(&b);
+  b.activate(true);
+  m.held[std::size_t(i)] = 0;
+  ++pending_released_;
+  pending_released_rect_.include(pit);
+  terrain_changed(pit);
+}
+
+int TerrainWorld::raise_to_body_tops(const Rect& rect, std::span<float> out) const {
+  const Rect r{std::max(rect.c0, 0), std::max(rect.r0, 0), std::min(rect.c1, grid_.cols()),
+               std::min(rect.r1, grid_.rows())};
+  if (r.empty() || out.size() < std::size_t(rect.area())) return 0;
+  const double ground = grid_.spec().origin_m.y;
+  const int width = rect.c1 - rect.c0;
+  int raised = 0;
+  for (std::size_t i = 0; i < impl_->bodies.size(); ++i) {
+    if (impl_->held[i]) continue;
+    const btRigidBody& b = *impl_->bodies[i];
+    btVector3 lo, hi;
+    b.getAabb(lo, hi);
+    const Rect under = samples_under(lo, hi);
+    const Rect s{std::max(under.c0, r.c0), std::max(under.r0, r.r0), std::min(under.c1, r.c1),
+                 std::min(under.r1, r.r1)};
+    if (s.empty()) continue;
+    const btTransform& t = b.getWorldTransform();
+    const BodySpec& spec = specs_[i];
+    const Quat q = from_bt(t.getRotation());
+    const Quat inverse{q.w, -q.x, -q.y, -q.z};
+    const Vec3 centre = from_bt(t.getOrigin());
+    const double above = double(hi.y()) + 1.0;
+    const Vec3 down = rotate(inverse, {0.0, -1.0, 0.0});  // the ray, in the body's frame
+    for (int row = s.r0; row < s.r1; ++row)
+      for (int col = s.c0; col < s.c1; ++col) {
+        const Vec3 from = rotate(inverse, Vec3{grid_.sample_x(col), above, grid_.sample_z(row)} - centre);
+        const double hit = ray_entry(spec, from, down);
+        if (!(hit >= 0.0)) continue;  // misses (NaN)
+        const float top = float(above - hit - ground);
+        float& v = out[std::size_t((row - rect.r0) * width + (col - rect.c0))];
+        if (top > v) {
+          v = top;
+          ++raised;
+        }
+      }
+  }
+  return raised;
 }
 
 BladePose TerrainWorld::tool_plate_pose() const {

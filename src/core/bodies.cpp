@@ -1,5 +1,6 @@
 #include "terracut/core/bodies.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 
@@ -115,6 +116,62 @@ Vec3 half_extents_m(const BodySpec& spec) {
     case BodyShape::kCylinder:
       return {spec.radius_m, spec.height_m * 0.5, spec.radius_m};
   }
+  return {};
+}
+
+}  // namespace terracut
+
+namespace terracut {
+
+std::pair<Vec3, Vec3> initial_bounds_m(const BodySpec& spec) {
+  const Vec3 h = half_extents_m(spec);
+  const Quat q = normalized(initial_orientation(spec));
+  // The body's local axes in the world.
+  const Vec3 ax = rotate(q, {1.0, 0.0, 0.0}), ay = rotate(q, {0.0, 1.0, 0.0}),
+             az = rotate(q, {0.0, 0.0, 1.0});
+  Vec3 e{};
+  switch (spec.shape) {
+    case BodyShape::kSphere:
+      e = h;
+      break;
+    case BodyShape::kBox:
+      e = {std::fabs(ax.x) * h.x + std::fabs(ay.x) * h.y + std::fabs(az.x) * h.z,
+           std::fabs(ax.y) * h.x + std::fabs(ay.y) * h.y + std::fabs(az.y) * h.z,
+           std::fabs(ax.z) * h.x + std::fabs(ay.z) * h.y + std::fabs(az.z) * h.z};
+      break;
+    case BodyShape::kCylinder: {
+      // The axis' half length plus the rim's reach: r sqrt(1 - axis_i^2).
+      const auto reach = [&](double a) {
+        return std::fabs(a) * h.y + spec.radius_m * std::sqrt(std::max(0.0, 1.0 - a * a));
+      };
+      e = {reach(ay.x), reach(ay.y), reach(ay.z)};
+      break;
+    }
+  }
+  return {spec.position_m - e, spec.position_m + e};
+}
+
+std::string buried_problem(const BodySpec& body, const GridSpec& g, const float* heights) {
+  if (!body.buried) return {};
+  const auto [lo, hi] = initial_bounds_m(body);
+  // The samples whose centres lie under the bounding box.
+  const int c0 = std::max(0, int(std::ceil((lo.x - g.origin_m.x) / g.cell_x_m() - 0.5)));
+  const int c1 = std::min(g.cols, int(std::floor((hi.x - g.origin_m.x) / g.cell_x_m() - 0.5)) + 1);
+  const int r0 = std::max(0, int(std::ceil((lo.z - g.origin_m.z) / g.cell_z_m() - 0.5)));
+  const int r1 = std::min(g.rows, int(std::floor((hi.z - g.origin_m.z) / g.cell_z_m() - 0.5)) + 1);
+  if (c0 >= c1 || r0 >= r1)
+    return "buried: the body is not over the terrain (no sample lies under it)";
+  for (int r = r0; r < r1; ++r)
+    for (int c = c0; c < c1; ++c) {
+      const double soil_y = g.origin_m.y + double(heights[std::int64_t(r) * g.cols + c]);
+      if (!(soil_y > hi.y))
+        return "buried: the body's top (y = " + format_number(hi.y) +
+               " m) is not under the soil at x = " +
+               format_number(g.origin_m.x + (c + 0.5) * g.cell_x_m()) +
+               " m, z = " + format_number(g.origin_m.z + (r + 0.5) * g.cell_z_m()) +
+               " m (soil surface y = " + format_number(soil_y) +
+               " m); a buried body must be covered over its whole footprint";
+    }
   return {};
 }
 

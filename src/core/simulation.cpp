@@ -165,6 +165,12 @@ const StepOutput& Simulation::finish_step() {
   return out_;
 }
 
+void Simulation::include_changed(const Rect& rect) {
+  if (!in_step_) throw std::logic_error("Simulation::include_changed: only during a step");
+  out_.changed.include(rect);
+  if (soil_) soil_->wake(rect);
+}
+
 void Simulation::lift() {
   has_previous_ = false;
   for (StepListener* listener : listeners_) listener->on_lift();

@@ -74,6 +74,25 @@ std::pair<std::string, int> parse_endpoint(const std::string& text, const std::s
   return {address.value_or(default_address), *port};
 }
 
+std::unique_ptr<net::Endpoint> connect_operator_link(const MmtSettings& s,
+                                                     const std::string& endpoint,
+                                                     const std::string& option, double timeout_s) {
+  const auto [address, port] =
+      endpoint.empty() ? std::pair{s.address, s.port} : parse_endpoint(endpoint, option, s.address);
+  auto link = net::EnetEndpoint::connect(address, port, s.to_remote);
+  // Wait for the connection before the loop starts.
+  const auto start = Clock::now();
+  net::Inbox none;
+  while (!link->connected()) {
+    if (std::chrono::duration<double>(Clock::now() - start).count() > timeout_s)
+      throw InputError(option + ": no remote station answered at " + address + ":" +
+                       std::to_string(port) + " within " + format_number(timeout_s) + " s");
+    link->receive(0.0, none);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return link;
+}
+
 int run_remote_process(const Scenario& op, const ProcessOptions& o) {
   if (!op.mmt)
     throw InputError(op.base.source_path.string() + ": mmt: the scenario has no mmt: section");
@@ -119,18 +138,8 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
   const MmtSettings s = apply_overrides(*op.mmt, o.overrides);
   const auto [address, port] =
       o.endpoint.empty() ? std::pair{s.address, s.port} : parse_endpoint(o.endpoint, "--connect", s.address);
-  auto link = net::EnetEndpoint::connect(address, port, s.to_remote);
-  // Wait for the connection before the loop starts.
-  const auto start = Clock::now();
-  net::Inbox none;
-  while (!link->connected()) {
-    if (std::chrono::duration<double>(Clock::now() - start).count() > o.connect_timeout_s)
-      throw InputError("--connect: no remote station answered at " + address + ":" +
-                       std::to_string(port) + " within " + format_number(o.connect_timeout_s) +
-                       " s");
-    link->receive(0.0, none);
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
+  std::unique_ptr<net::Endpoint> link =
+      connect_operator_link(s, o.endpoint, "--connect", o.connect_timeout_s);
   std::unique_ptr<haptics::Device> device = make_operator_device(op);
   OperatorStation station(op, s, *device, *link,
                           std::uint32_t(Clock::now().time_since_epoch().count()));

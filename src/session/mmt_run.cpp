@@ -140,6 +140,7 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
   // Every record of the run has its room now: a tick allocates nothing.
   operator_->reserve_records(std::size_t(total_ticks_));
   remote_->reserve_records(std::size_t(total_ticks_));
+  sensed_.reserve(std::size_t(operator_->simulation().grid().spec().sample_count()));
   terrain_error_.reserve(std::size_t(total_ticks_ / std::max<std::int64_t>(1, std::llround(0.05 * rate_hz_)) + 1));
 }
 
@@ -159,7 +160,9 @@ void MmtRun::run() {
 }
 
 // RMS of local - remote over every sample either station worked (cut or
-// merged), metres; 0 before anything was worked.
+// merged), metres; 0 before anything was worked. The remote's heights are
+// its surface as sensed (the soil, or the top of an uncovered body): what
+// the local model is to predict.
 double MmtRun::terrain_rms() const {
   Rect region = operator_->worked();
   const Rect& w = remote_->worked();
@@ -169,11 +172,13 @@ double MmtRun::terrain_rms() const {
     region.include(w);
   if (region.empty()) return 0.0;
   const HeightGrid& a = operator_->simulation().grid();
-  const HeightGrid& b = remote_->simulation().grid();
+  sensed_.resize(std::size_t(region.area()));
+  remote_->rig().world().sense_heights(region, sensed_);
   double s = 0.0;
+  std::size_t k = 0;
   for (int r = region.r0; r < region.r1; ++r)
     for (int c = region.c0; c < region.c1; ++c) {
-      const double d = double(a.heights()[a.index(c, r)]) - b.heights()[b.index(c, r)];
+      const double d = double(a.heights()[a.index(c, r)]) - sensed_[k++];
       s += d * d;
     }
   return std::sqrt(s / double(region.area()));
@@ -234,6 +239,7 @@ MmtSummary MmtRun::summary() const {
   s.force_scale_final = remote_->force_scale();
   s.force_scale_applied = op.empty() ? 1.0 : op.back().scale_applied;
   s.estimate_samples = remote_->estimate_samples();
+  s.estimate_outliers = remote_->estimate_outliers();
   std::vector<double> c;
   for (const OperatorRecord& r : op) c.push_back(r.compute_s);
   s.operator_compute = timing_stats(c);
@@ -292,7 +298,8 @@ void MmtRun::write_outputs(const std::filesystem::path& dir) const {
                   {"max_force_step_while_updating_n", s.max_step_while_updating_n}};
   j["estimate"] = {{"force_scale", s.force_scale_final},
                    {"force_scale_applied", s.force_scale_applied},
-                   {"samples", s.estimate_samples}};
+                   {"samples", s.estimate_samples},
+                   {"outliers_left_out", s.estimate_outliers}};
   j["passivity"] = {{"window_s", 1.0},
                     {"mmt_max_energy_into_hand_j", s.passivity_max_mmt_j},
                     {"direct_max_energy_into_hand_j", s.passivity_max_dfr_j}};

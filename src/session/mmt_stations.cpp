@@ -227,6 +227,7 @@ RemoteStation::RemoteStation(const Scenario& remote, const MmtSettings& settings
   // flight, the commands of a tick arriving.
   const std::size_t samples = patch_samples(settings_, grid.spec());
   patch_.heights.reserve(samples);
+  sensed_.reserve(samples);
   buffer_.reserve(net::patch_datagram_bound(samples));
   codec_.reserve(samples);
   const double flight_s = in_flight_s(settings_.to_operator);
@@ -309,6 +310,16 @@ void RemoteStation::update_estimate(const haptics::LoopRecord& r) {
   const double x = length(horizontal(nominal_.compute(in).cutting_n)) / 100.0;
   const double y = length(horizontal(r.force_world_n)) / 100.0;
   if (!(x > 0.01) || !std::isfinite(y)) return;  // below 1 N the ratio says little
+  // Once it has settled, a sample more than kOutlier times off the estimate
+  // is something no soil does (the plate striking a rock: Bullet's impact
+  // is a hundred times the cut): left out, or it would be carried into the
+  // operator's soil for the next second.
+  constexpr double kOutlier = 4.0;
+  constexpr std::int64_t kSettled = 200;
+  if (rls_samples_ >= kSettled && (y > kOutlier * theta_ * x || kOutlier * y < theta_ * x)) {
+    ++rls_outliers_;
+    return;
+  }
   const double lambda = settings_.forgetting;
   const double k = p_ * x / (lambda + x * p_ * x);
   theta_ = std::clamp(theta_ + k * (y - theta_ * x), 0.02, 50.0);
@@ -325,7 +336,15 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
   Rect cand = dirty_;
   dirty_ = {};
   if (has_command_) include_rect(cand, window_around(device_->pose().position_m));
+  if (cand.empty()) return send_estimate(t_s);
   const HeightGrid& grid = simulation().grid();
+  // What the camera sees: the soil, and the top of any body over it.
+  sensed_.resize(std::size_t(cand.area()));
+  rig_->world().sense_heights(cand, sensed_);
+  const int width = cand.c1 - cand.c0;
+  const auto seen = [&](int col, int row) {
+    return sensed_[std::size_t((row - cand.r0) * width + (col - cand.c0))];
+  };
   // Without the deadband the whole sensed rectangle goes (a depth camera's
   // frame: it also corrects what the operator's model did on its own);
   // with it, only the samples past the threshold, and nothing below it.
@@ -335,7 +354,7 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
   for (int row = cand.r0; row < cand.r1; ++row)
     for (int col = cand.c0; col < cand.c1; ++col) {
       const std::int64_t i = grid.index(col, row);
-      if (std::fabs(grid.heights()[i] - mirror_[std::size_t(i)]) > threshold) {
+      if (std::fabs(seen(col, row) - mirror_[std::size_t(i)]) > threshold) {
         if (diff.empty())
           diff = {col, row, col + 1, row + 1};
         else
@@ -350,8 +369,8 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
     for (int row = diff.r0; row < diff.r1; ++row)
       for (int col = diff.c0; col < diff.c1; ++col) {
         const std::int64_t i = grid.index(col, row);
-        patch_.heights[k++] = grid.heights()[i];
-        mirror_[std::size_t(i)] = grid.heights()[i];
+        patch_.heights[k++] = seen(col, row);
+        mirror_[std::size_t(i)] = seen(col, row);
       }
     net::Header h{net::MessageType::kPatch, settings_.link_id, session_, seq_patch_++, to_ns(t_s)};
     if (codec_.encode(h, patch_, buffer_) > 0) {
@@ -359,7 +378,11 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
       ++counters_.patches;
     }
   }
-  // The estimate, when it moved (by the JND fraction with the deadband).
+  send_estimate(t_s);
+}
+
+// The estimate, when it moved (by the JND fraction with the deadband).
+void RemoteStation::send_estimate(double t_s) {
   if (rls_samples_ > 0) {
     const double moved = std::fabs(theta_ - theta_sent_);
     const bool send = settings_.deadband > 0.0 ? moved > settings_.deadband * theta_sent_
@@ -583,17 +606,22 @@ void OperatorStation::receive(double t_s) {
 // samples near its edge (within exclusion_m, where the force is read: the
 // depth ahead and the failure wedge) are not touched: their ramp starts
 // again from their current height once the tool has left them, so a patch
-// never changes the terrain the tool is feeling. Samples the local tool
+// never changes the terrain the tool is feeling. Out of contact the same
+// holds for the samples a patch would raise to the edge or above (the top
+// of a body the remote sensed under the tool): a patch never makes contact. Samples the local tool
 // changed recently wait the same way (the remote has not seen that change
 // yet); every sample ends at the remote's height.
 void OperatorStation::merge(double t_s) {
   HeightGrid& grid = rig_->world().simulation().grid();
   const haptics::LoopRecord& last = rig_->loop().last();
   const bool in_contact = last.contact_length_m > 0.0;
-  const Segment edge = simulation().last().edge;
+  // The edge where the tool is now (the loop steps the simulation only
+  // near the terrain, so its last step's edge can be old).
+  const Segment edge = blade_segment(simulation().params().blade, last.tool);
   const double ex = settings_.exclusion_m;
   const double x0 = std::min(edge.a.x, edge.b.x) - ex, x1 = std::max(edge.a.x, edge.b.x) + ex;
   const double z0 = std::min(edge.a.z, edge.b.z) - ex, z1 = std::max(edge.a.z, edge.b.z) + ex;
+  const float edge_low = float(std::min(edge.a.y, edge.b.y) - grid.spec().origin_m.y);
   for (std::size_t bi = 0; bi < active_blends_; ++bi) {
     Blend& b = blends_[bi];
     b.done = true;
@@ -602,7 +630,10 @@ void OperatorStation::merge(double t_s) {
       for (int col = b.rect.c0; col < b.rect.c1; ++col, ++k) {
         const std::int64_t i = grid.index(col, row);
         const float now = grid.heights()[i];
-        if (in_contact) {
+        // Near the edge a sample waits while the tool is in contact, and
+        // also out of contact when the patch would lift it to the edge (a
+        // body's top under the tool): a patch never pushes terrain into it.
+        if (in_contact || b.to[k] >= edge_low) {
           const double x = grid.sample_x(col), z = grid.sample_z(row);
           if (x >= x0 && x <= x1 && z >= z0 && z <= z1) {
             b.t0_s[k] = float(t_s);  // wait, and start from here later

@@ -1,6 +1,7 @@
 // Loading a scenario with all its sections. See scenario.hpp.
 #include "terracut/session/scenario.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <numbers>
@@ -17,6 +18,27 @@ namespace terracut::session {
 
 namespace {
 
+// A buried body must be under the soil of the initial terrain, which is
+// known only once the whole file is read: checked here, the error pointing
+// at the body's `buried:` line.
+void check_buried(const Scenario& sc, const std::vector<std::string>& where) {
+  const auto buried = [](const BodySpec& b) { return b.buried; };
+  if (std::none_of(sc.bodies.begin(), sc.bodies.end(), buried)) return;
+  const GridSpec grid = io::grid_spec(sc.base);
+  const std::vector<float> heights = io::build_initial_heights(sc.base);
+  for (std::size_t i = 0; i < sc.bodies.size(); ++i) {
+    if (!sc.bodies[i].buried) continue;
+    // Soil that flows would have to flow around a held body and over it:
+    // not modelled (docs/bullet.md, "Buried bodies").
+    if (sc.base.soil.model == SoilModel::kFlow)
+      throw InputError(where[i] + ": a buried body needs soil.model vanish (flowing soil around a "
+                                  "held body is not modelled)");
+    std::string problem = buried_problem(sc.bodies[i], grid, heights.data());
+    if (!problem.empty())
+      throw InputError(where[i] + ": " + problem.substr(std::string_view("buried: ").size()));
+  }
+}
+
 // Reads a scenario with each of its sections by the reader of the layer that
 // owns it (bodies before haptics: the order in which their errors are found).
 template <class Load>
@@ -30,6 +52,7 @@ Scenario read_with_sections(Load&& load) {
   out.haptics = std::move(settings.settings);
   out.bodies = std::move(bodies.bodies);
   out.mmt = std::move(mmt.settings);
+  check_buried(out, bodies.buried_where);
   return out;
 }
 

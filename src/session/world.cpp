@@ -49,6 +49,16 @@ const BodySource* World::bodies() const {
 #endif
 }
 
+void World::sense_heights(const Rect& rect, std::span<float> out) const {
+  const HeightGrid& g = sim_->grid();
+  std::size_t k = 0;
+  for (int row = rect.r0; row < rect.r1; ++row)
+    for (int col = rect.c0; col < rect.c1; ++col) out[k++] = g.heights()[g.index(col, row)];
+#ifdef TERRACUT_HAVE_BULLET
+  if (bodies_) bodies_->world().raise_to_body_tops(rect, out);
+#endif
+}
+
 void World::finish() {
 #ifdef TERRACUT_HAVE_BULLET
   if (bodies_) bodies_->finish();

@@ -23,6 +23,8 @@
 
 extern char** environ;
 
+#include "../support/spawn.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -55,18 +57,9 @@ class CliTest : public ::testing::Test {
   Result exec(std::vector<std::string> argv) {
     const fs::path out = dir_ / "stdout.txt";
     const fs::path err = dir_ / "stderr.txt";
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    std::vector<char*> args;
-    for (std::string& a : argv) args.push_back(a.data());
-    args.push_back(nullptr);
-    pid_t pid = 0;
     Result r;
-    const int rc = posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (rc != 0) {
+    const pid_t pid = terracut::test::spawn(argv, out, err);
+    if (pid < 0) {
       ADD_FAILURE() << "cannot start " << argv[0];
       return r;
     }

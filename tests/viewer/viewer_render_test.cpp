@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "png_rgb.hpp"
+#include "../support/spawn.hpp"
 #include "terracut/io/image.hpp"
 
 extern char** environ;
@@ -83,26 +84,14 @@ class ViewerRenderTest : public ::testing::Test {
   Result run(std::vector<std::string> argv) {
     argv.insert(argv.begin(), TERRACUT_VIEWER_BIN);
     const fs::path err = dir_ / "stderr.txt";
-    const fs::path out = dir_ / "stdout.txt";
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    std::vector<char*> args;
-    for (std::string& a : argv) args.push_back(a.data());
-    args.push_back(nullptr);
-    pid_t pid = 0;
     Result r;
-    if (posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ) != 0) {
-      posix_spawn_file_actions_destroy(&actions);
+    const pid_t pid = terracut::test::spawn(argv, dir_ / "stdout.txt", err);
+    if (pid < 0) {
       r.err = "cannot start " + argv[0];
       return r;
     }
-    posix_spawn_file_actions_destroy(&actions);
-    int status = 0;
-    waitpid(pid, &status, 0);
-    r.exited = WIFEXITED(status);
-    r.code = r.exited ? WEXITSTATUS(status) : -1;
+    r.code = terracut::test::wait_exit(pid);
+    r.exited = r.code >= 0;
     r.err = slurp(err);
     return r;
   }

@@ -11,6 +11,7 @@
 //       rotation_deg: [0, 30, 0]   # optional, extrinsic X-Y-Z degrees like keyframes
 //       friction: 0.6              # optional, [0, 10]
 //       restitution: 0.0           # optional, [0, 1]
+//       buried: false              # optional: covered by the soil, held until the blade reaches it
 //
 // A field that does not belong to the shape (radius_m on a box, size_m on a
 // sphere) is refused, as are unknown keys and repeated names.
@@ -32,7 +33,12 @@ namespace terracut::bullet {
 /// empty). `file` names the scenario in error messages. Every error is a
 /// terracut::InputError reading "FILE:LINE: bodies[i].field: what is wrong"
 /// (LINE 1-based). The returned list passes terracut::validate(bodies).
-std::vector<BodySpec> parse_bodies(const YAML::Node& node, const std::string& file);
+/// buried_where, when given, gets per body "FILE:LINE: bodies[i].buried" for
+/// a buried one (empty for the others): whether the soil covers it is
+/// checked once the terrain is known (session::load_scenario), and the
+/// error points there.
+std::vector<BodySpec> parse_bodies(const YAML::Node& node, const std::string& file,
+                                   std::vector<std::string>* buried_where = nullptr);
 
 /// The `bodies:` section's reader for io::load_scenario: after the load,
 /// bodies holds the section's list (parse_bodies), empty when the file has
@@ -42,9 +48,10 @@ class BodiesReader final : public io::SectionReader {
  public:
   std::string_view key() const override { return "bodies"; }
   void read(const YAML::Node& value, const std::string& file) override {
-    bodies = parse_bodies(value, file);
+    bodies = parse_bodies(value, file, &buried_where);
   }
   std::vector<BodySpec> bodies;
+  std::vector<std::string> buried_where;  ///< parse_bodies' buried_where
 };
 
 }  // namespace terracut::bullet

@@ -28,6 +28,16 @@
 // their cached contact points with the terrain, so they fall at once instead
 // of hovering on stale contacts.
 //
+// Buried bodies (BodySpec::buried: the soil covers them) are held still,
+// static in Bullet and touching nothing (the soil carries them; a buried
+// body that fell would sink through the heightfield, which is only a
+// surface), until the blade reaches one: the cut lowers the soil over its
+// footprint to its top, or the tool plate's box meets its box. Then it is
+// released: it becomes dynamic, and the soil it stood in (the samples under
+// its bounding box and one more all round, so that no terrain triangle cuts
+// into it) is lowered to its lowest point, where it rests; the plate then
+// meets it through Bullet. docs/bullet.md, "Buried bodies".
+//
 // One step (step(out)) after each Simulation::step: terrain_changed(changed
 // rectangle), move the tool plate to the blade pose, advance Bullet by exactly
 // 1 / rate_hz (one fixed sub-step: deterministic), and sum the tool's contact
@@ -37,6 +47,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -44,6 +55,7 @@
 #include "terracut/core/simulation.hpp"
 
 class btDiscreteDynamicsWorld;
+class btVector3;
 class btRigidBody;
 class btHeightfieldTerrainShape;
 
@@ -116,6 +128,7 @@ struct BodyState {
   Vec3 velocity_m_s{};          ///< linear velocity, m/s
   Vec3 angular_velocity_rad_s{};  ///< angular velocity, rad/s
   bool active = true;           ///< false when Bullet has put it to sleep
+  bool held = false;            ///< buried and not yet reached by the blade: held still
 };
 
 /// What the last step did.
@@ -128,6 +141,11 @@ struct WorldStepInfo {
   Vec3 tool_force_n{};
   int tool_contact_points = 0;      ///< contact points between the tool and bodies
   int bodies_woken = 0;             ///< bodies woken by the last terrain change
+  /// Buried bodies released in the last step, and the samples lowered under
+  /// them (the caller tells whoever caches heights: BodiesListener adds it
+  /// to the step's changed rectangle).
+  int bodies_released = 0;
+  Rect released_rect{};
   double physics_s = 0.0;           ///< wall-clock time of Bullet's step, seconds
   double total_s = 0.0;             ///< wall-clock time of the whole step(), seconds
 };
@@ -175,6 +193,18 @@ class TerrainWorld {
   /// Advances Bullet by dt_s() and updates last().
   void advance();
 
+  /// The heights a depth camera looking straight down would see over rect
+  /// (clipped to the grid; out holds rect.area() values, row-major, metres
+  /// above ground, the soil's heights on entry): each sample becomes the
+  /// higher of its value and the top of a body over it, by a vertical ray
+  /// test against each body whose bounding box overlaps the rectangle (held
+  /// buried bodies are under the soil: skipped). Returns how many samples a
+  /// body raised. Allocation-free; not during advance().
+  int raise_to_body_tops(const Rect& rect, std::span<float> out) const;
+
+  /// Held bodies (buried, not yet reached by the blade).
+  int held_count() const;
+
   int body_count() const { return int(specs_.size()); }
   const BodySpec& body_spec(int i) const { return specs_[std::size_t(i)]; }
   BodyState body_state(int i) const;
@@ -212,6 +242,14 @@ class TerrainWorld {
   std::int64_t steps_ = 0;
   bool tool_teleport_ = true;
   int pending_woken_ = 0;
+  int pending_released_ = 0;
+  Rect pending_released_rect_{};
+  /// Releases the held bodies the blade reached this step (changed: the
+  /// step's cut), before Bullet advances.
+  void release_reached(const Rect& changed);
+  void release(int i);
+  /// The samples whose centres lie under a world box's X-Z extent (clipped).
+  Rect samples_under(const btVector3& lo, const btVector3& hi) const;
   std::int64_t pending_clamped_ = 0;
 };
 

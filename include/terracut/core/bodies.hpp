@@ -9,11 +9,13 @@
 #pragma once
 
 #include <optional>
+#include <utility>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "terracut/core/grid.hpp"
 #include "terracut/core/math.hpp"
 #include "terracut/core/ranges.hpp"
 
@@ -61,6 +63,11 @@ struct BodySpec {
   double friction = 0.6;
   /// Coefficient of restitution (bounciness), in [0, 1]; combined by multiplying.
   double restitution = 0.0;
+  /// Buried in the soil: the soil covers the body's top over its whole
+  /// footprint at the start (buried_problem checks it). The engine holds a
+  /// buried body still (the soil carries it) until the blade reaches it,
+  /// then it moves freely (docs/bullet.md, "Buried bodies").
+  bool buried = false;
 };
 
 /// Returns an empty string when spec is valid, else a message naming the bad
@@ -81,6 +88,17 @@ Quat initial_orientation(const BodySpec& spec);
 /// Half of the body's extent along its local axes, metres: the box's half
 /// sizes, (r, r, r) for a sphere, (r, h/2, r) for a cylinder.
 Vec3 half_extents_m(const BodySpec& spec);
+
+/// The world axis-aligned box of a body at its initial pose, metres (lo, hi):
+/// exact for a box's corners, a sphere and a cylinder's rims.
+std::pair<Vec3, Vec3> initial_bounds_m(const BodySpec& spec);
+
+/// For a buried body: empty when the soil covers its top over its whole
+/// footprint (every sample whose centre lies under its bounding box has a
+/// height above the body's highest point), else what is wrong, starting with
+/// "buried: " (the caller adds which body). heights: the grid's initial
+/// heights, spec.rows x spec.cols. Not buried: always empty.
+std::string buried_problem(const BodySpec& body, const GridSpec& grid, const float* heights);
 
 /// Where one rigid body is and what it looks like, as a viewer draws it.
 struct BodyView {

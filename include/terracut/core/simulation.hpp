@@ -111,6 +111,13 @@ class Simulation {
     return finish_step();
   }
 
+  /// For a step listener that edits heights during its on_step (the Bullet
+  /// world lowering the soil a released buried body stood in, with
+  /// HeightGrid::lower): adds the rectangle to this step's
+  /// StepOutput::changed, which the listeners after it and whoever reads
+  /// last() see. std::logic_error outside a step.
+  void include_changed(const Rect& rect);
+
   const StepOutput& last() const { return out_; }
   std::int64_t step_count() const { return step_count_; }
   double time_s() const { return double(step_count_) / params_.rate_hz; }

@@ -127,6 +127,9 @@ class RemoteStation {
   const Rect& worked() const { return worked_; }
   double force_scale() const { return theta_; }
   std::int64_t estimate_samples() const { return rls_samples_; }
+  /// Samples the estimate left out as outliers (more than 4 times off it,
+  /// once 200 samples had settled it).
+  std::int64_t estimate_outliers() const { return rls_outliers_; }
   /// Packets sent that carried model updates (patches + estimates).
   std::int64_t update_packets() const { return counters_.patches + counters_.estimates; }
 
@@ -134,6 +137,7 @@ class RemoteStation {
   void receive(double t_s);
   void update_estimate(const haptics::LoopRecord& r);
   void sense(double t_s, const haptics::LoopRecord& r);
+  void send_estimate(double t_s);
   Rect window_around(Vec3 p) const;
 
   MmtSettings settings_;
@@ -143,6 +147,7 @@ class RemoteStation {
   std::unique_ptr<FollowerDevice> device_;
   std::unique_ptr<HapticRig> rig_;
   std::vector<float> mirror_;  // what the operator was sent (starts as its initial heights)
+  std::vector<float> sensed_;  // the sensed rectangle: soil, or a body's top over it
   wire::SequenceFilter commands_;
   std::uint32_t command_sequence_ = 0;
   Vec3 commanded_m_{};
@@ -154,6 +159,7 @@ class RemoteStation {
   Rect worked_{};
   double theta_ = 1.0, p_ = 10.0, theta_sent_ = 1.0;
   std::int64_t rls_samples_ = 0;
+  std::int64_t rls_outliers_ = 0;
   bool estimate_sent_ = false;
   double previous_t_s_ = 0.0;
   bool ticked_ = false;
@@ -304,6 +310,7 @@ struct MmtSummary {
   double force_scale_final = 1.0;    ///< the remote's estimate
   double force_scale_applied = 1.0;  ///< what the operator applied at the end
   std::int64_t estimate_samples = 0;
+  std::int64_t estimate_outliers = 0;  ///< samples the estimate left out (remote's estimate_outliers)
   TimingStats operator_compute{}, remote_compute{};
 };
 
@@ -345,6 +352,7 @@ class MmtRun {
   std::int64_t tick_ = 0, total_ticks_ = 0;
   double rate_hz_ = 1000.0;
   std::vector<std::pair<double, double>> terrain_error_;
+  mutable std::vector<float> sensed_;  // terrain_rms's remote surface, reserved for the grid
 };
 
 /// The per-tick files (docs/teleoperation.md lists the columns). Throw

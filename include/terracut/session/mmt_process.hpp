@@ -8,6 +8,7 @@
 #include <atomic>
 #include <filesystem>
 #include <iosfwd>
+#include <memory>
 #include <string>
 
 #include "terracut/session/mmt.hpp"
@@ -33,6 +34,15 @@ struct ProcessOptions {
 /// (haptics/device_option.hpp). Throws InputError naming option on bad text.
 std::pair<std::string, int> parse_endpoint(const std::string& text, const std::string& option,
                                            const std::string& default_address);
+
+/// The operator's UDP link: connects to the remote station at endpoint
+/// ("ADDR:PORT" or "PORT"; empty: mmt.udp) with the to_remote conditions at
+/// the sender, and waits up to timeout_s for the connection. option names
+/// the command-line option in errors. Throws InputError (bad text, no
+/// answer in time).
+std::unique_ptr<net::Endpoint> connect_operator_link(const MmtSettings& s,
+                                                     const std::string& endpoint,
+                                                     const std::string& option, double timeout_s);
 
 /// Runs the remote station (returns the exit code, 0). Throws InputError.
 int run_remote_process(const Scenario& op, const ProcessOptions& options);

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "terracut/core/bodies.hpp"
@@ -58,6 +59,13 @@ class World {
   /// The Bullet listener, or null when the scenario has no bodies.
   bullet::BodiesListener* bodies_listener() { return bodies_.get(); }
   const bullet::BodiesListener* bodies_listener() const { return bodies_.get(); }
+
+  /// The heights a depth camera looking straight down at the world would
+  /// see over rect (inside the grid, not empty): out gets rect.area()
+  /// values, row-major, metres above ground: the soil's height, or the top
+  /// of a rigid body over the sample where that is higher (a buried body is
+  /// under the soil until the blade reaches it). Allocation-free.
+  void sense_heights(const Rect& rect, std::span<float> out) const;
 
   /// After the run: flushes and closes the listeners' files (bodies.csv).
   /// Throws InputError naming a file that could not be written.
