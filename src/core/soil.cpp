@@ -26,6 +26,9 @@ constexpr double kDepositAheadCells = 1.5;
 /// 0.5 degree above the repose angle (34 degrees: 34.4). Smaller tolerances
 /// only lengthen the tail of a settling pile.
 constexpr double kToleranceOfLimit = 0.02;
+/// How far, in cells, the blade's ends move before the soil it held up is
+/// examined again.
+constexpr double kHeldMoveCells = 0.25;
 /// Longest run of cells the blade pushes ahead of it, per cut sample.
 constexpr int kMaxPushCells = 512;
 
@@ -43,7 +46,6 @@ constexpr Neighbour kNeighbours[8] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 1},  {0, -1
 
 double to_cells(double v, double origin, double cell) { return (v - origin) / cell; }
 
-bool same_point(const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; }
 
 }  // namespace
 
@@ -239,8 +241,18 @@ void SoilFlow::lowered(std::uint32_t cell, const float* h) {
 void SoilFlow::wake_held(const Segment* edge) {
   // Soil the blade held up is examined again once the blade is elsewhere
   // (or gone); while it stands still, nothing it holds can move.
+  // "Elsewhere": an end moved by a quarter of a cell or more (what the
+  // blade holds changes only where its line crosses a cell's centre or
+  // edge; a step of 0.6 mm on 1 cm cells would wake them every step).
   if (held_.empty()) return;
-  if (edge != nullptr && same_point(edge->a, held_edge_.a) && same_point(edge->b, held_edge_.b)) return;
+  if (edge != nullptr) {
+    const double q2 = kHeldMoveCells * kHeldMoveCells * std::min(dx_ * dx_, dz_ * dz_);
+    const auto near = [&](const Vec3& p, const Vec3& q) {
+      const Vec3 d = p - q;
+      return d.x * d.x + d.y * d.y + d.z * d.z < q2;
+    };
+    if (near(edge->a, held_edge_.a) && near(edge->b, held_edge_.b)) return;
+  }
   for (std::uint32_t cell : held_) {
     queued_[cell] &= std::uint8_t(~kHeld);
     activate(cell);
@@ -285,34 +297,44 @@ void SoilFlow::before_cut(const HeightGrid& grid, const Segment& from, const Seg
 }
 
 void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
-  // Points every half cell along the edge; each marks the 5 x 5 cells around
-  // it that lie within kBladeRadiusCells of the edge in plan.
+  // The cells whose centres lie within kBladeRadiusCells of the edge in
+  // plan: row by row, the columns where the row's line can meet that
+  // capsule (the part of the edge within the radius of the row, widened by
+  // the radius), each tested exactly.
   const GridSpec& spec = grid.spec();
   const double radius = kBladeRadiusCells * std::max(dx_, dz_);
   const Vec3 d = edge.b - edge.a;
   const double plan_length = std::hypot(d.x, d.z);
   blade_ = {edge.a.x, edge.a.z, d.x, d.z, edge.a.y - spec.origin_m.y, d.y, plan_length > 0.0};
   if (!blade_.present) return;
-  const int points = int(std::ceil(plan_length / (0.5 * std::min(dx_, dz_)))) + 1;
-  for (int k = 0; k < points; ++k) {
-    const double t = double(k) / double(points - 1);
-    const int pc = int(std::floor(to_cells(edge.a.x + d.x * t, spec.origin_m.x, dx_)));
-    const int pr = int(std::floor(to_cells(edge.a.z + d.z * t, spec.origin_m.z, dz_)));
-    for (int r = pr - 2; r <= pr + 2; ++r)
-      for (int c = pc - 2; c <= pc + 2; ++c) {
-        if (c < 0 || r < 0 || c >= cols_ || r >= rows_) continue;
-        const std::uint32_t i = std::uint32_t(std::int64_t(r) * cols_ + c);
-        if (near_blade_[i]) continue;
-        const double x = spec.origin_m.x + (c + 0.5) * dx_;
-        const double z = spec.origin_m.z + (r + 0.5) * dz_;
-        const double s = std::clamp(((x - edge.a.x) * d.x + (z - edge.a.z) * d.z) /
-                                        (plan_length * plan_length),
-                                    0.0, 1.0);
-        const double ex = x - (edge.a.x + d.x * s), ez = z - (edge.a.z + d.z * s);
-        if (ex * ex + ez * ez > radius * radius) continue;
-        near_blade_[i] = 1;
-        marked_.push_back(i);
-      }
+  const double len2 = plan_length * plan_length;
+  const double zlo = std::min(edge.a.z, edge.b.z) - radius, zhi = std::max(edge.a.z, edge.b.z) + radius;
+  const int r0 = std::max(0, int(std::floor(to_cells(zlo, spec.origin_m.z, dz_) - 0.5)));
+  const int r1 = std::min(rows_ - 1, int(std::ceil(to_cells(zhi, spec.origin_m.z, dz_) - 0.5)));
+  for (int r = r0; r <= r1; ++r) {
+    const double z = spec.origin_m.z + (r + 0.5) * dz_;
+    // The edge's parameters where it is within the radius of this row's z.
+    double s0 = 0.0, s1 = 1.0;
+    if (std::abs(d.z) > 1e-12) {
+      const double sa = (z - radius - edge.a.z) / d.z, sb = (z + radius - edge.a.z) / d.z;
+      s0 = std::max(0.0, std::min(sa, sb));
+      s1 = std::min(1.0, std::max(sa, sb));
+      if (s0 > s1) continue;
+    } else if (std::abs(z - edge.a.z) > radius) {
+      continue;
+    }
+    const double xa = edge.a.x + d.x * s0, xb = edge.a.x + d.x * s1;
+    const int c0 = std::max(0, int(std::floor(to_cells(std::min(xa, xb) - radius, spec.origin_m.x, dx_) - 0.5)));
+    const int c1 = std::min(cols_ - 1, int(std::ceil(to_cells(std::max(xa, xb) + radius, spec.origin_m.x, dx_) - 0.5)));
+    for (int c = c0; c <= c1; ++c) {
+      const std::uint32_t i = std::uint32_t(std::int64_t(r) * cols_ + c);
+      const double x = spec.origin_m.x + (c + 0.5) * dx_;
+      const double s = std::clamp(((x - edge.a.x) * d.x + (z - edge.a.z) * d.z) / len2, 0.0, 1.0);
+      const double ex = x - (edge.a.x + d.x * s), ez = z - (edge.a.z + d.z * s);
+      if (ex * ex + ez * ez > radius * radius) continue;
+      near_blade_[i] = 1;
+      marked_.push_back(i);
+    }
   }
 }
 
@@ -646,7 +668,8 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   // The rectangle of the cells that shed soil; the cells they shed to are
   // their neighbours, so the changed rectangle is that plus a cell.
   int changed_c0 = cols_, changed_c1 = -1, changed_r0 = rows_, changed_r1 = -1;
-  while (work + 8 <= cap) {
+  bool out_of_work = false;
+  while (!out_of_work) {
     if (active_.empty()) {
       // The next pass starts from the cells queued for it.
       if (next_.empty()) break;
@@ -654,17 +677,25 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       for (std::uint32_t a : active_) queued_[a] &= std::uint8_t(~kQueued);
     }
     if (examined_ < active_.size()) {
-      out.moved_pairs += examine(active_[examined_++], h);
-      work += 8;
-      continue;
+      const std::size_t can = std::size_t((cap - work) / 8);
+      const std::size_t end = std::min(active_.size(), examined_ + can);
+      std::int64_t moved = 0;
+      for (std::size_t j = examined_; j < end; ++j) moved += examine(active_[j], h);
+      out.moved_pairs += moved;
+      work += 8 * std::int64_t(end - examined_);
+      examined_ = end;
+      if (examined_ < active_.size()) break;  // the rest in the next step
     }
-    if (applied_ < fluxes_.size()) {
+    while (applied_ < fluxes_.size()) {
       // A source's fluxes are contiguous: applied together, then its fall
       // tested against its neighbours.
       const std::uint32_t a = fluxes_[applied_].from;
       std::size_t end = applied_;
       while (end < fluxes_.size() && fluxes_[end].from == a) ++end;
-      if (work + 8 + std::int64_t(end - applied_) > cap) break;
+      if (work + 8 + std::int64_t(end - applied_) > cap) {
+        out_of_work = true;
+        break;
+      }
       work += 8 + std::int64_t(end - applied_);
       if (queued_[a] & kDirty) {
         applied_ = end;  // changed since it was examined: examined again
@@ -708,12 +739,10 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       }
       pass_gained_m_ += gained;
       lowered(a, h);
-      continue;
     }
+    if (applied_ < fluxes_.size()) break;
     finish_pass(grid, out);
   }
-  // A pass whose last flux was applied is finished now, not in the next step.
-  if (!active_.empty() && examined_ == active_.size() && applied_ == fluxes_.size()) finish_pass(grid, out);
   out.pair_checks += work;
   if (changed_c1 >= 0) {
     out.changed.include(std::max(changed_c0 - 1, 0), std::max(changed_r0 - 1, 0));
@@ -746,7 +775,7 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   // The blade's wall matters only to a pass: marked only when one runs.
   if (pending()) {
     mark_blade(grid, to);
-    held_edge_ = to;
+    if (held_.empty()) held_edge_ = to;  // where the blade holds what the passes find held
     run_passes(grid, out);
     clear_blade();
   }
