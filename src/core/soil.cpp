@@ -153,7 +153,7 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   const std::size_t active = std::min(n, std::max<std::size_t>(std::size_t(1) << 16, 4 * footprint));
   active_.reserve(active);
   next_.reserve(active);
-  fluxes_.reserve(2 * active);
+  fluxes_.reserve(4 * active);  // up to 8 per cell; 4 covers a collapsing block
   held_.reserve(footprint);
   dirty_.reserve(footprint);
 

@@ -37,10 +37,20 @@
 //
 // Cost follows activity: only cells whose height changed (and, once, at
 // construction, every cell steeper than the repose angle) are examined, and
-// a pass examines each active cell's 8 pairs; a cell that changed, and the neighbours of one
-// that fell, are examined in the next pass. A step runs whole
-// passes while the next fits in max_pair_checks_per_step (the first always runs); what is left
-// active is carried to the next step (the backlog), so a large collapse is spread over ticks.
+// a pass examines each active cell's 8 pairs. A cell that changed is
+// examined in the next pass, and so is a neighbour of one that fell when
+// the pair between them is now too steep (only that pair of the neighbour
+// changed); soil the blade held up (a pair it blocked) is examined again
+// once the blade has moved a quarter of a cell, so nothing it held stays
+// steeper than the repose angle after it has gone.
+// The work of a step is bounded by max_pair_checks_per_step, always: a pass
+// too large for what is left of it is carried on in the next step where it
+// stopped. A pass is examined whole from the heights it started from before
+// any of its fluxes is applied, so spreading it over steps gives the same
+// bits as running it at once (a flux from or to a cell the cut, the
+// displacement or an edit changed meanwhile is dropped, and the cell
+// examined again). What is left is the backlog, carried over: a large
+// collapse is spread over ticks of bounded work.
 // A step with nothing active costs microseconds: the blade is marked only when a pass runs.
 //
 // A bucket (BladeSpec::bucket) takes what its lip cuts while it digs
@@ -103,12 +113,14 @@ struct SoilFlowParams {
   /// (0, 80]. Dry sand about 34, wet sand about 45, saturated 15-30
   /// (Al-Hashemi & Al-Amoudi, Powder Technology 330 (2018) 397).
   double repose_deg = 34.0;
-  /// Work cap of one step's relaxation: pair checks, in [1000, 1e9]. A pass
-  /// checks 8 pairs per active cell; a pass runs only when it fits in what
-  /// is left of the cap (the step's first pass always runs).
-  /// The default, about 0.45 ms on a 2-core 2020s server, leaves a 1 kHz
-  /// loop half its millisecond.
-  std::int64_t max_pair_checks_per_step = 100000;
+  /// Work cap of one step's relaxation, in pair checks, in [1000, 1e9]: 8
+  /// per cell examined, 8 per cell whose fall is tested against its
+  /// neighbours, 1 per flux applied. A step never does more; the rest is
+  /// carried on in the next step (see above). The default is calibrated on
+  /// the project's 2-core machine (docs/soil.md, "Measured"): a capped step
+  /// costs about 0.25 ms there when it is quiet and under 0.9 ms with the
+  /// machine loaded 6x over its cores, so a 1 kHz loop keeps its millisecond.
+  std::int64_t max_pair_checks_per_step = 60000;
   /// The grid's edge: a wall, or open (bare ground beyond it at height 0).
   SoilEdge edge = SoilEdge::kWall;
 };
@@ -147,7 +159,7 @@ struct SoilObstacle {
 double bucket_retained_m3(const BladeSpec& blade, const Quat& orientation, double repose_deg);
 
 /// The soil phase's state (kFlow): the active cells and the scratch of the
-/// passes, sized at construction (7 bytes per sample, plus lists for the
+/// passes, sized at construction (3 bytes per sample, plus lists for the
 /// blade's footprint and an active set of at least 65536 cells) so that a
 /// step allocates nothing (tested in the haptic loop on flowing soil); only
 /// a backlog larger than that grows them.
