@@ -657,8 +657,9 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   float* h = layers.height_m;
   const double cell_area = dx_ * dz_;
   const std::uint32_t cols = std::uint32_t(cols_);
-  // The work of the step, in pair checks: 8 per cell examined, 8 per cell
-  // whose fall is tested against its neighbours and 1 per flux applied. It
+  // The work of the step, in pair checks: 8 per cell examined and 1 per
+  // flux applied (the fall test of a source, at most 8 reads, rides on its
+  // fluxes: a time bound either way, with a work of up to 9 per flux). It
   // never passes the cap: a pass too large for what is left is carried on
   // in the next step, where it stopped (its heights stay those it started
   // from until all its cells are examined), so a collapse of any size is
@@ -692,11 +693,11 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       const std::uint32_t a = fluxes_[applied_].from;
       std::size_t end = applied_;
       while (end < fluxes_.size() && fluxes_[end].from == a) ++end;
-      if (work + 8 + std::int64_t(end - applied_) > cap) {
+      if (work + std::int64_t(end - applied_) > cap) {
         out_of_work = true;
         break;
       }
-      work += 8 + std::int64_t(end - applied_);
+      work += std::int64_t(end - applied_);
       if (queued_[a] & kDirty) {
         applied_ = end;  // changed since it was examined: examined again
         continue;

@@ -114,11 +114,11 @@ struct SoilFlowParams {
   /// (Al-Hashemi & Al-Amoudi, Powder Technology 330 (2018) 397).
   double repose_deg = 34.0;
   /// Work cap of one step's relaxation, in pair checks, in [1000, 1e9]: 8
-  /// per cell examined, 8 per cell whose fall is tested against its
-  /// neighbours, 1 per flux applied. A step never does more; the rest is
+  /// per cell examined, 1 per flux applied (a source's fall test, at most 8
+  /// reads, rides on its fluxes). A step never does more; the rest is
   /// carried on in the next step (see above). A step at the default cap
-  /// costs about 0.55 ms p50, 1 ms p99 on the project's 2-core machine
-  /// loaded 7 to 10 (docs/soil.md, "Measured"); a lower cap is a tighter time bound, but lets a pushed pile lag further
+  /// costs up to about 2 ms on the project's 2-core machine (docs/soil.md,
+  /// "Measured"): it is a work bound, not the 1 ms; a lower cap is a tighter time bound, but lets a pushed pile lag further
   /// behind the blade (at 60000 the pile's centre-line section leaves the
   /// mass balance's tolerance: terracut validate, check 3.1b).
   std::int64_t max_pair_checks_per_step = 100000;
