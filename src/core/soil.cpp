@@ -26,6 +26,9 @@ constexpr double kDepositAheadCells = 1.5;
 /// 0.5 degree above the repose angle (34 degrees: 34.4). Smaller tolerances
 /// only lengthen the tail of a settling pile.
 constexpr double kToleranceOfLimit = 0.02;
+/// How far, in cells, the blade's ends move before the soil it held up is
+/// examined again.
+constexpr double kHeldMoveCells = 0.25;
 /// Longest run of cells the blade pushes ahead of it, per cut sample.
 constexpr int kMaxPushCells = 512;
 
@@ -42,6 +45,7 @@ constexpr Neighbour kNeighbours[8] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 1},  {0, -1
                                       {1, 1, 2},  {-1, 1, 2}, {1, -1, 2}, {-1, -1, 2}};
 
 double to_cells(double v, double origin, double cell) { return (v - origin) / cell; }
+
 
 }  // namespace
 
@@ -128,9 +132,13 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   origin_x_ = spec.origin_m.x;
   origin_z_ = spec.origin_m.z;
 
+  for (int k = 0; k < 8; ++k) {
+    offset_[k] = std::int64_t(kNeighbours[k].dr) * cols_ + kNeighbours[k].dc;
+    limit8_[k] = float(limit_[kNeighbours[k].kind]);
+  }
+
   const std::size_t n = std::size_t(grid.spec().sample_count());
   queued_.assign(n, 0);
-  delta_.assign(n, 0.0f);
   near_blade_.assign(n, 0);
   obstacle_.assign(n, 0);
   obstacles_.reserve(16);
@@ -144,7 +152,10 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   marked_.reserve(footprint);
   const std::size_t active = std::min(n, std::max<std::size_t>(std::size_t(1) << 16, 4 * footprint));
   active_.reserve(active);
-  touched_.reserve(active);
+  next_.reserve(active);
+  fluxes_.reserve(4 * active);  // up to 8 per cell; 4 covers a collapsing block
+  held_.reserve(footprint);
+  dirty_.reserve(footprint);
 
   // Every cell of a slope already steeper than the repose angle starts active.
   const float* h = grid.heights();
@@ -210,10 +221,43 @@ void SoilFlow::set_obstacles(std::span<const SoilObstacle> obstacles) noexcept {
   }
 }
 
-void SoilFlow::activate(std::uint32_t cell) {
-  if (queued_[cell]) return;
-  queued_[cell] = 1;
-  active_.push_back(cell);
+void SoilFlow::lowered(std::uint32_t cell, const float* h) {
+  // Only the pairs of this cell changed: a neighbour that now stands too
+  // steep above it is examined in the next pass (the same test as a pass's).
+  activate(cell);
+  const int c = int(cell % std::uint32_t(cols_)), r = int(cell / std::uint32_t(cols_));
+  const bool inside = c > 0 && r > 0 && c < cols_ - 1 && r < rows_ - 1;
+  const float hc = h[cell];
+  for (int k = 0; k < 8; ++k) {
+    if (!inside) {
+      const int cb = c + kNeighbours[k].dc, rb = r + kNeighbours[k].dr;
+      if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_) continue;
+    }
+    const std::uint32_t b = std::uint32_t(std::int64_t(cell) + offset_[k]);
+    if (h[b] - hc - limit8_[k] > tolerance_m_) activate(b);
+  }
+}
+
+void SoilFlow::wake_held(const Segment* edge) {
+  // Soil the blade held up is examined again once the blade is elsewhere
+  // (or gone); while it stands still, nothing it holds can move.
+  // "Elsewhere": an end moved by a quarter of a cell or more (what the
+  // blade holds changes only where its line crosses a cell's centre or
+  // edge; a step of 0.6 mm on 1 cm cells would wake them every step).
+  if (held_.empty()) return;
+  if (edge != nullptr) {
+    const double q2 = kHeldMoveCells * kHeldMoveCells * std::min(dx_ * dx_, dz_ * dz_);
+    const auto near = [&](const Vec3& p, const Vec3& q) {
+      const Vec3 d = p - q;
+      return d.x * d.x + d.y * d.y + d.z * d.z < q2;
+    };
+    if (near(edge->a, held_edge_.a) && near(edge->b, held_edge_.b)) return;
+  }
+  for (std::uint32_t cell : held_) {
+    queued_[cell] &= std::uint8_t(~kHeld);
+    activate(cell);
+  }
+  held_.clear();
 }
 
 void SoilFlow::wake(const Rect& rect) {
@@ -221,7 +265,11 @@ void SoilFlow::wake(const Rect& rect) {
   const int c0 = std::max(rect.c0 - 1, 0), c1 = std::min(rect.c1 + 1, cols_);
   const int r0 = std::max(rect.r0 - 1, 0), r1 = std::min(rect.r1 + 1, rows_);
   for (int r = r0; r < r1; ++r)
-    for (int c = c0; c < c1; ++c) activate(std::uint32_t(std::int64_t(r) * cols_ + c));
+    for (int c = c0; c < c1; ++c) {
+      const auto cell = std::uint32_t(std::int64_t(r) * cols_ + c);
+      dirty(cell);
+      activate(cell);
+    }
 }
 
 void SoilFlow::before_cut(const HeightGrid& grid, const Segment& from, const Segment& to) {
@@ -249,34 +297,44 @@ void SoilFlow::before_cut(const HeightGrid& grid, const Segment& from, const Seg
 }
 
 void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
-  // Points every half cell along the edge; each marks the 5 x 5 cells around
-  // it that lie within kBladeRadiusCells of the edge in plan.
+  // The cells whose centres lie within kBladeRadiusCells of the edge in
+  // plan: row by row, the columns where the row's line can meet that
+  // capsule (the part of the edge within the radius of the row, widened by
+  // the radius), each tested exactly.
   const GridSpec& spec = grid.spec();
   const double radius = kBladeRadiusCells * std::max(dx_, dz_);
   const Vec3 d = edge.b - edge.a;
   const double plan_length = std::hypot(d.x, d.z);
   blade_ = {edge.a.x, edge.a.z, d.x, d.z, edge.a.y - spec.origin_m.y, d.y, plan_length > 0.0};
   if (!blade_.present) return;
-  const int points = int(std::ceil(plan_length / (0.5 * std::min(dx_, dz_)))) + 1;
-  for (int k = 0; k < points; ++k) {
-    const double t = double(k) / double(points - 1);
-    const int pc = int(std::floor(to_cells(edge.a.x + d.x * t, spec.origin_m.x, dx_)));
-    const int pr = int(std::floor(to_cells(edge.a.z + d.z * t, spec.origin_m.z, dz_)));
-    for (int r = pr - 2; r <= pr + 2; ++r)
-      for (int c = pc - 2; c <= pc + 2; ++c) {
-        if (c < 0 || r < 0 || c >= cols_ || r >= rows_) continue;
-        const std::uint32_t i = std::uint32_t(std::int64_t(r) * cols_ + c);
-        if (near_blade_[i]) continue;
-        const double x = spec.origin_m.x + (c + 0.5) * dx_;
-        const double z = spec.origin_m.z + (r + 0.5) * dz_;
-        const double s = std::clamp(((x - edge.a.x) * d.x + (z - edge.a.z) * d.z) /
-                                        (plan_length * plan_length),
-                                    0.0, 1.0);
-        const double ex = x - (edge.a.x + d.x * s), ez = z - (edge.a.z + d.z * s);
-        if (ex * ex + ez * ez > radius * radius) continue;
-        near_blade_[i] = 1;
-        marked_.push_back(i);
-      }
+  const double len2 = plan_length * plan_length;
+  const double zlo = std::min(edge.a.z, edge.b.z) - radius, zhi = std::max(edge.a.z, edge.b.z) + radius;
+  const int r0 = std::max(0, int(std::floor(to_cells(zlo, spec.origin_m.z, dz_) - 0.5)));
+  const int r1 = std::min(rows_ - 1, int(std::ceil(to_cells(zhi, spec.origin_m.z, dz_) - 0.5)));
+  for (int r = r0; r <= r1; ++r) {
+    const double z = spec.origin_m.z + (r + 0.5) * dz_;
+    // The edge's parameters where it is within the radius of this row's z.
+    double s0 = 0.0, s1 = 1.0;
+    if (std::abs(d.z) > 1e-12) {
+      const double sa = (z - radius - edge.a.z) / d.z, sb = (z + radius - edge.a.z) / d.z;
+      s0 = std::max(0.0, std::min(sa, sb));
+      s1 = std::min(1.0, std::max(sa, sb));
+      if (s0 > s1) continue;
+    } else if (std::abs(z - edge.a.z) > radius) {
+      continue;
+    }
+    const double xa = edge.a.x + d.x * s0, xb = edge.a.x + d.x * s1;
+    const int c0 = std::max(0, int(std::floor(to_cells(std::min(xa, xb) - radius, spec.origin_m.x, dx_) - 0.5)));
+    const int c1 = std::min(cols_ - 1, int(std::ceil(to_cells(std::max(xa, xb) + radius, spec.origin_m.x, dx_) - 0.5)));
+    for (int c = c0; c <= c1; ++c) {
+      const std::uint32_t i = std::uint32_t(std::int64_t(r) * cols_ + c);
+      const double x = spec.origin_m.x + (c + 0.5) * dx_;
+      const double s = std::clamp(((x - edge.a.x) * d.x + (z - edge.a.z) * d.z) / len2, 0.0, 1.0);
+      const double ex = x - (edge.a.x + d.x * s), ez = z - (edge.a.z + d.z * s);
+      if (ex * ex + ez * ez > radius * radius) continue;
+      near_blade_[i] = 1;
+      marked_.push_back(i);
+    }
   }
 }
 
@@ -358,6 +416,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   double taken = 0.0, put = 0.0;
   std::int64_t last_put = -1;
   const auto write = [&](std::int64_t cell, float value) {
+    dirty(std::uint32_t(cell));
     put += double(value) - double(layers.height_m[cell]);
     layers.height_m[cell] = value;
     last_put = cell;
@@ -382,7 +441,8 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       const std::int64_t i = std::int64_t(row) * cols_ + c;
       const float cut = before_[k] - layers.height_m[i];
       if (!(cut > 0.0f)) continue;
-      activate(std::uint32_t(i));  // its walls may now be too steep
+      dirty(std::uint32_t(i));
+      lowered(std::uint32_t(i), layers.height_m);  // its walls may now be too steep
       const float kept = keep >= 1.0 ? cut : float(double(cut) * keep);
       out.bucket_in_m3 += double(kept) * spec.cell_area_m2();
       const float lost = cut - kept;  // what is displaced
@@ -436,7 +496,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           const float old = layers.height_m[cell_j];
           write(cell_j, previous);
           out.changed.include(int(cell_j % cols_), int(cell_j / cols_));
-          activate(std::uint32_t(cell_j));
+          if (previous < old)
+            lowered(std::uint32_t(cell_j), layers.height_m);
+          else
+            activate(std::uint32_t(cell_j));
           previous = old;
         }
       } else {
@@ -497,145 +560,191 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   }
 }
 
+std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
+  // Cell a sheds half of its steepest excess, shared among its lower
+  // neighbours in proportion to their excess (from the heights frozen at
+  // the pass's start): its fluxes are appended to the pass's list.
+  const int ca = int(a % std::uint32_t(cols_)), ra = int(a / std::uint32_t(cols_));
+  const float ha = h[a];
+  const float tol = tolerance_m_;
+  float excess[8];
+  bool outside[8] = {};
+  float max_excess = 0.0f;
+  if (ca > 0 && ra > 0 && ca < cols_ - 1 && ra < rows_ - 1) {
+    // Inside the grid: all 8 neighbours exist. Most examined cells cannot
+    // move: the 8 excesses and their maximum, without a branch, say so.
+    for (int k = 0; k < 8; ++k) {
+      excess[k] = ha - h[std::int64_t(a) + offset_[k]] - limit8_[k];
+      max_excess = std::max(max_excess, excess[k]);
+    }
+  } else {
+    for (int k = 0; k < 8; ++k) {
+      const int cb = ca + kNeighbours[k].dc, rb = ra + kNeighbours[k].dr;
+      if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_) {
+        // Beyond an open edge lies bare ground (height 0) that takes what
+        // slides onto it; a wall takes nothing.
+        outside[k] = true;
+        excess[k] = params_.edge == SoilEdge::kOpen ? ha - limit8_[k] : 0.0f;
+      } else {
+        excess[k] = ha - h[std::int64_t(a) + offset_[k]] - limit8_[k];
+      }
+      max_excess = std::max(max_excess, excess[k]);
+    }
+  }
+  if (!(max_excess > tol)) return 0;
+  const bool blade = blade_.present && near_blade_[a];
+  const bool obstacles = !obstacles_.empty();
+  std::uint32_t lower[8];
+  float shed[8];
+  int n = 0;
+  float top = 0.0f, sum = 0.0f;
+  for (int k = 0; k < 8; ++k) {
+    const float e = excess[k];
+    if (!(e > tol)) continue;
+    std::uint32_t b = kOutside;
+    if (!outside[k]) {
+      b = std::uint32_t(std::int64_t(a) + offset_[k]);
+      // The blade is a wall between the cells on its two sides, and soil
+      // does not flow into the cells it passes through. What it holds up
+      // is examined again once it has moved.
+      if (blade && near_blade_[b] && blade_blocks(a, b, ha)) {
+        if (!(queued_[a] & kHeld)) {
+          queued_[a] |= kHeld;
+          held_.push_back(a);
+        }
+        continue;
+      }
+      // Nor into a rigid body: not once the receiving cell's soil would
+      // rise (by at most half the excess) into its underside.
+      if (obstacles && obstructed(b, h[b] + kShedFraction * e)) continue;
+    }
+    lower[n] = b;
+    shed[n] = e;
+    ++n;
+    top = std::max(top, e);
+    sum += e;
+  }
+  if (n == 0) return 0;
+  const float share = kShedFraction * top / sum;
+  for (int k = 0; k < n; ++k) fluxes_.push_back({a, lower[k], share * shed[k]});
+  return n;
+}
+
+void SoilFlow::finish_pass(HeightGrid& grid, SoilStepResult& out) {
+  // The fluxes cancel exactly; the float heights do not quite: what the
+  // pass gained or lost by rounding was measured in double and is given
+  // back to the highest cell it changed, so no bias builds up over a run.
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  if (pass_gained_m_ != 0.0 && pass_highest_h_ > 0.0f) {
+    float& hh = layers.height_m[pass_highest_];
+    hh = float(std::max(0.0, double(hh) - pass_gained_m_));
+  }
+  pass_gained_m_ = 0.0;
+  pass_highest_h_ = -1.0f;
+  for (std::uint32_t cell : dirty_) queued_[cell] &= std::uint8_t(~kDirty);
+  dirty_.clear();
+  active_.clear();
+  fluxes_.clear();
+  examined_ = applied_ = 0;
+  ++out.passes;
+}
+
 void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   const HeightGrid::EditLayers layers = grid.edit_layers();
   float* h = layers.height_m;
-  const float tol = tolerance_m_;
-  const bool blade = blade_.present;
-  const bool open_edge = params_.edge == SoilEdge::kOpen;
-  const bool obstacles = !obstacles_.empty();
   const double cell_area = dx_ * dz_;
   const std::uint32_t cols = std::uint32_t(cols_);
-  // The neighbours as index offsets and their limits, in kNeighbours' order.
-  std::int64_t offset[8];
-  float limit[8];
-  for (int k = 0; k < 8; ++k) {
-    offset[k] = std::int64_t(kNeighbours[k].dr) * cols_ + kNeighbours[k].dc;
-    limit[k] = float(limit_[kNeighbours[k].kind]);
-  }
-  // A cell off the grid's border has all 8 neighbours on the grid.
-  const auto interior = [&](int c, int r) { return c > 0 && r > 0 && c < cols_ - 1 && r < rows_ - 1; };
+  // The work of the step, in pair checks: 8 per cell examined and 1 per
+  // flux applied (the fall test of a source, at most 8 reads, rides on its
+  // fluxes: a time bound either way, with a work of up to 9 per flux). It
+  // never passes the cap: a pass too large for what is left is carried on
+  // in the next step, where it stopped (its heights stay those it started
+  // from until all its cells are examined), so a collapse of any size is
+  // spread over ticks of bounded work.
+  const std::int64_t cap = params_.max_pair_checks_per_step;
+  std::int64_t work = 0;
+  // The rectangle of the cells that shed soil; the cells they shed to are
+  // their neighbours, so the changed rectangle is that plus a cell.
   int changed_c0 = cols_, changed_c1 = -1, changed_r0 = rows_, changed_r1 = -1;
-  while (!active_.empty()) {
-    double left_m = 0.0;  // height that slid off the grid in this pass
-    // A pass is run whole or not at all (its fluxes come from one frozen
-    // state); it starts only when it fits in what is left of the cap, except
-    // the step's first pass, which always runs.
-    const std::int64_t pass_checks = 8 * std::int64_t(active_.size());
-    if (out.passes > 0 && out.pair_checks + pass_checks > params_.max_pair_checks_per_step) break;
-    ++out.passes;
-    out.pair_checks += pass_checks;
-    // Each active cell sheds half of its steepest excess, shared among its
-    // lower neighbours in proportion to their excess (from the heights
-    // frozen at the pass's start).
-    for (std::uint32_t a : active_) {
-      queued_[a] = 0;
-      const int ca = int(a % cols), ra = int(a / cols);
-      const bool inside = interior(ca, ra);
-      const float ha = h[a];
-      std::uint32_t lower[8];
-      float excess[8];
-      int n = 0;
-      float max_excess = 0.0f, sum_excess = 0.0f;
-      for (int k = 0; k < 8; ++k) {
-        std::uint32_t b = std::uint32_t(std::int64_t(a) + offset[k]);
-        float hb = 0.0f;
-        if (inside) {
-          hb = h[b];
-        } else {
-          const int cb = ca + kNeighbours[k].dc, rb = ra + kNeighbours[k].dr;
-          // Beyond an open edge lies bare ground (height 0) that takes what
-          // slides onto it; a wall takes nothing.
-          if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_) {
-            if (!open_edge) continue;
-            b = kOutside;
-          } else {
-            hb = h[b];
-          }
-        }
-        const float e = ha - hb - limit[k];
-        if (!(e > tol)) continue;
-        if (b != kOutside) {
-          // The blade is a wall between the cells on its two sides, and soil
-          // does not flow into the cells it passes through.
-          if (blade && near_blade_[a] && near_blade_[b] && blade_blocks(a, b, ha)) continue;
-          // Nor into a rigid body: not once the receiving cell's soil would
-          // rise (by at most half the excess) into its underside.
-          if (obstacles && obstructed(b, hb + kShedFraction * e)) continue;
-        }
-        lower[n] = b;
-        excess[n] = e;
-        ++n;
-        max_excess = std::max(max_excess, e);
-        sum_excess += e;
+  bool out_of_work = false;
+  while (!out_of_work) {
+    if (active_.empty()) {
+      // The next pass starts from the cells queued for it.
+      if (next_.empty()) break;
+      active_.swap(next_);
+      for (std::uint32_t a : active_) queued_[a] &= std::uint8_t(~kQueued);
+    }
+    if (examined_ < active_.size()) {
+      const std::size_t can = std::size_t((cap - work) / 8);
+      const std::size_t end = std::min(active_.size(), examined_ + can);
+      std::int64_t moved = 0;
+      for (std::size_t j = examined_; j < end; ++j) moved += examine(active_[j], h);
+      out.moved_pairs += moved;
+      work += 8 * std::int64_t(end - examined_);
+      examined_ = end;
+      if (examined_ < active_.size()) break;  // the rest in the next step
+    }
+    while (applied_ < fluxes_.size()) {
+      // A source's fluxes are contiguous: applied together, then its fall
+      // tested against its neighbours.
+      const std::uint32_t a = fluxes_[applied_].from;
+      std::size_t end = applied_;
+      while (end < fluxes_.size() && fluxes_[end].from == a) ++end;
+      if (work + std::int64_t(end - applied_) > cap) {
+        out_of_work = true;
+        break;
       }
-      if (n == 0) continue;
-      const float share = kShedFraction * max_excess / sum_excess;
-      if (delta_[a] == 0.0f) touched_.push_back(a);
-      for (int k = 0; k < n; ++k) {
-        const float flux = share * excess[k];
-        delta_[a] -= flux;
-        if (lower[k] == kOutside) {
-          left_m += double(flux);
+      work += std::int64_t(end - applied_);
+      if (queued_[a] & kDirty) {
+        applied_ = end;  // changed since it was examined: examined again
+        continue;
+      }
+      float total = 0.0f;
+      for (std::size_t j = applied_; j < end; ++j)
+        if (fluxes_[j].to == kOutside || !(queued_[fluxes_[j].to] & kDirty)) total += fluxes_[j].height;
+      // What the cell can give: never below the floor (the blade may have
+      // cut it since the pass was examined).
+      const float before = h[a];
+      const float scale = total > before ? before / total : 1.0f;
+      const float now = total > before ? 0.0f : before - total;
+      h[a] = now;
+      // The grid's change in double: float rounding is what it gains.
+      double gained = double(now) - double(before);
+      if (now > pass_highest_h_) {
+        pass_highest_h_ = now;
+        pass_highest_ = a;
+      }
+      const int ca = int(a % cols), ra = int(a / cols);
+      changed_c0 = std::min(changed_c0, ca);
+      changed_c1 = std::max(changed_c1, ca);
+      changed_r0 = std::min(changed_r0, ra);
+      changed_r1 = std::max(changed_r1, ra);
+      for (; applied_ < end; ++applied_) {
+        const Flux& f = fluxes_[applied_];
+        if (f.to != kOutside && (queued_[f.to] & kDirty)) continue;
+        const float give = f.height * scale;
+        if (f.to == kOutside) {
+          out.left_over_edge_m3 += double(give) * cell_area;
+          gained += double(give);  // what left is no rounding gain
           continue;
         }
-        if (delta_[lower[k]] == 0.0f) touched_.push_back(lower[k]);
-        delta_[lower[k]] += flux;
+        const float old = h[f.to], raised = old + give;
+        h[f.to] = raised;
+        gained += double(raised) - double(old);
+        activate(f.to);
       }
-      out.moved_pairs += n;
+      pass_gained_m_ += gained;
+      lowered(a, h);
     }
-    active_.clear();
-    // Apply the pass. A cell that changed is examined in the next pass, and
-    // so are all the neighbours of one that fell. (Waking only those whose
-    // pair with it became too steep would be exact if a cell left inactive
-    // never kept an excess; but soil the blade or a body holds up does, and
-    // is woken this way as the pile around it moves: with the narrower rule,
-    // the trench's walls stayed steeper than the repose angle.)
-    // The fluxes cancel exactly; the float heights do not quite: what the
-    // pass gained or lost by rounding is measured in double and given back
-    // to the highest cell it changed, so no bias builds up over a run.
-    double gained = left_m;  // what left over the edge in this pass is no gain
-    std::uint32_t highest = 0;
-    float highest_h = -1.0f;
-    for (std::uint32_t t : touched_) {
-      const float d = delta_[t];
-      delta_[t] = 0.0f;
-      if (d == 0.0f) continue;  // fluxes that cancelled
-      const float old = h[t];
-      const float now = std::max(0.0f, old + d);
-      h[t] = now;
-      gained += double(now) - double(old);
-      if (now > highest_h) {
-        highest_h = now;
-        highest = t;
-      }
-      const int ct = int(t % cols), rt = int(t / cols);
-      changed_c0 = std::min(changed_c0, ct);
-      changed_c1 = std::max(changed_c1, ct);
-      changed_r0 = std::min(changed_r0, rt);
-      changed_r1 = std::max(changed_r1, rt);
-      activate(t);
-      if (!(d < 0.0f)) continue;
-      const bool inside = interior(ct, rt);
-      for (int k = 0; k < 8; ++k) {
-        if (!inside) {
-          const int c = ct + kNeighbours[k].dc, r = rt + kNeighbours[k].dr;
-          if (c < 0 || r < 0 || c >= cols_ || r >= rows_) continue;
-        }
-        activate(std::uint32_t(std::int64_t(t) + offset[k]));
-      }
-    }
-    if (gained != 0.0 && highest_h > 0.0f) {
-      h[highest] = float(std::max(0.0, double(h[highest]) - gained));
-    }
-    out.left_over_edge_m3 += left_m * cell_area;
-    touched_.clear();
+    if (applied_ < fluxes_.size()) break;
+    finish_pass(grid, out);
   }
+  out.pair_checks += work;
   if (changed_c1 >= 0) {
-    out.changed.include(changed_c0, changed_r0);
-    out.changed.include(changed_c1, changed_r1);
+    out.changed.include(std::max(changed_c0 - 1, 0), std::max(changed_r0 - 1, 0));
+    out.changed.include(std::min(changed_c1 + 1, cols_ - 1), std::min(changed_r1 + 1, rows_ - 1));
   }
-  out.backlog_cells = std::int64_t(active_.size());
+  out.backlog_cells = active_cells();
 }
 
 SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const Segment& to,
@@ -658,12 +767,15 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     load_m3_ = holds;
   }
   out.bucket_load_m3 = load_m3_;
+  wake_held(&to);
   // The blade's wall matters only to a pass: marked only when one runs.
-  if (!active_.empty()) {
+  if (pending()) {
     mark_blade(grid, to);
+    if (held_.empty()) held_edge_ = to;  // where the blade holds what the passes find held
     run_passes(grid, out);
     clear_blade();
   }
+  out.backlog_cells = active_cells();
   return out;
 }
 
@@ -687,6 +799,7 @@ void SoilFlow::pour(HeightGrid& grid, const Segment& lip, double volume_m3, Soil
     }
     const int c = std::clamp(int(std::floor(u)), 0, cols_ - 1), r = std::clamp(int(std::floor(v)), 0, rows_ - 1);
     const std::int64_t i = std::int64_t(r) * cols_ + c;
+    dirty(std::uint32_t(i));
     const float now = float(double(layers.height_m[i]) + share_m);
     put += double(now) - double(layers.height_m[i]);
     wanted += share_m;
@@ -705,6 +818,7 @@ void SoilFlow::pour(HeightGrid& grid, const Segment& lip, double volume_m3, Soil
 
 SoilStepResult SoilFlow::relax(HeightGrid& grid) {
   SoilStepResult out;
+  wake_held(nullptr);  // no blade now
   run_passes(grid, out);
   return out;
 }

@@ -187,12 +187,10 @@ TEST(SoilFlow, WorkPerStepIsCappedAndTheBacklogCarriedOver) {
   std::int64_t max_backlog = 0;
   while (f.active_cells() > 0 && steps < 200000) {
     const SoilStepResult r = f.relax(g);
-    // Whole passes while the next fits in the cap; only a step's first
-    // pass may exceed it alone (8 pairs per active cell, at most the grid).
-    if (r.passes > 1) {
-      EXPECT_LE(r.pair_checks, cap);
-    }
-    EXPECT_LE(r.pair_checks, std::max(cap, 8 * std::int64_t(n) * n));
+    // Never more than the cap, even when one pass alone is larger (the
+    // block's first passes hold thousands of cells): it is carried on.
+    EXPECT_LE(r.pair_checks, cap);
+    EXPECT_GT(r.pair_checks, 0);
     EXPECT_EQ(r.backlog_cells, f.active_cells());
     max_backlog = std::max(max_backlog, r.backlog_cells);
     ++steps;
@@ -201,6 +199,25 @@ TEST(SoilFlow, WorkPerStepIsCappedAndTheBacklogCarriedOver) {
   EXPECT_GT(steps, 10);  // the collapse was spread over many steps
   EXPECT_GT(max_backlog, 100);
   EXPECT_NEAR(sum_heights(g), before, 1e-6 * before);
+}
+
+TEST(SoilFlow, APassSpreadOverStepsGivesTheSameBitsAsWholePasses) {
+  // The same collapse with a cap far below one pass's work (its passes are
+  // split over many steps) and with no effective cap: each pass is
+  // examined from the heights it started from and applied in the same
+  // order either way, so the results are identical, not merely close.
+  const int n = 120;
+  std::vector<float> h(std::size_t(n) * n, 0.0f);
+  for (int r = 40; r < 80; ++r)
+    for (int c = 30; c < 90; ++c) h[std::size_t(r) * n + c] = 0.3f;
+  HeightGrid split(grid_of_cells(n, n, 0.01), h), whole(grid_of_cells(n, n, 0.01), h);
+  SoilFlow fs(flow(34.0, 1000), split), fw(flow(34.0, 1000000000), whole);
+  const int split_steps = settle(fs, split, 1000000), whole_steps = settle(fw, whole);
+  ASSERT_EQ(fs.active_cells(), 0);
+  ASSERT_EQ(fw.active_cells(), 0);
+  EXPECT_EQ(whole_steps, 1);
+  EXPECT_GT(split_steps, 100);
+  EXPECT_EQ(split.state_hash(), whole.state_hash());
 }
 
 TEST(SoilFlow, AnOpenEdgeLetsSoilLeaveAndCountsIt) {
