@@ -103,15 +103,24 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
   const haptics::LoopParams nominal(op.haptics, op.base.blade);
   const World local(op);  // the operator's initial terrain: what the deadband compares against
   auto link = net::EnetEndpoint::listen(address, port, s.to_operator);
+  // The records go to remote.csv as they are made: a live session has no set end.
+  RemoteOptions options;
+  options.keep_records = false;
   RemoteStation station(remote, s, nominal.force_model(), local.simulation().grid(), *link,
-                        std::uint32_t(Clock::now().time_since_epoch().count()));
+                        std::uint32_t(Clock::now().time_since_epoch().count()), options);
+  std::filesystem::create_directories(o.out);
+  StationCsv csv = StationCsv::remote_csv(o.out / "remote.csv");
   if (o.log)
     *o.log << "terracut mmt: remote listening on " << address << ":" << link->port() << std::endl;
   const double max_s = o.remote_max_s > 0.0 ? o.remote_max_s : operator_duration_s(op) + 10.0;
   double last_command_s = -1.0;
   std::int64_t accepted = 0;
   const double duration = paced(
-      op.haptics.rate_hz, [&](double t) { station.tick(t); },
+      op.haptics.rate_hz,
+      [&](double t) {
+        station.tick(t);
+        csv.add(station.last_record());
+      },
       [&](double t) {
         if (station.counters().accepted > accepted) {
           accepted = station.counters().accepted;
@@ -119,8 +128,7 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
         }
         return t >= max_s || (last_command_s >= 0.0 && t - last_command_s > o.remote_idle_end_s);
       });
-  std::filesystem::create_directories(o.out);
-  write_remote_csv(station.records(), o.out / "remote.csv");
+  csv.finish();
   nlohmann::ordered_json j = station_json(station.counters(), *link, duration);
   j["role"] = "remote";
   j["connections"] = link->connections();
@@ -141,21 +149,30 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
   std::unique_ptr<net::Endpoint> link =
       connect_operator_link(s, o.endpoint, "--connect", o.connect_timeout_s);
   std::unique_ptr<haptics::Device> device = make_operator_device(op);
+  // The records go to operator.csv as they are made: a live session's
+  // duration is the user's.
+  OperatorOptions options;
+  options.keep_records = false;
   OperatorStation station(op, s, *device, *link,
-                          std::uint32_t(Clock::now().time_since_epoch().count()));
+                          std::uint32_t(Clock::now().time_since_epoch().count()), options);
+  std::filesystem::create_directories(o.out);
+  StationCsv csv = StationCsv::operator_csv(o.out / "operator.csv");
+  double passivity = 0.0;
   const double duration_s = o.overrides.duration_s.value_or(
       operator_duration_s(op) + s.to_remote.delay_s + s.to_operator.delay_s + s.blend_s + 0.3);
   if (o.log) *o.log << "terracut mmt: operator connected to " << address << ":" << port << "\n";
   const double ran = paced(
-      station.rate_hz(), [&](double t) { station.tick(t); },
+      station.rate_hz(),
+      [&](double t) {
+        station.tick(t);
+        csv.add(station.last_record());
+        passivity = std::max(passivity, station.last_record().passivity_j);
+      },
       [&](double t) { return t + 0.5 / station.rate_hz() >= duration_s; });
-  std::filesystem::create_directories(o.out);
-  write_operator_csv(station.records(), o.out / "operator.csv");
+  csv.finish();
   nlohmann::ordered_json j = station_json(station.counters(), *link, ran);
   j["role"] = "operator";
   j["max_force_step_at_update_n"] = station.max_update_step_n();
-  double passivity = 0.0;
-  for (const OperatorRecord& r : station.records()) passivity = std::max(passivity, r.passivity_j);
   j["passivity_max_energy_into_hand_j"] = passivity;
   write_json(o.out / "summary.json", j);
   if (o.log)

@@ -460,6 +460,7 @@ void RemoteStation::tick(double t_s) {
   rec.holding = holding;
   rec.active = has_command_;
   rec.compute_s = compute_s;
+  last_ = rec;
   if (options_.keep_records) records_.push_back(rec);
 }
 

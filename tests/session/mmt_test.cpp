@@ -392,6 +392,43 @@ TEST(Mmt, ARestartedOperatorIsANewSession) {
   EXPECT_EQ(p.remote.counters().rejected[net::Reject::kReordered], 1);
 }
 
+// The live stations of `terracut mmt --role` keep no records (an hour at
+// 1 kHz would be about 1.1 GB) and stream each tick's row instead: the
+// streamed files are the batch writer's, byte for byte, and an unwritable
+// file is named.
+TEST(Mmt, StreamedStationFilesEqualTheBatchFiles) {
+  const Scenario sc = trench_with_remote("stream", 0.28, "clay");
+  MmtRun run(sc);
+  const fs::path dir = fs::temp_directory_path() / "terracut_mmt_stream_out";
+  fs::create_directories(dir);
+  StationCsv op = StationCsv::operator_csv(dir / "operator_streamed.csv");
+  StationCsv rm = StationCsv::remote_csv(dir / "remote_streamed.csv");
+  std::int64_t ticks = 0;
+  while (run.ticks_run() < run.total_ticks()) {
+    run.tick();
+    op.add(run.operator_station().last_record());
+    rm.add(run.remote_station().last_record());
+    ++ticks;
+  }
+  op.finish();
+  rm.finish();
+  ASSERT_EQ(std::int64_t(run.operator_station().records().size()), ticks);
+  ASSERT_GT(ticks, 1000);
+  write_operator_csv(run.operator_station().records(), dir / "operator.csv");
+  write_remote_csv(run.remote_station().records(), dir / "remote.csv");
+  EXPECT_EQ(read_text(dir / "operator_streamed.csv"), read_text(dir / "operator.csv"));
+  EXPECT_EQ(read_text(dir / "remote_streamed.csv"), read_text(dir / "remote.csv"));
+
+  const fs::path bad = dir / "no_such_folder" / "operator.csv";
+  try {
+    StationCsv::operator_csv(bad);
+    FAIL() << "an unwritable file was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(bad.string() + ": cannot be written"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Mmt, BadSettingsNameTheField) {
   const std::string text = read_text(kTrench);
   auto fails = [&](const std::string& from, const std::string& to, const std::string& want) {

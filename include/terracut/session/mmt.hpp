@@ -25,6 +25,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <iosfwd>
 #include <memory>
 #include <optional>
 #include <string>
@@ -97,8 +98,9 @@ class ScaleCorrection;
 
 /// What a remote station does beyond its settings.
 struct RemoteOptions {
-  /// One record per tick (records()); false: none kept, for a session
-  /// without a set end (the viewer's).
+  /// One record per tick (records()); false: only the newest
+  /// (last_record()), for a session without a set end (the viewer's, the
+  /// live stations of `terracut mmt --role`, which stream them to a file).
   bool keep_records = true;
 };
 
@@ -120,6 +122,8 @@ class RemoteStation {
   void reserve_records(std::size_t ticks) { records_.reserve(ticks); }
 
   const std::vector<RemoteRecord>& records() const { return records_; }
+  /// The newest tick's record (kept with or without keep_records).
+  const RemoteRecord& last_record() const { return last_; }
   const StationCounters& counters() const { return counters_; }
   const Simulation& simulation() const;
   const HapticRig& rig() const { return *rig_; }
@@ -164,6 +168,7 @@ class RemoteStation {
   double previous_t_s_ = 0.0;
   bool ticked_ = false;
   std::vector<RemoteRecord> records_;
+  RemoteRecord last_{};
   RemoteOptions options_;
   StationCounters counters_{};
   net::Inbox inbox_;
@@ -179,7 +184,8 @@ struct OperatorOptions {
   /// thread sees the remote's updates; nullptr: none.
   haptics::SnapshotExchange* snapshot = nullptr;
   /// One record per tick (records()); false: only the newest (last_record()),
-  /// for a session without a set end (the viewer's).
+  /// for a session without a set end (the viewer's, the live stations of
+  /// `terracut mmt --role`, which stream them to a file).
   bool keep_records = true;
 };
 
@@ -360,6 +366,30 @@ class MmtRun {
 void write_operator_csv(const std::vector<OperatorRecord>& records,
                         const std::filesystem::path& path);
 void write_remote_csv(const std::vector<RemoteRecord>& records, const std::filesystem::path& path);
+
+/// The same files written a tick at a time, for a live station whose
+/// records are not kept (an hour at 1 kHz is about 1.1 GB of them): the
+/// header on opening, a row per add(), buffered (a write to the file about
+/// every 400 rows). Throws InputError naming the file when it cannot be
+/// opened, and from add() or finish() when a write failed.
+class StationCsv {
+ public:
+  static StationCsv operator_csv(const std::filesystem::path& path);
+  static StationCsv remote_csv(const std::filesystem::path& path);
+  void add(const OperatorRecord& r);
+  void add(const RemoteRecord& r);
+  /// Flushes and closes; checks that every row reached the file.
+  void finish();
+  StationCsv(StationCsv&&) noexcept;
+  StationCsv& operator=(StationCsv&&) noexcept;
+  ~StationCsv();
+
+ private:
+  StationCsv(const std::filesystem::path& path, const char* header);
+  std::filesystem::path path_;
+  std::unique_ptr<char[]> buffer_;
+  std::unique_ptr<std::ofstream> out_;
+};
 
 /// The operator's device of an mmt run: the scenario's script, sim or udp
 /// (bridge) device, haptics.device. Throws InputError (e.g. a port in use).
