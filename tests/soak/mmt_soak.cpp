@@ -24,8 +24,8 @@
 //     within mmt.timeout_s + watchdog_timeout_s + watchdog_ramp_s (+2 ticks);
 //   - no crash, no exception: every tick of both stations runs;
 //   - resident memory at the end within 4 MiB (256 under ASan: kRssSlackBytes) of that halfway (past the
-//     warm-up: pools, zstd contexts, Bullet and the soil sized on first use),
-//     beyond the per-tick records the stations keep by design (counted);
+//     warm-up: pools, zstd contexts, Bullet and the soil sized on first use);
+//     the stations keep no per-tick records, as in `terracut mmt --role`;
 //   - every datagram is counted under its reason: each station's counts of
 //     each rejection reason equal the hostile endpoint's own account, and
 //     its accepted count equals the real datagrams delivered plus the forged
@@ -445,17 +445,20 @@ int run_mmt_soak(const MmtSoakOptions& o) {
   const GridSpec grid = io::grid_spec(b);
   HostileEndpoint op_side(*op_link, true, s.link_id, grid, outage, o.seed);
   HostileEndpoint remote_side(*remote_link, false, s.link_id, grid, outage, o.seed + 7);
-  session::OperatorStation operator_station(op, s, checker, op_side, 1u);
+  // No per-tick records, as the live stations of `terracut mmt --role`
+  // (they stream theirs to a file): memory must not grow at all.
+  session::OperatorOptions op_options;
+  op_options.keep_records = false;
+  session::RemoteOptions remote_options;
+  remote_options.keep_records = false;
+  session::OperatorStation operator_station(op, s, checker, op_side, 1u, op_options);
   session::RemoteStation remote_station(remote_scn, s, operator_station.rig().loop().force_model(),
-                                        operator_station.simulation().grid(), remote_side, 2u);
+                                        operator_station.simulation().grid(), remote_side, 2u,
+                                        remote_options);
 
   std::mt19937 rng(o.seed + 13);
   RawUdpSender raw;
   const std::int64_t ticks = std::llround(o.duration_s * rate_hz);
-  // The records in place from the start (as MmtRun does), so that their
-  // growth is the pages they fill, not a vector's doublings.
-  operator_station.reserve_records(std::size_t(ticks));
-  remote_station.reserve_records(std::size_t(ticks));
   const double tick_s = 1.0 / rate_hz;
   const SafetyParams& safety = op.haptics.safety;
   int failures = 0;
@@ -475,6 +478,7 @@ int run_mmt_soak(const MmtSoakOptions& o) {
   std::int64_t outages = 0;
   double next_outage_s = 0.5 + std::uniform_real_distribution<double>(0.0, 1.0)(rng);
   std::int64_t rss_start = 0;
+  double last_tick_s = -1.0;
   const double start = wall_s();
   for (std::int64_t i = 0; i < ticks; ++i) {
     const double t = enet ? wall_s() - start : double(i) * tick_s;
@@ -489,6 +493,7 @@ int run_mmt_soak(const MmtSoakOptions& o) {
     }
     operator_station.tick(t);
     remote_station.tick(t);
+    last_tick_s = t;
 
     // The watchdog across the link. The operator's device is silent to its
     // loop once the link has been silent for more than timeout_s; the loop's
@@ -537,15 +542,7 @@ int run_mmt_soak(const MmtSoakOptions& o) {
     }
   }
   const std::int64_t rss_end = rss_bytes();
-  // The stations keep one record per tick (for their CSV files): by design,
-  // and counted apart from the growth that would be a leak.
-  const auto records_bytes = [&](double from_fraction) {
-    return std::int64_t(double(operator_station.records().size() * sizeof(session::OperatorRecord) +
-                               remote_station.records().size() * sizeof(session::RemoteRecord)) *
-                        (1.0 - from_fraction));
-  };
   const double rss_fraction = double(ticks / 2) / double(ticks);
-  const std::int64_t records_growth = records_bytes(rss_fraction);
 
   failures += int(checker.failures);
   auto require = [&](bool ok, const std::string& what) {
@@ -553,11 +550,14 @@ int run_mmt_soak(const MmtSoakOptions& o) {
   };
   require(checker.writes == ticks, "the operator's device got " + std::to_string(checker.writes) + " of " +
                                        std::to_string(ticks) + " commands");
-  require(std::int64_t(remote_station.records().size()) == ticks, "the remote ran " +
-                                                                      std::to_string(remote_station.records().size()) + " ticks");
-  require(rss_end - rss_start <= kRssSlackBytes + records_growth,
-          "resident memory grew by " + std::to_string(rss_end - rss_start) + " bytes (records: " +
-              std::to_string(records_growth) + ")");
+  // Both stations ran to the last tick (its record is the newest).
+  require(remote_station.last_record().t_s == last_tick_s &&
+              operator_station.last_record().t_s == last_tick_s,
+          "the stations' last records are not the last tick's (" + std::to_string(last_tick_s) + " s)");
+  require(operator_station.records().empty() && remote_station.records().empty(),
+          "the stations kept per-tick records");
+  require(rss_end - rss_start <= kRssSlackBytes,
+          "resident memory grew by " + std::to_string(rss_end - rss_start) + " bytes");
   require(outages > 0 && trips > 0, "no watchdog trip (the outages did not reach the loop)");
   struct Side {
     const char* name;
@@ -593,9 +593,8 @@ int run_mmt_soak(const MmtSoakOptions& o) {
               safety.watchdog_timeout_s * 1e3, safety.watchdog_ramp_s * 1e3);
   std::printf("  latest watchdog trip %.1f ms after timeout_s + watchdog_timeout_s (the ticks' own lateness)\n",
               worst_late_trip_s * 1e3);
-  std::printf("  resident memory after %.1f s %.2f MiB, at the end %.2f MiB (the stations' per-tick records: %.2f MiB of it)\n",
-              rss_fraction * o.duration_s, double(rss_start) / (1 << 20), double(rss_end) / (1 << 20),
-              double(records_growth) / (1 << 20));
+  std::printf("  resident memory after %.1f s %.2f MiB, at the end %.2f MiB\n",
+              rss_fraction * o.duration_s, double(rss_start) / (1 << 20), double(rss_end) / (1 << 20));
   for (const Side& side : sides) {
     std::printf("  %s: real datagrams delivered %lld (lost to outages %lld), hostile %lld, forged valid %lld, accepted %lld; rejected:",
                 side.name, static_cast<long long>(side.hostile.delivered), static_cast<long long>(side.hostile.dropped),
