@@ -2,7 +2,7 @@
 // that does what the window does -- acquire frames, read the device's
 // published state, post controls and targets -- while the loop runs on its
 // own thread, paced and lock-step. Built and run under ThreadSanitizer by
-// tests/haptics/tsan_test.sh: the exchange between the threads must be free
+// tests/tsan/tsan_test.sh: the exchange between the threads must be free
 // of data races. (The viewer's own tests cover what the driver computes.)
 #include <gtest/gtest.h>
 

@@ -11,6 +11,8 @@ source=$1 scratch=$2
 jobs=${TERRACUT_JOBS:-2}
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+# ccache caches a file built with a precompiled header only when told to.
+export CCACHE_SLOPPINESS=pch_defines,time_macros
 CCACHE_BASEDIR=$source cmake -S "$source" -B "$scratch" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" "${launcher[@]}" \
   -DCMAKE_CXX_FLAGS="-fsanitize=thread -Wno-tsan" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" \
