@@ -53,14 +53,27 @@ struct RowChange {
 
 /// HeightGrid::lower for sample c of the row starting at index row, with
 /// target t (metres above the ground), booked in change (first and last
-/// sample, removed height; not visited, which the caller counts). Without a
-/// branch on the data: the rows of an oblique sliver hold one to three
-/// samples, lowered or not in a ragged pattern, and a mispredicted branch
-/// here waited for the sample's load (from memory, on a big terrain) before
-/// the walk could go on. The minimum keeps the old bits where the target is
-/// not lower (the sample is stored back unchanged), and a drop of +0 leaves
-/// the sum's bits as they are: the values of HeightGrid::lower, bit for bit.
-inline void lower_one(float* row, int c, float t, RowChange& change) {
+/// sample, removed height; not visited, which the caller counts).
+inline void lower_one(const HeightGrid::EditLayers& layers, std::int64_t row, int c, float t, RowChange& change) {
+  float h = t > 0.0f ? t : 0.0f;
+  float old = layers.height_m[row + c];
+  if (!(h < old)) return;
+  layers.height_m[row + c] = h;
+  change.removed_m += double(old - h);
+  if (change.first < 0) change.first = c;
+  change.last = c;
+}
+
+/// lower_one for sample c of row (the row's first sample) without a branch
+/// on the data, for the columns band: its rows hold two to four cells,
+/// lowered or not in a pattern that shifts from row to row, and there a
+/// mispredicted branch waited for the sample's load from memory before the
+/// walk went on. (Where nearly every sample is lowered, as in the surface
+/// walks, the branch predicts well and this form measured slower.) The
+/// minimum keeps the old bits where the target is not lower (stored back
+/// unchanged), and a drop of +0 leaves the sum's bits as they are: the
+/// values of lower_one, bit for bit.
+inline void lower_one_unbranched(float* row, int c, float t, RowChange& change) {
   const float h = t > 0.0f ? t : 0.0f;
   const float old = row[c];
   const float now = h < old ? h : old;
@@ -194,7 +207,7 @@ inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& f
     // moves obliquely): inline, without the batch machinery.
     float t[kSmallSpan];
     fill(c_lo, change.visited, t);
-    for (int k = 0; k < change.visited; ++k) lower_one(height, c_lo + k, t[k], change);
+    for (int k = 0; k < change.visited; ++k) lower_one(layers, row, c_lo + k, t[k], change);
     return change;
   }
   // Ask for the row's first cache lines at once, so that on a terrain
@@ -670,7 +683,7 @@ void cut_oblique_points(HeightGrid& grid, const GridFrame& f, const ObliqueSweep
     const std::int64_t row = grid.index(0, r);
     RowChange change;
     change.visited = c_hi - c_lo + 1;
-    for (int c = c_lo; c <= c_hi; ++c) lower_one(layers.height_m + row, c, float(base + double(c) * step), change);
+    for (int c = c_lo; c <= c_hi; ++c) lower_one(layers, row, c, float(base + double(c) * step), change);
     rows.add(r, change);
   };
   // Rows with any of the sides bounding them: the lowest and highest bound.
@@ -1026,10 +1039,6 @@ bool setup_oblique_columns(const GridFrame& f, const Parallelogram& p, ColumnsOb
   return true;
 }
 
-/// Rows ahead of the one being cut whose first cache line the band walks
-/// ask for.
-constexpr int kAheadRows = 16;
-
 void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsOblique& w, CutBook& book) {
   CutBook rows;  // a local, so that its fields stay in registers
   const HeightGrid::EditLayers layers = grid.edit_layers();
@@ -1057,7 +1066,7 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
     change.visited = c_hi - c_lo + 1;
     for (int c = c_lo; c <= c_hi; ++c) {
       double lowest = u_star < c ? chord_min(c) : u_star > c + 1 ? chord_min(c + 1) : y_min;
-      lower_one(layers.height_m + row, c, float(lowest), change);
+      lower_one(layers, row, c, float(lowest), change);
     }
     rows.add(r, change);
   };
@@ -1162,13 +1171,6 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
     const int c_hi = floor_clamped(umax, -1, f.cols - 1);
     if (c_lo > c_hi) continue;
     float* const cells = height + grid.index(0, r);
-    if (r + kAheadRows <= band_r1) {
-      // The row kAheadRows on, where its section starts: the misses of a
-      // transverse walk (one line a row, 16 KiB apart on a 4096 side)
-      // overlap instead of each row waiting for its own.
-      const double u_ahead = lo_u + (vb + double(kAheadRows - 1) - lo_r) * lo_k;
-      prefetch(height + grid.index(floor_clamped(u_ahead, 0, f.cols - 1), r + kAheadRows));
-    }
     RowChange change;
     change.visited = c_hi - c_lo + 1;
     double left = chord_min(double(c_lo));
@@ -1177,7 +1179,7 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
       const double right = chord_min(cd + 1.0);
       const double lowest = u_star < cd ? left : u_star > cd + 1.0 ? right : y_min;
       left = right;
-      lower_one(cells, c, float(lowest), change);
+      lower_one_unbranched(cells, c, float(lowest), change);
     }
     rows.add(r, change);
   }
