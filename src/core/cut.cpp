@@ -69,7 +69,7 @@ inline void lower_one(const HeightGrid::EditLayers& layers, std::int64_t row, in
 /// lowered or not in a pattern that shifts from row to row, and there a
 /// mispredicted branch waited for the sample's load from memory before the
 /// walk went on. (Where nearly every sample is lowered, as in the surface
-/// walks, the branch predicts well and this form measured slower.) The
+/// walks, the branch predicts well and this form measured no faster.) The
 /// minimum keeps the old bits where the target is not lower (stored back
 /// unchanged), and a drop of +0 leaves the sum's bits as they are: the
 /// values of lower_one, bit for bit.
