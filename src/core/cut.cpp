@@ -36,6 +36,11 @@ using detail::GridFrame;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+/// std::min and std::max by value (the same result, the first argument on a
+/// tie): references to locals keep GCC's operands on the stack in hot loops.
+inline double min_value(double a, double b) { return b < a ? b : a; }
+inline double max_value(double a, double b) { return a < b ? b : a; }
+
 /// What lowering one row (or part of it) changed: the removed heights summed
 /// (metres), the first and last sample changed (-1 when none), the samples
 /// examined.
@@ -57,6 +62,26 @@ inline void lower_one(const HeightGrid::EditLayers& layers, std::int64_t row, in
   change.removed_m += double(old - h);
   if (change.first < 0) change.first = c;
   change.last = c;
+}
+
+/// lower_one for sample c of row (the row's first sample) without a branch
+/// on the data, for the columns band: its rows hold two to four cells,
+/// lowered or not in a pattern that shifts from row to row, and there a
+/// mispredicted branch waited for the sample's load from memory before the
+/// walk went on. (Where nearly every sample is lowered, as in the surface
+/// walks, the branch predicts well and this form measured no faster.) The
+/// minimum keeps the old bits where the target is not lower (stored back
+/// unchanged), and a drop of +0 leaves the sum's bits as they are: the
+/// values of lower_one, bit for bit.
+inline void lower_one_unbranched(float* row, int c, float t, RowChange& change) {
+  const float h = t > 0.0f ? t : 0.0f;
+  const float old = row[c];
+  const float now = h < old ? h : old;
+  row[c] = now;
+  change.removed_m += double(old - now);
+  const bool lowered = now < old;
+  change.first = lowered && change.first < 0 ? c : change.first;
+  change.last = lowered ? c : change.last;
 }
 
 /// What a cut has changed so far: height removed (sum over samples, metres),
@@ -1102,29 +1127,63 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
   const double chain_v = low_end ? w.low_v[chain] : w.up_v[chain];
   const double chain_u = low_end ? w.low_u[chain] : w.up_u[chain];
   const double chain_k = low_end ? w.low_k[chain] : w.up_k[chain];
+  const double y0 = w.y0, gu = w.gu, gv = w.gv;
+  // Written out for the band's four corners, with no array, no call and no
+  // branch on the data (the general walk's arrays and std::min references
+  // kept its candidates on the stack, and the branches on each cell's
+  // case and on whether it is lowered mispredicted on the ragged 2 to 3
+  // cells a transverse row holds; each mispredict also waited on that
+  // row's load from memory). The same arithmetic on the same operands as
+  // lowest_vertex, cut_cells and lower_one, so the same values, bit for bit:
+  // the corners of row r's bottom line are those of row r - 1's top line,
+  // heights included.
+  auto corner_y = [&](double u, double v) { return y0 + gu * u + gv * v; };
+  double u_lo_a = 0.0, u_hi_a = 0.0, y_lo_a = 0.0, y_hi_a = 0.0;
+  if (double(band_r0) == carried_v) {
+    u_lo_a = carried_lo, u_hi_a = carried_hi;
+  } else {
+    const double va = double(band_r0);
+    u_lo_a = lo_u + (va - lo_r) * lo_k, u_hi_a = hi_u + (va - hi_r) * hi_k;
+  }
+  y_lo_a = corner_y(u_lo_a, double(band_r0));
+  y_hi_a = corner_y(u_hi_a, double(band_r0));
+  float* const height = layers.height_m;
   for (int r = band_r0; r <= band_r1; ++r) {
     const double va = double(r), vb = double(r) + 1.0;  // inside [vmin, vmax]
-    double cand_u[4];
-    if (va == carried_v) {
-      cand_u[0] = carried_lo, cand_u[1] = carried_hi;
-    } else {
-      cand_u[0] = lo_u + (va - lo_r) * lo_k, cand_u[1] = hi_u + (va - hi_r) * hi_k;
+    const double u_lo_b = lo_u + (vb - lo_r) * lo_k, u_hi_b = hi_u + (vb - hi_r) * hi_k;
+    const double y_lo_b = corner_y(u_lo_b, vb), y_hi_b = corner_y(u_hi_b, vb);
+    // lowest_vertex over (u_lo_a, va), (u_hi_a, va), (u_lo_b, vb), (u_hi_b, vb):
+    // the first of the lowest.
+    const double umin = min_value(min_value(u_lo_a, u_hi_a), min_value(u_lo_b, u_hi_b));
+    const double umax = max_value(max_value(u_lo_a, u_hi_a), max_value(u_lo_b, u_hi_b));
+    double y_min = y_lo_a, u_star = u_lo_a;
+    u_star = y_hi_a < y_min ? u_hi_a : u_star, y_min = y_hi_a < y_min ? y_hi_a : y_min;
+    u_star = y_lo_b < y_min ? u_lo_b : u_star, y_min = y_lo_b < y_min ? y_lo_b : y_min;
+    u_star = y_hi_b < y_min ? u_hi_b : u_star, y_min = y_hi_b < y_min ? y_hi_b : y_min;
+    u_lo_a = u_lo_b, u_hi_a = u_hi_b, y_lo_a = y_lo_b, y_hi_a = y_hi_b;
+    // The chord's lowest point on side line U (cut_cells' chord_min).
+    auto chord_min = [&](double U) {
+      const double chain_at = chain_v + (U - chain_u) * chain_k;
+      const double v = low_end ? max_value(va, chain_at) : min_value(vb, chain_at);
+      return y0 + gu * U + gv * v;
+    };
+    const int c_lo = std::max(0, ceil_clamped(umin, 0, f.cols + 1) - 1);
+    const int c_hi = floor_clamped(umax, -1, f.cols - 1);
+    if (c_lo > c_hi) continue;
+    float* const cells = height + grid.index(0, r);
+    RowChange change;
+    change.visited = c_hi - c_lo + 1;
+    double left = chord_min(double(c_lo));
+    for (int c = c_lo; c <= c_hi; ++c) {
+      const double cd = double(c);
+      const double right = chord_min(cd + 1.0);
+      const double lowest = u_star < cd ? left : u_star > cd + 1.0 ? right : y_min;
+      left = right;
+      lower_one_unbranched(cells, c, float(lowest), change);
     }
-    cand_u[2] = lo_u + (vb - lo_r) * lo_k, cand_u[3] = hi_u + (vb - hi_r) * hi_k;
-    carried_v = vb, carried_lo = cand_u[2], carried_hi = cand_u[3];
-    const double cand_v[4] = {va, va, vb, vb};
-    double umin, umax, u_star, y_min;
-    lowest_vertex(w, cand_u, cand_v, 4, umin, umax, u_star, y_min);
-    if (low_end) {
-      cut_cells(r, umin, umax, u_star, y_min, [&](double U) {
-        return w.y0 + w.gu * U + w.gv * std::max(va, chain_v + (U - chain_u) * chain_k);
-      });
-    } else {
-      cut_cells(r, umin, umax, u_star, y_min, [&](double U) {
-        return w.y0 + w.gu * U + w.gv * std::min(vb, chain_v + (U - chain_u) * chain_k);
-      });
-    }
+    rows.add(r, change);
   }
+  carried_v = double(band_r1) + 1.0, carried_lo = u_lo_a, carried_hi = u_hi_a;
   cut_rows(band_r1 + 1, w.r_hi);
   book.add(rows);
 }

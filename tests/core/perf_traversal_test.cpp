@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "terracut/core/brute_force.hpp"
@@ -223,6 +224,52 @@ TEST(PerfTraversal, SweepsEqualBruteForce) {
   expect_same_cut(t, rotated(0.0), rotated(2.0), "rotation 2 degrees");
   expect_same_cut(t, rotated(10.0), rotated(25.0), "rotation 15 degrees");
   expect_same_cut(t, rotated(80.0), rotated(100.0), "rotation through the vertical axis");
+}
+
+// A blade crossing the rows at the benchmark's yaws (a transverse one
+// through a rotation, as a quaternion leaves cos(pi/2) ~ 6e-17 in it),
+// moving along its normal a fraction of a cell per step: the rows of each
+// sweep are the parallelogram walks' straight bands, and after the first
+// step most of a row's cells are already at or below the next target (the
+// walks lower without branching on that), so the run is compared with the
+// brute force step by step.
+TEST(PerfTraversal, BladeRunsAcrossTheRowsEqualBruteForce) {
+  Terrain t = make_terrain(150, 110, 29);
+  const GridSpec& s = t.spec;
+  const double cx = s.cell_x_m(), cz = s.cell_z_m();
+  const Vec3 centre{s.origin_m.x + 70.3123 * cx, s.origin_m.y + 0.32, s.origin_m.z + 50.2371 * cz};
+  for (double yaw_deg : {10.0, 30.0, 45.0, 60.0, 90.0}) {
+    const double a = yaw_deg * std::numbers::pi / 180.0;
+    const Vec3 along{std::cos(a), 0.0, std::sin(a)};  // the blade's edge
+    const Vec3 normal{-std::sin(a), -0.002, std::cos(a)};  // its travel, slightly down
+    const Vec3 half = along * (0.3 * s.size_z_m);
+    for (Representation rep : kBoth) {
+      HeightGrid fast(s, t.heights), slow(s, t.heights);
+      Segment from{centre - half, centre + half};
+      for (int step = 0; step < 12; ++step) {
+        const double move = (0.37 + 0.11 * (step % 3)) * std::min(cx, cz);
+        const Segment to{from.a + normal * move, from.b + normal * move};
+        const CutResult got = cut_sweep(fast, rep, from, to);
+        const CutResult want = cut_sweep_brute_force(slow, rep, from, to);
+        const std::string what = std::string(to_string(rep)) + " yaw " + std::to_string(int(yaw_deg)) + " step " +
+                                 std::to_string(step);
+        EXPECT_NEAR(got.removed_volume_m3, want.removed_volume_m3,
+                    1e-9 * s.size_x_m * s.size_z_m + 1e-7 * want.removed_volume_m3)
+            << what;
+        int differing = 0;
+        for (std::int64_t i = 0; i < s.sample_count(); ++i) {
+          differing += std::abs(fast.heights()[i] - slow.heights()[i]) > 1e-6;
+        }
+        EXPECT_EQ(differing, 0) << what;
+        if (!want.changed.empty()) {
+          Rect both = got.changed;
+          both.include(want.changed);
+          EXPECT_EQ(both, got.changed) << what;
+        }
+        from = to;
+      }
+    }
+  }
 }
 
 }  // namespace
