@@ -77,6 +77,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <optional>
@@ -191,6 +192,12 @@ class SoilFlow {
   /// Allocation-free once the list has grown to its largest size.
   void set_obstacles(std::span<const SoilObstacle> obstacles) noexcept;
   static constexpr int kMaxObstacles = 255;
+  /// The highest the displacement may pile soil, metres above the ground
+  /// (default: unbounded). The Bullet world sets its heightfield's upper
+  /// bound here, so that no pile rises past it and is clamped (deleted).
+  /// Relaxation only moves soil down, so it never rises past it either.
+  void set_ceiling(float height_m) noexcept { ceiling_m_ = height_m > 0.0f ? height_m : ceiling_m_; }
+  float ceiling_m() const { return ceiling_m_; }
   /// Soil in the bucket, m^3 (0 without one).
   double bucket_load_m3() const { return load_m3_; }
   /// Marks the cells of `rect` and their neighbours (clipped to the grid)
@@ -218,6 +225,8 @@ class SoilFlow {
   bool pending() const { return !active_.empty() || !next_.empty(); }
   void displace(HeightGrid& grid, const Segment& from, const Segment& to, double bucket_room_m3,
                 SoilStepResult& out);
+  void beside_body(const HeightGrid& grid, double x, double z, double tx, double tz,
+                   std::int64_t& first, std::int64_t& second) const;
   void pour(HeightGrid& grid, const Segment& lip, double volume_m3, SoilStepResult& out);
   void run_passes(HeightGrid& grid, SoilStepResult& out);
   std::int64_t examine(std::uint32_t a, const float* h);
@@ -226,6 +235,7 @@ class SoilFlow {
   SoilFlowParams params_;
   BladeSpec blade_spec_{};
   double load_m3_ = 0.0;  // soil in the bucket
+  float ceiling_m_ = std::numeric_limits<float>::infinity();  // set_ceiling
   int cols_ = 0;
   int rows_ = 0;
   double dx_ = 0.0;
@@ -285,14 +295,15 @@ class SoilFlow {
   std::vector<std::uint8_t> near_blade_;  // per cell: 1 within reach of the step's blade
   std::vector<std::uint8_t> obstacle_;    // per cell: 1 + index into obstacles_, 0 for none
   std::vector<SoilObstacle> obstacles_;   // the obstacles, their cells clipped to the grid
-  /// True when the cell's soil at height_m would stand inside an obstacle.
-  bool obstructed(std::uint32_t cell, float height_m) const {
-    return obstacle_[cell] != 0 && height_m > obstacles_[obstacle_[cell] - 1u].bottom_m;
-  }
+  /// True when a body stands over the cell: no soil flows or is pushed into
+  /// it, whatever the gap under the body (soil filling the gap would lift
+  /// the body from below instead of banking against its side).
+  bool obstructed(std::uint32_t cell) const { return obstacle_[cell] != 0; }
   std::vector<std::uint32_t> marked_;     // cells with near_blade_ set
 
   Rect before_rect_{};        // where before_ holds the pre-cut heights
   std::vector<float> before_;  // (rect rows) x (rect cols), row-major
+  std::vector<float> after_cut_;  // the same samples after the cut, before the displacement writes
 };
 
 }  // namespace terracut
