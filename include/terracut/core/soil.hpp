@@ -66,10 +66,13 @@
 // floor and back are not obstacles for the terrain.
 //
 // Rigid obstacles (set_obstacles; the Bullet bodies' listener sets them
-// from the bodies' bounding boxes every step): no soil flows or is pushed
-// into a cell under an obstacle once it would rise above the obstacle's
-// underside there, so soil banks against a body instead of passing through
-// it. Soil under a body can still slide out from under it.
+// from the bodies' bounding boxes every step): no soil flows, is pushed or
+// is put down into a cell under an obstacle, whatever the gap under it, so
+// soil banks against a body instead of passing through or under it (and
+// never lifts it from below); cut soil with no free cell between the blade
+// and a body goes round it. Soil under a body can still slide out from
+// under it. set_ceiling bounds how high the displacement piles soil (the
+// Bullet heightfield's upper bound, above which soil would be clamped).
 //
 // The rigid floor stays: heights never go below 0. The grid's edge is a wall
 // (no soil leaves) or, with SoilEdge::kOpen, bare ground beyond which soil
@@ -144,8 +147,9 @@ struct SoilStepResult {
   Rect changed{};                    ///< samples whose height the phase changed
 };
 
-/// A rigid obstacle for flowing soil: the samples under it and the height of
-/// its underside above the ground there, metres.
+/// A rigid obstacle for flowing soil: the samples under it (closed to soil
+/// coming in) and the height of its underside above the ground there,
+/// metres (a change of it, as of the cells, wakes the soil along its sides).
 struct SoilObstacle {
   Rect cells{};
   float bottom_m = 0.0f;
