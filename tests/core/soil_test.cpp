@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <vector>
 
@@ -408,19 +409,28 @@ TEST(SoilObstacles, ACollapsingColumnBanksAgainstABodyInsteadOfFlowingIntoIt) {
   EXPECT_NEAR(sum_heights(blocked), before, 1e-6 * before);
 }
 
-TEST(SoilObstacles, ABladePushesThePileUpToABodyAndNotThroughIt) {
-  // The dozing run of TheBladePushesAPile..., with a body standing on the
-  // sand 10 cm beyond the end of the push: the pile grows against it, and
-  // none of it enters the body's cells above the sand.
+// A 1 m blade over a 0.2 m layer of dry sand (repose 34) on 2 m x 2 m of
+// 1 cm cells, with a body resting on the sand over `body`.
+constexpr float kDozeLayer = 0.2f;
+std::unique_ptr<Simulation> dozing_at(const Rect& body) {
   SimParams params;
   params.grid = grid_of_cells(200, 200, 0.01);
   params.blade.length_m = 1.0;
   params.soil = flow(34.0, 400000);
-  const float layer = 0.2f;
-  Simulation sim(params, std::vector<float>(std::size_t(200) * 200, layer));
+  auto sim = std::make_unique<Simulation>(params, std::vector<float>(std::size_t(200) * 200, kDozeLayer));
+  const SoilObstacle obstacle{body, kDozeLayer};
+  sim->soil()->set_obstacles({&obstacle, 1});
+  return sim;
+}
+
+TEST(SoilObstacles, ABladePushesThePileUpToABodyAndNotThroughIt) {
+  // The dozing run of TheBladePushesAPile..., with a body standing on the
+  // sand 10 cm beyond the end of the push: the pile grows against it, and
+  // none of it enters the body's cells above the sand.
+  const float layer = kDozeLayer;
   const Rect body{60, 110, 140, 130};  // x 0.6-1.4 m, z 1.1-1.3 m
-  const SoilObstacle obstacle{body, layer};
-  sim.soil()->set_obstacles({&obstacle, 1});
+  const std::unique_ptr<Simulation> dozer = dozing_at(body);
+  Simulation& sim = *dozer;
   const int steps = int(std::lround(0.6 / 0.0006));
   for (int i = 0; i <= steps; ++i) sim.step({{1.0, 0.15, 0.4 + 0.6 * i / steps}, Quat{}});
   const HeightGrid& g = sim.grid();
@@ -446,15 +456,10 @@ TEST(SoilObstacles, ABladeCuttingUnderABodyPutsNoSoilUnderIt) {
   // would lift the slab from below instead of banking against its side).
   // What the blade cuts under it goes round it, beside it along the edge,
   // and is pushed on.
-  SimParams params;
-  params.grid = grid_of_cells(200, 200, 0.01);
-  params.blade.length_m = 1.0;
-  params.soil = flow(34.0, 400000);
-  const float layer = 0.2f;
-  Simulation sim(params, std::vector<float>(std::size_t(200) * 200, layer));
+  const float layer = kDozeLayer;
   const Rect body{80, 90, 120, 110};
-  const SoilObstacle obstacle{body, layer};
-  sim.soil()->set_obstacles({&obstacle, 1});
+  const std::unique_ptr<Simulation> dozer = dozing_at(body);
+  Simulation& sim = *dozer;
   const double before = sim.grid().volume_m3();
   std::vector<float> under(std::size_t(body.area()), layer);
   const int steps = int(std::lround(1.0 / 0.0006));
@@ -490,15 +495,10 @@ TEST(SoilObstacles, TheDisplacementNeverPilesAboveTheCeiling) {
   // The Bullet world's heightfield has an upper bound; soil above it would
   // be clamped (deleted). A push against a body with the ceiling 6 cm above
   // the layer: no sample ever rises past it, and the volume is kept.
-  SimParams params;
-  params.grid = grid_of_cells(200, 200, 0.01);
-  params.blade.length_m = 1.0;
-  params.soil = flow(34.0, 400000);
-  const float layer = 0.2f, ceiling = layer + 0.06f;
-  Simulation sim(params, std::vector<float>(std::size_t(200) * 200, layer));
+  const float layer = kDozeLayer, ceiling = layer + 0.06f;
   const Rect body{60, 110, 140, 130};
-  const SoilObstacle obstacle{body, layer};
-  sim.soil()->set_obstacles({&obstacle, 1});
+  const std::unique_ptr<Simulation> dozer = dozing_at(body);
+  Simulation& sim = *dozer;
   sim.soil()->set_ceiling(ceiling);
   const double before = sim.grid().volume_m3();
   const int steps = int(std::lround(0.6 / 0.0006));
