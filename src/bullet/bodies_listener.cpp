@@ -19,6 +19,9 @@ BodiesListener::BodiesListener(Simulation& sim, std::vector<BodySpec> bodies,
     csv_->write_step(*world_);  // the initial state, t = 0
   }
   obstacles_.reserve(bodies_.size());
+  // Soil piled above the heightfield's upper bound would be clamped to it
+  // (lost): the soil never piles higher.
+  if (SoilFlow* soil = sim_.soil()) soil->set_ceiling(float(world_->bounds().max_height_m));
   sim_.add_listener(*this);
 }
 

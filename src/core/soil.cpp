@@ -149,6 +149,7 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   const double reach_cells = blade.length_m / std::min(dx_, dz_) + 8.0;
   const std::size_t footprint = std::size_t(std::min(double(n), reach_cells * reach_cells));
   before_.reserve(footprint);
+  after_cut_.reserve(footprint);
   marked_.reserve(footprint);
   const std::size_t active = std::min(n, std::max<std::size_t>(std::size_t(1) << 16, 4 * footprint));
   active_.reserve(active);
@@ -290,6 +291,7 @@ void SoilFlow::before_cut(const HeightGrid& grid, const Segment& from, const Seg
   r.r1 = int(std::clamp(std::floor(v1) + 2.0, 0.0, double(rows_)));
   before_rect_ = r;
   before_.resize(std::size_t(r.area()));
+  after_cut_.resize(std::size_t(r.area()));
   const float* h = grid.heights();
   std::size_t k = 0;
   for (int row = r.r0; row < r.r1; ++row)
@@ -376,6 +378,31 @@ bool SoilFlow::blade_blocks(std::uint32_t high, std::uint32_t low, float top_m) 
   return double(top_m) > blade_.ay + blade_.dy * t;
 }
 
+void SoilFlow::beside_body(const HeightGrid& grid, double x, double z, double tx, double tz,
+                           std::int64_t& first, std::int64_t& second) const {
+  // Walk from the point (x, z) both ways along the unit (tx, tz), a cell at
+  // a time, to the first sample on each side that no body stands over.
+  const GridSpec& spec = grid.spec();
+  const double step = std::min(dx_ / std::max(std::abs(tx), 1e-9), dz_ / std::max(std::abs(tz), 1e-9));
+  const auto at = [&](double along) -> std::int64_t {
+    const double u = to_cells(x + tx * along, spec.origin_m.x, dx_);
+    const double v = to_cells(z + tz * along, spec.origin_m.z, dz_);
+    if (u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_) return -1;
+    return std::int64_t(std::floor(v)) * cols_ + std::int64_t(std::floor(u));
+  };
+  for (int j = 1; j <= kMaxPushCells; ++j) {
+    const std::int64_t a = at(j * step), b = at(-j * step);
+    const bool fa = a >= 0 && obstacle_[a] == 0, fb = b >= 0 && obstacle_[b] == 0;
+    if (!fa && !fb) {
+      if (a < 0 && b < 0) return;  // off the grid both ways: stays where it was
+      continue;
+    }
+    first = fa ? a : b;
+    second = fa && fb ? b : -1;
+    return;
+  }
+}
+
 void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to,
                         double bucket_room_m3, SoilStepResult& out) {
   const GridSpec& spec = grid.spec();
@@ -421,6 +448,32 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
     layers.height_m[cell] = value;
     last_put = cell;
   };
+  // Puts `add` metres on `cell`, never above the ceiling (a Bullet
+  // heightfield's upper bound would clamp, and so delete, soil above it):
+  // what would rise above it goes to the nearest cells around with room,
+  // ring by ring, none under a body.
+  const auto put_down = [&](std::int64_t cell, float add) {
+    float v = std::max(0.0f, layers.height_m[cell] + add);
+    float over = v > ceiling_m_ ? v - ceiling_m_ : 0.0f;
+    write(cell, v - over);
+    out.changed.include(int(cell % cols_), int(cell / cols_));
+    activate(std::uint32_t(cell));
+    const int c0 = int(cell % cols_), r0 = int(cell / cols_);
+    for (int ring = 1; ring <= kMaxPushCells && over > 0.0f; ++ring)
+      for (int dr = -ring; dr <= ring && over > 0.0f; ++dr)
+        for (int dc = -ring; dc <= ring && over > 0.0f; dc += (dr == -ring || dr == ring) ? 1 : 2 * ring) {
+          const int c = c0 + dc, r = r0 + dr;
+          if (c < 0 || r < 0 || c >= cols_ || r >= rows_) continue;
+          const std::int64_t j = std::int64_t(r) * cols_ + c;
+          const float room = ceiling_m_ - layers.height_m[j];
+          if (obstacle_[j] != 0 || !(room > 0.0f)) continue;
+          const float give = std::min(over, room);
+          write(j, layers.height_m[j] + give);
+          over -= give;
+          out.changed.include(c, r);
+          activate(std::uint32_t(j));
+        }
+  };
   // The share of each sample's cut that goes into the bucket: all of it
   // while the bucket has room for the step's cut, else what fits.
   double keep = 0.0;
@@ -435,11 +488,17 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
     cut *= spec.cell_area_m2();
     keep = cut > 0.0 ? std::min(1.0, bucket_room_m3 / cut) : 0.0;
   }
+  // The heights the cut left, before any is written: soil put down on a cut
+  // sample not yet handled must not shrink what that sample's cut counts
+  // (else the books give back less than the cut took, and soil is lost).
   std::size_t k = 0;
+  for (int row = r.r0; row < r.r1; ++row)
+    for (int c = r.c0; c < r.c1; ++c, ++k) after_cut_[k] = layers.height_m[std::int64_t(row) * cols_ + c];
+  k = 0;
   for (int row = r.r0; row < r.r1; ++row)
     for (int c = r.c0; c < r.c1; ++c, ++k) {
       const std::int64_t i = std::int64_t(row) * cols_ + c;
-      const float cut = before_[k] - layers.height_m[i];
+      const float cut = before_[k] - after_cut_[k];
       if (!(cut > 0.0f)) continue;
       dirty(std::uint32_t(i));
       lowered(std::uint32_t(i), layers.height_m);  // its walls may now be too steep
@@ -447,7 +506,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       out.bucket_in_m3 += double(kept) * spec.cell_area_m2();
       const float lost = cut - kept;  // what is displaced
       if (!(lost > 0.0f)) continue;
-      taken += double(before_[k]) - double(layers.height_m[i]) - double(kept);
+      taken += double(before_[k]) - double(after_cut_[k]) - double(kept);
       // Straight ahead of the edge: the cell centre's distance to the edge's
       // line along the normal, plus kDepositAheadCells. At rest, away from
       // the line on the cell's own side.
@@ -476,19 +535,19 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       // a pile pushed by a blade does; what the shift does not account for
       // (the cut layer itself) is put down just beyond the pile's toe. On
       // flat ground nothing shifts and the cut soil is put down ahead.
-      const float edge_top = layers.height_m[i];  // the cut column's new height
+      const float edge_top = after_cut_[k];  // the cut column's new height
       std::int64_t ray[kMaxPushCells];
       int length = 0;
       ray[length++] = cell_at(go);
       float previous = before_[k];
       // A bucket taking soil in does not push a pile.
       if (kept == 0.0f && layers.height_m[ray[0]] < previous && !(layers.height_m[ray[0]] < edge_top) &&
-          !obstructed(std::uint32_t(ray[0]), previous)) {
+          !obstructed(std::uint32_t(ray[0]))) {
         while (length < kMaxPushCells) {
           const std::int64_t next = cell_at(go + side * length * step);
           if (next == ray[length - 1]) break;  // against the grid's edge
           const float here = layers.height_m[ray[length - 1]], ahead = layers.height_m[next];
-          if (!(ahead < here) || ahead < edge_top || obstructed(std::uint32_t(next), here)) break;
+          if (!(ahead < here) || ahead < edge_top || obstructed(std::uint32_t(next))) break;
           ray[length++] = next;
         }
         for (int j = 0; j < length; ++j) {
@@ -528,15 +587,14 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
         }
         const std::int64_t u = cell_at(go + side * m * step);
         if (u == t && m > 0) break;  // against the grid's edge
-        float top = level - float(limit_step);
-        if (obstacle_[u] != 0) top = std::min(top, obstacles_[obstacle_[u] - 1u].bottom_m);
-        const float room = top - layers.height_m[u];
         t = u;
+        if (obstacle_[u] != 0) break;  // never into, under or through a body
+        const float room = level - float(limit_step) - layers.height_m[u];
         if (!(room > 0.0f)) {
-          if (m > 0 || length > 0 || obstacle_[u] != 0) break;  // never through a body
+          if (m > 0 || length > 0) break;
           continue;
         }
-        if (obstacle_[u] == 0) free = u;
+        free = u;
         const float add = std::min(rest, room);
         write(u, layers.height_m[u] + add);
         rest -= add;
@@ -546,11 +604,19 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       }
       // What did not fit (or, by rounding, came out negative) is settled on
       // the last cell reached, keeping the volume.
-      if (obstacle_[t] != 0 && rest > 0.0f) t = free;
-      if (rest != 0.0f) {
-        write(t, std::max(0.0f, layers.height_m[t] + rest));
-        out.changed.include(int(t % cols_), int(t / cols_));
-        activate(std::uint32_t(t));
+      // Against a body with no free cell between it and the blade (the
+      // blade at or under it), it goes round the body: to the nearest cells
+      // beside it along the edge, half to each side when both are as near
+      // (so a mirrored scene gives the mirrored result).
+      std::int64_t t2 = -1;
+      if (obstacle_[t] != 0 && rest > 0.0f) {
+        t = free;
+        if (free == i) beside_body(grid, x + nx * go, z + nz * go, -nz, nx, t, t2);
+      }
+      const float half = t2 >= 0 ? 0.5f * rest : 0.0f;
+      for (const auto& [target, share] : {std::pair{t, rest - half}, std::pair{t2, half}}) {
+        if (target < 0 || share == 0.0f) continue;
+        put_down(target, share);
       }
     }
   // Give back the rounding of the writes on the last cell written.
@@ -614,9 +680,8 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
         }
         continue;
       }
-      // Nor into a rigid body: not once the receiving cell's soil would
-      // rise (by at most half the excess) into its underside.
-      if (obstacles && obstructed(b, h[b] + kShedFraction * e)) continue;
+      // Nor into a rigid body's footprint (soil under it may slide out).
+      if (obstacles && obstructed(b)) continue;
     }
     lower[n] = b;
     shed[n] = e;

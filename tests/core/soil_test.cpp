@@ -12,6 +12,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <numbers>
 #include <vector>
 
@@ -407,19 +409,28 @@ TEST(SoilObstacles, ACollapsingColumnBanksAgainstABodyInsteadOfFlowingIntoIt) {
   EXPECT_NEAR(sum_heights(blocked), before, 1e-6 * before);
 }
 
-TEST(SoilObstacles, ABladePushesThePileUpToABodyAndNotThroughIt) {
-  // The dozing run of TheBladePushesAPile..., with a body standing on the
-  // sand 10 cm beyond the end of the push: the pile grows against it, and
-  // none of it enters the body's cells above the sand.
+// A 1 m blade over a 0.2 m layer of dry sand (repose 34) on 2 m x 2 m of
+// 1 cm cells, with a body resting on the sand over `body`.
+constexpr float kDozeLayer = 0.2f;
+std::unique_ptr<Simulation> dozing_at(const Rect& body) {
   SimParams params;
   params.grid = grid_of_cells(200, 200, 0.01);
   params.blade.length_m = 1.0;
   params.soil = flow(34.0, 400000);
-  const float layer = 0.2f;
-  Simulation sim(params, std::vector<float>(std::size_t(200) * 200, layer));
+  auto sim = std::make_unique<Simulation>(params, std::vector<float>(std::size_t(200) * 200, kDozeLayer));
+  const SoilObstacle obstacle{body, kDozeLayer};
+  sim->soil()->set_obstacles({&obstacle, 1});
+  return sim;
+}
+
+TEST(SoilObstacles, ABladePushesThePileUpToABodyAndNotThroughIt) {
+  // The dozing run of TheBladePushesAPile..., with a body standing on the
+  // sand 10 cm beyond the end of the push: the pile grows against it, and
+  // none of it enters the body's cells above the sand.
+  const float layer = kDozeLayer;
   const Rect body{60, 110, 140, 130};  // x 0.6-1.4 m, z 1.1-1.3 m
-  const SoilObstacle obstacle{body, layer};
-  sim.soil()->set_obstacles({&obstacle, 1});
+  const std::unique_ptr<Simulation> dozer = dozing_at(body);
+  Simulation& sim = *dozer;
   const int steps = int(std::lround(0.6 / 0.0006));
   for (int i = 0; i <= steps; ++i) sim.step({{1.0, 0.15, 0.4 + 0.6 * i / steps}, Quat{}});
   const HeightGrid& g = sim.grid();
@@ -428,6 +439,78 @@ TEST(SoilObstacles, ABladePushesThePileUpToABodyAndNotThroughIt) {
   // The pile stands against the body's face (z = 1.1 m), above the layer.
   EXPECT_GT(g.height(100, body.r0 - 1), layer + 0.05);
   EXPECT_NEAR(g.volume_m3(), 200 * 200 * 0.01 * 0.01 * layer, 1e-6);
+}
+
+// The volume the float heights can drift by in a run that gives each step's
+// rounding back: one float rounding (eps x the highest height) per sample.
+double float_rounding_m3(const HeightGrid& g, double highest_m) {
+  return double(g.spec().sample_count()) * double(std::numeric_limits<float>::epsilon()) *
+         highest_m * g.spec().cell_area_m2();
+}
+
+TEST(SoilObstacles, ABladeCuttingUnderABodyPutsNoSoilUnderIt) {
+  // A slab resting on a 0.2 m layer (its underside at the sand's top) over
+  // x 0.8-1.2 m, z 0.9-1.1 m; a 1 m blade cuts 5 cm deep along +Z from
+  // z = 0.4 to 1.4 m, under the slab. Under the slab the soil may only go
+  // down (cut, or sliding out): none is pushed, put down or slides in (it
+  // would lift the slab from below instead of banking against its side).
+  // What the blade cuts under it goes round it, beside it along the edge,
+  // and is pushed on.
+  const float layer = kDozeLayer;
+  const Rect body{80, 90, 120, 110};
+  const std::unique_ptr<Simulation> dozer = dozing_at(body);
+  Simulation& sim = *dozer;
+  const double before = sim.grid().volume_m3();
+  std::vector<float> under(std::size_t(body.area()), layer);
+  const int steps = int(std::lround(1.0 / 0.0006));
+  bool rose = false;
+  for (int i = 0; i <= steps; ++i) {
+    sim.step({{1.0, 0.15, 0.4 + 1.0 * i / steps}, Quat{}});
+    std::size_t k = 0;
+    for (int r = body.r0; r < body.r1; ++r)
+      for (int c = body.c0; c < body.c1; ++c, ++k) {
+        const float h = sim.grid().height(c, r);
+        if (h > under[k]) rose = true;
+        under[k] = h;
+      }
+  }
+  EXPECT_FALSE(rose);
+  const HeightGrid& g = sim.grid();
+  // The blade cut under it: its cells are at the edge's height or below.
+  for (int r = body.r0; r < body.r1; ++r)
+    for (int c = body.c0; c < body.c1; ++c) EXPECT_LE(g.height(c, r), 0.15f + 1e-6f) << c << "," << r;
+  // It is not lost: the blade pushed it on, and the pile stands ahead of
+  // the blade's last position (z = 1.4 m), above the layer.
+  float highest = 0.0f, ahead = 0.0f;
+  for (int r = 0; r < 200; ++r)
+    for (int c = 0; c < 200; ++c) {
+      highest = std::max(highest, g.height(c, r));
+      if (r > 140) ahead = std::max(ahead, g.height(c, r));
+    }
+  EXPECT_GT(ahead, layer + 0.05f);
+  EXPECT_NEAR(g.volume_m3(), before, float_rounding_m3(g, highest));
+}
+
+TEST(SoilObstacles, TheDisplacementNeverPilesAboveTheCeiling) {
+  // The Bullet world's heightfield has an upper bound; soil above it would
+  // be clamped (deleted). A push against a body with the ceiling 6 cm above
+  // the layer: no sample ever rises past it, and the volume is kept.
+  const float layer = kDozeLayer, ceiling = layer + 0.06f;
+  const Rect body{60, 110, 140, 130};
+  const std::unique_ptr<Simulation> dozer = dozing_at(body);
+  Simulation& sim = *dozer;
+  sim.soil()->set_ceiling(ceiling);
+  const double before = sim.grid().volume_m3();
+  const int steps = int(std::lround(0.6 / 0.0006));
+  float highest = 0.0f;
+  for (int i = 0; i <= steps; ++i) {
+    sim.step({{1.0, 0.15, 0.4 + 0.6 * i / steps}, Quat{}});
+    const float* h = sim.grid().heights();
+    for (std::int64_t j = 0; j < sim.grid().spec().sample_count(); ++j) highest = std::max(highest, h[j]);
+  }
+  EXPECT_LE(highest, ceiling);
+  EXPECT_GT(highest, ceiling - 0.01f);  // the pile did reach it
+  EXPECT_NEAR(sim.grid().volume_m3(), before, float_rounding_m3(sim.grid(), ceiling));
 }
 
 // --- The bucket -------------------------------------------------------------

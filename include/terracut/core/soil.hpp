@@ -66,10 +66,13 @@
 // floor and back are not obstacles for the terrain.
 //
 // Rigid obstacles (set_obstacles; the Bullet bodies' listener sets them
-// from the bodies' bounding boxes every step): no soil flows or is pushed
-// into a cell under an obstacle once it would rise above the obstacle's
-// underside there, so soil banks against a body instead of passing through
-// it. Soil under a body can still slide out from under it.
+// from the bodies' bounding boxes every step): no soil flows, is pushed or
+// is put down into a cell under an obstacle, whatever the gap under it, so
+// soil banks against a body instead of passing through or under it (and
+// never lifts it from below); cut soil with no free cell between the blade
+// and a body goes round it. Soil under a body can still slide out from
+// under it. set_ceiling bounds how high the displacement piles soil (the
+// Bullet heightfield's upper bound, above which soil would be clamped).
 //
 // The rigid floor stays: heights never go below 0. The grid's edge is a wall
 // (no soil leaves) or, with SoilEdge::kOpen, bare ground beyond which soil
@@ -77,6 +80,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <optional>
@@ -143,8 +147,9 @@ struct SoilStepResult {
   Rect changed{};                    ///< samples whose height the phase changed
 };
 
-/// A rigid obstacle for flowing soil: the samples under it and the height of
-/// its underside above the ground there, metres.
+/// A rigid obstacle for flowing soil: the samples under it (closed to soil
+/// coming in) and the height of its underside above the ground there,
+/// metres (a change of it, as of the cells, wakes the soil along its sides).
 struct SoilObstacle {
   Rect cells{};
   float bottom_m = 0.0f;
@@ -191,6 +196,12 @@ class SoilFlow {
   /// Allocation-free once the list has grown to its largest size.
   void set_obstacles(std::span<const SoilObstacle> obstacles) noexcept;
   static constexpr int kMaxObstacles = 255;
+  /// The highest the displacement may pile soil, metres above the ground
+  /// (default: unbounded). The Bullet world sets its heightfield's upper
+  /// bound here, so that no pile rises past it and is clamped (deleted).
+  /// Relaxation only moves soil down, so it never rises past it either.
+  void set_ceiling(float height_m) noexcept { ceiling_m_ = height_m > 0.0f ? height_m : ceiling_m_; }
+  float ceiling_m() const { return ceiling_m_; }
   /// Soil in the bucket, m^3 (0 without one).
   double bucket_load_m3() const { return load_m3_; }
   /// Marks the cells of `rect` and their neighbours (clipped to the grid)
@@ -218,6 +229,8 @@ class SoilFlow {
   bool pending() const { return !active_.empty() || !next_.empty(); }
   void displace(HeightGrid& grid, const Segment& from, const Segment& to, double bucket_room_m3,
                 SoilStepResult& out);
+  void beside_body(const HeightGrid& grid, double x, double z, double tx, double tz,
+                   std::int64_t& first, std::int64_t& second) const;
   void pour(HeightGrid& grid, const Segment& lip, double volume_m3, SoilStepResult& out);
   void run_passes(HeightGrid& grid, SoilStepResult& out);
   std::int64_t examine(std::uint32_t a, const float* h);
@@ -226,6 +239,7 @@ class SoilFlow {
   SoilFlowParams params_;
   BladeSpec blade_spec_{};
   double load_m3_ = 0.0;  // soil in the bucket
+  float ceiling_m_ = std::numeric_limits<float>::infinity();  // set_ceiling
   int cols_ = 0;
   int rows_ = 0;
   double dx_ = 0.0;
@@ -285,14 +299,15 @@ class SoilFlow {
   std::vector<std::uint8_t> near_blade_;  // per cell: 1 within reach of the step's blade
   std::vector<std::uint8_t> obstacle_;    // per cell: 1 + index into obstacles_, 0 for none
   std::vector<SoilObstacle> obstacles_;   // the obstacles, their cells clipped to the grid
-  /// True when the cell's soil at height_m would stand inside an obstacle.
-  bool obstructed(std::uint32_t cell, float height_m) const {
-    return obstacle_[cell] != 0 && height_m > obstacles_[obstacle_[cell] - 1u].bottom_m;
-  }
+  /// True when a body stands over the cell: no soil flows or is pushed into
+  /// it, whatever the gap under the body (soil filling the gap would lift
+  /// the body from below instead of banking against its side).
+  bool obstructed(std::uint32_t cell) const { return obstacle_[cell] != 0; }
   std::vector<std::uint32_t> marked_;     // cells with near_blade_ set
 
   Rect before_rect_{};        // where before_ holds the pre-cut heights
   std::vector<float> before_;  // (rect rows) x (rect cols), row-major
+  std::vector<float> after_cut_;  // the same samples after the cut, before the displacement writes
 };
 
 }  // namespace terracut
