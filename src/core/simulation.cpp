@@ -190,7 +190,16 @@ void Simulation::remove_listener(StepListener& listener) {
 
 void Simulation::reset() {
   grid_.reset();
-  if (soil_) soil_ = std::make_unique<SoilFlow>(params_.soil, grid_, params_.blade);
+  if (soil_) {
+    // A fresh soil state, with the obstacles and the ceiling it was given
+    // (the bodies are not part of the terrain's reset: their listener sets
+    // them again only when they change).
+    const std::vector<SoilObstacle> obstacles(soil_->obstacles().begin(), soil_->obstacles().end());
+    const float ceiling = soil_->ceiling_m();
+    soil_ = std::make_unique<SoilFlow>(params_.soil, grid_, params_.blade);
+    soil_->set_obstacles(obstacles);
+    soil_->set_ceiling(ceiling);
+  }
   has_previous_ = false;
   in_step_ = false;
   step_count_ = 0;

@@ -202,6 +202,8 @@ class SoilFlow {
   /// Relaxation only moves soil down, so it never rises past it either.
   void set_ceiling(float height_m) noexcept { ceiling_m_ = height_m > 0.0f ? height_m : ceiling_m_; }
   float ceiling_m() const { return ceiling_m_; }
+  /// The obstacles as last set (their cells clipped to the grid).
+  std::span<const SoilObstacle> obstacles() const { return obstacles_; }
   /// Soil in the bucket, m^3 (0 without one).
   double bucket_load_m3() const { return load_m3_; }
   /// Marks the cells of `rect` and their neighbours (clipped to the grid)
