@@ -101,24 +101,20 @@ void write_row(std::ostream& out, const RemoteRecord& r) {
       << int(r.holding) << ',' << int(r.active) << ',' << r.compute_s * 1e6 << '\n';
 }
 
-template <typename Record>
-void write_csv(const std::vector<Record>& records, const std::filesystem::path& path,
-               const char* header) {
-  std::ofstream out = open_out(path);
-  out << header;
-  for (const Record& r : records) write_row(out, r);
-  if (!out) throw InputError(path.string() + ": cannot be written");
-}
-
 }  // namespace
 
+// The batch files are the streamed ones written in one go: one writer.
 void write_operator_csv(const std::vector<OperatorRecord>& records,
                         const std::filesystem::path& path) {
-  write_csv(records, path, kOperatorCsvHeader);
+  StationCsv csv = StationCsv::operator_csv(path);
+  for (const OperatorRecord& r : records) csv.add(r);
+  csv.finish();
 }
 
 void write_remote_csv(const std::vector<RemoteRecord>& records, const std::filesystem::path& path) {
-  write_csv(records, path, kRemoteCsvHeader);
+  StationCsv csv = StationCsv::remote_csv(path);
+  for (const RemoteRecord& r : records) csv.add(r);
+  csv.finish();
 }
 
 StationCsv::StationCsv(const std::filesystem::path& path, const char* header)
