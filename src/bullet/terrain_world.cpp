@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
@@ -115,6 +116,10 @@ class ReservedSolver final : public btSequentialImpulseConstraintSolver {
   }
 };
 
+// The samples under a body's box: its ring (TerrainWorld::ring_around, not
+// clipped) less one sample all round.
+Rect footprint_of(const SoilObstacle& o) { return {o.cells.c0 + 1, o.cells.r0 + 1, o.cells.c1 - 1, o.cells.r1 - 1}; }
+
 const TerrainWorldParams& checked(const TerrainWorldParams& params) {
   if (std::string e = validate(params); !e.empty()) throw InputError(e);
   return params;
@@ -143,6 +148,10 @@ std::string validate(const TerrainWorldParams& p) {
     return must_be("tool.thickness_m", "in (0, 100]", p.tool.thickness_m);
   if (p.tool.enabled && !in_range(p.tool.friction, 0.0, 10.0))
     return must_be("tool.friction", "in [0, 10]", p.tool.friction);
+  if (p.pile.enabled && !(p.pile.unit_weight_n_per_m3 > 0.0 && p.pile.unit_weight_n_per_m3 <= 1e5))
+    return must_be("pile.unit_weight_n_per_m3", "in (0, 1e5]", p.pile.unit_weight_n_per_m3);
+  if (p.pile.enabled && !(p.pile.friction_angle_deg > 0.0 && p.pile.friction_angle_deg <= 80.0))
+    return must_be("pile.friction_angle_deg", "in (0, 80]", p.pile.friction_angle_deg);
   return {};
 }
 
@@ -326,6 +335,7 @@ TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& bl
     m.world.addRigidBody(body.get());
     m.inertia.push_back(inertia);
     m.held.push_back(held ? 1 : 0);
+    obstacles_.reserve(specs_.size());
     m.body_shapes.push_back(std::move(shape));
     m.bodies.push_back(std::move(body));
   }
@@ -338,6 +348,8 @@ void TerrainWorld::step(const StepOutput& out) {
   terrain_changed(out.changed);
   set_tool_pose(out.pose);
   release_reached(out.changed);
+  shed_rings();
+  apply_pile_pressure(out.changed);
   advance();
   info_.total_s = now_s() - start;
 }
@@ -445,6 +457,12 @@ void TerrainWorld::advance() {
   info_.tool_contact_points = points;
   info_.bodies_woken = pending_woken_;
   pending_woken_ = 0;
+  info_.pile_force_n = pending_pile_force_n_;
+  pending_pile_force_n_ = 0.0;
+  info_.shed_m3 = pending_shed_m3_;
+  info_.shed_rect = pending_shed_rect_;
+  pending_shed_m3_ = 0.0;
+  pending_shed_rect_ = {};
   info_.bodies_released = pending_released_;
   info_.released_rect = pending_released_rect_;
   pending_released_ = 0;
@@ -468,6 +486,134 @@ BodyState TerrainWorld::body_state(int i) const {
   s.active = b.isActive();
   s.held = impl_->held[std::size_t(i)] != 0;
   return s;
+}
+
+SoilObstacle TerrainWorld::ring_around(int i) const {
+  btVector3 lo, hi;
+  impl_->bodies[std::size_t(i)]->getAabb(lo, hi);
+  // The samples whose centres lie under the box, and one more all round;
+  // not clipped to the grid (at most one sample past each edge).
+  const GridSpec& g = grid_.spec();
+  const double cx = g.cell_x_m(), cz = g.cell_z_m();
+  const double c0 = std::ceil((double(lo.x()) - g.origin_m.x) / cx - 0.5) - 1.0;
+  const double c1 = std::floor((double(hi.x()) - g.origin_m.x) / cx - 0.5) + 2.0;
+  const double r0 = std::ceil((double(lo.z()) - g.origin_m.z) / cz - 0.5) - 1.0;
+  const double r1 = std::floor((double(hi.z()) - g.origin_m.z) / cz - 0.5) + 2.0;
+  const float bottom = float(double(lo.y()) - g.origin_m.y);
+  if (!(std::isfinite(c0) && std::isfinite(c1) && std::isfinite(r0) && std::isfinite(r1)))
+    return {{}, bottom};  // a body gone to infinity (NaN) covers nothing
+  const auto bound = [](double v, int n) { return int(std::clamp(v, -1.0, double(n + 1))); };
+  return {{bound(c0, g.cols), bound(r0, g.rows), bound(c1, g.cols), bound(r1, g.rows)}, bottom};
+}
+
+SoilObstacle TerrainWorld::soil_obstacle(int i) const {
+  SoilObstacle o = ring_around(i);
+  o.cells = {std::max(o.cells.c0, 0), std::max(o.cells.r0, 0), std::min(o.cells.c1, grid_.cols()),
+             std::min(o.cells.r1, grid_.rows())};
+  return o;
+}
+
+void TerrainWorld::shed_rings() {
+  if (!params_.pile.enabled) return;
+  Impl& m = *impl_;
+  obstacles_.clear();
+  for (int i = 0; i < body_count(); ++i) obstacles_.push_back(soil_obstacle(i));
+  const auto obstructed = [this](int col, int row) {
+    for (const SoilObstacle& o : obstacles_)
+      if (col >= o.cells.c0 && col < o.cells.c1 && row >= o.cells.r0 && row < o.cells.r1) return true;
+    return false;
+  };
+  float* h = grid_.edit_layers().height_m;
+  const float ceiling = float(bounds_.max_height_m);
+  Rect changed{};
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    const btRigidBody& b = *m.bodies[i];
+    if (m.held[i] || b.isStaticOrKinematicObject()) continue;
+    const SoilObstacle& o = obstacles_[i];
+    if (o.cells.empty()) continue;
+    const Rect f = footprint_of(ring_around(int(i)));
+    const float keep = o.bottom_m + float(m.body_shapes[i]->getMargin());
+    for (int row = o.cells.r0; row < o.cells.r1; ++row)
+      for (int col = o.cells.c0; col < o.cells.c1; ++col) {
+        const int dc = col < f.c0 ? -1 : (col >= f.c1 ? 1 : 0);
+        const int dr = row < f.r0 ? -1 : (row >= f.r1 ? 1 : 0);
+        if (dc == 0 && dr == 0) continue;  // under the body: its support
+        const int tc = col + dc, tr = row + dr;
+        if (tc < 0 || tc >= grid_.cols() || tr < 0 || tr >= grid_.rows() || obstructed(tc, tr)) continue;
+        float& from = h[grid_.index(col, row)];
+        float& to = h[grid_.index(tc, tr)];
+        const float move = std::min(from - keep, ceiling - to);
+        if (!(move > 0.0f)) continue;
+        from -= move;
+        to += move;
+        pending_shed_m3_ += double(move) * grid_.spec().cell_area_m2();
+        changed.include(col, row);
+        changed.include(tc, tr);
+      }
+  }
+  if (changed.empty()) return;
+  pending_shed_rect_.include(changed);
+  terrain_changed(changed);
+}
+
+void TerrainWorld::apply_pile_pressure(const Rect& changed) {
+  if (!params_.pile.enabled) return;
+  Impl& m = *impl_;
+  const GridSpec& g = grid_.spec();
+  const float* h = grid_.heights();
+  // Rankine's active coefficient on a smooth vertical face: K = tan^2(45 - phi/2).
+  const double half_phi = 0.5 * params_.pile.friction_angle_deg * std::numbers::pi / 180.0;
+  const double t = std::tan(0.25 * std::numbers::pi - half_phi);
+  const double coeff = 0.5 * t * t * params_.pile.unit_weight_n_per_m3;  // P / h^2, N/m^3
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    btRigidBody& b = *m.bodies[i];
+    if (m.held[i] || b.isStaticOrKinematicObject()) continue;
+    const SoilObstacle o = soil_obstacle(int(i));
+    if (o.cells.empty()) continue;
+    btVector3 lo, hi;
+    b.getAabb(lo, hi);
+    const double bottom = double(o.bottom_m), tall = double(hi.y() - lo.y());
+    // The samples that press on the body: the first ones outside the ring,
+    // on its four sides (corners excluded: they face no side).
+    const Rect band{std::max(o.cells.c0 - 1, 0), std::max(o.cells.r0 - 1, 0),
+                    std::min(o.cells.c1 + 1, g.cols), std::min(o.cells.r1 + 1, g.rows)};
+    const btVector3 centre = b.getCenterOfMassPosition();
+    btVector3 force(0, 0, 0), torque(0, 0, 0);
+    double magnitude = 0.0;
+    // One sample's push, along `inward` (a unit axis), on the face at `face`
+    // (world X or Z of the box's side), over `width` metres of it.
+    const auto press = [&](int col, int row, double width, btVector3 inward, bool along_x, double face) {
+      const double above = std::clamp(double(h[grid_.index(col, row)]) - bottom, 0.0, tall);
+      if (!(above > 0.0)) return;
+      const double p = coeff * above * above * width;
+      const btVector3 f = inward * btScalar(p);
+      const btVector3 at(btScalar(along_x ? face : grid_.sample_x(col)),
+                         btScalar(g.origin_m.y + bottom + above / 3.0),
+                         btScalar(along_x ? grid_.sample_z(row) : face));
+      force += f;
+      torque += (at - centre).cross(f);
+      magnitude += p;
+    };
+    for (int row = o.cells.r0; row < o.cells.r1; ++row) {
+      if (band.c0 < o.cells.c0) press(band.c0, row, g.cell_z_m(), btVector3(1, 0, 0), true, lo.x());
+      if (band.c1 > o.cells.c1) press(band.c1 - 1, row, g.cell_z_m(), btVector3(-1, 0, 0), true, hi.x());
+    }
+    for (int col = o.cells.c0; col < o.cells.c1; ++col) {
+      if (band.r0 < o.cells.r0) press(col, band.r0, g.cell_x_m(), btVector3(0, 0, 1), false, lo.z());
+      if (band.r1 > o.cells.r1) press(col, band.r1 - 1, g.cell_x_m(), btVector3(0, 0, -1), false, hi.z());
+    }
+    if (!(magnitude > 0.0)) continue;
+    // A sleeping body wakes when the soil that presses on it changed.
+    if (!b.isActive()) {
+      const bool touched = changed.c0 < band.c1 && changed.c1 > band.c0 && changed.r0 < band.r1 &&
+                           changed.r1 > band.r0;
+      if (!touched) continue;
+      b.activate(true);
+    }
+    b.applyCentralForce(force);
+    b.applyTorque(torque);
+    pending_pile_force_n_ += magnitude;
+  }
 }
 
 int TerrainWorld::held_count() const {
