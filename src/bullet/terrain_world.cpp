@@ -393,9 +393,13 @@ void TerrainWorld::terrain_changed(const Rect& changed) {
     if (body->isStaticObject()) continue;
     btBroadphaseProxy* proxy = body->getBroadphaseHandle();
     // The broadphase box already includes the contact breaking threshold.
-    if (proxy->m_aabbMax.x() < x0 || proxy->m_aabbMin.x() > x1 || proxy->m_aabbMax.z() < z0 ||
-        proxy->m_aabbMin.z() > z1)
-      continue;
+    // With piles (PilePressureSpec) the body's own box: the soil it banks
+    // against changes every step a sample outside its ring, on triangles
+    // the body does not reach, and dropping its contacts for that would
+    // cost it its static friction (it would creep under the pile's thrust).
+    btVector3 lo = proxy->m_aabbMin, hi = proxy->m_aabbMax;
+    if (params_.pile.enabled) body->getAabb(lo, hi);
+    if (hi.x() < x0 || lo.x() > x1 || hi.z() < z0 || lo.z() > z1) continue;
     body->activate(true);
     // Drop the cached contact points with the terrain: the persistent
     // manifold keeps them in the terrain's frame at the old surface.
@@ -603,6 +607,14 @@ void TerrainWorld::apply_pile_pressure(const Rect& changed) {
       if (band.r1 > o.cells.r1) press(col, band.r1 - 1, g.cell_x_m(), btVector3(0, 0, -1), false, hi.z());
     }
     if (!(magnitude > 0.0)) continue;
+    pending_pile_force_n_ += magnitude;
+    // Static friction carries a thrust below the body's sliding friction on
+    // level ground (Bullet multiplies the two friction coefficients): the
+    // body would not move, and Bullet's iterative solver lets an awake body
+    // under a steady sub-friction push creep (about 3 um per step).
+    const double friction = double(b.getFriction()) * params_.terrain_friction *
+                            specs_[i].mass_kg * params_.gravity_m_s2;
+    if (!(double(force.length()) > friction)) continue;
     // A sleeping body wakes when the soil that presses on it changed.
     if (!b.isActive()) {
       const bool touched = changed.c0 < band.c1 && changed.c1 > band.c0 && changed.r0 < band.r1 &&
@@ -612,7 +624,6 @@ void TerrainWorld::apply_pile_pressure(const Rect& changed) {
     }
     b.applyCentralForce(force);
     b.applyTorque(torque);
-    pending_pile_force_n_ += magnitude;
   }
 }
 
