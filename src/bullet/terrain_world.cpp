@@ -536,7 +536,16 @@ void TerrainWorld::shed_rings() {
     const SoilObstacle& o = obstacles_[i];
     if (o.cells.empty()) continue;
     const Rect f = footprint_of(ring_around(int(i)));
-    const float keep = o.bottom_m + float(m.body_shapes[i]->getMargin());
+    // What stays in the ring: up to the body's lowest point, or to the
+    // lowest soil under it where that is higher (a body resting on the soil
+    // sinks into it by a fraction of a millimetre; keeping the ring at its
+    // support level means that a body pushed on meets soil no higher than
+    // what it stood on, with no step to ride up).
+    float support = std::numeric_limits<float>::infinity();
+    for (int row = std::max(f.r0, 0); row < std::min(f.r1, grid_.rows()); ++row)
+      for (int col = std::max(f.c0, 0); col < std::min(f.c1, grid_.cols()); ++col)
+        support = std::min(support, h[grid_.index(col, row)]);
+    const float keep = std::isfinite(support) ? std::max(o.bottom_m, support) : o.bottom_m;
     for (int row = o.cells.r0; row < o.cells.r1; ++row)
       for (int col = o.cells.c0; col < o.cells.c1; ++col) {
         const int dc = col < f.c0 ? -1 : (col >= f.c1 ? 1 : 0);

@@ -137,6 +137,43 @@ TEST(PilePressure, TheSameRunGivesTheSameBits) {
   EXPECT_EQ(std::memcmp(&sa.orientation, &sb.orientation, sizeof(Quat)), 0);
 }
 
+TEST(PilePressure, ABoxPushedIntoABankPushesItAsideInsteadOfRidingUpIt) {
+  // The blade 1 cm above the layer pushes a 2 kg box with its plate along +Z
+  // at 0.3 m/s, from z = 0.3 m into a bank 3 cm high that starts at z =
+  // 0.4 m (the box's front face is at 0.35 m) and runs past the push.
+  SimParams params;
+  params.grid = test::spec(100, 100, 1.0, 1.0);
+  params.blade.length_m = 0.3;
+  params.soil.model = SoilModel::kFlow;
+  params.soil.max_pair_checks_per_step = 400000;
+  constexpr float kBank = 0.03f;
+  std::vector<float> heights(100 * 100, kLayer);
+  for (int r = 40; r < 100; ++r)
+    for (int c = 0; c < 100; ++c) heights[std::size_t(r * 100 + c)] = kLayer + kBank;
+  Simulation sim(params, heights);
+  const double before = sim.grid().volume_m3();
+  BodiesListener bodies(sim, {test::box("box", {0.1, 0.1, 0.1}, 2.0, {0.5, kLayer + 0.05, 0.3})});
+  double most_tilt = 0.0, highest = 0.0, shed = 0.0;
+  const int steps = 1000;  // 0.3 m at 0.3 mm per step
+  for (int i = 0; i <= steps + 300; ++i) {
+    sim.step({{0.5, kLayer + 0.01, 0.23 + 0.3 * std::min(i, steps) / steps}, Quat{}});
+    const BodyState s = bodies.world().body_state(0);
+    most_tilt = std::max(most_tilt, tilt_deg(s.orientation));
+    highest = std::max(highest, s.position_m.y);
+    shed += bodies.world().last().shed_m3;
+  }
+  const BodyState end = bodies.world().body_state(0);
+  EXPECT_GT(end.position_m.z, 0.3 + 0.2);  // pushed well into the bank
+  EXPECT_GT(shed, 0.0);                    // and pushed the bank's soil aside
+  // Not lifted onto the bank (its 3 cm) past its resting depth, nor tipped
+  // more than one cell over its 0.1 m depth would tip it.
+  const double margin = TerrainWorldParams{}.convex_margin_m;
+  EXPECT_LT(highest, kLayer + 0.05 + margin);
+  EXPECT_LT(most_tilt, std::atan(kCell / 0.1) * 180.0 / std::numbers::pi);
+  // The plate's cut of the bank is kept too: nothing lost.
+  EXPECT_NEAR(sim.grid().volume_m3(), before, 1e-6);
+}
+
 TEST(PilePressure, ABoxWhoseSupportIsCutAwayStillFalls) {
   // A level pass 5 cm deep under a 5 kg box (the tool plate off: the blade
   // passes under it); the cut soil goes round it and the box drops the
