@@ -64,17 +64,13 @@ TEST(PilePressure, ABankAgainstAFaceGivesRankinesActiveThrust) {
 // A 0.4 m blade 5 cm deep pushes a pile along +Z toward a light box resting
 // on the sand (face at z = 0.6 m); the blade stops at z = 0.55, short of it.
 struct PushTowardBox {
-  SimParams params;
+  SimParams params = test::flow_on_1cm(0.4);
   std::unique_ptr<Simulation> sim;
   std::unique_ptr<BodiesListener> bodies;
   double most_tilt_deg = 0.0, highest_m = 0.0, furthest_z_m = 0.0;
   double soil_under_m3 = 0.0;  // the most soil above the layer under the box's footprint
 
   explicit PushTowardBox(double mass_kg) {
-    params.grid = test::spec(100, 100, 1.0, 1.0);
-    params.blade.length_m = 0.4;
-    params.soil.model = SoilModel::kFlow;
-    params.soil.max_pair_checks_per_step = 400000;
     sim = std::make_unique<Simulation>(params, std::vector<float>(100 * 100, kLayer));
     BodiesListenerOptions o;
     o.world = test::no_tool();
@@ -141,11 +137,7 @@ TEST(PilePressure, ABoxPushedIntoABankPushesItAsideInsteadOfRidingUpIt) {
   // The blade 1 cm above the layer pushes a 2 kg box with its plate along +Z
   // at 0.3 m/s, from z = 0.3 m into a bank 3 cm high that starts at z =
   // 0.4 m (the box's front face is at 0.35 m) and runs past the push.
-  SimParams params;
-  params.grid = test::spec(100, 100, 1.0, 1.0);
-  params.blade.length_m = 0.3;
-  params.soil.model = SoilModel::kFlow;
-  params.soil.max_pair_checks_per_step = 400000;
+  const SimParams params = test::flow_on_1cm(0.3);
   constexpr float kBank = 0.03f;
   std::vector<float> heights(100 * 100, kLayer);
   for (int r = 40; r < 100; ++r)
@@ -178,11 +170,7 @@ TEST(PilePressure, ABoxWhoseSupportIsCutAwayStillFalls) {
   // A level pass 5 cm deep under a 5 kg box (the tool plate off: the blade
   // passes under it); the cut soil goes round it and the box drops the
   // cut's depth.
-  SimParams params;
-  params.grid = test::spec(100, 100, 1.0, 1.0);
-  params.blade.length_m = 0.4;
-  params.soil.model = SoilModel::kFlow;
-  Simulation sim(params, std::vector<float>(100 * 100, kLayer));
+  Simulation sim(test::flow_on_1cm(0.4), std::vector<float>(100 * 100, kLayer));
   BodiesListenerOptions o;
   o.world = test::no_tool();
   BodiesListener bodies(sim, {test::box("box", {0.2, 0.05, 0.2}, 5.0, {0.5, kLayer + 0.025, 0.6})}, o);

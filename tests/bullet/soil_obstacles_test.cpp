@@ -15,15 +15,11 @@ namespace {
 
 struct PushIntoBody {
   static constexpr float kLayer = 0.1f;
-  SimParams params;
+  SimParams params = test::flow_on_1cm(0.4);
   std::unique_ptr<Simulation> sim;
   std::unique_ptr<BodiesListener> bodies;
 
   explicit PushIntoBody(bool with_body) {
-    params.grid = test::spec(100, 100, 1.0, 1.0);
-    params.blade.length_m = 0.4;
-    params.soil.model = SoilModel::kFlow;
-    params.soil.max_pair_checks_per_step = 400000;
     sim = std::make_unique<Simulation>(params, std::vector<float>(100 * 100, kLayer));
     if (with_body) {
       // A heavy static block resting on the sand, its face at z = 0.6 m.

@@ -38,6 +38,14 @@
 // into it) is lowered to its lowest point, where it rests; the plate then
 // meets it through Bullet. docs/bullet.md, "Buried bodies".
 //
+// Piles (TerrainWorldParams::pile, on with soil that flows): the soil
+// keeps a ring of one sample free round each body (soil_obstacle), a body
+// that moved into soil pushes what stands in its ring a sample out, and the
+// soil outside the ring presses on the body's sides with Rankine's active
+// earth pressure, instead of the ramp a heightfield makes from a pile to
+// the samples under a body (which Bullet climbed). docs/bullet.md, "Piles
+// against bodies".
+//
 // One step (step(out)) after each Simulation::step: terrain_changed(changed
 // rectangle), move the tool plate to the blade pose, advance Bullet by exactly
 // 1 / rate_hz (one fixed sub-step: deterministic), and sum the tool's contact
