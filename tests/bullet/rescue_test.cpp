@@ -116,7 +116,9 @@ void Rescue::undercut_block_tips_into_the_trench() {
   EXPECT_GE(soil_lo, floor - tol());  // the cut reached the trench's floor, not below
   EXPECT_GT(lowest, soil_lo - tol());
   EXPECT_LT(lowest, soil_hi + tol());
-  if (input_.soil.model == SoilModel::kVanish) EXPECT_NEAR(lowest, floor, tol());
+  if (input_.soil.model == SoilModel::kVanish) {
+    EXPECT_NEAR(lowest, floor, tol());  // the trench's floor, bare
+  }
   // On its side in the trench: its 0.2 m X edge is now vertical, to 5
   // degrees on a level floor, and further by the slope of the soil under it
   // (the sand that slid back in) across the length of its box.
