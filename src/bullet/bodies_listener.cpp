@@ -11,6 +11,12 @@ namespace terracut::bullet {
 BodiesListener::BodiesListener(Simulation& sim, std::vector<BodySpec> bodies,
                                const BodiesListenerOptions& options)
     : sim_(sim), bodies_(std::move(bodies)), options_(options) {
+  // Soil that flows banks against the bodies and presses on them, with the
+  // soil's angle of repose as the pile's friction angle.
+  if (const SoilFlow* soil = sim_.soil()) {
+    options_.world.pile.enabled = true;
+    options_.world.pile.friction_angle_deg = soil->params().repose_deg;
+  }
   world_ = std::make_unique<TerrainWorld>(sim, bodies_, options_.world);
   // Shapes and sizes never change: kept for the viewer's frames.
   for (const BodySpec& b : bodies_) half_extents_.push_back(half_extents_m(b));
@@ -33,28 +39,18 @@ Vec3 BodiesListener::on_step(const StepOutput& out) noexcept {
   const WorldStepInfo& info = world_->last();
   // A released buried body lowered the soil it stood in: part of this step's change.
   if (info.bodies_released > 0) sim_.include_changed(info.released_rect);
+  // So did soil a body pushed out of its ring.
+  if (!info.shed_rect.empty()) sim_.include_changed(info.shed_rect);
   peak_tool_force_n_ = std::max(peak_tool_force_n_, length(info.tool_force_n));
   if (info.tool_contact_points > 0) ++steps_touching_;
   ++steps_;
   physics_sum_s_ += info.physics_s;
   physics_max_s_ = std::max(physics_max_s_, info.physics_s);
   if (SoilFlow* soil = sim_.soil()) {
-    // Each body's bounding box (Bullet's, margin included) as an obstacle:
-    // the samples whose centres lie under it, and its lowest point.
-    const GridSpec& g = sim_.grid().spec();
-    const double cx = g.cell_x_m(), cz = g.cell_z_m();
+    // Each body's bounding box (Bullet's, margin included) and a ring of
+    // one sample round it as an obstacle (TerrainWorld::soil_obstacle).
     obstacles_.clear();
-    for (int i = 0; i < world_->body_count(); ++i) {
-      btVector3 lo, hi;
-      world_->body(i).getAabb(lo, hi);
-      const double c0 = std::ceil((double(lo.x()) - g.origin_m.x) / cx - 0.5);
-      const double c1 = std::floor((double(hi.x()) - g.origin_m.x) / cx - 0.5) + 1.0;
-      const double r0 = std::ceil((double(lo.z()) - g.origin_m.z) / cz - 0.5);
-      const double r1 = std::floor((double(hi.z()) - g.origin_m.z) / cz - 0.5) + 1.0;
-      const auto to_int = [](double v) { return v == v ? int(std::clamp(v, -1.0, 2e9)) : -1; };  // NaN -> -1
-      obstacles_.push_back({{to_int(c0), to_int(r0), to_int(c1), to_int(r1)},
-                            float(double(lo.y()) - g.origin_m.y)});
-    }
+    for (int i = 0; i < world_->body_count(); ++i) obstacles_.push_back(world_->soil_obstacle(i));
     soil->set_obstacles(obstacles_);
   }
   return info.tool_force_n;

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
@@ -115,6 +116,10 @@ class ReservedSolver final : public btSequentialImpulseConstraintSolver {
   }
 };
 
+// The samples under a body's box: its ring (TerrainWorld::ring_around, not
+// clipped) less one sample all round.
+Rect footprint_of(const SoilObstacle& o) { return {o.cells.c0 + 1, o.cells.r0 + 1, o.cells.c1 - 1, o.cells.r1 - 1}; }
+
 const TerrainWorldParams& checked(const TerrainWorldParams& params) {
   if (std::string e = validate(params); !e.empty()) throw InputError(e);
   return params;
@@ -143,6 +148,10 @@ std::string validate(const TerrainWorldParams& p) {
     return must_be("tool.thickness_m", "in (0, 100]", p.tool.thickness_m);
   if (p.tool.enabled && !in_range(p.tool.friction, 0.0, 10.0))
     return must_be("tool.friction", "in [0, 10]", p.tool.friction);
+  if (p.pile.enabled && !(p.pile.unit_weight_n_per_m3 > 0.0 && p.pile.unit_weight_n_per_m3 <= 1e5))
+    return must_be("pile.unit_weight_n_per_m3", "in (0, 1e5]", p.pile.unit_weight_n_per_m3);
+  if (p.pile.enabled && !(p.pile.friction_angle_deg > 0.0 && p.pile.friction_angle_deg <= 80.0))
+    return must_be("pile.friction_angle_deg", "in (0, 80]", p.pile.friction_angle_deg);
   return {};
 }
 
@@ -326,6 +335,7 @@ TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& bl
     m.world.addRigidBody(body.get());
     m.inertia.push_back(inertia);
     m.held.push_back(held ? 1 : 0);
+    obstacles_.reserve(specs_.size());
     m.body_shapes.push_back(std::move(shape));
     m.bodies.push_back(std::move(body));
   }
@@ -338,6 +348,8 @@ void TerrainWorld::step(const StepOutput& out) {
   terrain_changed(out.changed);
   set_tool_pose(out.pose);
   release_reached(out.changed);
+  shed_rings();
+  apply_pile_pressure(out.changed);
   advance();
   info_.total_s = now_s() - start;
 }
@@ -381,9 +393,13 @@ void TerrainWorld::terrain_changed(const Rect& changed) {
     if (body->isStaticObject()) continue;
     btBroadphaseProxy* proxy = body->getBroadphaseHandle();
     // The broadphase box already includes the contact breaking threshold.
-    if (proxy->m_aabbMax.x() < x0 || proxy->m_aabbMin.x() > x1 || proxy->m_aabbMax.z() < z0 ||
-        proxy->m_aabbMin.z() > z1)
-      continue;
+    // With piles (PilePressureSpec) the body's own box: the soil it banks
+    // against changes every step a sample outside its ring, on triangles
+    // the body does not reach, and dropping its contacts for that would
+    // cost it its static friction (it would creep under the pile's thrust).
+    btVector3 lo = proxy->m_aabbMin, hi = proxy->m_aabbMax;
+    if (params_.pile.enabled) body->getAabb(lo, hi);
+    if (hi.x() < x0 || lo.x() > x1 || hi.z() < z0 || lo.z() > z1) continue;
     body->activate(true);
     // Drop the cached contact points with the terrain: the persistent
     // manifold keeps them in the terrain's frame at the old surface.
@@ -445,6 +461,12 @@ void TerrainWorld::advance() {
   info_.tool_contact_points = points;
   info_.bodies_woken = pending_woken_;
   pending_woken_ = 0;
+  info_.pile_force_n = pending_pile_force_n_;
+  pending_pile_force_n_ = 0.0;
+  info_.shed_m3 = pending_shed_m3_;
+  info_.shed_rect = pending_shed_rect_;
+  pending_shed_m3_ = 0.0;
+  pending_shed_rect_ = {};
   info_.bodies_released = pending_released_;
   info_.released_rect = pending_released_rect_;
   pending_released_ = 0;
@@ -468,6 +490,150 @@ BodyState TerrainWorld::body_state(int i) const {
   s.active = b.isActive();
   s.held = impl_->held[std::size_t(i)] != 0;
   return s;
+}
+
+SoilObstacle TerrainWorld::ring_around(int i) const {
+  btVector3 lo, hi;
+  impl_->bodies[std::size_t(i)]->getAabb(lo, hi);
+  // The samples whose centres lie under the box, and one more all round;
+  // not clipped to the grid (at most one sample past each edge).
+  const GridSpec& g = grid_.spec();
+  const double cx = g.cell_x_m(), cz = g.cell_z_m();
+  const double c0 = std::ceil((double(lo.x()) - g.origin_m.x) / cx - 0.5) - 1.0;
+  const double c1 = std::floor((double(hi.x()) - g.origin_m.x) / cx - 0.5) + 2.0;
+  const double r0 = std::ceil((double(lo.z()) - g.origin_m.z) / cz - 0.5) - 1.0;
+  const double r1 = std::floor((double(hi.z()) - g.origin_m.z) / cz - 0.5) + 2.0;
+  const float bottom = float(double(lo.y()) - g.origin_m.y);
+  if (!(std::isfinite(c0) && std::isfinite(c1) && std::isfinite(r0) && std::isfinite(r1)))
+    return {{}, bottom};  // a body gone to infinity (NaN) covers nothing
+  const auto bound = [](double v, int n) { return int(std::clamp(v, -1.0, double(n + 1))); };
+  return {{bound(c0, g.cols), bound(r0, g.rows), bound(c1, g.cols), bound(r1, g.rows)}, bottom};
+}
+
+SoilObstacle TerrainWorld::soil_obstacle(int i) const {
+  SoilObstacle o = ring_around(i);
+  o.cells = {std::max(o.cells.c0, 0), std::max(o.cells.r0, 0), std::min(o.cells.c1, grid_.cols()),
+             std::min(o.cells.r1, grid_.rows())};
+  return o;
+}
+
+void TerrainWorld::shed_rings() {
+  if (!params_.pile.enabled) return;
+  Impl& m = *impl_;
+  obstacles_.clear();
+  for (int i = 0; i < body_count(); ++i) obstacles_.push_back(soil_obstacle(i));
+  const auto obstructed = [this](int col, int row) {
+    for (const SoilObstacle& o : obstacles_)
+      if (col >= o.cells.c0 && col < o.cells.c1 && row >= o.cells.r0 && row < o.cells.r1) return true;
+    return false;
+  };
+  float* h = grid_.edit_layers().height_m;
+  const float ceiling = float(bounds_.max_height_m);
+  Rect changed{};
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    const btRigidBody& b = *m.bodies[i];
+    if (m.held[i] || b.isStaticOrKinematicObject()) continue;
+    const SoilObstacle& o = obstacles_[i];
+    if (o.cells.empty()) continue;
+    const Rect f = footprint_of(ring_around(int(i)));
+    // What stays in the ring: up to the body's lowest point, or to the
+    // lowest soil under it where that is higher (a body resting on the soil
+    // sinks into it by a fraction of a millimetre; keeping the ring at its
+    // support level means that a body pushed on meets soil no higher than
+    // what it stood on, with no step to ride up).
+    float support = std::numeric_limits<float>::infinity();
+    for (int row = std::max(f.r0, 0); row < std::min(f.r1, grid_.rows()); ++row)
+      for (int col = std::max(f.c0, 0); col < std::min(f.c1, grid_.cols()); ++col)
+        support = std::min(support, h[grid_.index(col, row)]);
+    const float keep = std::isfinite(support) ? std::max(o.bottom_m, support) : o.bottom_m;
+    for (int row = o.cells.r0; row < o.cells.r1; ++row)
+      for (int col = o.cells.c0; col < o.cells.c1; ++col) {
+        const int dc = col < f.c0 ? -1 : (col >= f.c1 ? 1 : 0);
+        const int dr = row < f.r0 ? -1 : (row >= f.r1 ? 1 : 0);
+        if (dc == 0 && dr == 0) continue;  // under the body: its support
+        const int tc = col + dc, tr = row + dr;
+        if (tc < 0 || tc >= grid_.cols() || tr < 0 || tr >= grid_.rows() || obstructed(tc, tr)) continue;
+        float& from = h[grid_.index(col, row)];
+        float& to = h[grid_.index(tc, tr)];
+        const float move = std::min(from - keep, ceiling - to);
+        if (!(move > 0.0f)) continue;
+        from -= move;
+        to += move;
+        pending_shed_m3_ += double(move) * grid_.spec().cell_area_m2();
+        changed.include(col, row);
+        changed.include(tc, tr);
+      }
+  }
+  if (changed.empty()) return;
+  pending_shed_rect_.include(changed);
+  terrain_changed(changed);
+}
+
+void TerrainWorld::apply_pile_pressure(const Rect& changed) {
+  if (!params_.pile.enabled) return;
+  Impl& m = *impl_;
+  const GridSpec& g = grid_.spec();
+  const float* h = grid_.heights();
+  // Rankine's active coefficient on a smooth vertical face: K = tan^2(45 - phi/2).
+  const double half_phi = 0.5 * params_.pile.friction_angle_deg * std::numbers::pi / 180.0;
+  const double t = std::tan(0.25 * std::numbers::pi - half_phi);
+  const double coeff = 0.5 * t * t * params_.pile.unit_weight_n_per_m3;  // P / h^2, N/m^3
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    btRigidBody& b = *m.bodies[i];
+    if (m.held[i] || b.isStaticOrKinematicObject()) continue;
+    const SoilObstacle o = soil_obstacle(int(i));
+    if (o.cells.empty()) continue;
+    btVector3 lo, hi;
+    b.getAabb(lo, hi);
+    const double bottom = double(o.bottom_m), tall = double(hi.y() - lo.y());
+    // The samples that press on the body: the first ones outside the ring,
+    // on its four sides (corners excluded: they face no side).
+    const Rect band{std::max(o.cells.c0 - 1, 0), std::max(o.cells.r0 - 1, 0),
+                    std::min(o.cells.c1 + 1, g.cols), std::min(o.cells.r1 + 1, g.rows)};
+    const btVector3 centre = b.getCenterOfMassPosition();
+    btVector3 force(0, 0, 0), torque(0, 0, 0);
+    double magnitude = 0.0;
+    // One sample's push, along `inward` (a unit axis), on the face at `face`
+    // (world X or Z of the box's side), over `width` metres of it.
+    const auto press = [&](int col, int row, double width, btVector3 inward, bool along_x, double face) {
+      const double above = std::clamp(double(h[grid_.index(col, row)]) - bottom, 0.0, tall);
+      if (!(above > 0.0)) return;
+      const double p = coeff * above * above * width;
+      const btVector3 f = inward * btScalar(p);
+      const btVector3 at(btScalar(along_x ? face : grid_.sample_x(col)),
+                         btScalar(g.origin_m.y + bottom + above / 3.0),
+                         btScalar(along_x ? grid_.sample_z(row) : face));
+      force += f;
+      torque += (at - centre).cross(f);
+      magnitude += p;
+    };
+    for (int row = o.cells.r0; row < o.cells.r1; ++row) {
+      if (band.c0 < o.cells.c0) press(band.c0, row, g.cell_z_m(), btVector3(1, 0, 0), true, lo.x());
+      if (band.c1 > o.cells.c1) press(band.c1 - 1, row, g.cell_z_m(), btVector3(-1, 0, 0), true, hi.x());
+    }
+    for (int col = o.cells.c0; col < o.cells.c1; ++col) {
+      if (band.r0 < o.cells.r0) press(col, band.r0, g.cell_x_m(), btVector3(0, 0, 1), false, lo.z());
+      if (band.r1 > o.cells.r1) press(col, band.r1 - 1, g.cell_x_m(), btVector3(0, 0, -1), false, hi.z());
+    }
+    if (!(magnitude > 0.0)) continue;
+    pending_pile_force_n_ += magnitude;
+    // Static friction carries a thrust below the body's sliding friction on
+    // level ground (Bullet multiplies the two friction coefficients): the
+    // body would not move, and Bullet's iterative solver lets an awake body
+    // under a steady sub-friction push creep (about 3 um per step).
+    const double friction = double(b.getFriction()) * params_.terrain_friction *
+                            specs_[i].mass_kg * params_.gravity_m_s2;
+    if (!(double(force.length()) > friction)) continue;
+    // A sleeping body wakes when the soil that presses on it changed.
+    if (!b.isActive()) {
+      const bool touched = changed.c0 < band.c1 && changed.c1 > band.c0 && changed.r0 < band.r1 &&
+                           changed.r1 > band.r0;
+      if (!touched) continue;
+      b.activate(true);
+    }
+    b.applyCentralForce(force);
+    b.applyTorque(torque);
+  }
 }
 
 int TerrainWorld::held_count() const {

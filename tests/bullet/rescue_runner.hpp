@@ -28,6 +28,24 @@ struct BodiesRun {
   std::vector<double> physics_s;             ///< per step: wall time of Bullet's step, seconds
   bullet::BoundsReport bounds{};
   std::int64_t csv_rows = 0;
+  GridSpec grid{};
+  std::vector<float> final_heights_m;        ///< rows x cols, row-major: the terrain at the end
+
+  /// The highest and lowest heights (metres above ground) of the samples
+  /// whose centres lie under the X-Z box [x0, x1] x [z0, z1], at the end.
+  std::pair<double, double> heights_under(double x0, double x1, double z0, double z1) const {
+    double lo = INFINITY, hi = -INFINITY;
+    for (int r = 0; r < grid.rows; ++r)
+      for (int c = 0; c < grid.cols; ++c) {
+        const double x = grid.origin_m.x + (c + 0.5) * grid.cell_x_m();
+        const double z = grid.origin_m.z + (r + 0.5) * grid.cell_z_m();
+        if (x < x0 || x > x1 || z < z0 || z > z1) continue;
+        const double h = final_heights_m[std::size_t(r) * std::size_t(grid.cols) + std::size_t(c)];
+        lo = std::min(lo, h);
+        hi = std::max(hi, h);
+      }
+    return {lo, hi};
+  }
 
   const bullet::BodyState& state(std::int64_t k, int body) const {
     return states[std::size_t(k) * bodies.size() + std::size_t(body)];
@@ -88,6 +106,8 @@ inline BodiesRun run_with_bodies(const BodiesScenario& input, const std::filesys
   }
   run.bounds = world.bounds();
   run.csv_rows = listener.csv_rows();
+  run.grid = sim.grid().spec();
+  run.final_heights_m.assign(sim.grid().heights(), sim.grid().heights() + run.grid.sample_count());
   listener.finish();
   return run;
 }

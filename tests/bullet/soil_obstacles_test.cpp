@@ -15,15 +15,11 @@ namespace {
 
 struct PushIntoBody {
   static constexpr float kLayer = 0.1f;
-  SimParams params;
+  SimParams params = test::flow_on_1cm(0.4);
   std::unique_ptr<Simulation> sim;
   std::unique_ptr<BodiesListener> bodies;
 
   explicit PushIntoBody(bool with_body) {
-    params.grid = test::spec(100, 100, 1.0, 1.0);
-    params.blade.length_m = 0.4;
-    params.soil.model = SoilModel::kFlow;
-    params.soil.max_pair_checks_per_step = 400000;
     sim = std::make_unique<Simulation>(params, std::vector<float>(100 * 100, kLayer));
     if (with_body) {
       // A heavy static block resting on the sand, its face at z = 0.6 m.
@@ -51,8 +47,11 @@ TEST(SoilObstacles, APushedPileBanksAgainstABodyAndNeverEntersIt) {
   EXPECT_GT(free.soil_in_block(), 1e-4);  // without the block the pile runs on
   // None of it, to the float rounding of the footprint's 800 heights of 0.1 m.
   EXPECT_LT(blocked.soil_in_block(), 800 * 1e-4 * 0.1 * 1.2e-7);
-  // The pile stands against the block's face, above the layer.
-  EXPECT_GT(blocked.sim->grid().height(50, 59), PushIntoBody::kLayer + 0.03f);
+  // The pile stands against the block's face (at z = 0.6 m) a sample away,
+  // above the layer: sample 59 (z = 0.595) is the ring kept free round the
+  // block, sample 58 holds the pile.
+  EXPECT_LT(blocked.sim->grid().height(50, 59), PushIntoBody::kLayer + 1e-6f);
+  EXPECT_GT(blocked.sim->grid().height(50, 58), PushIntoBody::kLayer + 0.03f);
   // Nothing was lost, and the block did not move.
   EXPECT_NEAR(blocked.sim->grid().volume_m3(), 1.0 * 1.0 * PushIntoBody::kLayer, 1e-6);
   EXPECT_NEAR(blocked.bodies->world().body_state(0).position_m.z, 0.7, 1e-6);  // Bullet's floats

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "terracut/bullet/terrain_world.hpp"
+#include "terracut/core/simulation.hpp"
 
 namespace terracut::bullet::test {
 
@@ -29,6 +30,18 @@ inline BodySpec box(const std::string& name, Vec3 size, double mass, Vec3 positi
   b.mass_kg = mass;
   b.position_m = position;
   return b;
+}
+
+// 1 m x 1 m of soil that flows on 100 x 100 samples (1 cm cells), a blade
+// of the given length, and a relaxation cap that keeps a pushed pile up
+// with the blade.
+inline SimParams flow_on_1cm(double blade_length_m) {
+  SimParams p;
+  p.grid = spec(100, 100, 1.0, 1.0);
+  p.blade.length_m = blade_length_m;
+  p.soil.model = SoilModel::kFlow;
+  p.soil.max_pair_checks_per_step = 400000;
+  return p;
 }
 
 inline TerrainWorldParams no_tool() {

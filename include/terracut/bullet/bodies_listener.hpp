@@ -9,8 +9,10 @@
 // of 1 / rate), then a row per body to bodies.csv when one is written, and
 // the bodies' force on the tool plate is returned to the step (the haptic
 // loop adds it to the force the operator feels). With soil that flows it
-// sets the soil's obstacles (SoilFlow::set_obstacles) to the bodies'
-// bounding boxes, for the next step. It also tells the viewer where the
+// turns the world's piles on (TerrainWorldParams::pile, with the soil's
+// repose angle as the pile's friction angle) and sets the soil's obstacles
+// (SoilFlow::set_obstacles) to the bodies' bounding boxes and a ring of one
+// sample round them (TerrainWorld::soil_obstacle), for the next step. It also tells the viewer where the
 // bodies are (BodySource).
 #pragma once
 

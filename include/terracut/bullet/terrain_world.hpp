@@ -38,6 +38,14 @@
 // into it) is lowered to its lowest point, where it rests; the plate then
 // meets it through Bullet. docs/bullet.md, "Buried bodies".
 //
+// Piles (TerrainWorldParams::pile, on with soil that flows): the soil
+// keeps a ring of one sample free round each body (soil_obstacle), a body
+// that moved into soil pushes what stands in its ring a sample out, and the
+// soil outside the ring presses on the body's sides with Rankine's active
+// earth pressure, instead of the ramp a heightfield makes from a pile to
+// the samples under a body (which Bullet climbed). docs/bullet.md, "Piles
+// against bodies".
+//
 // One step (step(out)) after each Simulation::step: terrain_changed(changed
 // rectangle), move the tool plate to the blade pose, advance Bullet by exactly
 // 1 / rate_hz (one fixed sub-step: deterministic), and sum the tool's contact
@@ -53,6 +61,7 @@
 
 #include "terracut/core/bodies.hpp"
 #include "terracut/core/simulation.hpp"
+#include "terracut/core/soil.hpp"
 
 class btDiscreteDynamicsWorld;
 class btVector3;
@@ -70,6 +79,25 @@ struct ToolPlateSpec {
   double height_m = 0.1;       ///< extent above the edge along blade local +Y, metres, in (0, 100]
   double thickness_m = 0.02;   ///< extent along blade local Z, metres, in (0, 100]
   double friction = 0.5;       ///< Coulomb friction coefficient, [0, 10]
+};
+
+/// The push of soil that flows on the bodies it banks against (docs/bullet.md,
+/// "Piles against bodies"). The soil keeps one sample away from a body's
+/// footprint (soil_obstacle), so that no heightfield triangle ramps from a
+/// pile under the body's edge; the pile's push is Rankine's active earth
+/// pressure on a smooth vertical face instead, horizontal, per unit width
+///   P = 0.5 K gamma h^2,  K = tan^2(45 deg - phi / 2),
+/// acting at h / 3 above the body's lowest point, with h the soil's height
+/// above that point on the first samples outside the kept-free ring (at most
+/// the body's height).
+struct PilePressureSpec {
+  bool enabled = false;                   ///< false: no earth pressure (soil that vanishes)
+  /// gamma: unit weight of the piled soil, N/m^3, in (0, 1e5]. Default: dry
+  /// sand, as SoilParams' dry_sand preset (Das).
+  double unit_weight_n_per_m3 = 16.25e3;
+  /// phi: friction angle of the piled (loose) soil, degrees, in (0, 80]; a
+  /// loose cohesionless pile's is about its angle of repose.
+  double friction_angle_deg = 34.0;
 };
 
 /// Parameters of the Bullet world; validated at construction, read-only during a run.
@@ -105,6 +133,7 @@ struct TerrainWorldParams {
   /// two triangles per square everywhere.
   double merge_tolerance_m = 1e-5;
   ToolPlateSpec tool{};
+  PilePressureSpec pile{};
 };
 
 /// Returns an empty string when params are valid, else a message naming the field.
@@ -146,6 +175,15 @@ struct WorldStepInfo {
   /// to the step's changed rectangle).
   int bodies_released = 0;
   Rect released_rect{};
+  /// Soil moved out of the rings round the bodies in the last step
+  /// (PilePressureSpec: a body that moved into soil pushes it a sample out),
+  /// m^3, and the samples that changed (the caller tells whoever caches
+  /// heights, as for released_rect).
+  double shed_m3 = 0.0;
+  Rect shed_rect{};
+  /// Sum over the bodies of the horizontal earth pressure of the piles
+  /// against them in the last step (PilePressureSpec), newtons.
+  double pile_force_n = 0.0;
   double physics_s = 0.0;           ///< wall-clock time of Bullet's step, seconds
   double total_s = 0.0;             ///< wall-clock time of the whole step(), seconds
 };
@@ -202,6 +240,13 @@ class TerrainWorld {
   /// body raised. Allocation-free; not during advance().
   int raise_to_body_tops(const Rect& rect, std::span<float> out) const;
 
+  /// Where soil that flows may not go for body i: the samples whose centres
+  /// lie under its bounding box, and one more all round (clipped to the
+  /// grid; empty when the body's box is not finite), with the box's lowest
+  /// point, metres above ground. The ring keeps a pile's last slope outside
+  /// the body (PilePressureSpec).
+  SoilObstacle soil_obstacle(int i) const;
+
   /// Held bodies (buried, not yet reached by the blade).
   int held_count() const;
 
@@ -248,6 +293,22 @@ class TerrainWorld {
   /// step's cut), before Bullet advances.
   void release_reached(const Rect& changed);
   void release(int i);
+  /// Applies the piles' earth pressure (params_.pile) to the dynamic bodies,
+  /// for the next advance; wakes a sleeping body when `changed` touches the
+  /// soil that presses on it. Sums the forces into pending_pile_force_n_.
+  void apply_pile_pressure(const Rect& changed);
+  /// Moves the soil standing in a body's ring (soil_obstacle minus its
+  /// footprint) higher than its lowest point plus the collision margin one
+  /// sample further out, away from the body (not onto another body's
+  /// obstacle, not past the upper bound): a body that moved into soil pushes
+  /// it aside instead of riding up the slope the heightfield makes there.
+  void shed_rings();
+  /// soil_obstacle(i) before clipping to the grid (at most one sample past an edge).
+  SoilObstacle ring_around(int i) const;
+  double pending_pile_force_n_ = 0.0;
+  double pending_shed_m3_ = 0.0;
+  Rect pending_shed_rect_{};
+  std::vector<SoilObstacle> obstacles_;  // per body, this step's soil_obstacle (reserved)
   /// The samples whose centres lie under a world box's X-Z extent (clipped).
   Rect samples_under(const btVector3& lo, const btVector3& hi) const;
   std::int64_t pending_clamped_ = 0;
