@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -232,6 +233,18 @@ constexpr int kMaxPending = 4 * kChunkColumns;
 /// two-cell branch).
 inline bool pair_columns(const Line& l) { return std::abs(l.dq * (1.0 / l.dp)) < 0.5; }
 
+/// Calls walk(up, pairs) with the instance of a fast walk that the line l
+/// needs: up, whether its minor coordinate does not decrease (dq >= 0), and
+/// pairs, pair_columns(l), both as std::bool_constant.
+template <class Walk>
+std::int64_t fast_walk(const Line& l, Walk&& walk) {
+  const bool up = l.dq >= 0.0;
+  if (pair_columns(l)) {
+    return up ? walk(std::true_type{}, std::true_type{}) : walk(std::false_type{}, std::true_type{});
+  }
+  return up ? walk(std::true_type{}, std::false_type{}) : walk(std::false_type{}, std::false_type{});
+}
+
 /// Adds the queued pieces.
 void add_pending(const Pending* pending, int n, double eps, ContactSums& sums) {
   for (int k = 0; k < n; ++k) add_piece(pending[k].s0, pending[k].s1, pending[k].d0, pending[k].d1, eps, sums);
@@ -385,13 +398,9 @@ ContactResult contact_columns(const HeightGrid& grid, const Segment& edge) {
     double s_first = (p_first - l.p0) * inv_dp;
     double s_end = (p_end - l.p0) * inv_dp;
     if (s_first > s0) visited += columns_general(h, l, s0, s_first, eps, sums);
-    if (pair_columns(l)) {
-      visited += l.dq >= 0.0 ? columns_full<true, true>(h, l, p_first, p_end, eps, sums)
-                             : columns_full<false, true>(h, l, p_first, p_end, eps, sums);
-    } else {
-      visited += l.dq >= 0.0 ? columns_full<true, false>(h, l, p_first, p_end, eps, sums)
-                             : columns_full<false, false>(h, l, p_first, p_end, eps, sums);
-    }
+    visited += fast_walk(l, [&](auto up, auto pairs) {
+      return columns_full<up(), pairs()>(h, l, p_first, p_end, eps, sums);
+    });
     if (s1 > s_end) visited += columns_general(h, l, s_end, s1, eps, sums);
   } else {
     visited += columns_general(h, l, s0, s1, eps, sums);
@@ -680,13 +689,9 @@ ContactResult contact_surface(const HeightGrid& grid, const Segment& edge) {
     double s_first = (p_first - l.p0) * inv_dp;
     double s_end = (p_end - l.p0) * inv_dp;
     visited += surface_general(h, l, s0, s_first, eps, sums);
-    if (pair_columns(l)) {
-      visited += l.dq >= 0.0 ? surface_columns<true, true>(h, l, p_first, p_end, eps, sums)
-                             : surface_columns<false, true>(h, l, p_first, p_end, eps, sums);
-    } else {
-      visited += l.dq >= 0.0 ? surface_columns<true, false>(h, l, p_first, p_end, eps, sums)
-                             : surface_columns<false, false>(h, l, p_first, p_end, eps, sums);
-    }
+    visited += fast_walk(l, [&](auto up, auto pairs) {
+      return surface_columns<up(), pairs()>(h, l, p_first, p_end, eps, sums);
+    });
     visited += surface_general(h, l, s_end, s1, eps, sums);
   } else {
     visited += surface_general(h, l, s0, s1, eps, sums);
