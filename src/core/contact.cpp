@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -222,6 +223,28 @@ struct Pending {
 constexpr int kChunkColumns = 64;
 constexpr int kMaxPending = 4 * kChunkColumns;
 
+/// Whether the fast walks try two columns at once (in SSE2 lanes): only
+/// when the edge is closer to its major axis than 1 in 2 (|dq / dp| < 1/2),
+/// as only then do two columns in a row without a minor crossing happen
+/// often. The walks are instantiated with and without the two-column path:
+/// without it, its accumulators and constants no longer hold registers
+/// through the oblique walks' loops, which then keep fewer of their values
+/// on the stack (GCC 12 still keeps twice the area there in the columns'
+/// two-cell branch).
+inline bool pair_columns(const Line& l) { return std::abs(l.dq * (1.0 / l.dp)) < 0.5; }
+
+/// Calls walk(up, pairs) with the instance of a fast walk that the line l
+/// needs: up, whether its minor coordinate does not decrease (dq >= 0), and
+/// pairs, pair_columns(l), both as std::bool_constant.
+template <class Walk>
+std::int64_t fast_walk(const Line& l, Walk&& walk) {
+  const bool up = l.dq >= 0.0;
+  if (pair_columns(l)) {
+    return up ? walk(std::true_type{}, std::true_type{}) : walk(std::false_type{}, std::true_type{});
+  }
+  return up ? walk(std::true_type{}, std::false_type{}) : walk(std::false_type{}, std::false_type{});
+}
+
 /// Adds the queued pieces.
 void add_pending(const Pending* pending, int n, double eps, ContactSums& sums) {
   for (int k = 0; k < n; ++k) add_piece(pending[k].s0, pending[k].s1, pending[k].d0, pending[k].d1, eps, sums);
@@ -232,7 +255,7 @@ void add_pending(const Pending* pending, int n, double eps, ContactSums& sums) {
 /// for the surface (see surface_columns): the minor offset b = q - Q and the
 /// edge height y advance by constants per column; a column wholly in
 /// material adds (d_in + d_out) to twice the area, in a-units.
-template <bool kUp>
+template <bool kUp, bool kPairs>
 std::int64_t columns_full(const float* h, const Line& l, int p_first, int p_end, double eps,
                           ContactSums& sums) {
   const double inv_dp = 1.0 / l.dp;
@@ -261,8 +284,8 @@ std::int64_t columns_full(const float* h, const Line& l, int p_first, int p_end,
     __m128d area2_pair = _mm_setzero_pd(), max_pair = _mm_set1_pd(max_depth);
     const __m128d ky_pair = _mm_set1_pd(ky), eps_pair = _mm_set1_pd(eps);
     // Two columns in a row without a minor crossing are only likely when
-    // the edge is closer to the major axis than 1 in 2.
-    const bool pairs = std::abs(r) < 0.5;
+    // the edge is closer to the major axis than 1 in 2 (pair_columns).
+    constexpr bool pairs = kPairs;
 #endif
     for (int P = chunk; P < chunk_end; ++P) {
 #if defined(__SSE2__)
@@ -375,8 +398,9 @@ ContactResult contact_columns(const HeightGrid& grid, const Segment& edge) {
     double s_first = (p_first - l.p0) * inv_dp;
     double s_end = (p_end - l.p0) * inv_dp;
     if (s_first > s0) visited += columns_general(h, l, s0, s_first, eps, sums);
-    visited += l.dq >= 0.0 ? columns_full<true>(h, l, p_first, p_end, eps, sums)
-                           : columns_full<false>(h, l, p_first, p_end, eps, sums);
+    visited += fast_walk(l, [&](auto up, auto pairs) {
+      return columns_full<up(), pairs()>(h, l, p_first, p_end, eps, sums);
+    });
     if (s1 > s_end) visited += columns_general(h, l, s_end, s1, eps, sums);
   } else {
     visited += columns_general(h, l, s0, s1, eps, sums);
@@ -447,7 +471,7 @@ std::int64_t surface_general(const float* h, const Line& l, double sa, double sb
 /// against rounding. b and y are carried from column to column; their
 /// rounding stays many orders below the float heights' (b in [0, 1]).
 /// kUp: the edge's minor coordinate does not decrease (dq >= 0).
-template <bool kUp>
+template <bool kUp, bool kPairs>
 std::int64_t surface_columns(const float* h, const Line& l, int p_first, int p_end, double eps,
                              ContactSums& sums) {
   const double inv_dp = 1.0 / l.dp;
@@ -496,8 +520,8 @@ std::int64_t surface_columns(const float* h, const Line& l, int p_first, int p_e
     const __m128d r_pair = _mm_set1_pd(r), ky_pair = _mm_set1_pd(ky), one = _mm_set1_pd(1.0);
     const __m128d inv_1r_pair = _mm_set1_pd(inv_1r), eps_pair = _mm_set1_pd(eps);
     // Two columns in a row without a minor crossing are only likely when
-    // the edge is closer to the major axis than 1 in 2.
-    const bool pairs = std::abs(r) < 0.5;
+    // the edge is closer to the major axis than 1 in 2 (pair_columns).
+    constexpr bool pairs = kPairs;
 #endif
     for (int P = chunk; P < chunk_end; ++P) {
 #if defined(__SSE2__)
@@ -665,8 +689,9 @@ ContactResult contact_surface(const HeightGrid& grid, const Segment& edge) {
     double s_first = (p_first - l.p0) * inv_dp;
     double s_end = (p_end - l.p0) * inv_dp;
     visited += surface_general(h, l, s0, s_first, eps, sums);
-    visited += l.dq >= 0.0 ? surface_columns<true>(h, l, p_first, p_end, eps, sums)
-                           : surface_columns<false>(h, l, p_first, p_end, eps, sums);
+    visited += fast_walk(l, [&](auto up, auto pairs) {
+      return surface_columns<up(), pairs()>(h, l, p_first, p_end, eps, sums);
+    });
     visited += surface_general(h, l, s_end, s1, eps, sums);
   } else {
     visited += surface_general(h, l, s0, s1, eps, sums);
