@@ -9,7 +9,7 @@
 namespace terracut::viewer {
 namespace {
 
-const char* kVertexShader = R"(#version 330 core
+const char* kShapeVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 uniform mat4 u_vp;
@@ -24,7 +24,7 @@ void main() {
 }
 )";
 
-const char* kFragmentShader = R"(#version 330 core
+const char* kShapeFragmentShader = R"(#version 330 core
 in vec3 v_world;
 in vec3 v_normal;
 uniform vec4 u_color;
@@ -113,7 +113,7 @@ std::vector<V> round_vertices(int slices, bool cone) {
 }  // namespace
 
 ShapeRenderer::ShapeRenderer() {
-  program_ = build_program("shapes", kVertexShader, kFragmentShader);
+  program_ = build_program("shapes", kShapeVertexShader, kShapeFragmentShader);
   auto make = [](Mesh& m, const std::vector<V>& v, GLenum mode, bool dynamic) {
     glGenVertexArrays(1, &m.vao);
     glGenBuffers(1, &m.vbo);

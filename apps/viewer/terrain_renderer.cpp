@@ -95,7 +95,7 @@ void main() {
 }
 )";
 
-const char* kFragmentShader = R"(#version 330 core
+const char* kTerrainFragmentShader = R"(#version 330 core
 in vec3 v_world;
 in vec2 v_sample;
 in float v_wall;  // 1 on the terrain's outer walls
@@ -269,8 +269,8 @@ TerrainRenderer::TerrainRenderer(const GridSpec& spec, Representation representa
   mesh_max = std::max(mesh_max, 2);
   blocky_ = representation == Representation::kColumns && 2 * spec.cols <= mesh_max &&
             2 * spec.rows <= mesh_max;
-  program_ = blocky_ ? build_program("terrain (boxes)", kBoxVertexShader, kFragmentShader)
-                     : build_program("terrain", kLodVertexShader, kFragmentShader);
+  program_ = blocky_ ? build_program("terrain (boxes)", kBoxVertexShader, kTerrainFragmentShader)
+                     : build_program("terrain", kLodVertexShader, kTerrainFragmentShader);
   GLint filter = representation == Representation::kColumns ? GL_NEAREST : GL_LINEAR;
   heights_tex_ = make_height_texture(spec.cols, spec.rows, heights_m, filter);
   initial_tex_ = make_height_texture(spec.cols, spec.rows, initial_m, filter);

@@ -32,9 +32,13 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "c_file.hpp"
 
 namespace terracut::io {
 namespace {
+
+using detail::FilePtr;
+using detail::quoted;
 
 // Largest accepted image: per side and in total (checked before allocating).
 constexpr std::uint64_t kMaxSide = 65536;
@@ -58,14 +62,6 @@ constexpr int kRowsPerBlock = 64;
 constexpr double kLumaR = 0.2126;
 constexpr double kLumaG = 0.7152;
 constexpr double kLumaB = 0.0722;
-
-// A path in quotes, for messages.
-std::string quoted(const std::filesystem::path& path) {
-  std::string s = path.string();
-  s.insert(s.begin(), '\'');
-  s.push_back('\'');
-  return s;
-}
 
 // Reserves (address space only: nothing is touched, so nothing is committed)
 // a buffer of n floats for a large image. On Linux a buffer of 8 MiB or more
@@ -152,11 +148,6 @@ void on_png_flush(png_structp png) {
   auto* io = static_cast<PngIo*>(png_get_io_ptr(png));
   std::fflush(io->file);
 }
-
-struct FileCloser {
-  void operator()(std::FILE* file) const { std::fclose(file); }
-};
-using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
 
 // Owns the libpng read structures.
 class PngReadHandle {

@@ -22,25 +22,17 @@
 #include "terracut/core/error.hpp"
 #include "terracut/io/image.hpp"
 
+#include "c_file.hpp"
+
 namespace terracut::io {
 namespace {
+
+using detail::FilePtr;
+using detail::quoted;
 
 constexpr char kMagic[] = "\x93NUMPY";
 constexpr std::size_t kMagicSize = 6;
 constexpr std::size_t kAlignment = 64;
-
-// A path in quotes, for messages.
-std::string quoted(const std::filesystem::path& path) {
-  std::string s = path.string();
-  s.insert(s.begin(), '\'');
-  s.push_back('\'');
-  return s;
-}
-
-struct FileCloser {
-  void operator()(std::FILE* file) const { std::fclose(file); }
-};
-using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
 
 std::uint32_t byteswap32(std::uint32_t v) {
   return (v >> 24U) | ((v >> 8U) & 0xff00U) | ((v << 8U) & 0xff0000U) | (v << 24U);
