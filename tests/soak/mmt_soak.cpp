@@ -118,9 +118,8 @@ class HostileEndpoint final : public net::Endpoint {
         ++dropped;
         continue;
       }
-      net::Header h;
-      if (net::decode_header(d.data(), d.size(), link_, h) == net::Reject::kNone) remember(h, d);
       ++delivered;
+      judge_real(d);
       out.push(d.data(), d.size());
     }
     if (uniform() < 0.3) {
@@ -131,6 +130,13 @@ class HostileEndpoint final : public net::Endpoint {
 
   net::RejectCounts expected{};  // the account: what the station must reject, by reason
   std::int64_t delivered = 0;    // real datagrams handed on
+  // Real datagrams the transport handed on that the station must reject: a
+  // copy, one out of order, or not a datagram of its peer at all (over
+  // ENet: bytes of the raw flood taken for one of the peer's packets). The
+  // in-memory link never makes one; `real_order` and `real_framing` are
+  // their reasons' counts (also in `expected`).
+  std::int64_t real_order = 0, real_framing = 0;
+  std::string first_anomaly;  // the first of them, described
   std::int64_t forged = 0;       // forged valid ones (must be accepted)
   std::int64_t dropped = 0;      // real ones lost to outages
   std::int64_t hostile = 0;      // hostile datagrams in all
@@ -149,6 +155,40 @@ class HostileEndpoint final : public net::Endpoint {
     Last& l = last_[std::size_t(h.type)];
     l.bytes = d;
     l.header = h;
+  }
+  // The verdict on a real datagram, from the rule of docs/teleoperation.md
+  // restated (a new session is accepted; in the same one a repeated
+  // sequence number is a duplicate, an older one reordered, a newer one
+  // with an older time stale) against the last accepted datagram of its
+  // type; then adds it to the account, or remembers it as accepted.
+  void judge_real(const Bytes& d) {
+    net::Header h;
+    net::Reject verdict = net::decode_header(d.data(), d.size(), link_, h);
+    if (verdict == net::Reject::kNone && !received_type(h.type)) verdict = net::Reject::kBadType;
+    if (verdict == net::Reject::kNone) {
+      const Last& l = last_[std::size_t(h.type)];
+      if (!l.bytes.empty() && l.header.session == h.session) {
+        const auto ahead = static_cast<std::int32_t>(h.sequence - l.header.sequence);
+        if (ahead == 0)
+          verdict = net::Reject::kDuplicate;
+        else if (ahead < 0)
+          verdict = net::Reject::kReordered;
+        else if (h.timestamp_ns < l.header.timestamp_ns)
+          verdict = net::Reject::kStale;
+      }
+      if (verdict == net::Reject::kNone) {
+        remember(h, d);
+        return;
+      }
+      ++real_order;
+    } else {
+      ++real_framing;
+    }
+    expected.add(verdict);
+    if (first_anomaly.empty())
+      first_anomaly = std::string(net::to_string(verdict)) + " (a real datagram of " + std::to_string(d.size()) +
+                      " bytes, sequence " + std::to_string(h.sequence) + ", session " + std::to_string(h.session) +
+                      ")";
   }
   bool received_type(net::MessageType t) const {
     return operator_ ? t != net::MessageType::kCommand : t == net::MessageType::kCommand;
@@ -572,9 +612,15 @@ int run_mmt_soak(const MmtSoakOptions& o) {
               std::string(side.name) + " rejected as " + std::string(net::to_string(net::Reject(r))) + ": " +
                   std::to_string(side.counters.rejected.by_reason[r]) + ", the hostile account " +
                   std::to_string(side.hostile.expected.by_reason[r]));
-    require(side.counters.accepted == side.hostile.delivered + side.hostile.forged,
+    const std::int64_t real_rejected = side.hostile.real_order + side.hostile.real_framing;
+    require(side.counters.accepted == side.hostile.delivered - real_rejected + side.hostile.forged,
             std::string(side.name) + " accepted " + std::to_string(side.counters.accepted) + ", real delivered " +
-                std::to_string(side.hostile.delivered) + " + forged " + std::to_string(side.hostile.forged));
+                std::to_string(side.hostile.delivered) + " - real rejected " + std::to_string(real_rejected) +
+                " + forged " + std::to_string(side.hostile.forged));
+    // The in-memory link delivers what was sent, once and in order.
+    if (!enet)
+      require(real_rejected == 0, std::string(side.name) + ": the in-memory link delivered a datagram to reject: " +
+                                      side.hostile.first_anomaly);
   }
 
   std::sort(latencies_s.begin(), latencies_s.end());
@@ -603,7 +649,9 @@ int run_mmt_soak(const MmtSoakOptions& o) {
     for (std::size_t r = 1; r < net::kRejectReasonCount; ++r)
       std::printf(" %s %lld", std::string(net::to_string(net::Reject(r))).c_str(),
                   static_cast<long long>(side.counters.rejected.by_reason[r]));
-    std::printf("\n");
+    std::printf("\n    real datagrams to reject: out of order or repeated %lld, not the peer's %lld%s%s\n",
+                static_cast<long long>(side.hostile.real_order), static_cast<long long>(side.hostile.real_framing),
+                side.hostile.first_anomaly.empty() ? "" : "; the first: ", side.hostile.first_anomaly.c_str());
   }
   if (enet) std::printf("  raw UDP datagrams to the ENet ports: %lld\n", static_cast<long long>(raw.sent));
   std::printf("  %s\n", failures == 0 ? "all promises kept" : "PROMISES BROKEN");
