@@ -354,6 +354,7 @@ TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& bl
     m.body_shapes.push_back(std::move(shape));
     m.bodies.push_back(std::move(body));
   }
+  refresh_views();  // what each body sees before the first edit
 }
 
 TerrainWorld::~TerrainWorld() = default;
@@ -393,20 +394,6 @@ void TerrainWorld::terrain_changed(const Rect& changed) {
   bounds_.clamped_total += clamped;
   pending_clamped_ += clamped;
 
-  // The triangles that use sample c span world X from origin + (c - 0.5) *
-  // cell to origin + (c + 1.5) * cell (Z likewise): `reach` gives the first
-  // and the last sample whose triangles a box meets, per axis. A body whose
-  // reach holds an edited sample that differs from what it saw (SoilView)
-  // may have lost (or gained) support.
-  const GridSpec& spec = grid_.spec();
-  const auto reach = [](double lo, double hi, double origin, double cell, int& first, int& last) {
-    first = int(std::ceil((lo - origin) / cell - 1.5));
-    while (!(lo > origin + (first - 1 + 1.5) * cell)) --first;
-    while (lo > origin + (first + 1.5) * cell) ++first;
-    last = int(std::floor((hi - origin) / cell + 0.5));
-    while (!(hi < origin + (last + 1 - 0.5) * cell)) ++last;
-    while (hi < origin + (last - 0.5) * cell) --last;
-  };
   Impl& m = *impl_;
   btOverlappingPairCache* pairs = m.world.getPairCache();
   btBroadphaseProxy* terrain_proxy = m.terrain_body->getBroadphaseHandle();
@@ -421,39 +408,14 @@ void TerrainWorld::terrain_changed(const Rect& changed) {
   for (std::size_t i = 0; i < m.bodies.size(); ++i) {
     btRigidBody& body = *m.bodies[i];
     if (body.isStaticObject()) continue;
-    btBroadphaseProxy* proxy = body.getBroadphaseHandle();
-    // The broadphase box already includes the contact breaking threshold.
-    // With piles (PilePressureSpec) the body's own box: the soil it banks
-    // against changes every step a sample outside its ring, on triangles
-    // the body does not reach, and dropping its contacts for that would
-    // cost it its static friction (it would creep under the pile's thrust).
-    btVector3 lo = proxy->m_aabbMin, hi = proxy->m_aabbMax;
-    if (params_.pile.enabled) body.getAabb(lo, hi);
     SoilView& view = views_[i];
-    if (!(std::isfinite(lo.x()) && std::isfinite(hi.x()) && std::isfinite(lo.z()) &&
-          std::isfinite(hi.z()))) {
+    Rect reached{}, seen{};
+    if (!view_region(int(i), reached, seen)) {
       // A body gone to NaN sees nothing; it is woken as it always was.
       view.region = {};
       wake_and_retest(body);
       continue;
     }
-    // Far outside the grid a box meets the same samples as at two cells out
-    // (and the indices below stay small).
-    const auto near = [](btScalar v, double origin, double cell, int n) {
-      return std::clamp(double(v), origin - 2.0 * cell, origin + (n + 2.0) * cell);
-    };
-    Rect reached{};
-    reach(near(lo.x(), spec.origin_m.x, spec.cell_x_m(), spec.cols),
-          near(hi.x(), spec.origin_m.x, spec.cell_x_m(), spec.cols), spec.origin_m.x,
-          spec.cell_x_m(), reached.c0, reached.c1);
-    reach(near(lo.z(), spec.origin_m.z, spec.cell_z_m(), spec.rows),
-          near(hi.z(), spec.origin_m.z, spec.cell_z_m(), spec.rows), spec.origin_m.z,
-          spec.cell_z_m(), reached.r0, reached.r1);
-    ++reached.c1;
-    ++reached.r1;
-    // The samples it sees: the reach and its pile band (clipped).
-    const Rect seen{std::max(reached.c0 - 2, 0), std::max(reached.r0 - 2, 0),
-                    std::min(reached.c1 + 2, grid_.cols()), std::min(reached.r1 + 2, grid_.rows())};
     const Rect band = params_.pile.enabled ? pile_band(soil_obstacle(int(i))) : Rect{};
     // Compare the edited samples it sees with what it saw; a sample it did
     // not see before counts as changed.
@@ -473,18 +435,69 @@ void TerrainWorld::terrain_changed(const Rect& changed) {
                             (col >= band.c0 && col < band.c1 && row >= band.r0 && row < band.r1);
       }
     // What it sees now (when it moved, or the soil it sees changed).
-    if (!(seen == old) || differs) {
-      if (std::size_t(seen.area()) <= view.heights_m.capacity()) {
-        view.region = seen;
-        view.heights_m.resize(std::size_t(seen.area()));
-        float* to = view.heights_m.data();
-        for (int row = seen.r0; row < seen.r1; ++row, to += seen.c1 - seen.c0)
-          std::copy_n(h + grid_.index(seen.c0, row), seen.c1 - seen.c0, to);
-      } else {
-        view.region = {};  // wider than any box the body can have: sees nothing
-      }
-    }
+    if (!(seen == old) || differs) see(view, seen);
     if (under) wake_and_retest(body);
+  }
+}
+
+bool TerrainWorld::view_region(int i, Rect& reached, Rect& seen) const {
+  const btRigidBody& body = *impl_->bodies[std::size_t(i)];
+  const btBroadphaseProxy* proxy = body.getBroadphaseHandle();
+  // The broadphase box already includes the contact breaking threshold.
+  // With piles (PilePressureSpec) the body's own box: the soil it banks
+  // against changes every step a sample outside its ring, on triangles
+  // the body does not reach, and dropping its contacts for that would
+  // cost it its static friction (it would creep under the pile's thrust).
+  btVector3 lo = proxy->m_aabbMin, hi = proxy->m_aabbMax;
+  if (params_.pile.enabled) body.getAabb(lo, hi);
+  if (!(std::isfinite(lo.x()) && std::isfinite(hi.x()) && std::isfinite(lo.z()) &&
+        std::isfinite(hi.z())))
+    return false;
+  // The triangles that use sample c span world X from origin + (c - 0.5) *
+  // cell to origin + (c + 1.5) * cell (Z likewise): the first and the last
+  // sample whose triangles the box meets, per axis. Far outside the grid a
+  // box meets the same samples as at two cells out (and indices stay small).
+  const GridSpec& spec = grid_.spec();
+  const auto reach = [](btScalar lo_m, btScalar hi_m, double origin, double cell, int n, int& first,
+                        int& end) {
+    const double lo = std::clamp(double(lo_m), origin - 2.0 * cell, origin + (n + 2.0) * cell);
+    const double hi = std::clamp(double(hi_m), origin - 2.0 * cell, origin + (n + 2.0) * cell);
+    first = int(std::ceil((lo - origin) / cell - 1.5));
+    while (!(lo > origin + (first - 1 + 1.5) * cell)) --first;
+    while (lo > origin + (first + 1.5) * cell) ++first;
+    int last = int(std::floor((hi - origin) / cell + 0.5));
+    while (!(hi < origin + (last + 1 - 0.5) * cell)) ++last;
+    while (hi < origin + (last - 0.5) * cell) --last;
+    end = last + 1;
+  };
+  reach(lo.x(), hi.x(), spec.origin_m.x, spec.cell_x_m(), spec.cols, reached.c0, reached.c1);
+  reach(lo.z(), hi.z(), spec.origin_m.z, spec.cell_z_m(), spec.rows, reached.r0, reached.r1);
+  // The samples it sees: the reach and its pile band (clipped).
+  seen = {std::max(reached.c0 - 2, 0), std::max(reached.r0 - 2, 0),
+          std::min(reached.c1 + 2, grid_.cols()), std::min(reached.r1 + 2, grid_.rows())};
+  return true;
+}
+
+void TerrainWorld::see(SoilView& view, const Rect& seen) const {
+  if (seen.empty() || std::size_t(seen.area()) > view.heights_m.capacity()) {
+    view.region = {};  // off the grid, or wider than any box the body can have: sees nothing
+    return;
+  }
+  const float* h = grid_.heights();
+  view.region = seen;
+  view.heights_m.resize(std::size_t(seen.area()));
+  float* to = view.heights_m.data();
+  for (int row = seen.r0; row < seen.r1; ++row, to += seen.c1 - seen.c0)
+    std::copy_n(h + grid_.index(seen.c0, row), seen.c1 - seen.c0, to);
+}
+
+void TerrainWorld::refresh_views() {
+  for (std::size_t i = 0; i < views_.size(); ++i) {
+    const btRigidBody& body = *impl_->bodies[i];
+    if (body.isStaticObject() || !body.isActive()) continue;  // it did not move
+    Rect reached{}, seen{};
+    if (!view_region(int(i), reached, seen)) seen = {};
+    if (!(seen == views_[i].region)) see(views_[i], seen);
   }
 }
 
@@ -556,6 +569,8 @@ void TerrainWorld::advance() {
   ++steps_;
   info_.t_s = time_s();
   info_.total_s = info_.physics_s;
+  // A body that moved sees other samples: what they hold before the next edit.
+  refresh_views();
 }
 
 BodyState TerrainWorld::body_state(int i) const {

@@ -337,6 +337,14 @@ class TerrainWorld {
     bool band_changed = false;
   };
   std::vector<SoilView> views_;  // one per body
+  /// Body i's samples whose triangles reach its box (`reached`, not clipped)
+  /// and those it sees (`seen`: two more all round, clipped); false when its
+  /// box is not finite.
+  bool view_region(int i, Rect& reached, Rect& seen) const;
+  /// Copies the heights over `seen` into the view (none when it does not fit).
+  void see(SoilView& view, const Rect& seen) const;
+  /// Each awake body that moved to other samples sees what they hold now.
+  void refresh_views();
   std::int64_t pending_clamped_ = 0;
 };
 
