@@ -436,7 +436,11 @@ void TerrainWorld::terrain_changed(const Rect& changed) {
       }
     // What it sees now (when it moved, or the soil it sees changed).
     if (!(seen == old) || differs) see(view, seen);
-    if (under) wake_and_retest(body);
+    // An awake body over the reported rectangle is re-tested as before:
+    // keeping its manifold across the piles' small changes made its steps
+    // dearer (docs/bullet.md, "Cost"). A sleeping one only for its own soil.
+    const bool over = reached.c0 < r.c1 && reached.c1 > r.c0 && reached.r0 < r.r1 && reached.r1 > r.r0;
+    if (under || (over && body.isActive())) wake_and_retest(body);
   }
 }
 
