@@ -156,18 +156,26 @@ double advance_tracking_min_y(TerrainWorld& world, int body, int steps) {
   return lowest;
 }
 
-TEST(TerrainWorldSupport, BodyFallsByTheCutDepthAndOthersStayPut) {
-  // 1 m x 1 m of soil 0.3 m deep, 2 cm cells; two 0.2 m cubes, one over the
-  // cut, one far from it.
-  const double h0 = 0.3, depth = 0.1, half = 0.1;
-  const GridSpec g = spec(50, 50, 1.0, 1.0);
-  HeightGrid grid(g, std::vector<float>(2500, float(h0)));
-  TerrainWorld world(grid, 1000.0, BladeSpec{},
+// 1 m x 1 m of soil 0.3 m deep, 2 cm cells; two 0.2 m cubes resting on it,
+// one at (0.3, 0.3), one far from it at (0.75, 0.75), settled until both
+// sleep (Bullet's deactivation time is 2 s).
+struct TwoRestingBoxes {
+  static constexpr double h0 = 0.3, half = 0.1;
+  HeightGrid grid{spec(50, 50, 1.0, 1.0), std::vector<float>(2500, float(h0))};
+  TerrainWorld world{grid, 1000.0, BladeSpec{},
                      {box("over_cut", {0.2, 0.2, 0.2}, 8.0, {0.3, h0 + half, 0.3}),
                       box("far", {0.2, 0.2, 0.2}, 8.0, {0.75, h0 + half, 0.75})},
-                     no_tool());
-  // Settle until both sleep (Bullet's deactivation time is 2 s).
-  for (int i = 0; i < 2500; ++i) world.advance();
+                     no_tool()};
+  TwoRestingBoxes() {
+    for (int i = 0; i < 2500; ++i) world.advance();
+  }
+};
+
+TEST(TerrainWorldSupport, BodyFallsByTheCutDepthAndOthersStayPut) {
+  TwoRestingBoxes scene;
+  const double h0 = scene.h0, depth = 0.1, half = scene.half;
+  HeightGrid& grid = scene.grid;
+  TerrainWorld& world = scene.world;
   ASSERT_FALSE(world.body_state(0).active);
   ASSERT_FALSE(world.body_state(1).active);
   const BodyState before = world.body_state(0);
@@ -214,17 +222,13 @@ TEST(TerrainWorldSupport, AWideReportWakesOnlyTheBodyWhoseSoilChanged) {
   // One rectangle round the whole grid is reported (as a step whose soil
   // moved here and there reports it), first for an edit far from both
   // bodies, then for a cut under the first one only.
-  const double h0 = 0.3, depth = 0.1, half = 0.1;
-  const GridSpec g = spec(50, 50, 1.0, 1.0);
-  HeightGrid grid(g, std::vector<float>(2500, float(h0)));
-  TerrainWorld world(grid, 1000.0, BladeSpec{},
-                     {box("over_cut", {0.2, 0.2, 0.2}, 8.0, {0.3, h0 + half, 0.3}),
-                      box("far", {0.2, 0.2, 0.2}, 8.0, {0.75, h0 + half, 0.75})},
-                     no_tool());
-  for (int i = 0; i < 2500; ++i) world.advance();
+  TwoRestingBoxes scene;
+  const double h0 = scene.h0, depth = 0.1;
+  HeightGrid& grid = scene.grid;
+  TerrainWorld& world = scene.world;
   ASSERT_FALSE(world.body_state(0).active);
   ASSERT_FALSE(world.body_state(1).active);
-  const Rect whole{0, 0, g.cols, g.rows};
+  const Rect whole{0, 0, grid.cols(), grid.rows()};
   // A dip 4 cells from every box's reach (x, z in [0.02, 0.06]): nobody's soil.
   for (int r = 1; r < 3; ++r)
     for (int c = 1; c < 3; ++c) grid.lower(grid.index(c, r), float(h0 - depth));
