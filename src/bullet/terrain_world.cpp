@@ -152,6 +152,8 @@ std::string validate(const TerrainWorldParams& p) {
     return must_be("pile.unit_weight_n_per_m3", "in (0, 1e5]", p.pile.unit_weight_n_per_m3);
   if (p.pile.enabled && !(p.pile.friction_angle_deg > 0.0 && p.pile.friction_angle_deg <= 80.0))
     return must_be("pile.friction_angle_deg", "in (0, 80]", p.pile.friction_angle_deg);
+  if (p.pile.enabled && !(p.pile.shed_tolerance_m >= 0.0 && p.pile.shed_tolerance_m <= 0.01))
+    return must_be("pile.shed_tolerance_m", "in [0, 0.01]", p.pile.shed_tolerance_m);
   return {};
 }
 
@@ -336,9 +338,23 @@ TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& bl
     m.inertia.push_back(inertia);
     m.held.push_back(held ? 1 : 0);
     obstacles_.reserve(specs_.size());
+    // Its soil view holds the samples round the widest box the body can
+    // have (its bounding sphere about its origin, with 5 cm for Bullet's
+    // contact threshold and margin): under it, the triangles' reach (one
+    // more) and the band (two more) on each side, and one for rounding.
+    btVector3 sphere_centre;
+    btScalar radius = 0;
+    shape->getBoundingSphere(sphere_centre, radius);
+    const double half_m = double(sphere_centre.length() + radius) + 0.05;
+    const auto across = [&](double cell_m) { return int(std::ceil(2.0 * half_m / cell_m)) + 1 + 2 * 4; };
+    SoilView view;
+    view.heights_m.reserve(std::size_t(across(grid_.spec().cell_x_m())) *
+                           std::size_t(across(grid_.spec().cell_z_m())));
+    views_.push_back(std::move(view));
     m.body_shapes.push_back(std::move(shape));
     m.bodies.push_back(std::move(body));
   }
+  refresh_views();  // what each body sees before the first edit
 }
 
 TerrainWorld::~TerrainWorld() = default;
@@ -349,7 +365,7 @@ void TerrainWorld::step(const StepOutput& out) {
   set_tool_pose(out.pose);
   release_reached(out.changed);
   shed_rings();
-  apply_pile_pressure(out.changed);
+  apply_pile_pressure();
   advance();
   info_.total_s = now_s() - start;
 }
@@ -378,34 +394,114 @@ void TerrainWorld::terrain_changed(const Rect& changed) {
   bounds_.clamped_total += clamped;
   pending_clamped_ += clamped;
 
-  // The triangles that use the edited samples span from sample c0 - 1 to
-  // sample c1 (and r0 - 1 to r1): that is the ground region whose bodies may
-  // have lost (or gained) support.
-  const GridSpec& spec = grid_.spec();
-  const double x0 = spec.origin_m.x + (r.c0 - 0.5) * spec.cell_x_m();
-  const double x1 = spec.origin_m.x + (r.c1 + 0.5) * spec.cell_x_m();
-  const double z0 = spec.origin_m.z + (r.r0 - 0.5) * spec.cell_z_m();
-  const double z1 = spec.origin_m.z + (r.r1 + 0.5) * spec.cell_z_m();
   Impl& m = *impl_;
   btOverlappingPairCache* pairs = m.world.getPairCache();
   btBroadphaseProxy* terrain_proxy = m.terrain_body->getBroadphaseHandle();
-  for (auto& body : m.bodies) {
-    if (body->isStaticObject()) continue;
-    btBroadphaseProxy* proxy = body->getBroadphaseHandle();
-    // The broadphase box already includes the contact breaking threshold.
-    // With piles (PilePressureSpec) the body's own box: the soil it banks
-    // against changes every step a sample outside its ring, on triangles
-    // the body does not reach, and dropping its contacts for that would
-    // cost it its static friction (it would creep under the pile's thrust).
-    btVector3 lo = proxy->m_aabbMin, hi = proxy->m_aabbMax;
-    if (params_.pile.enabled) body->getAabb(lo, hi);
-    if (hi.x() < x0 || lo.x() > x1 || hi.z() < z0 || lo.z() > z1) continue;
-    body->activate(true);
+  const auto wake_and_retest = [&](btRigidBody& body) {
+    body.activate(true);
     // Drop the cached contact points with the terrain: the persistent
     // manifold keeps them in the terrain's frame at the old surface.
-    if (btBroadphasePair* pair = pairs->findPair(proxy, terrain_proxy))
+    if (btBroadphasePair* pair = pairs->findPair(body.getBroadphaseHandle(), terrain_proxy))
       pairs->cleanOverlappingPair(*pair, &m.dispatcher);
     ++pending_woken_;
+  };
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    btRigidBody& body = *m.bodies[i];
+    if (body.isStaticObject()) continue;
+    SoilView& view = views_[i];
+    Rect reached{}, seen{};
+    if (!view_region(int(i), reached, seen)) {
+      // A body gone to NaN sees nothing; it is woken as it always was.
+      view.region = {};
+      wake_and_retest(body);
+      continue;
+    }
+    const Rect band = params_.pile.enabled ? pile_band(soil_obstacle(int(i))) : Rect{};
+    // Compare the edited samples it sees with what it saw; a sample it did
+    // not see before counts as changed.
+    bool under = false, differs = false;
+    const Rect e{std::max(r.c0, seen.c0), std::max(r.r0, seen.r0), std::min(r.c1, seen.c1),
+                 std::min(r.r1, seen.r1)};
+    const Rect& old = view.region;
+    for (int row = e.r0; row < e.r1; ++row)
+      for (int col = e.c0; col < e.c1; ++col) {
+        const bool known = col >= old.c0 && col < old.c1 && row >= old.r0 && row < old.r1;
+        if (known && view.heights_m[std::size_t((row - old.r0) * (old.c1 - old.c0) + (col - old.c0))] ==
+                         h[grid_.index(col, row)])
+          continue;
+        differs = true;
+        under = under || (col >= reached.c0 && col < reached.c1 && row >= reached.r0 && row < reached.r1);
+        view.band_changed = view.band_changed ||
+                            (col >= band.c0 && col < band.c1 && row >= band.r0 && row < band.r1);
+      }
+    // What it sees now (when it moved, or the soil it sees changed).
+    if (!(seen == old) || differs) see(view, seen);
+    // An awake body over the reported rectangle is re-tested as before:
+    // keeping its manifold across the piles' small changes made its steps
+    // dearer (docs/bullet.md, "Cost"). A sleeping one only for its own soil.
+    const bool over = reached.c0 < r.c1 && reached.c1 > r.c0 && reached.r0 < r.r1 && reached.r1 > r.r0;
+    if (under || (over && body.isActive())) wake_and_retest(body);
+  }
+}
+
+bool TerrainWorld::view_region(int i, Rect& reached, Rect& seen) const {
+  const btRigidBody& body = *impl_->bodies[std::size_t(i)];
+  const btBroadphaseProxy* proxy = body.getBroadphaseHandle();
+  // The broadphase box already includes the contact breaking threshold.
+  // With piles (PilePressureSpec) the body's own box: the soil it banks
+  // against changes every step a sample outside its ring, on triangles
+  // the body does not reach, and dropping its contacts for that would
+  // cost it its static friction (it would creep under the pile's thrust).
+  btVector3 lo = proxy->m_aabbMin, hi = proxy->m_aabbMax;
+  if (params_.pile.enabled) body.getAabb(lo, hi);
+  if (!(std::isfinite(lo.x()) && std::isfinite(hi.x()) && std::isfinite(lo.z()) &&
+        std::isfinite(hi.z())))
+    return false;
+  // The triangles that use sample c span world X from origin + (c - 0.5) *
+  // cell to origin + (c + 1.5) * cell (Z likewise): the first and the last
+  // sample whose triangles the box meets, per axis. Far outside the grid a
+  // box meets the same samples as at two cells out (and indices stay small).
+  const GridSpec& spec = grid_.spec();
+  const auto reach = [](btScalar lo_m, btScalar hi_m, double origin, double cell, int n, int& first,
+                        int& end) {
+    const double lo = std::clamp(double(lo_m), origin - 2.0 * cell, origin + (n + 2.0) * cell);
+    const double hi = std::clamp(double(hi_m), origin - 2.0 * cell, origin + (n + 2.0) * cell);
+    first = int(std::ceil((lo - origin) / cell - 1.5));
+    while (!(lo > origin + (first - 1 + 1.5) * cell)) --first;
+    while (lo > origin + (first + 1.5) * cell) ++first;
+    int last = int(std::floor((hi - origin) / cell + 0.5));
+    while (!(hi < origin + (last + 1 - 0.5) * cell)) ++last;
+    while (hi < origin + (last - 0.5) * cell) --last;
+    end = last + 1;
+  };
+  reach(lo.x(), hi.x(), spec.origin_m.x, spec.cell_x_m(), spec.cols, reached.c0, reached.c1);
+  reach(lo.z(), hi.z(), spec.origin_m.z, spec.cell_z_m(), spec.rows, reached.r0, reached.r1);
+  // The samples it sees: the reach and its pile band (clipped).
+  seen = {std::max(reached.c0 - 2, 0), std::max(reached.r0 - 2, 0),
+          std::min(reached.c1 + 2, grid_.cols()), std::min(reached.r1 + 2, grid_.rows())};
+  return true;
+}
+
+void TerrainWorld::see(SoilView& view, const Rect& seen) const {
+  if (seen.empty() || std::size_t(seen.area()) > view.heights_m.capacity()) {
+    view.region = {};  // off the grid, or wider than any box the body can have: sees nothing
+    return;
+  }
+  const float* h = grid_.heights();
+  view.region = seen;
+  view.heights_m.resize(std::size_t(seen.area()));
+  float* to = view.heights_m.data();
+  for (int row = seen.r0; row < seen.r1; ++row, to += seen.c1 - seen.c0)
+    std::copy_n(h + grid_.index(seen.c0, row), seen.c1 - seen.c0, to);
+}
+
+void TerrainWorld::refresh_views() {
+  for (std::size_t i = 0; i < views_.size(); ++i) {
+    const btRigidBody& body = *impl_->bodies[i];
+    if (body.isStaticObject() || !body.isActive()) continue;  // it did not move
+    Rect reached{}, seen{};
+    if (!view_region(int(i), reached, seen)) seen = {};
+    if (!(seen == views_[i].region)) see(views_[i], seen);
   }
 }
 
@@ -477,6 +573,8 @@ void TerrainWorld::advance() {
   ++steps_;
   info_.t_s = time_s();
   info_.total_s = info_.physics_s;
+  // A body that moved sees other samples: what they hold before the next edit.
+  refresh_views();
 }
 
 BodyState TerrainWorld::body_state(int i) const {
@@ -529,6 +627,7 @@ void TerrainWorld::shed_rings() {
   };
   float* h = grid_.edit_layers().height_m;
   const float ceiling = float(bounds_.max_height_m);
+  const float tolerance = float(params_.pile.shed_tolerance_m);
   Rect changed{};
   for (std::size_t i = 0; i < m.bodies.size(); ++i) {
     const btRigidBody& b = *m.bodies[i];
@@ -555,6 +654,9 @@ void TerrainWorld::shed_rings() {
         if (tc < 0 || tc >= grid_.cols() || tr < 0 || tr >= grid_.rows() || obstructed(tc, tr)) continue;
         float& from = h[grid_.index(col, row)];
         float& to = h[grid_.index(tc, tr)];
+        // Soil within the tolerance of what stays is left (a resting body
+        // settles by fractions of a micrometre).
+        if (!(from - keep > tolerance)) continue;
         const float move = std::min(from - keep, ceiling - to);
         if (!(move > 0.0f)) continue;
         from -= move;
@@ -569,7 +671,7 @@ void TerrainWorld::shed_rings() {
   terrain_changed(changed);
 }
 
-void TerrainWorld::apply_pile_pressure(const Rect& changed) {
+void TerrainWorld::apply_pile_pressure() {
   if (!params_.pile.enabled) return;
   Impl& m = *impl_;
   const GridSpec& g = grid_.spec();
@@ -588,8 +690,7 @@ void TerrainWorld::apply_pile_pressure(const Rect& changed) {
     const double bottom = double(o.bottom_m), tall = double(hi.y() - lo.y());
     // The samples that press on the body: the first ones outside the ring,
     // on its four sides (corners excluded: they face no side).
-    const Rect band{std::max(o.cells.c0 - 1, 0), std::max(o.cells.r0 - 1, 0),
-                    std::min(o.cells.c1 + 1, g.cols), std::min(o.cells.r1 + 1, g.rows)};
+    const Rect band = pile_band(o);
     const btVector3 centre = b.getCenterOfMassPosition();
     btVector3 force(0, 0, 0), torque(0, 0, 0);
     double magnitude = 0.0;
@@ -626,14 +727,18 @@ void TerrainWorld::apply_pile_pressure(const Rect& changed) {
     if (!(double(force.length()) > friction)) continue;
     // A sleeping body wakes when the soil that presses on it changed.
     if (!b.isActive()) {
-      const bool touched = changed.c0 < band.c1 && changed.c1 > band.c0 && changed.r0 < band.r1 &&
-                           changed.r1 > band.r0;
-      if (!touched) continue;
+      if (!views_[i].band_changed) continue;
       b.activate(true);
     }
     b.applyCentralForce(force);
     b.applyTorque(torque);
   }
+  for (SoilView& view : views_) view.band_changed = false;
+}
+
+Rect TerrainWorld::pile_band(const SoilObstacle& o) const {
+  return {std::max(o.cells.c0 - 1, 0), std::max(o.cells.r0 - 1, 0),
+          std::min(o.cells.c1 + 1, grid_.cols()), std::min(o.cells.r1 + 1, grid_.rows())};
 }
 
 int TerrainWorld::held_count() const {

@@ -156,18 +156,26 @@ double advance_tracking_min_y(TerrainWorld& world, int body, int steps) {
   return lowest;
 }
 
-TEST(TerrainWorldSupport, BodyFallsByTheCutDepthAndOthersStayPut) {
-  // 1 m x 1 m of soil 0.3 m deep, 2 cm cells; two 0.2 m cubes, one over the
-  // cut, one far from it.
-  const double h0 = 0.3, depth = 0.1, half = 0.1;
-  const GridSpec g = spec(50, 50, 1.0, 1.0);
-  HeightGrid grid(g, std::vector<float>(2500, float(h0)));
-  TerrainWorld world(grid, 1000.0, BladeSpec{},
+// 1 m x 1 m of soil 0.3 m deep, 2 cm cells; two 0.2 m cubes resting on it,
+// one at (0.3, 0.3), one far from it at (0.75, 0.75), settled until both
+// sleep (Bullet's deactivation time is 2 s).
+struct TwoRestingBoxes {
+  static constexpr double h0 = 0.3, half = 0.1;
+  HeightGrid grid{spec(50, 50, 1.0, 1.0), std::vector<float>(2500, float(h0))};
+  TerrainWorld world{grid, 1000.0, BladeSpec{},
                      {box("over_cut", {0.2, 0.2, 0.2}, 8.0, {0.3, h0 + half, 0.3}),
                       box("far", {0.2, 0.2, 0.2}, 8.0, {0.75, h0 + half, 0.75})},
-                     no_tool());
-  // Settle until both sleep (Bullet's deactivation time is 2 s).
-  for (int i = 0; i < 2500; ++i) world.advance();
+                     no_tool()};
+  TwoRestingBoxes() {
+    for (int i = 0; i < 2500; ++i) world.advance();
+  }
+};
+
+TEST(TerrainWorldSupport, BodyFallsByTheCutDepthAndOthersStayPut) {
+  TwoRestingBoxes scene;
+  const double h0 = scene.h0, depth = 0.1, half = scene.half;
+  HeightGrid& grid = scene.grid;
+  TerrainWorld& world = scene.world;
   ASSERT_FALSE(world.body_state(0).active);
   ASSERT_FALSE(world.body_state(1).active);
   const BodyState before = world.body_state(0);
@@ -208,6 +216,55 @@ TEST(TerrainWorldSupport, BodyFallsByTheCutDepthAndOthersStayPut) {
   EXPECT_EQ(far_after.position_m.y, far_before.position_m.y);
   EXPECT_EQ(far_after.position_m.z, far_before.position_m.z);
   EXPECT_EQ(far_after.orientation.w, far_before.orientation.w);
+}
+
+TEST(TerrainWorldSupport, AWideReportWakesOnlyTheBodyWhoseSoilChanged) {
+  // One rectangle round the whole grid is reported (as a step whose soil
+  // moved here and there reports it), first for an edit far from both
+  // bodies, then for a cut under the first one only.
+  TwoRestingBoxes scene;
+  const double h0 = scene.h0, depth = 0.1;
+  HeightGrid& grid = scene.grid;
+  TerrainWorld& world = scene.world;
+  ASSERT_FALSE(world.body_state(0).active);
+  ASSERT_FALSE(world.body_state(1).active);
+  const Rect whole{0, 0, grid.cols(), grid.rows()};
+  // A dip 4 cells from every box's reach (x, z in [0.02, 0.06]): nobody's soil.
+  for (int r = 1; r < 3; ++r)
+    for (int c = 1; c < 3; ++c) grid.lower(grid.index(c, r), float(h0 - depth));
+  world.terrain_changed(whole);
+  world.advance();
+  EXPECT_EQ(world.last().bodies_woken, 0);
+  EXPECT_FALSE(world.body_state(0).active);
+  EXPECT_FALSE(world.body_state(1).active);
+
+  // The cut under the first body, reported the same way: it wakes and
+  // falls by the cut's depth; the far one sleeps on, unmoved.
+  const BodyState before = world.body_state(0);
+  const BodyState far_before = world.body_state(1);
+  for (int r = 8; r < 23; ++r)
+    for (int c = 8; c < 23; ++c) grid.lower(grid.index(c, r), float(h0 - depth));
+  world.terrain_changed(whole);
+  world.advance();
+  EXPECT_EQ(world.last().bodies_woken, 1);
+  EXPECT_TRUE(world.body_state(0).active);
+  const int bound = int(std::ceil((3.0 * std::sqrt(2.0 * depth / kG) + 0.1) * 1000.0));
+  advance_tracking_min_y(world, 0, bound);
+  const double tol = world.params().convex_margin_m;
+  EXPECT_NEAR(world.body_state(0).position_m.y, before.position_m.y - depth, tol);
+  EXPECT_FALSE(world.body_state(1).active);
+  EXPECT_EQ(world.body_state(1).position_m.y, far_before.position_m.y);
+  EXPECT_EQ(world.body_state(1).position_m.x, far_before.position_m.x);
+
+  // One sample lowered under the far body's edge (its last column of samples
+  // under the box, x = 0.83), reported as the whole grid: that is its soil.
+  // (The first body, still awake, is re-tested too: awake bodies over the
+  // reported rectangle always are.)
+  grid.lower(grid.index(41, 37), float(h0 - depth));
+  world.terrain_changed(whole);
+  world.advance();
+  EXPECT_EQ(world.last().bodies_woken, world.body_state(0).active ? 2 : 1);
+  EXPECT_TRUE(world.body_state(1).active);
 }
 
 TEST(TerrainWorldSupport, WithoutTheWakeABodyWouldHoverOnTheOldSurface) {

@@ -98,6 +98,14 @@ struct PilePressureSpec {
   /// phi: friction angle of the piled (loose) soil, degrees, in (0, 80]; a
   /// loose cohesionless pile's is about its angle of repose.
   double friction_angle_deg = 34.0;
+  /// Soil in a body's ring up to this height above what stays there
+  /// (TerrainWorld::shed_rings) is left in place, metres, in [0, 0.01].
+  /// Bullet's solver lets a resting body settle by fractions of a micrometre
+  /// every few steps; shedding that much soil changed the triangles under
+  /// the body's edge, which woke it and dropped its contacts, so it settled
+  /// again and never slept. The default is the merged heightfield's coplanar
+  /// tolerance (TerrainWorldParams::merge_tolerance_m).
+  double shed_tolerance_m = 1e-5;
 };
 
 /// Parameters of the Bullet world; validated at construction, read-only during a run.
@@ -214,7 +222,8 @@ class TerrainWorld {
 
   /// Tells the world that heights inside `changed` were edited (any rectangle;
   /// clipped to the grid): clamps them to the bounds (counted), wakes the
-  /// bodies over the affected triangles and drops their cached terrain
+  /// bodies over triangles whose samples now differ from what the body last
+  /// saw (samples inside `changed` only) and drops their cached terrain
   /// contacts. Call it after every edit made outside step() (set_heights,
   /// Simulation::reset with the whole grid's rectangle).
   void terrain_changed(const Rect& changed);
@@ -294,9 +303,10 @@ class TerrainWorld {
   void release_reached(const Rect& changed);
   void release(int i);
   /// Applies the piles' earth pressure (params_.pile) to the dynamic bodies,
-  /// for the next advance; wakes a sleeping body when `changed` touches the
-  /// soil that presses on it. Sums the forces into pending_pile_force_n_.
-  void apply_pile_pressure(const Rect& changed);
+  /// for the next advance; wakes a sleeping body when the soil that presses
+  /// on it changed since the last call (SoilView::band_changed). Sums the
+  /// forces into pending_pile_force_n_.
+  void apply_pile_pressure();
   /// Moves the soil standing in a body's ring (soil_obstacle minus its
   /// footprint) higher than its lowest point plus the collision margin one
   /// sample further out, away from the body (not onto another body's
@@ -311,6 +321,30 @@ class TerrainWorld {
   std::vector<SoilObstacle> obstacles_;  // per body, this step's soil_obstacle (reserved)
   /// The samples whose centres lie under a world box's X-Z extent (clipped).
   Rect samples_under(const btVector3& lo, const btVector3& hi) const;
+  /// The samples that press on body i's sides (apply_pile_pressure): its
+  /// soil_obstacle and one more all round (clipped).
+  Rect pile_band(const SoilObstacle& o) const;
+  /// What a dynamic body last saw of the soil round it: the samples whose
+  /// triangles reach its box and two more all round (its pile band), and
+  /// their heights. A reported change wakes the body (and drops its terrain
+  /// contacts) only where one of those heights differs, so the one rectangle
+  /// a step reports round everything the soil moved does not wake bodies
+  /// the change never reached.
+  struct SoilView {
+    Rect region{};                 ///< samples, clipped to the grid; empty: nothing seen yet
+    std::vector<float> heights_m;  ///< region rows x cols, row-major, metres (capacity reserved)
+    /// A sample of the pile band changed since the last apply_pile_pressure.
+    bool band_changed = false;
+  };
+  std::vector<SoilView> views_;  // one per body
+  /// Body i's samples whose triangles reach its box (`reached`, not clipped)
+  /// and those it sees (`seen`: two more all round, clipped); false when its
+  /// box is not finite.
+  bool view_region(int i, Rect& reached, Rect& seen) const;
+  /// Copies the heights over `seen` into the view (none when it does not fit).
+  void see(SoilView& view, const Rect& seen) const;
+  /// Each awake body that moved to other samples sees what they hold now.
+  void refresh_views();
   std::int64_t pending_clamped_ = 0;
 };
 
