@@ -13,6 +13,7 @@
 #   scripts/fuzz.sh            # an hour per target
 #   scripts/fuzz.sh 30         # the bounded run of scripts/sanitize.sh
 #   scripts/fuzz.sh 60 png     # only the named targets
+#   scripts/fuzz.sh 0          # only the build
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${1:-3600}
@@ -36,6 +37,7 @@ CCACHE_BASEDIR=$root cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Fuzz -DCMAK
   -DTERRACUT_BUILD_APPS=OFF -DTERRACUT_BUILD_BENCH=OFF -DTERRACUT_BUILD_PYTHON=OFF -DCMAKE_CXX_FLAGS="$flags" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
 CCACHE_BASEDIR=$root cmake --build "$build" -j"$jobs" --target "${targets[@]/#/fuzz_}"
+[[ $seconds == 0 ]] && exit 0
 
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:allocator_may_return_null=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
