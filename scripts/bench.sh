@@ -21,7 +21,7 @@ jobs=${JOBS:-2}
 python=/usr/bin/python3   # the one with matplotlib (another python3 may come first on PATH)
 
 # shellcheck disable=SC2086
-cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTERRACUT_BUILD_BENCH=ON ${CMAKE_ARGS:-} >/dev/null
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTERRACUT_BUILD_BENCH=ON -DPYTHON_EXECUTABLE=$python ${CMAKE_ARGS:-} >/dev/null
 cmake --build "$build" -j"$jobs" --target terracut_bench terracut_bench_io terracut_bench_soil
 # The rigid bodies' and the viewer's cases need Bullet and OpenGL; without
 # them those sections say so.
