@@ -2,7 +2,8 @@
 # The whole test suite under AddressSanitizer and UndefinedBehaviorSanitizer
 # (leaks included), then every libFuzzer target for a bounded time, from one
 # build: build-asan/ (or $TERRACUT_ASAN_BUILD_DIR). Run by scripts/test.sh
-# after the Release suite (TERRACUT_SANITIZE=0 there skips it).
+# in two steps: its builds while the Release suites run, then its tests
+# (TERRACUT_SANITIZE=0 there skips it).
 #
 # With clang (installed by scripts/install-deps.sh): a clang build, and the
 # fuzz programs in build-fuzz/ (scripts/fuzz.sh: only the library layers
