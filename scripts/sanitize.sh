@@ -12,8 +12,10 @@
 # without clang a gcc build, and the fuzz runs are skipped (the corpus
 # replays still run in CTest). The library at -O1 with line tables only:
 # sanitizer reports keep file:line, and the build costs about half of -O2
-# -g; the test programs at -O0 (TERRACUT_TEST_CXX_FLAGS: their own code is
-# assertions and set-up, 40 % of -O1's compile CPU).
+# -g; the programs' own code at -O0 (TERRACUT_PROGRAM_CXX_FLAGS: the test
+# programs, the tools, the soak program and the Python module are set-up,
+# parsing, reports and assertions; a third to two fifths of -O1's compile
+# CPU).
 #
 # Built and run: every C++ suite but three (TERRACUT_TEST_SUITES), and the
 # Python tests with the runtime preloaded (python/tests/CMakeLists.txt). Left
@@ -55,7 +57,7 @@ if [[ $step != test ]]; then
     -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1" -DCMAKE_C_FLAGS_SANITIZE="-O1" \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 \
     -DTERRACUT_BUILD_BENCH=OFF -DTERRACUT_BUILD_VIEWER=OFF -DCMAKE_CXX_FLAGS="$flags" \
-    -DTERRACUT_TEST_SUITES="core;io;haptics;net;bullet;session;apps;fuzz;soak;python" -DTERRACUT_TEST_CXX_FLAGS=-O0 \
+    -DTERRACUT_TEST_SUITES="core;io;haptics;net;bullet;session;apps;fuzz;soak;python" -DTERRACUT_PROGRAM_CXX_FLAGS=-O0 \
     -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=$sanitizers" \
     -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=$sanitizers" \
     -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=$sanitizers" >/dev/null

@@ -2,20 +2,20 @@
 # The README's test command: installs dependencies, builds everything
 # (Release: the programs, the viewer, the Python module, the benchmarks) and
 # runs with CTest the suites that need this build (the viewer's renders, the
-# install test, the ThreadSanitizer build of the threaded tests, the Python
-# tests); then every C++ suite and the Python tests again under
-# AddressSanitizer and UndefinedBehaviorSanitizer, and every libFuzzer target
-# for 30 s (scripts/sanitize.sh, its own build, built while the Release
-# suites run). Each C++ test is compiled
-# and run once, in the sanitizer build: compiling the C++ suites twice was
-# about a third of the run (docs/reliability.md, "CI time").
+# install test, the ThreadSanitizer build of the threaded tests); then every
+# C++ suite and the Python tests under AddressSanitizer and
+# UndefinedBehaviorSanitizer, and every libFuzzer target for 30 s
+# (scripts/sanitize.sh, its own build, built while the Release suites run).
+# Each test is compiled and run once, in the sanitizer build: compiling the
+# C++ suites twice was about a third of the run, and the Python tests ran
+# in both builds (docs/reliability.md, "CI time").
 #
 #   TERRACUT_SANITIZE=0  no sanitizer build: every suite runs in the Release build
 #   TERRACUT_FULL_SUITE=1  every suite in the Release build as well
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/install-deps.sh"
-suites="viewer;install;tsan;python"
+suites="viewer;install;tsan"
 if [[ ${TERRACUT_SANITIZE:-1} == 0 || ${TERRACUT_FULL_SUITE:-0} != 0 ]]; then
   suites="core;io;haptics;net;bullet;session;apps;viewer;install;fuzz;soak;tsan;python"
 fi

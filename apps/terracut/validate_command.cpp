@@ -56,9 +56,10 @@ SoilFlowParams flow_params(double repose_deg) {
 }
 
 double tallest_m(const HeightGrid& g) {
+  const float* heights = g.heights();
+  const std::int64_t n = g.spec().sample_count();
   double h = 0.0;
-  for (std::int64_t i = 0; i < g.spec().sample_count(); ++i)
-    h = std::max(h, double(g.heights()[i]));
+  for (std::int64_t i = 0; i < n; ++i) h = std::max(h, double(heights[i]));
   return h;
 }
 
