@@ -5,7 +5,7 @@
 # install test, the ThreadSanitizer build of the threaded tests); then every
 # C++ suite and the Python tests under AddressSanitizer and
 # UndefinedBehaviorSanitizer, and every libFuzzer target for 30 s
-# (scripts/sanitize.sh, its own build, built while the Release suites run).
+# (scripts/sanitize.sh, its own builds, beside the Release build and suites).
 # Each test is compiled and run once, in the sanitizer build: compiling the
 # C++ suites twice was about a third of the run, and the Python tests ran
 # in both builds (docs/reliability.md, "CI time").
@@ -19,31 +19,36 @@ suites="viewer;install;tsan"
 if [[ ${TERRACUT_SANITIZE:-1} == 0 || ${TERRACUT_FULL_SUITE:-0} != 0 ]]; then
   suites="core;io;haptics;net;bullet;session;apps;viewer;install;fuzz;soak;tsan;python"
 fi
-"$root/scripts/build.sh" -DTERRACUT_TEST_SUITES="$suites"
 build=${TERRACUT_BUILD_DIR:-$root/build}
 release_tests() {
   ctest --test-dir "$build" --output-on-failure -j"${TERRACUT_JOBS:-$(nproc)}" --timeout 600
 }
 if [[ ${TERRACUT_SANITIZE:-1} == 0 ]]; then
+  "$root/scripts/build.sh" -DTERRACUT_TEST_SUITES="$suites"
   release_tests
   exit 0
 fi
-# The Release tree's suites run while the sanitizer and fuzz trees build:
-# each leaves the processors idle part of the time (tests that wait on the
-# clock, links, a build's last long file), and on CI's two cores the two
-# together take less time than one after the other (docs/reliability.md,
-# "CI time"). Their output is printed when both are done.
-log=$build/release-tests.log
-release_tests >"$log" 2>&1 &
-release_pid=$!
-build_status=0
-TERRACUT_SANITIZE_STEP=build "$root/scripts/sanitize.sh" || build_status=$?
+# The sanitizer and fuzz trees build from the start, beside the Release
+# build and then the Release tree's suites: each leaves the processors idle
+# part of the time (a build's last long files and links, tests that wait on
+# the clock), and on CI's two cores they take less time together than one
+# after the other (docs/reliability.md, "CI time"). Their output is printed
+# when the Release suites are done.
+mkdir -p "$build"
+san_log=$build/sanitizer-build.log
+# (its own process group, so that a failure here stops its compilers too)
+TERRACUT_SANITIZE_STEP=build setsid "$root/scripts/sanitize.sh" >"$san_log" 2>&1 &
+san_pid=$!
+trap 'kill -- -"$san_pid" 2>/dev/null || true' EXIT
 release_status=0
-wait "$release_pid" || release_status=$?
-echo "== the Release tree's suites ($log)"
-cat "$log"
-if [[ $release_status != 0 || $build_status != 0 ]]; then
-  echo "test.sh: the Release tree's suites exited $release_status, the sanitizer builds $build_status" >&2
+{ "$root/scripts/build.sh" -DTERRACUT_TEST_SUITES="$suites" && release_tests; } || release_status=$?
+san_status=0
+wait "$san_pid" || san_status=$?
+trap - EXIT
+echo "== the sanitizer and fuzz builds ($san_log)"
+cat "$san_log"
+if [[ $release_status != 0 || $san_status != 0 ]]; then
+  echo "test.sh: the Release build and suites exited $release_status, the sanitizer builds $san_status" >&2
   exit 1
 fi
 TERRACUT_SANITIZE_STEP=test "$root/scripts/sanitize.sh"
