@@ -19,7 +19,11 @@ constexpr float kShedFraction = 0.5f;
 /// Radius around the edge, in cells, of the cells whose pairs are tested
 /// against the blade (a pair is at most one diagonal long).
 constexpr double kBladeRadiusCells = 1.5;
-/// Distance beyond the edge's line, in cells, where displaced soil is put.
+/// Distance beyond the edge's line, in cells, where displaced soil is put:
+/// the cell there is the first whose centre is clear of the blade (0.5 to
+/// 1.5 cells ahead), so that the push shifts the profile in front of the
+/// blade as a whole (at 1.5 it skipped the cell against the blade and left
+/// a dip there that drained the whole face).
 constexpr double kDepositAheadCells = 1.0;
 /// A slope moves only when it exceeds the repose limit of a cell pair by
 /// more than this fraction of the limit: 2 % of tan(repose), at most about
