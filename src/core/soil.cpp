@@ -19,8 +19,12 @@ constexpr float kShedFraction = 0.5f;
 /// Radius around the edge, in cells, of the cells whose pairs are tested
 /// against the blade (a pair is at most one diagonal long).
 constexpr double kBladeRadiusCells = 1.5;
-/// Distance beyond the edge's line, in cells, where displaced soil is put.
-constexpr double kDepositAheadCells = 1.5;
+/// Distance beyond the edge's line, in cells, where displaced soil is put:
+/// the cell there is the first whose centre is clear of the blade (0.5 to
+/// 1.5 cells ahead), so that the push shifts the profile in front of the
+/// blade as a whole (at 1.5 it skipped the cell against the blade and left
+/// a dip there that drained the whole face).
+constexpr double kDepositAheadCells = 1.0;
 /// A slope moves only when it exceeds the repose limit of a cell pair by
 /// more than this fraction of the limit: 2 % of tan(repose), at most about
 /// 0.5 degree above the repose angle (34 degrees: 34.4). Smaller tolerances
@@ -529,6 +533,59 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
                                   0, rows_ - 1);
         return std::int64_t(tr) * cols_ + tc;
       };
+      // The rest of the cut lands where an avalanche down the face ahead
+      // would leave it: the cells along the push from `from` (metres along
+      // the normal from this sample's centre), up to the first one above
+      // it, are filled to one line falling at the repose slope, the line as
+      // high as the volume `volume` (metres of height on one cell) needs.
+      // Cells beyond an open edge stand for the bare ground there (height
+      // 0): what fills them leaves the terrain. A wall or a body ends the
+      // run. Returns what found no cell (all of it when the first cell is
+      // a body's or the grid's end), for the caller to put down.
+      const auto fill_ahead = [&](double from, float volume) -> float {
+        std::int64_t cells[kMaxPushCells];
+        double reach[kMaxPushCells];  // the line's height at the first cell that just reaches this one
+        int count = 0;
+        double sum = 0.0, line = 0.0;
+        std::int64_t last = -1;
+        for (int m = 0; m < kMaxPushCells; ++m) {
+          const double along = from + side * m * step;
+          const bool off = params_.edge == SoilEdge::kOpen && beyond(along);
+          const std::int64_t u = off ? -1 : cell_at(along);
+          if (!off && (u == last || obstacle_[u] != 0)) break;  // against the grid's edge, or a body
+          const double b = (off ? 0.0 : double(layers.height_m[u])) + limit_step * m;
+          if (count > 0 && !(b < line)) break;  // at or above the line: nothing reaches it
+          cells[count] = u;
+          reach[count] = b;
+          sum += b;
+          ++count;
+          line = (double(volume) + sum) / count;
+          if (!off) last = u;
+        }
+        if (count == 0) return volume;
+        // A cell of the run above the final line (a hump) takes nothing:
+        // without it the line comes lower, until no more drop out.
+        for (int in = count;;) {
+          double s_in = 0.0;
+          int n_in = 0;
+          for (int j = 0; j < count; ++j)
+            if (reach[j] < line) s_in += reach[j], ++n_in;
+          if (n_in == in || n_in == 0) break;
+          in = n_in;
+          line = (double(volume) + s_in) / n_in;
+        }
+        for (int j = 0; j < count; ++j) {
+          const double add = line - reach[j];
+          if (!(add > 0.0)) continue;
+          if (cells[j] < 0) {
+            out.left_over_edge_m3 += add * spec.cell_area_m2();
+            taken -= add;
+          } else {
+            put_down(cells[j], float(add));
+          }
+        }
+        return 0.0f;
+      };
       // The blade pushes what stands in front of it: along the push, the
       // descending profile ahead (cells above the edge's height) moves on by
       // one cell, the cut column's height taking the first cell's place, as
@@ -572,6 +629,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       const float raised = length > 0 ? before_[k] - previous : 0.0f;
       float rest = lost - raised;
       out.displaced_volume_m3 += double(lost) * spec.cell_area_m2();
+      if (rest > 0.0f) rest = fill_ahead(go, rest);
       std::int64_t t = length > 0 ? ray[length - 1] : ray[0];
       float level = length > 0 ? layers.height_m[t] : before_[k];
       // The last cell reached that is not under a rigid body (the cut

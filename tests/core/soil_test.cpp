@@ -358,6 +358,32 @@ TEST(SoilDisplacement, TheBladePushesAPileThatFollowsTheMassBalance) {
   for (std::int64_t i = 0; i < g.spec().sample_count(); ++i) EXPECT_GE(g.heights()[i], 0.0f);
 }
 
+TEST(SoilDisplacement, ThePushedPilesFaceFallsInOneSlopeFromTheBladeToTheToe) {
+  // The cut soil lands where an avalanche down the face would leave it, so
+  // along the centre line the face ahead of the blade falls from its top to
+  // its toe without a second hump: no cell stands above the one before it
+  // (to a float step of the heights), and no drop is steeper than the
+  // repose limit plus the relaxation's 2 % tolerance.
+  Dozing d(SoilModel::kFlow);
+  const HeightGrid& g = d.sim->grid();
+  const double cell = 0.01;
+  const double limit = std::tan(34.0 * kDeg) * cell;
+  const double float_step = 1e-6;  // a few float ulps at 0.5 m
+  // From the first row whose centre is clear of the blade (0.5 cell ahead
+  // of its edge) to the layer.
+  int r = int(std::ceil(d.blade_z() / cell - 0.5)) + 1;
+  const int top = r;
+  for (; r + 1 < 200 && g.height(100, r + 1) > d.layer_m + float_step; ++r) {
+    const double drop = double(g.height(100, r)) - double(g.height(100, r + 1));
+    EXPECT_GE(drop, -float_step) << "row " << r;
+    EXPECT_LE(drop, 1.02 * limit + float_step) << "row " << r;
+  }
+  // A face, not a flat: it spans at least the wedge's run, h / tan(repose),
+  // less two cells.
+  const double wedge = std::sqrt(2.0 * d.depth_m * d.push_m * std::tan(34.0 * kDeg));
+  EXPECT_GE((r - top) * cell, wedge / std::tan(34.0 * kDeg) - 2.0 * cell);
+}
+
 TEST(SoilDisplacement, SoilLayersKeepTheirIdentity) {
   // removed = initial - height per sample, now signed: < 0 where the blade
   // put soil down.
