@@ -148,14 +148,87 @@ std::string validate(const TerrainWorldParams& p) {
     return must_be("tool.thickness_m", "in (0, 100]", p.tool.thickness_m);
   if (p.tool.enabled && !in_range(p.tool.friction, 0.0, 10.0))
     return must_be("tool.friction", "in [0, 10]", p.tool.friction);
-  if (p.pile.enabled && !(p.pile.unit_weight_n_per_m3 > 0.0 && p.pile.unit_weight_n_per_m3 <= 1e5))
-    return must_be("pile.unit_weight_n_per_m3", "in (0, 1e5]", p.pile.unit_weight_n_per_m3);
+  if (p.pile.enabled && !(p.pile.unit_weight_n_per_m3 > 0.0 && p.pile.unit_weight_n_per_m3 <= kRangeMax))
+    return must_be("pile.unit_weight_n_per_m3", "in (0, 1e9]", p.pile.unit_weight_n_per_m3);
   if (p.pile.enabled && !(p.pile.friction_angle_deg > 0.0 && p.pile.friction_angle_deg <= 80.0))
     return must_be("pile.friction_angle_deg", "in (0, 80]", p.pile.friction_angle_deg);
   if (p.pile.enabled && !(p.pile.shed_tolerance_m >= 0.0 && p.pile.shed_tolerance_m <= 0.01))
     return must_be("pile.shed_tolerance_m", "in [0, 0.01]", p.pile.shed_tolerance_m);
   return {};
 }
+
+namespace {
+
+// A vertical face of a body that piles press on: its bottom edge's ends
+// (world X and Z; Y unused) and its outward normal (horizontal, unit).
+struct SideFace {
+  btVector3 start, end, outward;
+};
+
+// The side faces of body b (spec: its BodySpec; lo, hi: its bounding box)
+// into faces; returns how many (at most 4).
+int side_faces(const btRigidBody& b, const BodySpec& spec, const btVector3& lo, const btVector3& hi,
+               SideFace (&faces)[4]) {
+  int n = 0;
+  if (spec.shape != BodyShape::kBox) {
+    // A sphere or an upright cylinder looks the same from every side: the
+    // four sides of its bounding box.
+    faces[n++] = {{lo.x(), 0, lo.z()}, {lo.x(), 0, hi.z()}, {-1, 0, 0}};
+    faces[n++] = {{hi.x(), 0, hi.z()}, {hi.x(), 0, lo.z()}, {1, 0, 0}};
+    faces[n++] = {{hi.x(), 0, lo.z()}, {lo.x(), 0, lo.z()}, {0, 0, -1}};
+    faces[n++] = {{lo.x(), 0, hi.z()}, {hi.x(), 0, hi.z()}, {0, 0, 1}};
+    return n;
+  }
+  // A box: its local axis nearest the world's Y is up, the faces normal to
+  // the other two are its sides (for a box yawed about Y, exactly its
+  // vertical faces), each as its horizontal projection.
+  const btMatrix3x3& basis = b.getWorldTransform().getBasis();
+  const btVector3 half = to_bt(half_extents_m(spec));
+  const btVector3 origin = b.getWorldTransform().getOrigin();
+  int up = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::fabs(basis.getColumn(k).y()) > std::fabs(basis.getColumn(up).y())) up = k;
+  const auto flat = [](btVector3 v) { return btVector3(v.x(), 0, v.z()); };
+  for (int axis = 0; axis < 3; ++axis) {
+    if (axis == up) continue;
+    const int other = 3 - up - axis;
+    btVector3 outward = flat(basis.getColumn(axis));
+    if (!(outward.length() > btScalar(1e-6))) continue;
+    outward.normalize();
+    const btVector3 tangent = basis.getColumn(other) * half[other];
+    for (const btScalar sign : {btScalar(1), btScalar(-1)}) {
+      const btVector3 middle = flat(origin + basis.getColumn(axis) * (sign * half[axis]));
+      faces[n++] = {middle - flat(tangent), middle + flat(tangent), outward * sign};
+    }
+  }
+  return n;
+}
+
+// The first sample outside cells (a body's ring, SoilObstacle::cells) on the
+// horizontal ray from `from` along `outward` into col, row; false when it
+// is off the grid (no soil there).
+bool first_sample_out(const HeightGrid& grid, const Rect& cells, const btVector3& from,
+                      const btVector3& outward, int& col, int& row) {
+  // Sample c is nearest to the points of cell coordinate u in [c, c + 1)
+  // (HeightGrid::cell_u): the ring's samples cover u in [c0, c1). Where the
+  // ray from `from` along `outward` leaves that rectangle, the sample on
+  // the far side of the edge it crosses is the first one outside.
+  const GridSpec& g = grid.spec();
+  const double u = grid.cell_u(double(from.x())), v = grid.cell_v(double(from.z()));
+  const double dx = double(outward.x()) / g.cell_x_m(), dz = double(outward.z()) / g.cell_z_m();
+  const double inf = std::numeric_limits<double>::infinity();
+  const double sx = dx > 0.0 ? (cells.c1 - u) / dx : (dx < 0.0 ? (cells.c0 - u) / dx : inf);
+  const double sz = dz > 0.0 ? (cells.r1 - v) / dz : (dz < 0.0 ? (cells.r0 - v) / dz : inf);
+  const double s = std::max(0.0, std::min(sx, sz));
+  if (!std::isfinite(s)) return false;
+  col = std::clamp(int(std::floor(u + s * dx)), cells.c0 - 1, cells.c1);
+  row = std::clamp(int(std::floor(v + s * dz)), cells.r0 - 1, cells.r1);
+  if (sx <= sz) col = dx > 0.0 ? cells.c1 : cells.c0 - 1;
+  else row = dz > 0.0 ? cells.r1 : cells.r0 - 1;
+  return col >= 0 && col < grid.cols() && row >= 0 && row < grid.rows();
+}
+
+}  // namespace
 
 // Bullet objects, in construction order (members are destroyed in reverse:
 // bodies before the world that holds them).
@@ -558,7 +631,9 @@ void TerrainWorld::advance() {
   info_.bodies_woken = pending_woken_;
   pending_woken_ = 0;
   info_.pile_force_n = pending_pile_force_n_;
+  info_.pile_thrust_n = pending_pile_thrust_n_;
   pending_pile_force_n_ = 0.0;
+  pending_pile_thrust_n_ = {};
   info_.shed_m3 = pending_shed_m3_;
   info_.shed_rect = pending_shed_rect_;
   pending_shed_m3_ = 0.0;
@@ -688,36 +763,39 @@ void TerrainWorld::apply_pile_pressure() {
     btVector3 lo, hi;
     b.getAabb(lo, hi);
     const double bottom = double(o.bottom_m), tall = double(hi.y() - lo.y());
-    // The samples that press on the body: the first ones outside the ring,
-    // on its four sides (corners excluded: they face no side).
-    const Rect band = pile_band(o);
     const btVector3 centre = b.getCenterOfMassPosition();
     btVector3 force(0, 0, 0), torque(0, 0, 0);
     double magnitude = 0.0;
-    // One sample's push, along `inward` (a unit axis), on the face at `face`
-    // (world X or Z of the box's side), over `width` metres of it.
-    const auto press = [&](int col, int row, double width, btVector3 inward, bool along_x, double face) {
-      const double above = std::clamp(double(h[grid_.index(col, row)]) - bottom, 0.0, tall);
-      if (!(above > 0.0)) return;
-      const double p = coeff * above * above * width;
-      const btVector3 f = inward * btScalar(p);
-      const btVector3 at(btScalar(along_x ? face : grid_.sample_x(col)),
-                         btScalar(g.origin_m.y + bottom + above / 3.0),
-                         btScalar(along_x ? grid_.sample_z(row) : face));
-      force += f;
-      torque += (at - centre).cross(f);
-      magnitude += p;
-    };
-    for (int row = o.cells.r0; row < o.cells.r1; ++row) {
-      if (band.c0 < o.cells.c0) press(band.c0, row, g.cell_z_m(), btVector3(1, 0, 0), true, lo.x());
-      if (band.c1 > o.cells.c1) press(band.c1 - 1, row, g.cell_z_m(), btVector3(-1, 0, 0), true, hi.x());
-    }
-    for (int col = o.cells.c0; col < o.cells.c1; ++col) {
-      if (band.r0 < o.cells.r0) press(col, band.r0, g.cell_x_m(), btVector3(0, 0, 1), false, lo.z());
-      if (band.r1 > o.cells.r1) press(col, band.r1 - 1, g.cell_x_m(), btVector3(0, 0, -1), false, hi.z());
+    // Each side face is split into pieces no wider than a cell; a piece is
+    // pressed by the soil on the first sample outside the ring straight out
+    // from it (along the face's outward normal): the soil banks against the
+    // ring, so that sample is the pile's height at the face.
+    const double piece_m = std::min(g.cell_x_m(), g.cell_z_m());
+    SideFace faces[4];
+    const int face_count = side_faces(b, specs_[i], lo, hi, faces);
+    for (int fi = 0; fi < face_count; ++fi) {
+      const SideFace& face = faces[fi];
+      const btVector3 along = face.end - face.start;
+      const double width = double(along.length());
+      if (!(width > 0.0)) continue;
+      const int pieces = std::max(1, int(std::ceil(width / piece_m)));
+      for (int k = 0; k < pieces; ++k) {
+        const btVector3 q = face.start + along * btScalar((k + 0.5) / pieces);
+        int col = 0, row = 0;
+        if (!first_sample_out(grid_, o.cells, q, face.outward, col, row)) continue;
+        const double above = std::clamp(double(h[grid_.index(col, row)]) - bottom, 0.0, tall);
+        if (!(above > 0.0)) continue;
+        const double p = coeff * above * above * width / pieces;
+        const btVector3 f = face.outward * btScalar(-p);
+        const btVector3 at(q.x(), btScalar(g.origin_m.y + bottom + above / 3.0), q.z());
+        force += f;
+        torque += (at - centre).cross(f);
+        magnitude += p;
+      }
     }
     if (!(magnitude > 0.0)) continue;
     pending_pile_force_n_ += magnitude;
+    pending_pile_thrust_n_ = pending_pile_thrust_n_ + from_bt(force);
     // Static friction carries a thrust below the body's sliding friction on
     // level ground (Bullet multiplies the two friction coefficients): the
     // body would not move, and Bullet's iterative solver lets an awake body

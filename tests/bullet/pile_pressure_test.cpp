@@ -61,6 +61,100 @@ TEST(PilePressure, ABankAgainstAFaceGivesRankinesActiveThrust) {
   EXPECT_LT(tilt_deg(s.orientation), 0.1);
 }
 
+// A heavy box yawed yaw_deg about Y on the layer, and a bank `bank` metres
+// high on the samples outside its ring in front of the face whose outward
+// normal is the box's local -Z (its 0.24 m face), after 50 steps.
+struct BankAgainstAYawedFace {
+  TerrainWorldParams params = test::no_tool();
+  std::unique_ptr<HeightGrid> grid;
+  std::unique_ptr<TerrainWorld> world;
+  Vec3 normal{};  // the face's outward normal, world
+  static constexpr double kWidth = 0.24, kDepth = 0.12, kBank = 0.06;
+
+  BankAgainstAYawedFace(double yaw_deg, double unit_weight_n_per_m3) {
+    grid = std::make_unique<HeightGrid>(test::spec(100, 100, 1.0, 1.0),
+                                        std::vector<float>(100 * 100, kLayer));
+    params.pile.enabled = true;
+    params.pile.unit_weight_n_per_m3 = unit_weight_n_per_m3;
+    BodySpec box = test::box("box", {kWidth, 0.1, kDepth}, 100.0, {0.5, kLayer + 0.05, 0.5});
+    box.rotation_deg = {0.0, yaw_deg, 0.0};
+    world = std::make_unique<TerrainWorld>(*grid, 1000.0, BladeSpec{}, std::vector<BodySpec>{box}, params);
+    normal = rotate(initial_orientation(box), {0.0, 0.0, -1.0});
+    // The bank: every sample outside the ring beyond the face's plane.
+    const Rect ring = world->soil_obstacle(0).cells;
+    std::vector<float> h(grid->heights(), grid->heights() + 100 * 100);
+    for (int r = 0; r < 100; ++r)
+      for (int c = 0; c < 100; ++c) {
+        const bool in_ring = c >= ring.c0 && c < ring.c1 && r >= ring.r0 && r < ring.r1;
+        const double ahead = (grid->sample_x(c) - 0.5) * normal.x + (grid->sample_z(r) - 0.5) * normal.z;
+        if (!in_ring && ahead > 0.5 * kDepth) h[std::size_t(r * 100 + c)] = float(kLayer + kBank);
+      }
+    world->terrain_changed(grid->set_heights({0, 0, 100, 100}, h.data()));
+    StepOutput out;
+    out.changed = {0, 0, 100, 100};
+    for (int i = 0; i < 50; ++i) world->step(out);
+  }
+  // Rankine's active thrust on the whole face, newtons.
+  double rankine_n() const {
+    return 0.5 * rankine_active(params.pile.friction_angle_deg) * params.pile.unit_weight_n_per_m3 *
+           kBank * kBank * kWidth;
+  }
+};
+
+TEST(PilePressure, AYawedBoxIsPushedAlongItsFacesNormalWithRankinesThrust) {
+  for (const double yaw : {0.0, 30.0, 45.0}) {
+    SCOPED_TRACE(yaw);
+    const BankAgainstAYawedFace b(yaw, 16.25e3);
+    const Vec3 thrust = b.world->last().pile_thrust_n;
+    // Horizontal, against the face's outward normal: off it by at most the
+    // push of a cell's width at each end of the face (its pieces there may
+    // take their height from a sample either side of the bank's edge).
+    EXPECT_EQ(thrust.y, 0.0);
+    const double along = -(thrust.x * b.normal.x + thrust.z * b.normal.z);
+    const double across = std::fabs(thrust.x * b.normal.z - thrust.z * b.normal.x);
+    ASSERT_GT(along, 0.0);
+    EXPECT_LT(std::atan2(across, along), std::atan(2.0 * kCell / b.kWidth));
+    // Its magnitude: the whole face's, to those two cells of width and the
+    // body's resting depth (its collision margin) in the bank's height.
+    const double expected = b.rankine_n();
+    const double margin = b.params.convex_margin_m;
+    EXPECT_NEAR(std::hypot(thrust.x, thrust.z), expected,
+                expected * (2.0 * kCell / b.kWidth + 2.0 * margin / b.kBank));
+    // 100 kg: held by its friction, it stays put and keeps its yaw.
+    const BodyState s = b.world->body_state(0);
+    EXPECT_NEAR(s.position_m.z, 0.5, 1e-3);
+    const Vec3 n = rotate(s.orientation, {0.0, 0.0, -1.0});
+    EXPECT_NEAR(n.x, b.normal.x, 1e-3);
+    EXPECT_NEAR(n.z, b.normal.z, 1e-3);
+  }
+}
+
+TEST(PilePressure, TheThrustScalesWithTheUnitWeightExactly) {
+  // P = 0.5 K gamma h^2: doubling or halving gamma (exact in binary) doubles
+  // or halves every piece of it, and nothing else changes.
+  const BankAgainstAYawedFace one(30.0, 16.25e3), two(30.0, 32.5e3), half(30.0, 8.125e3);
+  const WorldStepInfo &a = one.world->last(), &b = two.world->last(), &c = half.world->last();
+  ASSERT_GT(a.pile_force_n, 0.0);
+  EXPECT_EQ(b.pile_force_n, 2.0 * a.pile_force_n);
+  EXPECT_EQ(c.pile_force_n, 0.5 * a.pile_force_n);
+  EXPECT_EQ(b.pile_thrust_n.x, 2.0 * a.pile_thrust_n.x);
+  EXPECT_EQ(b.pile_thrust_n.z, 2.0 * a.pile_thrust_n.z);
+}
+
+TEST(PilePressure, TheUnitWeightIsCheckedOnTheSoilModelsRange) {
+  // (0, 1e9], SoilParams::unit_weight_n_per_m3's (a scenario's soil sets it).
+  TerrainWorldParams p = test::no_tool();
+  p.pile.enabled = true;
+  for (const double ok : {1e-9, 16.25e3, 1e9}) {
+    p.pile.unit_weight_n_per_m3 = ok;
+    EXPECT_EQ(validate(p), "") << ok;
+  }
+  for (const double bad : {0.0, -1.0, 1.000001e9, std::nan("")}) {
+    p.pile.unit_weight_n_per_m3 = bad;
+    EXPECT_NE(validate(p).find("pile.unit_weight_n_per_m3"), std::string::npos) << bad;
+  }
+}
+
 // A 0.4 m blade 5 cm deep pushes a pile along +Z toward a light box resting
 // on the sand (face at z = 0.6 m); the blade stops at z = 0.55, short of it.
 struct PushTowardBox {
@@ -122,6 +216,32 @@ TEST(PilePressure, AHeavyBoxHoldsThePileAndStaysPut) {
   EXPECT_LT(heavy.highest_m, kLayer + 0.05 + TerrainWorldParams{}.convex_margin_m);
   EXPECT_LT(heavy.most_tilt_deg, 0.5);
   EXPECT_NEAR(heavy.sim->grid().volume_m3(), 1.0 * 1.0 * kLayer, 1e-6);
+}
+
+TEST(PilePressure, APileGrowingAgainstASleepingBoxWakesAndPushesIt) {
+  // A 0.5 kg box rests on the layer until Bullet puts it to sleep (the
+  // blade held above the sand); then the blade, 5 cm deep, drives a pile
+  // into it (its plate off: only the soil touches the box).
+  Simulation sim(test::flow_on_1cm(0.4), std::vector<float>(100 * 100, kLayer));
+  BodiesListenerOptions o;
+  o.world = test::no_tool();
+  BodiesListener bodies(sim, {test::box("box", {0.2, 0.1, 0.2}, 0.5, {0.5, kLayer + 0.05, 0.7})}, o);
+  int waited = 0;
+  for (; waited < 5000 && bodies.world().body_state(0).active; ++waited)
+    sim.step({{0.5, kLayer + 0.05, 0.2}, Quat{}});
+  ASSERT_FALSE(bodies.world().body_state(0).active) << "not asleep after " << waited << " steps";
+  const double rest_z = bodies.world().body_state(0).position_m.z;
+  const int steps = int(std::lround(0.35 / 0.0006));
+  bool woke = false;
+  for (int i = 0; i <= steps + 500; ++i) {
+    sim.step({{0.5, kLayer - 0.05, 0.2 + 0.35 * std::min(i, steps) / steps}, Quat{}});
+    woke = woke || bodies.world().body_state(0).active;
+  }
+  EXPECT_TRUE(woke);
+  // Pushed on along +Z by more than a cell, as when it was awake
+  // (APileSlidesALightBoxWithoutLiftingOrTiltingIt).
+  EXPECT_GT(bodies.world().body_state(0).position_m.z, rest_z + kCell);
+  EXPECT_NEAR(sim.grid().volume_m3(), 1.0 * 1.0 * kLayer, 1e-6);
 }
 
 TEST(PilePressure, TheSameRunGivesTheSameBits) {

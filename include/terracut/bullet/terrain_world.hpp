@@ -87,13 +87,18 @@ struct ToolPlateSpec {
 /// pile under the body's edge; the pile's push is Rankine's active earth
 /// pressure on a smooth vertical face instead, horizontal, per unit width
 ///   P = 0.5 K gamma h^2,  K = tan^2(45 deg - phi / 2),
-/// acting at h / 3 above the body's lowest point, with h the soil's height
-/// above that point on the first samples outside the kept-free ring (at most
-/// the body's height).
+/// acting at h / 3 above the body's lowest point along the face's inward
+/// normal, with h the soil's height above that point on the first sample
+/// outside the kept-free ring straight out from the face (at most the
+/// body's height). A box's faces are its own four side faces (a yawed box
+/// is pushed along their normals); a sphere's or a cylinder's, the four
+/// sides of its bounding box.
 struct PilePressureSpec {
   bool enabled = false;                   ///< false: no earth pressure (soil that vanishes)
-  /// gamma: unit weight of the piled soil, N/m^3, in (0, 1e5]. Default: dry
-  /// sand, as SoilParams' dry_sand preset (Das).
+  /// gamma: unit weight of the piled soil, N/m^3, in (0, 1e9] (the range of
+  /// SoilParams::unit_weight_n_per_m3). Default: dry sand, as SoilParams'
+  /// dry_sand preset (Das). A scenario's run sets it from the scenario's
+  /// soil, haptics.forces.earthmoving.soil (session::World).
   double unit_weight_n_per_m3 = 16.25e3;
   /// phi: friction angle of the piled (loose) soil, degrees, in (0, 80]; a
   /// loose cohesionless pile's is about its angle of repose.
@@ -192,6 +197,9 @@ struct WorldStepInfo {
   /// Sum over the bodies of the horizontal earth pressure of the piles
   /// against them in the last step (PilePressureSpec), newtons.
   double pile_force_n = 0.0;
+  /// The same pushes as vectors, summed over the bodies (horizontal: each
+  /// along the inward normal of the face it presses on), newtons.
+  Vec3 pile_thrust_n{};
   double physics_s = 0.0;           ///< wall-clock time of Bullet's step, seconds
   double total_s = 0.0;             ///< wall-clock time of the whole step(), seconds
 };
@@ -316,6 +324,7 @@ class TerrainWorld {
   /// soil_obstacle(i) before clipping to the grid (at most one sample past an edge).
   SoilObstacle ring_around(int i) const;
   double pending_pile_force_n_ = 0.0;
+  Vec3 pending_pile_thrust_n_{};
   double pending_shed_m3_ = 0.0;
   Rect pending_shed_rect_{};
   std::vector<SoilObstacle> obstacles_;  // per body, this step's soil_obstacle (reserved)

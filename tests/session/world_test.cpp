@@ -1,0 +1,52 @@
+// The world a run builds from a scenario (session::World): the piles of
+// soil that flows press on the bodies with the scenario's own soil, the
+// unit weight the earthmoving force uses (haptics.forces.earthmoving.soil).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "terracut/session/scenario.hpp"
+#include "terracut/session/world.hpp"
+#include "../support/scenario_text.hpp"
+
+#ifdef TERRACUT_HAVE_BULLET
+#include "terracut/bullet/bodies_listener.hpp"
+#endif
+
+namespace terracut::session {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kRockPush = fs::path(TERRACUT_SOURCE_DIR) / "scenarios" / "rock_push.yaml";
+
+std::string rock_push_text() {
+  std::ifstream in(kRockPush);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+#ifdef TERRACUT_HAVE_BULLET
+// The unit weight the piles of scenarios/rock_push.yaml (soil: flow, a rock)
+// press with when its earthmoving soil is `soil`.
+double pile_unit_weight(const std::string& soil) {
+  const std::string text = test::replace(rock_push_text(), "soil: dry_sand", "soil: " + soil);
+  const World world(parse_scenario(text, kRockPush));
+  EXPECT_NE(world.bodies_listener(), nullptr);
+  const bullet::PilePressureSpec& pile = world.bodies_listener()->world().params().pile;
+  EXPECT_TRUE(pile.enabled);
+  return pile.unit_weight_n_per_m3;
+}
+
+TEST(World, PilesPressWithTheScenariosSoilUnitWeight) {
+  EXPECT_EQ(pile_unit_weight("dry_sand"), soil_preset(SoilPreset::kDrySand).unit_weight_n_per_m3);
+  EXPECT_EQ(pile_unit_weight("clay"), soil_preset(SoilPreset::kClay).unit_weight_n_per_m3);
+  EXPECT_EQ(pile_unit_weight("{preset: dry_sand, unit_weight_n_per_m3: 18000}"), 18000.0);
+}
+#endif
+
+}  // namespace
+}  // namespace terracut::session
