@@ -64,6 +64,7 @@ if [[ $step != test ]]; then
   CCACHE_BASEDIR=$root cmake --build "$build" -j"$jobs"
   # The fuzz programs' own build (fuzz.sh with 0 seconds builds and runs nothing).
   if [[ $fuzz == ON && $seconds != 0 ]]; then
+    echo "== $(date -u +%H:%M:%S) sanitize.sh: the fuzz programs' build"
     "$root/scripts/fuzz.sh" 0
   fi
 fi
@@ -74,5 +75,6 @@ ctest --test-dir "$build" --output-on-failure -j"$jobs" --timeout 600
 # Every fuzz target for a bounded time (30 s of wall time, all six at once;
 # docs/reliability.md).
 if [[ $fuzz == ON && $seconds != 0 ]]; then
+  echo "== $(date -u +%H:%M:%S) sanitize.sh: the fuzz runs"
   TERRACUT_FUZZ_JOBS=${TERRACUT_FUZZ_JOBS:-6} "$root/scripts/fuzz.sh" "$seconds"
 fi

@@ -20,6 +20,8 @@ if [[ ${TERRACUT_SANITIZE:-1} == 0 || ${TERRACUT_FULL_SUITE:-0} != 0 ]]; then
   suites="core;io;haptics;net;bullet;session;apps;viewer;install;fuzz;soak;tsan;python"
 fi
 build=${TERRACUT_BUILD_DIR:-$root/build}
+# Each step's start in the log, for docs/reliability.md's "CI time".
+stamp() { echo "== $(date -u +%H:%M:%S) $*"; }
 release_tests() {
   ctest --test-dir "$build" --output-on-failure -j"${TERRACUT_JOBS:-$(nproc)}" --timeout 600
 }
@@ -36,19 +38,24 @@ fi
 # when the Release suites are done.
 mkdir -p "$build"
 san_log=$build/sanitizer-build.log
+stamp "the Release build, and beside it the sanitizer and fuzz builds ($san_log)"
 # (its own process group, so that a failure here stops its compilers too)
 TERRACUT_SANITIZE_STEP=build setsid "$root/scripts/sanitize.sh" >"$san_log" 2>&1 &
 san_pid=$!
 trap 'kill -- -"$san_pid" 2>/dev/null || true' EXIT
 release_status=0
-{ "$root/scripts/build.sh" -DTERRACUT_TEST_SUITES="$suites" && release_tests; } || release_status=$?
+{ "$root/scripts/build.sh" -DTERRACUT_TEST_SUITES="$suites" && stamp "the Release tree's suites" &&
+  release_tests; } || release_status=$?
+stamp "the Release tree's suites done; waiting for the sanitizer and fuzz builds"
 san_status=0
 wait "$san_pid" || san_status=$?
 trap - EXIT
-echo "== the sanitizer and fuzz builds ($san_log)"
+stamp "the sanitizer and fuzz builds done ($san_log):"
 cat "$san_log"
 if [[ $release_status != 0 || $san_status != 0 ]]; then
   echo "test.sh: the Release build and suites exited $release_status, the sanitizer builds $san_status" >&2
   exit 1
 fi
+stamp "the sanitizer tree's suites, then the fuzz runs"
 TERRACUT_SANITIZE_STEP=test "$root/scripts/sanitize.sh"
+stamp "done"
