@@ -125,7 +125,7 @@ struct SoilFlowParams {
   /// "Measured"): it is a work bound, not the 1 ms; a lower cap is a tighter time bound, but lets a pushed pile lag further
   /// behind the blade (at 60000 the pile's centre-line section leaves the
   /// mass balance's tolerance: terracut validate, check 3.1b).
-  std::int64_t max_pair_checks_per_step = 60000;
+  std::int64_t max_pair_checks_per_step = 50000;
   /// The grid's edge: a wall, or open (bare ground beyond it at height 0).
   SoilEdge edge = SoilEdge::kWall;
 };
