@@ -3,8 +3,8 @@
 // ticks by the work cap. Prints a Markdown table (and writes it to the file
 // given as the first argument, for docs/bench/results.md).
 //
-// Cases, 1 cm cells, repose 34 degrees, the default work cap (100000 pair
-// checks per step):
+// Cases, 1 cm cells, repose 34 degrees, the default work cap (50000
+// neighbour visits per step):
 //  - bulldoze/side:N: a 2 m blade cutting 5 cm into a 20 cm layer, moving
 //    0.6 mm per step (0.6 m/s at 1 kHz) for 1 m along +Z, on an N x N grid
 //    (the grid's size must not matter: the phase walks only active cells);

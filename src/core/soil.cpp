@@ -35,6 +35,9 @@ constexpr double kToleranceOfLimit = 0.02;
 constexpr double kHeldMoveCells = 0.25;
 /// Longest run of cells the blade pushes ahead of it, per cut sample.
 constexpr int kMaxPushCells = 512;
+/// The work cap's charge for a source's fall test (lowered): its 8
+/// neighbours read again.
+constexpr std::int64_t kFallTestVisits = 8;
 
 // The 8 neighbours: offsets and which limit applies (0 along X, 1 along Z, 2 diagonal).
 struct Neighbour {
@@ -777,10 +780,10 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   float* h = layers.height_m;
   const double cell_area = dx_ * dz_;
   const std::uint32_t cols = std::uint32_t(cols_);
-  // The work of the step, in pair checks: 8 per cell examined and 1 per
-  // flux applied (the fall test of a source, at most 8 reads, rides on its
-  // fluxes: a time bound either way, with a work of up to 9 per flux). It
-  // never passes the cap: a pass too large for what is left is carried on
+  // The work of the step, in neighbour visits: 8 per cell examined, 1 per
+  // flux applied and 8 per source's fall test (its neighbours read again),
+  // so that a step's work tracks its time whether it examines or applies.
+  // It never passes the cap: a pass too large for what is left is carried on
   // in the next step, where it stopped (its heights stay those it started
   // from until all its cells are examined), so a collapse of any size is
   // spread over ticks of bounded work.
@@ -813,12 +816,14 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       const std::uint32_t a = fluxes_[applied_].from;
       std::size_t end = applied_;
       while (end < fluxes_.size() && fluxes_[end].from == a) ++end;
-      if (work + std::int64_t(end - applied_) > cap) {
+      const bool stale = (queued_[a] & kDirty) != 0;
+      const std::int64_t cost = std::int64_t(end - applied_) + (stale ? 0 : kFallTestVisits);
+      if (work + cost > cap) {
         out_of_work = true;
         break;
       }
-      work += std::int64_t(end - applied_);
-      if (queued_[a] & kDirty) {
+      work += cost;
+      if (stale) {
         applied_ = end;  // changed since it was examined: examined again
         continue;
       }

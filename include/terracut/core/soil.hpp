@@ -117,15 +117,15 @@ struct SoilFlowParams {
   /// (0, 80]. Dry sand about 34, wet sand about 45, saturated 15-30
   /// (Al-Hashemi & Al-Amoudi, Powder Technology 330 (2018) 397).
   double repose_deg = 34.0;
-  /// Work cap of one step's relaxation, in pair checks, in [1000, 1e9]: 8
-  /// per cell examined, 1 per flux applied (a source's fall test, at most 8
-  /// reads, rides on its fluxes). A step never does more; the rest is
-  /// carried on in the next step (see above). A step at the default cap
-  /// costs up to about 2 ms on the project's 2-core machine (docs/soil.md,
-  /// "Measured"): it is a work bound, not the 1 ms; a lower cap is a tighter time bound, but lets a pushed pile lag further
-  /// behind the blade (at 60000 the pile's centre-line section leaves the
-  /// mass balance's tolerance: terracut validate, check 3.1b).
-  std::int64_t max_pair_checks_per_step = 100000;
+  /// Work cap of one step's relaxation, in neighbour visits, in
+  /// [1000, 1e9]: 8 per cell examined, 1 per flux applied, 8 per fallen
+  /// cell's test of its neighbours. A step never does more; the rest is
+  /// carried on in the next step (see above). A visit costs about 6 ns on
+  /// the project's 2-core machine, so a step at the default cap costs up to
+  /// about 0.5 ms there at a quiet load (docs/soil.md, "Speed: the second
+  /// pass"): it is a work bound, not a clock; a lower cap is a tighter
+  /// time bound, but lets a pushed pile lag further behind the blade.
+  std::int64_t max_pair_checks_per_step = 50000;
   /// The grid's edge: a wall, or open (bare ground beyond it at height 0).
   SoilEdge edge = SoilEdge::kWall;
 };
@@ -137,7 +137,7 @@ std::string validate(const SoilFlowParams& params);
 struct SoilStepResult {
   double displaced_volume_m3 = 0.0;  ///< cut soil put down ahead of the blade (soil pushed again counts again), m^3
   int passes = 0;                    ///< relaxation passes run
-  std::int64_t pair_checks = 0;      ///< neighbour pairs examined
+  std::int64_t pair_checks = 0;      ///< work done, in neighbour visits (see max_pair_checks_per_step)
   std::int64_t moved_pairs = 0;      ///< pairs that exchanged soil
   std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
   double left_over_edge_m3 = 0.0;    ///< soil that left over an open edge, m^3
