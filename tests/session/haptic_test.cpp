@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "../support/scenario_text.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/haptics/device_option.hpp"
 #include "terracut/haptics/haptics_csv.hpp"
@@ -50,12 +51,7 @@ std::string error_of(const std::function<void()>& f) {
   return "";
 }
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string read(const fs::path& p) { return terracut::test::read_text(p); }
 
 TEST(Session, LoadsTheTrenchScenario) {
   const Scenario& s = test::trench();

@@ -28,12 +28,7 @@ namespace fs = std::filesystem;
 
 const fs::path kScenarios = fs::path(TERRACUT_SOURCE_DIR) / "scenarios";
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::read_text;
 
 // The trench (operator: sand, no bodies) whose remote world is the same
 // sand with a box of full size `size` resting on it, centred at (x, z).

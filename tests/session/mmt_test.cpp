@@ -23,12 +23,7 @@ namespace fs = std::filesystem;
 
 const fs::path kTrench = fs::path(TERRACUT_SOURCE_DIR) / "scenarios" / "mmt_trench_clay.yaml";
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::read_text;
 
 // The trench scenario, with the remote's world written next to it from the
 // same text after the edit (a different plane height, another soil).

@@ -22,12 +22,7 @@ namespace fs = std::filesystem;
 
 const fs::path kRockPush = fs::path(TERRACUT_SOURCE_DIR) / "scenarios" / "rock_push.yaml";
 
-std::string rock_push_text() {
-  std::ifstream in(kRockPush);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string rock_push_text() { return test::read_text(kRockPush); }
 
 #ifdef TERRACUT_HAVE_BULLET
 // The unit weight the piles of scenarios/rock_push.yaml (soil: flow, a rock)

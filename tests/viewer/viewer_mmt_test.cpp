@@ -31,12 +31,9 @@ namespace fs = std::filesystem;
 const fs::path kTrench = fs::path(TERRACUT_SOURCE_DIR) / "scenarios" / "mmt_trench_clay.yaml";
 
 session::Scenario trench_with_lower_remote() {
-  std::ifstream in(kTrench);
-  std::ostringstream text;
-  text << in.rdbuf();
   const fs::path dir = fs::temp_directory_path() / "terracut_viewer_mmt";
   fs::create_directories(dir);
-  std::ofstream(dir / "remote.yaml") << test::replace(text.str(), "height_m: 0.3", "height_m: 0.28");
+  std::ofstream(dir / "remote.yaml") << test::replace(test::read_text(kTrench), "height_m: 0.3", "height_m: 0.28");
   session::Scenario sc = session::load_scenario(kTrench);
   sc.mmt->remote_scenario = dir / "remote.yaml";
   return sc;
