@@ -164,6 +164,18 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   fluxes_.reserve(4 * active);  // up to 8 per cell; 4 covers a collapsing block
   held_.reserve(footprint);
   dirty_.reserve(footprint);
+  if (blade.bucket.enabled()) {
+    // The hull lies within this of the lip's centre in any orientation:
+    // its bounding rectangle is at most twice that across, plus a cell.
+    const double reach = std::sqrt(0.25 * blade.length_m * blade.length_m + blade.bucket.depth_m * blade.bucket.depth_m +
+                                   blade.bucket.height_m * blade.bucket.height_m);
+    const double box = (2.0 * reach / dx_ + 3.0) * (2.0 * reach / dz_ + 3.0);
+    const std::size_t hull = std::size_t(std::min(double(n), box));
+    hull_cells_.reserve(hull);
+    hull_under_.reserve(hull);
+    held_.reserve(footprint + hull);
+    dirty_.reserve(footprint + hull);
+  }
 
   // Every cell of a slope already steeper than the repose angle starts active.
   const float* h = grid.heights();
@@ -259,7 +271,9 @@ void SoilFlow::wake_held(const Segment* edge) {
       const Vec3 d = p - q;
       return d.x * d.x + d.y * d.y + d.z * d.z < q2;
     };
-    if (near(edge->a, held_edge_.a) && near(edge->b, held_edge_.b)) return;
+    if (near(edge->a, held_edge_.a) && near(edge->b, held_edge_.b) &&
+        (hull_cells_.empty() || (near(hull_heel_.a, held_heel_.a) && near(hull_heel_.b, held_heel_.b))))
+      return;
   }
   for (std::uint32_t cell : held_) {
     queued_[cell] &= std::uint8_t(~kHeld);
@@ -743,6 +757,15 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
       }
       // Nor into a rigid body's footprint (soil under it may slide out).
       if (obstacles && obstructed(b)) continue;
+      // Nor into a cell under the bucket's hull from higher than the hull's
+      // underside there (a flux never raises a cell above its source).
+      if ((queued_[b] & kHull) && ha > hull_under(b)) {
+        if (!(queued_[a] & kHeld)) {
+          queued_[a] |= kHeld;
+          held_.push_back(a);
+        }
+        continue;
+      }
     }
     lower[n] = b;
     shed[n] = e;
@@ -895,11 +918,16 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     load_m3_ = holds;
   }
   out.bucket_load_m3 = load_m3_;
+  if (blade_spec_.bucket.enabled()) {
+    // The hull at its new pose: what stands inside it is shouldered out.
+    mark_hull(grid, to, orientation);
+    shoulder(grid, out);
+  }
   wake_held(&to);
   // The blade's wall matters only to a pass: marked only when one runs.
   if (pending()) {
     mark_blade(grid, to);
-    if (held_.empty()) held_edge_ = to;  // where the blade holds what the passes find held
+    if (held_.empty()) held_edge_ = to, held_heel_ = hull_heel_;  // where the blade and hull hold what the passes find held
     run_passes(grid, out);
     clear_blade();
   }
@@ -944,9 +972,146 @@ void SoilFlow::pour(HeightGrid& grid, const Segment& lip, double volume_m3, Soil
   out.poured_m3 += volume_m3;
 }
 
+void SoilFlow::clear_hull() {
+  for (std::uint32_t cell : hull_cells_) queued_[cell] &= std::uint8_t(~kHull);
+  hull_cells_.clear();
+  hull_under_.clear();
+  hull_rect_ = {};
+}
+
+void SoilFlow::mark_hull(const HeightGrid& grid, const Segment& lip, const Quat& orientation) {
+  // The floor plate runs from the lip back depth_m along the blade frame's
+  // +Z, the back plate from the heel up height_m along its +Y. A cell is
+  // under the hull where its centre lies in the plan of either plate; the
+  // underside there is the lower plate's height over the centre.
+  clear_hull();
+  const GridSpec& spec = grid.spec();
+  const Vec3 back = rotate(orientation, {0.0, 0.0, blade_spec_.bucket.depth_m});
+  const Vec3 up = rotate(orientation, {0.0, blade_spec_.bucket.height_m, 0.0});
+  const Vec3 along = lip.b - lip.a;
+  hull_heel_ = {lip.a + back, lip.b + back};
+  const Vec3 corners[6] = {lip.a, lip.b, hull_heel_.a, hull_heel_.b, hull_heel_.a + up, hull_heel_.b + up};
+  double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
+  hull_cx_ = hull_cz_ = 0.0;
+  for (const Vec3& p : corners) {
+    const double u = to_cells(p.x, spec.origin_m.x, dx_), v = to_cells(p.z, spec.origin_m.z, dz_);
+    u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
+    hull_cx_ += p.x / 6.0;
+    hull_cz_ += p.z / 6.0;
+  }
+  // The cells whose centres can lie inside: centres at (c + 0.5) in cells.
+  Rect r;
+  r.c0 = int(std::clamp(std::ceil(u0 - 0.5), 0.0, double(cols_)));
+  r.c1 = int(std::clamp(std::floor(u1 - 0.5) + 1.0, 0.0, double(cols_)));
+  r.r0 = int(std::clamp(std::ceil(v0 - 0.5), 0.0, double(rows_)));
+  r.r1 = int(std::clamp(std::floor(v1 - 0.5) + 1.0, 0.0, double(rows_)));
+  if (r.empty()) return;
+  hull_rect_ = r;
+  hull_under_.assign(std::size_t(r.area()), std::numeric_limits<float>::infinity());
+  struct Plate {
+    Vec3 origin, s, t;
+  };
+  const Plate plates[2] = {{lip.a, along, back}, {hull_heel_.a, along, up}};
+  const double ground = spec.origin_m.y;
+  for (const Plate& p : plates) {
+    // Plan coordinates (s, t) of a point: solve the 2x2 system of the
+    // plate's two edges in plan; a plate seen edge-on covers no centre.
+    const double det = p.s.x * p.t.z - p.s.z * p.t.x;
+    const double area = std::hypot(p.s.x, p.s.z) * std::hypot(p.t.x, p.t.z);
+    if (!(std::abs(det) > 1e-9 * area) || area == 0.0) continue;
+    for (int row = r.r0; row < r.r1; ++row)
+      for (int c = r.c0; c < r.c1; ++c) {
+        const double px = spec.origin_m.x + (c + 0.5) * dx_ - p.origin.x;
+        const double pz = spec.origin_m.z + (row + 0.5) * dz_ - p.origin.z;
+        const double s = (px * p.t.z - pz * p.t.x) / det, t = (p.s.x * pz - p.s.z * px) / det;
+        if (s < 0.0 || s > 1.0 || t < 0.0 || t > 1.0) continue;
+        const float y = float(p.origin.y + s * p.s.y + t * p.t.y - ground);
+        float& under = hull_under_[std::size_t(row - r.r0) * std::size_t(r.c1 - r.c0) + std::size_t(c - r.c0)];
+        under = std::min(under, y);
+      }
+  }
+  for (int row = r.r0; row < r.r1; ++row)
+    for (int c = r.c0; c < r.c1; ++c)
+      if (hull_under_[std::size_t(row - r.r0) * std::size_t(r.c1 - r.c0) + std::size_t(c - r.c0)] <
+          std::numeric_limits<float>::infinity()) {
+        const auto cell = std::uint32_t(std::int64_t(row) * cols_ + c);
+        queued_[cell] |= kHull;
+        hull_cells_.push_back(cell);
+      }
+}
+
+void SoilFlow::shoulder(HeightGrid& grid, SoilStepResult& out) {
+  // Each cell under the hull with soil above the hull's underside gives
+  // that excess to the first cell outside the footprint (and not under a
+  // rigid body), walking away from the hull's plan centre; beyond a wall it
+  // walks the other way, beyond an open edge it leaves (counted). A cell
+  // too close to the ceiling takes what fits, the rest goes on outward.
+  const GridSpec& spec = grid.spec();
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  float* h = layers.height_m;
+  double taken = 0.0, put = 0.0;
+  std::int64_t last_put = -1;
+  for (std::uint32_t cell : hull_cells_) {
+    const float under = std::max(0.0f, hull_under(cell));
+    const float now = h[cell];
+    // Float rounding of the cut (which leaves the lip's height) is no excess.
+    if (!(now - under > 4.0f * std::numeric_limits<float>::epsilon() * std::max(now, 1.0f))) continue;
+    const int c = int(cell % std::uint32_t(cols_)), row = int(cell / std::uint32_t(cols_));
+    const double x = spec.origin_m.x + (c + 0.5) * dx_, z = spec.origin_m.z + (row + 0.5) * dz_;
+    double nx = x - hull_cx_, nz = z - hull_cz_;
+    const double len = std::hypot(nx, nz);
+    nx = len > 1e-12 ? nx / len : 1.0;
+    nz = len > 1e-12 ? nz / len : 0.0;
+    const double step = std::min(dx_ / std::max(std::abs(nx), 1e-9), dz_ / std::max(std::abs(nz), 1e-9));
+    float rest = now - under;
+    bool moved = false;
+    for (const double side : {1.0, -1.0}) {
+      for (int m = 1; m <= kMaxPushCells && rest > 0.0f; ++m) {
+        const double u = to_cells(x + side * nx * m * step, spec.origin_m.x, dx_);
+        const double v = to_cells(z + side * nz * m * step, spec.origin_m.z, dz_);
+        if (u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_) {
+          if (params_.edge == SoilEdge::kOpen) {
+            out.left_over_edge_m3 += double(rest) * spec.cell_area_m2();
+            taken -= double(rest);
+            rest = 0.0f;
+            moved = true;
+          }
+          break;
+        }
+        const std::int64_t t = std::int64_t(std::floor(v)) * cols_ + std::int64_t(std::floor(u));
+        if ((queued_[t] & kHull) || obstacle_[t] != 0) continue;
+        const float room = ceiling_m_ - h[t];
+        if (!(room > 0.0f)) continue;
+        const float add = std::min(rest, room);
+        dirty(std::uint32_t(t));
+        const float raised = h[t] + add;
+        put += double(raised) - double(h[t]);
+        h[t] = raised;
+        last_put = t;
+        rest -= add;
+        moved = true;
+        out.changed.include(int(t % cols_), int(t / cols_));
+        activate(std::uint32_t(t));
+      }
+      if (rest <= 0.0f) break;
+    }
+    if (!moved) continue;  // nowhere to go: it stays (a hull filling the grid)
+    // What found no room stays in the cell.
+    dirty(cell);
+    h[cell] = under + rest;
+    taken += double(now) - double(h[cell]);
+    out.changed.include(c, row);
+    lowered(cell, h);
+  }
+  // Give back the rounding of the writes on the last cell written.
+  if (last_put >= 0 && put != taken) h[last_put] = float(std::max(0.0, double(h[last_put]) + (taken - put)));
+  out.shouldered_m3 += taken * spec.cell_area_m2();
+}
+
 SoilStepResult SoilFlow::relax(HeightGrid& grid) {
   SoilStepResult out;
   wake_held(nullptr);  // no blade now
+  clear_hull();        // nor a bucket
   run_passes(grid, out);
   return out;
 }

@@ -674,6 +674,90 @@ TEST(Bucket, AFullBucketSpillsAheadLikeABlade) {
   EXPECT_NEAR(b.sim->grid().volume_m3() + b.load(), b.initial_m3, 1e-6);
 }
 
+// The bucket's body is a solid: a cell whose centre lies under the floor
+// keeps no soil above the floor's height there. Float rounding of a height
+// near 1 m: the shoulder leaves at most 4 float epsilons of excess.
+constexpr double kUnderHullSlack = 8.0 * 1.2e-7;
+
+// |grid + load - initial| allowed: the float rounding of every cell's height.
+double bucket_rounding_m3() {
+  return 4.0 * 200.0 * 200.0 * 0.3 * 1.2e-7 * BucketCycle::kCell * BucketCycle::kCell + 1e-9;
+}
+
+// Highest soil above the floor plate of a bucket whose lip (centre at x, z,
+// height lip_y, 0.4 m long along X) slopes down toward +Z at `heel_down`
+// metres of height per metre of plan (the floor's plan length is plan_m).
+double worst_above_floor(const HeightGrid& g, double x, double z, double lip_y, double heel_down, double plan_m) {
+  double worst = -1e9;
+  for (int r = 0; r < g.rows(); ++r)
+    for (int c = 0; c < g.cols(); ++c) {
+      const double cx = (c + 0.5) * BucketCycle::kCell, cz = (r + 0.5) * BucketCycle::kCell;
+      if (std::abs(cx - x) >= 0.2 || cz <= z || cz >= z + plan_m) continue;
+      const double under = std::max(0.0, lip_y - (cz - z) * heel_down);
+      worst = std::max(worst, double(g.height(c, r)) - under);
+    }
+  return worst;
+}
+
+TEST(Bucket, LoweredLevelIntoSoilLeavesNoneAboveItsFloor) {
+  // Lowered straight down, level, 5 cm into the 0.2 m layer: the floor
+  // behind the lip goes below the surface, and shoulders the soil aside.
+  BucketCycle b;
+  b.step({1.0, 0.25, 1.0}, Quat{});
+  b.move({1.0, 0.25, 1.0}, {1.0, 0.15, 1.0}, 200);
+  EXPECT_LE(worst_above_floor(b.sim->grid(), 1.0, 1.0, 0.15, 0.0, 0.3), kUnderHullSlack);
+  EXPECT_GT(b.sim->last().soil.shouldered_m3 + b.sim->last().soil.displaced_volume_m3, 0.0);
+  EXPECT_EQ(b.load(), 0.0);  // it did not dig toward its opening
+  EXPECT_LT(b.worst_conservation_m3, bucket_rounding_m3());
+  // Lifted away, the hole it left relaxes to the repose angle: no pair
+  // steeper than the repose limit plus the relaxation's 2 % tolerance.
+  b.move({1.0, 0.15, 1.0}, {1.0, 0.6, 1.0}, 300);
+  for (int i = 0; i < 20000 && b.sim->last().soil.backlog_cells > 0; ++i) b.step({1.0, 0.6, 1.0}, Quat{});
+  EXPECT_EQ(b.sim->last().soil.backlog_cells, 0);
+  const HeightGrid& g = b.sim->grid();
+  const double limit = std::tan(34.0 * kDeg) * BucketCycle::kCell * 1.02 + 1e-6;
+  double steepest = 0.0;
+  for (int r = 0; r + 1 < g.rows(); ++r)
+    for (int c = 0; c + 1 < g.cols(); ++c) {
+      steepest = std::max(steepest, std::abs(double(g.height(c, r)) - g.height(c + 1, r)));
+      steepest = std::max(steepest, std::abs(double(g.height(c, r)) - g.height(c, r + 1)));
+    }
+  EXPECT_LE(steepest, limit);
+  EXPECT_LT(b.worst_conservation_m3, bucket_rounding_m3());
+}
+
+TEST(Bucket, PushedDownHeelFirstShouldersTheSoilAsideAndKeepsItAll) {
+  // Curled 30 degrees (the back lowered), lip above the sand: only the
+  // heel and the floor go in, 10 cm deep at the heel.
+  BucketCycle b;
+  const Quat curl = pitch(30.0);
+  const double tan30 = std::tan(30.0 * kDeg), plan = 0.3 * std::cos(30.0 * kDeg);
+  b.step({1.0, 0.35, 1.0}, curl);
+  b.move({1.0, 0.35, 1.0}, {1.0, 0.25, 1.0}, 300, curl, curl);
+  EXPECT_LE(worst_above_floor(b.sim->grid(), 1.0, 1.0, 0.25, tan30, plan), kUnderHullSlack);
+  EXPECT_EQ(b.load(), 0.0);
+  EXPECT_LT(b.worst_conservation_m3, bucket_rounding_m3());
+  // The soil went beside and behind it: above the layer around the hull.
+  EXPECT_GT(b.max_height(), BucketCycle::kLayer + 0.005);
+}
+
+TEST(Bucket, SoilPiledAgainstTheBackDoesNotFlowThroughIt) {
+  // The bucket rests level on the sand (floor at the surface, heel at
+  // z = 1.3); a ridge 13 cm tall (below the back's top, 15 cm) stands just
+  // behind the back wall, outside.
+  BucketCycle b;
+  std::vector<float> h(std::size_t(200) * 200, float(BucketCycle::kLayer));
+  for (int r = 130; r < 136; ++r)
+    for (int c = 85; c < 115; ++c) h[std::size_t(r) * 200 + c] = float(BucketCycle::kLayer + 0.13);
+  b.sim = std::make_unique<Simulation>(b.params, h);
+  b.initial_m3 = b.sim->grid().volume_m3();
+  for (int i = 0; i < 3000; ++i) b.step({1.0, BucketCycle::kLayer, 1.0}, Quat{});
+  EXPECT_LE(worst_above_floor(b.sim->grid(), 1.0, 1.0, BucketCycle::kLayer, 0.0, 0.3), kUnderHullSlack);
+  // The ridge did slump, outward and around the bucket.
+  EXPECT_LT(b.max_height(), BucketCycle::kLayer + 0.12);
+  EXPECT_LT(b.worst_conservation_m3, bucket_rounding_m3());
+}
+
 TEST(Bucket, NeedsSoilThatFlowsAndAShape) {
   SimParams p;
   p.grid = grid_of_cells(20, 20, 0.01);

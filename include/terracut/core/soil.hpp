@@ -62,8 +62,14 @@
 // back is no steeper than the repose angle holds its struck capacity; tilted
 // back up, it holds less, and nothing once its floor is steeper than the
 // repose angle. What it can no longer hold pours from the lip onto the
-// terrain below the lip, where it relaxes. Only the lip cuts: the bucket's
-// floor and back are not obstacles for the terrain.
+// terrain below the lip, where it relaxes. Only the lip cuts, but the
+// bucket's body (its floor and back plates, their underside per cell under
+// them in plan) is a solid: soil above the underside of a cell under it is
+// shouldered out of its footprint (each cell's excess carried away from the
+// footprint's plan centre to the first cell outside it and not under a
+// body), and no soil flows into a cell under it higher than its underside
+// there, so nothing sits inside the bucket's body but its load; what the
+// hull held back is examined again once the bucket has moved.
 //
 // Rigid obstacles (set_obstacles; the Bullet bodies' listener sets them
 // from the bodies' bounding boxes every step): no soil flows, is pushed or
@@ -144,6 +150,7 @@ struct SoilStepResult {
   double bucket_in_m3 = 0.0;         ///< cut soil the bucket took in this step, m^3
   double poured_m3 = 0.0;            ///< soil poured from the bucket's lip this step, m^3
   double bucket_load_m3 = 0.0;       ///< soil in the bucket after the step, m^3
+  double shouldered_m3 = 0.0;        ///< soil the bucket's hull pushed out of its footprint this step, m^3
   Rect changed{};                    ///< samples whose height the phase changed
 };
 
@@ -234,6 +241,14 @@ class SoilFlow {
   void beside_body(const HeightGrid& grid, double x, double z, double tx, double tz,
                    std::int64_t& first, std::int64_t& second) const;
   void pour(HeightGrid& grid, const Segment& lip, double volume_m3, SoilStepResult& out);
+  void mark_hull(const HeightGrid& grid, const Segment& lip, const Quat& orientation);
+  void clear_hull();
+  void shoulder(HeightGrid& grid, SoilStepResult& out);
+  /// The hull's underside over a marked cell (kHull set), metres above the ground.
+  float hull_under(std::uint32_t cell) const {
+    const int c = int(cell % std::uint32_t(cols_)) - hull_rect_.c0, r = int(cell / std::uint32_t(cols_)) - hull_rect_.r0;
+    return hull_under_[std::size_t(r) * std::size_t(hull_rect_.c1 - hull_rect_.c0) + std::size_t(c)];
+  }
   void run_passes(HeightGrid& grid, SoilStepResult& out);
   std::int64_t examine(std::uint32_t a, const float* h);
   void finish_pass(HeightGrid& grid, SoilStepResult& out);
@@ -266,6 +281,7 @@ class SoilFlow {
   static constexpr std::uint8_t kQueued = 1;  // in next_
   static constexpr std::uint8_t kHeld = 2;    // in held_
   static constexpr std::uint8_t kDirty = 4;   // in dirty_
+  static constexpr std::uint8_t kHull = 8;    // under the bucket's hull (in hull_cells_)
   // A cell the cut, the displacement, the pour or an edit changed while a
   // pass was in progress: the pass's fluxes from or to it are dropped (they
   // came from heights it no longer has; it is examined again anyway).
@@ -298,6 +314,15 @@ class SoilFlow {
   // are examined again once the blade has moved (held_edge_ is where it was).
   std::vector<std::uint32_t> held_;
   Segment held_edge_{};
+  Segment held_heel_{};  // the bucket's heel where it held them (a turn about the lip moves it)
+  // The bucket's hull of the step: the cells under it (kHull set) and its
+  // underside over its bounding rectangle (+inf where it does not cover),
+  // and its plan centre.
+  std::vector<std::uint32_t> hull_cells_;
+  std::vector<float> hull_under_;
+  Rect hull_rect_{};
+  Segment hull_heel_{};
+  double hull_cx_ = 0.0, hull_cz_ = 0.0;
   std::vector<std::uint8_t> near_blade_;  // per cell: 1 within reach of the step's blade
   std::vector<std::uint8_t> obstacle_;    // per cell: 1 + index into obstacles_, 0 for none
   std::vector<SoilObstacle> obstacles_;   // the obstacles, their cells clipped to the grid
