@@ -625,22 +625,31 @@ struct BucketCycle {
 TEST(Bucket, ScoopsCarriesAndDumpsWithoutLosingAnything) {
   BucketCycle b;
   const double depth = 0.03, lip_y = BucketCycle::kLayer - depth;
-  // Scoop 0.5 m along -Z, 3 cm deep, 0.6 mm per step: 0.4 x 0.03 x 0.5 =
-  // 0.006 m^3, under the struck capacity 0.009 m^3: all of it goes in.
-  b.step({1.0, lip_y, 1.6}, Quat{});
-  b.move({1.0, lip_y, 1.6}, {1.0, lip_y, 1.1}, 833);
+  // The floor is a solid, so the bucket goes in as a real one does: heel
+  // up, the lip plunging 3 cm while it moves 0.2 m forward (a ramp of
+  // slope 0.15), the floor tilted 10 degrees (tan 0.18) so that it stays
+  // above the ramp the lip cut. Then it scoops 0.5 m along -Z, 3 cm deep,
+  // 0.6 mm per step. It takes in the ramp, 0.4 x 0.03 x 0.2 / 2, and the
+  // scoop, 0.4 x 0.03 x 0.5: 0.0072 m^3, under what it holds tilted so
+  // (0.008 m^3): all of it goes in.
+  const Quat heel_up = pitch(-10.0);
+  b.step({1.0, BucketCycle::kLayer, 1.8}, heel_up);
+  b.move({1.0, BucketCycle::kLayer, 1.8}, {1.0, lip_y, 1.6}, 333, heel_up, heel_up);
+  b.move({1.0, lip_y, 1.6}, {1.0, lip_y, 1.1}, 833, heel_up, heel_up);
   const double scooped = b.load();
-  EXPECT_NEAR(scooped, 0.4 * depth * 0.5, 0.4 * depth * 2.0 * BucketCycle::kCell);
-  // No pile ahead of the lip: nothing stands above the layer.
+  ASSERT_LT(0.4 * depth * 0.6, bucket_retained_m3(b.params.blade, heel_up, 34.0));
+  EXPECT_NEAR(scooped, 0.4 * depth * (0.5 + 0.1), 0.4 * depth * 2.0 * BucketCycle::kCell);
+  // The floor stayed in the lip's cut: nothing shouldered, and no pile
+  // ahead of the lip: nothing stands above the layer.
   EXPECT_LE(b.max_height(), BucketCycle::kLayer + 1e-6);
   // Lift out and carry it 0.6 m sideways, above the sand: the load stays.
-  b.move({1.0, lip_y, 1.1}, {1.0, 0.5, 1.1}, 300);
+  b.move({1.0, lip_y, 1.1}, {1.0, 0.5, 1.1}, 300, heel_up, heel_up);
   const double carried = b.load();
   EXPECT_NEAR(carried, scooped, 0.02 * scooped);  // the lift cuts the slumped walls aside
-  b.move({1.0, 0.5, 1.1}, {0.4, 0.5, 1.1}, 600);
+  b.move({1.0, 0.5, 1.1}, {0.4, 0.5, 1.1}, 600, heel_up, heel_up);
   EXPECT_EQ(b.load(), carried);
-  // Dump: raise the back past the repose angle (70 degrees over 0.5 s).
-  b.move({0.4, 0.5, 1.1}, {0.4, 0.5, 1.1}, 500, Quat{}, pitch(-70.0));
+  // Dump: raise the back past the repose angle (to 70 degrees over 0.5 s).
+  b.move({0.4, 0.5, 1.1}, {0.4, 0.5, 1.1}, 500, heel_up, pitch(-70.0));
   EXPECT_EQ(b.load(), 0.0);
   for (int i = 0; i < 2000; ++i) b.step({0.4, 0.5, 1.1}, pitch(-70.0));  // let the dump settle
   // Everything is back on the ground, and the dump lies under the lip: the
