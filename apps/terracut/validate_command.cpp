@@ -629,11 +629,18 @@ ConservationResult run_conservation(const fs::path& dir) {
 // A 0.4 m bucket (floor 0.3 m, back 0.15 m: 0.009 m^3 struck) on a 0.3 m
 // layer of sand on 1 cm cells: it plunges, scoops 0.6 m along its opening
 // (-Z) 3.5 cm deep, lifts out, carries the load 0.6 m sideways and dumps by
-// raising its back 70 degrees (as scenarios/bucket_cycle.yaml).
+// raising its back 70 degrees (as scenarios/bucket_cycle.yaml). Its floor
+// is a solid, so it goes in heel up (kScoopPitch_deg: the floor rises
+// tan 7 = 0.123 per metre behind the lip) while the lip plunges from the
+// surface over kPlunge_m (a ramp of 0.035 / 0.3 = 0.117): the floor stays
+// above what the lip cut and shoulders nothing. The ramp's half and the
+// flat scoop make the scooped length kScoop_m. At 7 degrees the bucket
+// still holds its struck capacity (the repose surface 27 degrees above the
+// floor: tan 27 x 0.3 m > 0.15 m).
 constexpr double kBucketCell_m = 0.01, kBucketLayer_m = 0.3, kBucketRepose = 34.0;
 constexpr int kBucketCells = 200;
 constexpr double kBucketLength_m = 0.4, kBucketDepth_m = 0.3, kBucketHeight_m = 0.15;
-constexpr double kScoopDepth_m = 0.035, kScoop_m = 0.6;
+constexpr double kScoopDepth_m = 0.035, kScoop_m = 0.6, kPlunge_m = 0.3, kScoopPitch_deg = -7.0;
 constexpr double kDumpX_m = 1.6, kDumpZ_m = 0.9;  // where the lip dumps (grid from 0 to 2 m)
 
 struct BucketResult {
@@ -656,26 +663,29 @@ BucketResult run_bucket(const fs::path& dir) {
   p.soil = flow_params(kBucketRepose);
   Simulation sim(p, std::vector<float>(std::size_t(kBucketCells) * kBucketCells, float(kBucketLayer_m)));
   BucketResult res;
-  res.capacity_m3 = bucket_retained_m3(p.blade, Quat{}, kBucketRepose);
+  const Quat heel_up = quat_from_axis_angle({1.0, 0.0, 0.0}, rad(kScoopPitch_deg));
+  res.capacity_m3 = bucket_retained_m3(p.blade, heel_up, kBucketRepose);
   const double initial = sim.grid().volume_m3();
   const double lip_y = kBucketLayer_m - kScoopDepth_m, z0 = 1.6, x0 = 1.0;
-  const Quat level{}, dump = quat_from_axis_angle({1.0, 0.0, 0.0}, rad(-70.0));
+  const Quat dump = quat_from_axis_angle({1.0, 0.0, 0.0}, rad(-70.0));
   struct Leg {
     const char* phase;
     Vec3 to;
     Quat turn;
     double seconds;
   };
-  const Leg legs[] = {{"scoop", {x0, lip_y, z0 - kScoop_m}, level, 1.0},
-                      {"lift", {x0, 0.6, z0 - kScoop_m}, level, 0.5},
-                      {"carry", {kDumpX_m, 0.6, kDumpZ_m}, level, 1.0},
+  // The plunge and the scoop at 0.6 m/s along -Z.
+  const Leg legs[] = {{"scoop", {x0, lip_y, z0 - 0.5 * kPlunge_m}, heel_up, kPlunge_m / 0.6},
+                      {"scoop", {x0, lip_y, z0 - kScoop_m}, heel_up, (kScoop_m - 0.5 * kPlunge_m) / 0.6},
+                      {"lift", {x0, 0.6, z0 - kScoop_m}, heel_up, 0.5},
+                      {"carry", {kDumpX_m, 0.6, kDumpZ_m}, heel_up, 1.0},
                       {"dump", {kDumpX_m, 0.6, kDumpZ_m}, dump, 0.6},
                       {"settle", {kDumpX_m, 0.6, kDumpZ_m}, dump, 2.0}};
   std::string csv = "step,t_s,phase,grid_m3,load_m3,error_m3\n";
   std::int64_t updates = 0;
   double tallest = kBucketLayer_m;
-  Vec3 at{x0, lip_y, z0};
-  Quat q = level;
+  Vec3 at{x0, kBucketLayer_m, z0 + 0.5 * kPlunge_m};
+  Quat q = heel_up;
   auto step = [&](const char* phase, const BladePose& pose) {
     const StepOutput& out = sim.step(pose);
     updates += 2 * out.soil.moved_pairs + out.changed.area();
@@ -1060,9 +1070,11 @@ std::string report_markdown(const Report& r) {
   md << "## 5. A bucket cycle: scoop, carry, dump\n\n"
      << "A " << fmt("%g", kBucketLength_m) << " m bucket (floor " << fmt("%g", kBucketDepth_m) << " m, back "
      << fmt("%g", kBucketHeight_m) << " m; it holds " << fmt("%.4f", b.capacity_m3)
-     << " m^3 level, its struck capacity W D H / 2) on a " << fmt("%g", kBucketLayer_m)
-     << " m layer, 1 cm cells, repose " << fmt("%g", kBucketRepose) << " degrees: it scoops "
-     << fmt("%g", kScoop_m) << " m along its opening " << fmt("%g", kScoopDepth_m * 100) << " cm deep, lifts out, "
+     << " m^3 heel up " << fmt("%g", -kScoopPitch_deg) << " degrees, its struck capacity W D H / 2) on a "
+     << fmt("%g", kBucketLayer_m) << " m layer, 1 cm cells, repose " << fmt("%g", kBucketRepose)
+     << " degrees: heel up (its floor is a solid and must stay above what the lip cut), its lip plunges "
+     << fmt("%g", kScoopDepth_m * 100) << " cm over " << fmt("%g", kPlunge_m) << " m and it scoops on, "
+     << fmt("%g", kScoop_m) << " m of full depth in all, along its opening, lifts out, "
         "carries the load 0.6 m sideways and dumps it by raising its back 70 degrees (past the repose "
         "angle: the floor itself is then steeper than the soil can stand, so the bucket holds nothing). "
         "The grid's volume and the bucket's load at every step are in `bucket/volume.csv`.\n\n"

@@ -1019,12 +1019,15 @@ void SoilFlow::mark_hull(const HeightGrid& grid, const Segment& lip, const Quat&
     const double det = p.s.x * p.t.z - p.s.z * p.t.x;
     const double area = std::hypot(p.s.x, p.s.z) * std::hypot(p.t.x, p.t.z);
     if (!(std::abs(det) > 1e-9 * area) || area == 0.0) continue;
+    // A centre on the lip's line (to a millionth of a cell) is the lip's to
+    // cut: the step's cut may just have missed it by rounding.
+    const double t_min = &p == &plates[0] ? 1e-6 * std::min(dx_, dz_) * std::hypot(p.s.x, p.s.z) / std::abs(det) : 0.0;
     for (int row = r.r0; row < r.r1; ++row)
       for (int c = r.c0; c < r.c1; ++c) {
         const double px = spec.origin_m.x + (c + 0.5) * dx_ - p.origin.x;
         const double pz = spec.origin_m.z + (row + 0.5) * dz_ - p.origin.z;
         const double s = (px * p.t.z - pz * p.t.x) / det, t = (p.s.x * pz - p.s.z * px) / det;
-        if (s < 0.0 || s > 1.0 || t < 0.0 || t > 1.0) continue;
+        if (s < 0.0 || s > 1.0 || t < t_min || t > 1.0) continue;
         const float y = float(p.origin.y + s * p.s.y + t * p.t.y - ground);
         float& under = hull_under_[std::size_t(row - r.r0) * std::size_t(r.c1 - r.c0) + std::size_t(c - r.c0)];
         under = std::min(under, y);
