@@ -247,7 +247,7 @@ TEST(Session, TheOperatorFeelsTheWeightOfTheBucketsLoad) {
   // All of it poured by the end, and nothing lost.
   EXPECT_EQ(sim.last().soil.bucket_load_m3, 0.0);
   EXPECT_NEAR(sim.grid().volume_m3(), initial_m3, 1e-5);
-  // 0.4 m x 3.5 cm x 0.6 m scooped, plus the plunge's share: 0.0084-0.0090 m^3.
+  // 0.4 m x 3.5 cm x 0.6 m of full depth scooped (half the plunge's ramp in it), at most the struck 0.0090 m^3.
   const double weight = -carry_y / n;
   EXPECT_GT(weight, unit_weight * 0.0084 * 0.98);
   EXPECT_LT(weight, unit_weight * 0.0090 * 1.02);
