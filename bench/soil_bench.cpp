@@ -9,8 +9,12 @@
 //    0.6 mm per step (0.6 m/s at 1 kHz) for 1 m along +Z, on an N x N grid
 //    (the grid's size must not matter: the phase walks only active cells);
 //  - scoop: a 1 m bucket (0.4 m floor, 0.2 m back: 0.04 m^3 struck) dragged
-//    5 cm deep for 1 m along -Z on a 512 x 512 grid, 0.6 mm per step: it
-//    fills, then (full after about 0.8 m) pushes a pile as a blade does;
+//    1 m along -Z on a 512 x 512 grid, 0.6 mm per step, heel up 7 degrees
+//    as a bucket goes in (its floor and back are solid: a level floor in
+//    the soil would shoulder what lies over it), the lip plunging from the
+//    surface to 5 cm deep over the first 0.45 m (a ramp of 0.11, under the
+//    floor's tan 7 = 0.123, so the floor rides over the cut rather than
+//    pressing into it): it fills, then pushes a pile ahead as a blade does;
 //  - collapse: a 100 x 100-cell block 0.5 m tall collapsing, relaxation
 //    only, until it settles: the soil time of every tick.
 // Each step is timed twice: on the wall clock (steady_clock, the step's
@@ -25,6 +29,7 @@
 #include <cstdio>
 #include <ctime>
 #include <fstream>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -64,19 +69,20 @@ struct Samples {
   Stats stats() const { return {percentiles(wall), percentiles(cpu), std::int64_t(wall.size()), max_backlog}; }
 };
 
-/// Drives the blade (or bucket) from `start` by `travel` in `steps` steps.
-Samples drive(Simulation& sim, const Vec3& start, const Vec3& travel, int steps) {
-  Samples s;
-  for (int i = 0; i <= steps; ++i) {
+/// Drives the blade (or bucket) at `attitude` from `start` by `travel` in
+/// `steps` steps (the pose at `start` too unless `from_start` is false, for
+/// a leg that goes on from the last), adding the step times to `s`.
+void drive(Simulation& sim, const Vec3& start, const Vec3& travel, int steps, Samples& s,
+           const Quat& attitude = Quat{}, bool from_start = true) {
+  for (int i = from_start ? 0 : 1; i <= steps; ++i) {
     const double t = double(i) / steps;
-    const BladePose pose{{start.x + travel.x * t, start.y + travel.y * t, start.z + travel.z * t}, Quat{}};
+    const BladePose pose{{start.x + travel.x * t, start.y + travel.y * t, start.z + travel.z * t}, attitude};
     const double c0 = thread_cpu_s();
     const StepOutput& out = sim.step(pose);
     s.cpu.push_back(thread_cpu_s() - c0);
     s.wall.push_back(out.timers.cut_s + out.timers.soil_s);
     s.max_backlog = std::max(s.max_backlog, out.soil.backlog_cells);
   }
-  return s;
 }
 
 Stats bulldoze(int side) {
@@ -87,7 +93,9 @@ Stats bulldoze(int side) {
   p.soil.model = SoilModel::kFlow;
   Simulation sim(p, std::vector<float>(std::size_t(side) * side, 0.2f));
   const double x = 0.5 * side * cell, z0 = 0.5 * side * cell - 0.5;
-  return drive(sim, {x, 0.15, z0}, {0.0, 0.0, 1.0}, int(std::lround(1.0 / 0.0006))).stats();
+  Samples s;
+  drive(sim, {x, 0.15, z0}, {0.0, 0.0, 1.0}, int(std::lround(1.0 / 0.0006)), s);
+  return s.stats();
 }
 
 Stats scoop() {
@@ -100,7 +108,13 @@ Stats scoop() {
   p.soil.model = SoilModel::kFlow;
   Simulation sim(p, std::vector<float>(std::size_t(side) * side, 0.2f));
   const double x = 0.5 * side * cell, z0 = 0.5 * side * cell + 0.5;
-  return drive(sim, {x, 0.15, z0}, {0.0, 0.0, -1.0}, int(std::lround(1.0 / 0.0006))).stats();
+  const Quat heel_up = quat_from_axis_angle({1.0, 0.0, 0.0}, -7.0 * std::numbers::pi / 180.0);
+  const double plunge_m = 0.45, depth_m = 0.05;
+  Samples s;
+  drive(sim, {x, 0.2, z0}, {0.0, -depth_m, -plunge_m}, int(std::lround(plunge_m / 0.0006)), s, heel_up);
+  drive(sim, {x, 0.2 - depth_m, z0 - plunge_m}, {0.0, 0.0, -(1.0 - plunge_m)},
+        int(std::lround((1.0 - plunge_m) / 0.0006)), s, heel_up, false);
+  return s.stats();
 }
 
 Stats collapse() {

@@ -95,6 +95,13 @@ double highest_initial_m(const HeightGrid& grid) {
   return double(top);
 }
 
+}  // namespace
+
+namespace detail {
+
+// (Outside the anonymous namespace: TerrainWorld::Impl holds one, and a
+// member of internal-linkage type in a class with external linkage warns,
+// -Wsubobject-linkage.)
 // Bullet's sequential-impulse solver with its scratch arrays reserved at
 // construction for the largest contact set the world is expected to reach,
 // so that the first contact of a new kind late in a run (the plate meeting a
@@ -115,6 +122,10 @@ class ReservedSolver final : public btSequentialImpulseConstraintSolver {
     m_orderFrictionConstraintPool.reserve(2 * points);
   }
 };
+
+}  // namespace detail
+
+namespace {
 
 // The samples under a body's box: its ring (TerrainWorld::ring_around, not
 // clipped) less one sample all round.
@@ -236,7 +247,7 @@ struct TerrainWorld::Impl {
   btDefaultCollisionConfiguration config;
   btCollisionDispatcher dispatcher{&config};
   btDbvtBroadphase broadphase;
-  ReservedSolver solver;
+  detail::ReservedSolver solver;
   btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
 
   std::unique_ptr<btHeightfieldTerrainShape> terrain_shape;

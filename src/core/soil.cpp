@@ -173,6 +173,8 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
     const std::size_t hull = std::size_t(std::min(double(n), box));
     hull_cells_.reserve(hull);
     hull_under_.reserve(hull);
+    hull_row_c0_.reserve(std::size_t(rows_));
+    hull_row_c1_.reserve(std::size_t(rows_));
     held_.reserve(footprint + hull);
     dirty_.reserve(footprint + hull);
   }
@@ -1008,6 +1010,8 @@ void SoilFlow::mark_hull(const HeightGrid& grid, const Segment& lip, const Quat&
   if (r.empty()) return;
   hull_rect_ = r;
   hull_under_.assign(std::size_t(r.area()), std::numeric_limits<float>::infinity());
+  hull_row_c0_.assign(std::size_t(r.r1 - r.r0), r.c1);
+  hull_row_c1_.assign(std::size_t(r.r1 - r.r0), r.c0);
   struct Plate {
     Vec3 origin, s, t;
   };
@@ -1022,21 +1026,52 @@ void SoilFlow::mark_hull(const HeightGrid& grid, const Segment& lip, const Quat&
     // A centre on the lip's line (to a millionth of a cell) is the lip's to
     // cut: the step's cut may just have missed it by rounding.
     const double t_min = &p == &plates[0] ? 1e-6 * std::min(dx_, dz_) * std::hypot(p.s.x, p.s.z) / std::abs(det) : 0.0;
-    for (int row = r.r0; row < r.r1; ++row)
-      for (int c = r.c0; c < r.c1; ++c) {
+    // Along a row s and t are linear in the column: the columns where both
+    // can lie in range, widened by a cell for rounding; the test itself is
+    // made on every one of them, so the cells marked are those a test of
+    // the whole rectangle would mark, at a cost that follows the plate.
+    const double inv_det = 1.0 / det;
+    const double ds = dx_ * p.t.z * inv_det, dt = -dx_ * p.s.z * inv_det;
+    const double slope_floor = 1e-9 * (1.0 + std::abs(ds) + std::abs(dt));
+    const double oy = p.origin.y - ground;
+    for (int row = r.r0; row < r.r1; ++row) {
+      const double pz = spec.origin_m.z + (row + 0.5) * dz_ - p.origin.z;
+      const double s_z = pz * p.t.x, t_z = p.s.x * pz;
+      const double px0 = spec.origin_m.x + (r.c0 + 0.5) * dx_ - p.origin.x;
+      const double s0 = (px0 * p.t.z - s_z) * inv_det, t0 = (t_z - p.s.z * px0) * inv_det;
+      double k0 = 0.0, k1 = double(r.c1 - r.c0 - 1);
+      const auto narrow = [&](double v0, double dv, double lo, double hi) {
+        if (std::abs(dv) <= slope_floor) return;  // (nearly) constant along the row: test them all
+        double a = (lo - v0) / dv, b = (hi - v0) / dv;
+        if (a > b) std::swap(a, b);
+        k0 = std::max(k0, std::floor(a) - 1.0);
+        k1 = std::min(k1, std::ceil(b) + 1.0);
+      };
+      narrow(s0, ds, 0.0, 1.0);
+      narrow(t0, dt, t_min, 1.0);
+      if (k0 > k1) continue;
+      const int c_first = r.c0 + int(k0), c_end = r.c0 + int(k1) + 1;
+      float* under_row = &hull_under_[hull_slot(r.c0, row)];
+      int first = c_end, end = c_first;
+      for (int c = c_first; c < c_end; ++c) {
         const double px = spec.origin_m.x + (c + 0.5) * dx_ - p.origin.x;
-        const double pz = spec.origin_m.z + (row + 0.5) * dz_ - p.origin.z;
-        const double s = (px * p.t.z - pz * p.t.x) / det, t = (p.s.x * pz - p.s.z * px) / det;
+        const double s = (px * p.t.z - s_z) * inv_det, t = (t_z - p.s.z * px) * inv_det;
         if (s < 0.0 || s > 1.0 || t < t_min || t > 1.0) continue;
-        const float y = float(p.origin.y + s * p.s.y + t * p.t.y - ground);
-        float& under = hull_under_[std::size_t(row - r.r0) * std::size_t(r.c1 - r.c0) + std::size_t(c - r.c0)];
+        const float y = float(oy + s * p.s.y + t * p.t.y);
+        float& under = under_row[c - r.c0];
         under = std::min(under, y);
+        first = std::min(first, c);
+        end = c + 1;
       }
+      int& row_first = hull_row_c0_[std::size_t(row - r.r0)];
+      int& row_end = hull_row_c1_[std::size_t(row - r.r0)];
+      row_first = std::min(row_first, first);
+      row_end = std::max(row_end, end);
+    }
   }
   for (int row = r.r0; row < r.r1; ++row)
-    for (int c = r.c0; c < r.c1; ++c)
-      if (hull_under_[std::size_t(row - r.r0) * std::size_t(r.c1 - r.c0) + std::size_t(c - r.c0)] <
-          std::numeric_limits<float>::infinity()) {
+    for (int c = hull_row_c0_[std::size_t(row - r.r0)]; c < hull_row_c1_[std::size_t(row - r.r0)]; ++c)
+      if (hull_under_[hull_slot(c, row)] < std::numeric_limits<float>::infinity()) {
         const auto cell = std::uint32_t(std::int64_t(row) * cols_ + c);
         queued_[cell] |= kHull;
         hull_cells_.push_back(cell);
@@ -1054,57 +1089,64 @@ void SoilFlow::shoulder(HeightGrid& grid, SoilStepResult& out) {
   float* h = layers.height_m;
   double taken = 0.0, put = 0.0;
   std::int64_t last_put = -1;
-  for (std::uint32_t cell : hull_cells_) {
-    const float under = std::max(0.0f, hull_under(cell));
-    const float now = h[cell];
-    // Float rounding of the cut (which leaves the lip's height) is no excess.
-    if (!(now - under > 4.0f * std::numeric_limits<float>::epsilon() * std::max(now, 1.0f))) continue;
-    const int c = int(cell % std::uint32_t(cols_)), row = int(cell / std::uint32_t(cols_));
-    const double x = spec.origin_m.x + (c + 0.5) * dx_, z = spec.origin_m.z + (row + 0.5) * dz_;
-    double nx = x - hull_cx_, nz = z - hull_cz_;
-    const double len = std::hypot(nx, nz);
-    nx = len > 1e-12 ? nx / len : 1.0;
-    nz = len > 1e-12 ? nz / len : 0.0;
-    const double step = std::min(dx_ / std::max(std::abs(nx), 1e-9), dz_ / std::max(std::abs(nz), 1e-9));
-    float rest = now - under;
-    bool moved = false;
-    for (const double side : {1.0, -1.0}) {
-      for (int m = 1; m <= kMaxPushCells && rest > 0.0f; ++m) {
-        const double u = to_cells(x + side * nx * m * step, spec.origin_m.x, dx_);
-        const double v = to_cells(z + side * nz * m * step, spec.origin_m.z, dz_);
-        if (u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_) {
-          if (params_.edge == SoilEdge::kOpen) {
-            out.left_over_edge_m3 += double(rest) * spec.cell_area_m2();
-            taken -= double(rest);
-            rest = 0.0f;
-            moved = true;
+  // The hull's cells in the order of hull_cells_ (row by row), with their
+  // columns and rows at hand.
+  const Rect& hr = hull_rect_;
+  for (int row = hr.r0; row < hr.r1; ++row) {
+    for (int c = hull_row_c0_[std::size_t(row - hr.r0)]; c < hull_row_c1_[std::size_t(row - hr.r0)]; ++c) {
+      const float covered = hull_under_[hull_slot(c, row)];
+      if (!(covered < std::numeric_limits<float>::infinity())) continue;
+      const auto cell = std::uint32_t(std::int64_t(row) * cols_ + c);
+      const float under = std::max(0.0f, covered);
+      const float now = h[cell];
+      // Float rounding of the cut (which leaves the lip's height) is no excess.
+      if (!(now - under > 4.0f * std::numeric_limits<float>::epsilon() * std::max(now, 1.0f))) continue;
+      const double x = spec.origin_m.x + (c + 0.5) * dx_, z = spec.origin_m.z + (row + 0.5) * dz_;
+      double nx = x - hull_cx_, nz = z - hull_cz_;
+      const double len = std::hypot(nx, nz);
+      nx = len > 1e-12 ? nx / len : 1.0;
+      nz = len > 1e-12 ? nz / len : 0.0;
+      const double step = std::min(dx_ / std::max(std::abs(nx), 1e-9), dz_ / std::max(std::abs(nz), 1e-9));
+      float rest = now - under;
+      bool moved = false;
+      for (const double side : {1.0, -1.0}) {
+        for (int m = 1; m <= kMaxPushCells && rest > 0.0f; ++m) {
+          const double u = to_cells(x + side * nx * m * step, spec.origin_m.x, dx_);
+          const double v = to_cells(z + side * nz * m * step, spec.origin_m.z, dz_);
+          if (u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_) {
+            if (params_.edge == SoilEdge::kOpen) {
+              out.left_over_edge_m3 += double(rest) * spec.cell_area_m2();
+              taken -= double(rest);
+              rest = 0.0f;
+              moved = true;
+            }
+            break;
           }
-          break;
+          const std::int64_t t = std::int64_t(std::floor(v)) * cols_ + std::int64_t(std::floor(u));
+          if ((queued_[t] & kHull) || obstacle_[t] != 0) continue;
+          const float room = ceiling_m_ - h[t];
+          if (!(room > 0.0f)) continue;
+          const float add = std::min(rest, room);
+          dirty(std::uint32_t(t));
+          const float raised = h[t] + add;
+          put += double(raised) - double(h[t]);
+          h[t] = raised;
+          last_put = t;
+          rest -= add;
+          moved = true;
+          out.changed.include(int(t % cols_), int(t / cols_));
+          activate(std::uint32_t(t));
         }
-        const std::int64_t t = std::int64_t(std::floor(v)) * cols_ + std::int64_t(std::floor(u));
-        if ((queued_[t] & kHull) || obstacle_[t] != 0) continue;
-        const float room = ceiling_m_ - h[t];
-        if (!(room > 0.0f)) continue;
-        const float add = std::min(rest, room);
-        dirty(std::uint32_t(t));
-        const float raised = h[t] + add;
-        put += double(raised) - double(h[t]);
-        h[t] = raised;
-        last_put = t;
-        rest -= add;
-        moved = true;
-        out.changed.include(int(t % cols_), int(t / cols_));
-        activate(std::uint32_t(t));
+        if (rest <= 0.0f) break;
       }
-      if (rest <= 0.0f) break;
+      if (!moved) continue;  // nowhere to go: it stays (a hull filling the grid)
+      // What found no room stays in the cell.
+      dirty(cell);
+      h[cell] = under + rest;
+      taken += double(now) - double(h[cell]);
+      out.changed.include(c, row);
+      lowered(cell, h);
     }
-    if (!moved) continue;  // nowhere to go: it stays (a hull filling the grid)
-    // What found no room stays in the cell.
-    dirty(cell);
-    h[cell] = under + rest;
-    taken += double(now) - double(h[cell]);
-    out.changed.include(c, row);
-    lowered(cell, h);
   }
   // Give back the rounding of the writes on the last cell written.
   if (last_put >= 0 && put != taken) h[last_put] = float(std::max(0.0, double(h[last_put]) + (taken - put)));

@@ -735,6 +735,39 @@ TEST(Bucket, LoweredLevelIntoSoilLeavesNoneAboveItsFloor) {
   EXPECT_LT(b.worst_conservation_m3, bucket_rounding_m3());
 }
 
+TEST(Bucket, AYawedBucketLoweredIntoSoilLeavesNoneAboveItsFloor) {
+  // The same lowering with the bucket turned about the vertical (37 and
+  // 90 + 23 degrees): the floor's plan is a rotated rectangle that crosses
+  // rows and columns obliquely, and no cell centre inside it (in the
+  // bucket's frame: |u| < half the lip, 0 < w < the floor's depth) keeps
+  // soil above the floor. Centres within a millionth of a cell of the
+  // rectangle's edge are left out (either side is right for them).
+  for (const double yaw_deg : {37.0, 113.0}) {
+    BucketCycle b;
+    const Quat yaw = quat_from_axis_angle({0.0, 1.0, 0.0}, yaw_deg * kDeg);
+    b.step({1.0, 0.25, 1.0}, yaw);
+    b.move({1.0, 0.25, 1.0}, {1.0, 0.15, 1.0}, 200, yaw, yaw);
+    const Quat inverse{yaw.w, -yaw.x, -yaw.y, -yaw.z};
+    const HeightGrid& g = b.sim->grid();
+    const double edge = 1e-6 * BucketCycle::kCell;
+    double worst = -1e9;
+    int inside = 0;
+    for (int r = 0; r < g.rows(); ++r)
+      for (int c = 0; c < g.cols(); ++c) {
+        const Vec3 d{(c + 0.5) * BucketCycle::kCell - 1.0, 0.0, (r + 0.5) * BucketCycle::kCell - 1.0};
+        const Vec3 local = rotate(inverse, d);
+        if (std::abs(local.x) >= 0.2 - edge || local.z <= edge || local.z >= 0.3 - edge) continue;
+        ++inside;
+        worst = std::max(worst, double(g.height(c, r)) - 0.15);
+      }
+    // The plan holds 0.4 x 0.3 m: 1200 cells, to a row of cells round its edge.
+    EXPECT_NEAR(inside, 1200, 2.0 * (0.4 + 0.3) / BucketCycle::kCell) << "yaw " << yaw_deg;
+    EXPECT_LE(worst, kUnderHullSlack) << "yaw " << yaw_deg;
+    EXPECT_GT(b.sim->last().soil.shouldered_m3 + b.sim->last().soil.displaced_volume_m3, 0.0);
+    EXPECT_LT(b.worst_conservation_m3, bucket_rounding_m3()) << "yaw " << yaw_deg;
+  }
+}
+
 TEST(Bucket, PushedDownHeelFirstShouldersTheSoilAsideAndKeepsItAll) {
   // Curled 30 degrees (the back lowered), lip above the sand: only the
   // heel and the floor go in, 10 cm deep at the heel.

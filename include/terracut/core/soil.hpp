@@ -244,10 +244,13 @@ class SoilFlow {
   void mark_hull(const HeightGrid& grid, const Segment& lip, const Quat& orientation);
   void clear_hull();
   void shoulder(HeightGrid& grid, SoilStepResult& out);
+  /// Where cell (c, row) of the hull's bounding rectangle is in hull_under_.
+  std::size_t hull_slot(int c, int row) const {
+    return std::size_t(row - hull_rect_.r0) * std::size_t(hull_rect_.c1 - hull_rect_.c0) + std::size_t(c - hull_rect_.c0);
+  }
   /// The hull's underside over a marked cell (kHull set), metres above the ground.
   float hull_under(std::uint32_t cell) const {
-    const int c = int(cell % std::uint32_t(cols_)) - hull_rect_.c0, r = int(cell / std::uint32_t(cols_)) - hull_rect_.r0;
-    return hull_under_[std::size_t(r) * std::size_t(hull_rect_.c1 - hull_rect_.c0) + std::size_t(c)];
+    return hull_under_[hull_slot(int(cell % std::uint32_t(cols_)), int(cell / std::uint32_t(cols_)))];
   }
   void run_passes(HeightGrid& grid, SoilStepResult& out);
   std::int64_t examine(std::uint32_t a, const float* h);
@@ -320,6 +323,9 @@ class SoilFlow {
   // and its plan centre.
   std::vector<std::uint32_t> hull_cells_;
   std::vector<float> hull_under_;
+  // Per row of the rectangle, the columns [first, end) that a plate may
+  // cover (mark_hull tests only those).
+  std::vector<int> hull_row_c0_, hull_row_c1_;
   Rect hull_rect_{};
   Segment hull_heel_{};
   double hull_cx_ = 0.0, hull_cz_ = 0.0;
