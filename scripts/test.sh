@@ -23,8 +23,14 @@ build=${TERRACUT_BUILD_DIR:-$root/build}
 # Each step's start in the log, for docs/reliability.md's "CI time".
 stamp() { echo "== $(date -u +%H:%M:%S) $*"; }
 release_tests() {
-  ctest --test-dir "$build" --output-on-failure -j"${TERRACUT_JOBS:-$(nproc)}" --timeout 600
+  ctest --test-dir "$build" --output-on-failure -j"${TERRACUT_JOBS:-$(nproc)}" --timeout 600 "$@"
 }
+# The two-process MMT test paces both stations by the wall clock, and its
+# soil estimate drifts back toward 1 when the machine is loaded (a known
+# limit, docs/teleoperation.md, "Not done yet"): beside the sanitizer
+# builds it runs after them, on an otherwise idle machine.
+wall_clock_test='^session_mmt_two_process$'
+
 if [[ ${TERRACUT_SANITIZE:-1} == 0 ]]; then
   "$root/scripts/build.sh" -DTERRACUT_TEST_SUITES="$suites"
   release_tests
@@ -45,11 +51,15 @@ san_pid=$!
 trap 'kill -- -"$san_pid" 2>/dev/null || true' EXIT
 release_status=0
 { "$root/scripts/build.sh" -DTERRACUT_TEST_SUITES="$suites" && stamp "the Release tree's suites" &&
-  release_tests; } || release_status=$?
+  release_tests -E "$wall_clock_test"; } || release_status=$?
 stamp "the Release tree's suites done; waiting for the sanitizer and fuzz builds"
 san_status=0
 wait "$san_pid" || san_status=$?
 trap - EXIT
+if [[ $release_status == 0 ]]; then
+  stamp "the Release tree's wall-clock test, alone"
+  release_tests -R "$wall_clock_test" || release_status=$?
+fi
 stamp "the sanitizer and fuzz builds done ($san_log):"
 cat "$san_log"
 if [[ $release_status != 0 || $san_status != 0 ]]; then
