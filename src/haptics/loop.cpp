@@ -98,6 +98,7 @@ void HapticLoop::step1(double t_s) noexcept {
   stepped_ = has_sample_ && !bad;
   if (!stepped_) {
     velocity_m_per_s_ = {};
+    acceleration_m_per_s2_ = {};
     yaw_rate_rad_per_s_ = 0.0;
     has_previous_tool_ = false;  // start the estimate afresh
     return;
@@ -168,9 +169,17 @@ void HapticLoop::estimate_velocity(const BladePose& pose, double t_s) noexcept {
     const double dt = device_clock ? device_t - previous_device_t_s_ : t_s - previous_tool_t_s_;
     const Vec3 raw = (pose.position_m - previous_tool_m_) * (1.0 / dt);
     const double alpha = filter_rc_s_ > 0.0 ? 1.0 - std::exp(-dt / filter_rc_s_) : 1.0;
+    const Vec3 before = velocity_m_per_s_;
     velocity_m_per_s_ = velocity_m_per_s_ + (raw - velocity_m_per_s_) * alpha;
+    // The acceleration: the filtered velocity's change, low-passed again. A
+    // first-order low-pass keeps the integral of what it filters, so the
+    // impulse of the load's inertia is its mass x its change of velocity.
+    const double beta = 1.0 - std::exp(-dt * 2.0 * std::numbers::pi * kAccelerationCutoffHz);
+    acceleration_m_per_s2_ =
+        acceleration_m_per_s2_ + ((velocity_m_per_s_ - before) * (1.0 / dt) - acceleration_m_per_s2_) * beta;
   } else {
     velocity_m_per_s_ = {};
+    acceleration_m_per_s2_ = {};
   }
   // The yaw rate: the turn of the edge's horizontal direction about +Y
   // (Ry(a) X = (cos a, 0, -sin a)), filtered as the velocity is.
@@ -263,11 +272,13 @@ ForceOutput HapticLoop::world_force(const StepOutput& out, const CutLoad& load) 
     }
   }
   ForceOutput force = params_.force_model().compute(in);
-  // The soil a bucket carries weighs on it (unit weight x volume, straight down).
+  // The soil a bucket carries weighs on it (unit weight x volume, straight
+  // down) and resists its acceleration (its mass, weight / g, x -a).
   const double load_n = params_.force_model().params().earthmoving.soil.unit_weight_n_per_m3 *
                         out.soil.bucket_load_m3;
   if (!sim_.listeners().empty() || load_n > 0.0) {
-    force.world_n = force.world_n + out.listener_force_world_n + Vec3{0.0, -load_n, 0.0};
+    const Vec3 inertia_n = acceleration_m_per_s2_ * (-load_n / kGravityM_s2);
+    force.world_n = force.world_n + out.listener_force_world_n + Vec3{0.0, -load_n, 0.0} + inertia_n;
     force.device_n = force.world_n * params_.force_model().params().force_scale;
   }
   return force;

@@ -255,5 +255,40 @@ TEST(Session, TheOperatorFeelsTheWeightOfTheBucketsLoad) {
   EXPECT_NEAR(after_dump_y, 0.0, 1e-9);  // empty, out of the sand: nothing
 }
 
+TEST(Session, TheBucketsLoadResistsItsAcceleration) {
+  // scenarios/bucket_cycle.yaml: out of the sand, the bucket's lift (0.67 m/s
+  // up, 1.9-2.4 s) turns into its carry (0.6 m/s along +X, 2.4-3.4 s). The
+  // load's inertia is all the horizontal force there, and its impulse over
+  // the turn is the load's mass x its change of velocity, whatever the
+  // filters: -m (0.6, -0.67, 0) N s, m = weight / g.
+  const Scenario sc = load_scenario(fs::path(TERRACUT_SOURCE_DIR) / "scenarios/bucket_cycle.yaml");
+  SessionOptions o;
+  o.clock = ClockMode::kFake;
+  HapticSession s(sc, o);
+  s.run();
+  double weight = 0.0, impulse_x = 0.0, impulse_y = 0.0, impulse_z = 0.0, peak_x = 0.0;
+  int n = 0;
+  for (const haptics::LoopRecord& r : s.loop().records()) {
+    if (r.t_s > 2.6 && r.t_s < 3.3) weight -= r.force_world_n.y, ++n;
+  }
+  ASSERT_GT(n, 100);
+  weight /= n;
+  const double dt = 1.0 / sc.base.rate_hz;
+  for (const haptics::LoopRecord& r : s.loop().records()) {
+    if (!(r.t_s > 2.3 && r.t_s < 3.3)) continue;
+    impulse_x += r.force_world_n.x * dt;
+    impulse_y += (r.force_world_n.y + weight) * dt;
+    impulse_z += r.force_world_n.z * dt;
+    peak_x = std::min(peak_x, r.force_world_n.x);
+  }
+  const double mass = weight / haptics::HapticLoop::kGravityM_s2;
+  EXPECT_GT(mass, 10.0);  // about 0.0084 m^3 of dry sand
+  EXPECT_NEAR(impulse_x, -mass * 0.6, 1e-3 * mass * 0.6);
+  EXPECT_NEAR(impulse_y, mass * (0.6 - 0.265) / 0.5, 1e-3 * mass);
+  EXPECT_NEAR(impulse_z, 0.0, 1e-9);
+  // Spread over the filter's time constant, not a single tick.
+  EXPECT_LT(-peak_x, mass * 0.6 * 2.0 * 3.14159265 * haptics::HapticLoop::kAccelerationCutoffHz * 1.01);
+}
+
 }  // namespace
 }  // namespace terracut::session

@@ -210,6 +210,18 @@ class HapticLoop {
   const LoopRecord& last() const { return last_; }
   /// The tool's estimated yaw rate about world +Y, rad/s (filtered as the velocity).
   double yaw_rate_rad_per_s() const { return yaw_rate_rad_per_s_; }
+  /// The tool's estimated acceleration, world m/s^2: the filtered velocity's
+  /// backward difference, low-passed at kAccelerationCutoffHz. The soil a
+  /// bucket carries resists it (its inertia, in the force).
+  Vec3 acceleration_m_per_s2() const { return acceleration_m_per_s2_; }
+  /// Cut-off of the acceleration's first-order low-pass, Hz: a tenth of the
+  /// velocity's default 100 Hz, so that device noise differentiated twice
+  /// does not reach the hand (at 10 um of position noise and 1 kHz the raw
+  /// second difference is about 10 m/s^2); a 16 ms time constant.
+  static constexpr double kAccelerationCutoffHz = 10.0;
+  /// Standard gravity, m/s^2: the carried soil's mass is its weight (unit
+  /// weight x volume) over this (the Bullet world's default gravity).
+  static constexpr double kGravityM_s2 = 9.81;
   /// The kept records, oldest first.
   std::vector<LoopRecord> records() const;
   /// Percentiles over the kept records: the period's deviation from the
@@ -287,6 +299,7 @@ class HapticLoop {
   double previous_tool_t_s_ = 0.0;
   bool has_previous_tool_ = false;
   Vec3 velocity_m_per_s_{};
+  Vec3 acceleration_m_per_s2_{};     // filtered, world
   double previous_yaw_rad_ = 0.0;    // the edge's heading at the previous good sample
   double previous_device_t_s_ = std::numeric_limits<double>::quiet_NaN();  // its device time
   double yaw_rate_rad_per_s_ = 0.0;  // filtered, about world +Y
