@@ -74,10 +74,12 @@ std::optional<double> LinkEmulator::schedule(double now_s, bool reliable) noexce
   double extra_s = 0.0;
   if (reliable) {
     // Each loss costs one retransmission timeout (at most 50 in a row).
-    for (int tries = 0; tries < 50 && lose(); ++tries) {
+    int tries = 0;
+    for (; tries < 50 && lose(); ++tries) {
       ++counters_.retransmits;
       extra_s += retransmit_s_;
     }
+    counters_.max_retransmits = std::max(counters_.max_retransmits, tries);
   } else if (lose()) {
     ++counters_.lost;
     return std::nullopt;

@@ -61,6 +61,7 @@ struct EmulatorCounters {
   std::int64_t datagrams = 0;    ///< scheduled
   std::int64_t lost = 0;         ///< unreliable datagrams dropped
   std::int64_t retransmits = 0;  ///< losses of reliable datagrams (each cost a timeout)
+  int max_retransmits = 0;       ///< the most one reliable datagram needed (its delay: that x the timeout)
   std::int64_t held_back = 0;    ///< datagrams held back for reordering
 };
 
@@ -75,6 +76,8 @@ class LinkEmulator {
 
   const LinkConditions& conditions() const { return c_; }
   const EmulatorCounters& counters() const { return counters_; }
+  /// The retransmission timeout a lost reliable datagram costs, s.
+  double retransmit_s() const { return retransmit_s_; }
 
  private:
   bool lose() noexcept;   // one loss draw (steps the Gilbert-Elliott chain)
