@@ -626,6 +626,8 @@ ForceOutput ForceModel::compute(const ForceInput& input) const noexcept {
       out.engaged_width_m = input.contact_length_m;
       out.cutting_n = contact_drag_force(params_.contact_drag, input.contact_length_m, v,
                                          params_.low_speed_damping_n_s_per_m);
+      out.cutting_uncapped_n = params_.contact_drag.drag_n_per_m * std::max(input.contact_length_m, 0.0);
+      out.cutting_cap_n = params_.low_speed_damping_n_s_per_m * length(v);
       break;
     case CuttingModel::kEarthmoving: {
       double width = input.cut_width_m >= 0.0 ? input.cut_width_m : input.contact_length_m;
@@ -648,6 +650,8 @@ ForceOutput ForceModel::compute(const ForceInput& input) const noexcept {
       }
       out.cutting_n =
           earthmoving_world_force(out.earthmoving, v, params_.low_speed_damping_n_s_per_m);
+      out.cutting_uncapped_n = std::abs(out.earthmoving.horizontal_n);
+      out.cutting_cap_n = params_.low_speed_damping_n_s_per_m * speed_xz;
       break;
     }
   }
@@ -680,6 +684,8 @@ ForceOutput ForceModel::compute(const ForceInput& input) const noexcept {
     const double k = check_.cutting_gain;
     if (k != 1.0) {
       out.cutting_n = out.cutting_n * k;
+      out.cutting_uncapped_n *= k;
+      out.cutting_cap_n *= k;
       out.penetration_n = out.penetration_n * k;
       out.twist_n = out.twist_n * k;
       out.twist_torque_n_m *= k;

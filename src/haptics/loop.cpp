@@ -301,6 +301,9 @@ LoopRecord& HapticLoop::write_record(const StepOutput& out, const ForceOutput& f
   r.force_world_n = force.world_n;
   r.body_force_world_n = body_force;
   r.penetration_force_n = force.penetration_n.y;
+  r.cutting_force_world_n = force.cutting_n;
+  r.cutting_uncapped_n = force.cutting_uncapped_n;
+  r.cutting_cap_n = force.cutting_cap_n;
   r.twist_torque_n_m = force.twist_torque_n_m;
   r.yaw_rate_rad_per_s = yaw_rate_rad_per_s_;
   r.force_device_n = command.force_n;

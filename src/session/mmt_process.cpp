@@ -133,6 +133,9 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
   j["role"] = "remote";
   j["connections"] = link->connections();
   j["force_scale"] = station.force_scale();
+  j["estimate"] = {{"samples", station.estimate_samples()},
+                   {"outliers_left_out", station.estimate_outliers()},
+                   {"capped_left_out", station.estimate_capped()}};
   write_json(o.out / "summary.json", j);
   if (o.log)
     *o.log << "terracut mmt: remote done: " << station.counters().accepted << " commands, "

@@ -290,6 +290,7 @@ MmtSummary MmtRun::summary() const {
   s.force_scale_applied = op.empty() ? 1.0 : op.back().scale_applied;
   s.estimate_samples = remote_->estimate_samples();
   s.estimate_outliers = remote_->estimate_outliers();
+  s.estimate_capped = remote_->estimate_capped();
   std::vector<double> c;
   for (const OperatorRecord& r : op) c.push_back(r.compute_s);
   s.operator_compute = timing_stats(c);
@@ -349,7 +350,8 @@ void MmtRun::write_outputs(const std::filesystem::path& dir) const {
   j["estimate"] = {{"force_scale", s.force_scale_final},
                    {"force_scale_applied", s.force_scale_applied},
                    {"samples", s.estimate_samples},
-                   {"outliers_left_out", s.estimate_outliers}};
+                   {"outliers_left_out", s.estimate_outliers},
+                   {"capped_left_out", s.estimate_capped}};
   j["passivity"] = {{"window_s", 1.0},
                     {"mmt_max_energy_into_hand_j", s.passivity_max_mmt_j},
                     {"direct_max_energy_into_hand_j", s.passivity_max_dfr_j}};

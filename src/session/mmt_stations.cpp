@@ -157,12 +157,15 @@ class LinkGuardDevice final : public haptics::Device {
 };
 
 // ---------------------------------------------------------------------------
-// The soil estimate on the operator's side: the horizontal cutting force of
-// the local model times (factor - 1), added as a step listener's force. The
-// factor applied moves toward the remote's estimate by at most
-// max_update_step_n of device force per tick. It reads the model's force of
-// the previous tick (the loop computes this tick's after the listeners):
-// one tick late, well inside the blend.
+// The soil estimate on the operator's side: the factor scales the soil's
+// horizontal cutting force before the low-speed cap, min(cap, factor x
+// soil), and the listener adds the difference from the model's own,
+// min(cap, soil), along it. Scaling after the cap would render factor x cap
+// where both worlds give the cap (a slow tool). The factor applied moves
+// toward the remote's estimate by at most max_update_step_n of device force
+// per tick. It reads the model's force of the previous tick (the loop
+// computes this tick's after the listeners): one tick late, well inside
+// the blend.
 // ---------------------------------------------------------------------------
 
 class ScaleCorrection final : public StepListener {
@@ -176,17 +179,23 @@ class ScaleCorrection final : public StepListener {
 
   Vec3 on_step(const StepOutput&) noexcept override {
     const haptics::LoopRecord& last = loop_.last();
-    const Vec3 model_h = horizontal(last.force_world_n - last.body_force_world_n);
-    const double device_n =
-        length(model_h) * loop_.force_model().params().force_scale;
+    const Vec3 model_h = horizontal(last.cutting_force_world_n);
+    const double model_n = length(model_h);
+    const double soil_n = last.cutting_uncapped_n, cap_n = last.cutting_cap_n;
+    const double scale = loop_.force_model().params().force_scale;
+    // A change of the factor changes min(cap, factor x soil) by at most the
+    // change x soil.
+    const double device_n = soil_n * scale;
     const double max_change = device_n > 1e-12 ? max_step_n_ / device_n : 1e300;
     const double change = std::clamp(target_ - applied_, -max_change, max_change);
     moving_ = change != 0.0;
+    const double before_n = std::min(cap_n, applied_ * soil_n);
     applied_ += change;
-    // What the update itself changed in the rendered force this tick:
-    // (the factor's change) x the model's force, device N.
-    last_step_n_ = std::fabs(change) * device_n;
-    return model_h * (applied_ - 1.0);
+    const double rendered_n = std::min(cap_n, applied_ * soil_n);
+    // What the update itself changed in the rendered force this tick, device N.
+    last_step_n_ = std::fabs(rendered_n - before_n) * scale;
+    if (!(model_n > 0.0)) return {};
+    return model_h * ((rendered_n - model_n) / model_n);
   }
   /// The device force the factor's change added this tick, N (<= max_step_n).
   double last_step_n() const { return last_step_n_; }
@@ -307,9 +316,21 @@ void RemoteStation::update_estimate(const haptics::LoopRecord& r) {
         r.velocity_m_per_s, haptics::depth_lookahead_m(simulation().grid().spec()));
     in.surcharge_pa = nominal_.params().earthmoving.soil.unit_weight_n_per_m3 * ahead.pile_m;
   }
-  const double x = length(horizontal(nominal_.compute(in).cutting_n)) / 100.0;
+  const ForceOutput nominal = nominal_.compute(in);
+  const double x = length(horizontal(nominal.cutting_n)) / 100.0;
   const double y = length(horizontal(r.force_world_n)) / 100.0;
   if (!(x > 0.01) || !std::isfinite(y)) return;  // below 1 N the ratio says little
+  // The low-speed cap (ForceModelParams::low_speed_damping_n_s_per_m) holds
+  // the soil's force at c |v| in both worlds below H / c: there both read
+  // c |v| whatever the soil, and the sample, fitted, pulls the factor toward
+  // 1 (a tool slowed by a loaded machine made it 1.01). A sample counts only
+  // where the cap stands clear of the soil's force in both models, the
+  // remote's at the current estimate (kMargin for the estimate's error).
+  constexpr double kMargin = 1.1;
+  if (!(nominal.cutting_cap_n > kMargin * std::max(theta_, 1.0) * nominal.cutting_uncapped_n)) {
+    ++rls_capped_;
+    return;
+  }
   // Once it has settled, a sample more than kOutlier times off the estimate
   // is something no soil does (the plate striking a rock: Bullet's impact
   // is a hundred times the cut): left out, or it would be carried into the

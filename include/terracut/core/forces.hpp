@@ -489,6 +489,14 @@ struct ForceOutput {
   PenetrationResult penetration{};  ///< tip and face resistance (zero when disabled)
   Vec3 twist_n{};                   ///< twist's net world force (horizontal), N
   double twist_torque_n_m = 0.0;    ///< twist's torque about world +Y, N m (not rendered by a 3-DOF device)
+  /// The cutting force before the low-speed cap, N, and the cap itself
+  /// (low_speed_damping_n_s_per_m x speed), N, both after the device's
+  /// cutting gain: the cutting force is the lower of the two (kEarthmoving:
+  /// its horizontal part, the speed the horizontal one; kContactDrag: the
+  /// drag along the motion, viscous part aside). Zero for kNone. A factor
+  /// on the soil scales the first, not the cap.
+  double cutting_uncapped_n = 0.0;
+  double cutting_cap_n = 0.0;
 };
 
 /// The combined model: validated and device-checked once, then a pure const

@@ -82,6 +82,12 @@ struct LoopRecord {
   Vec3 body_force_world_n{};
   /// The penetration model's part of force_world_n (vertical, +Y up), world N.
   double penetration_force_n = 0.0;
+  /// The cutting model's part of force_world_n, world N, and what it is the
+  /// lower of: the soil's force before the low-speed cap and the cap, N
+  /// (ForceOutput::cutting_uncapped_n, cutting_cap_n).
+  Vec3 cutting_force_world_n{};
+  double cutting_uncapped_n = 0.0;
+  double cutting_cap_n = 0.0;
   /// Twist torque on the tool about world +Y, N m (not in any force: a 3-DOF
   /// device cannot render it).
   double twist_torque_n_m = 0.0;

@@ -134,6 +134,9 @@ class RemoteStation {
   /// Samples the estimate left out as outliers (more than 4 times off it,
   /// once 200 samples had settled it).
   std::int64_t estimate_outliers() const { return rls_outliers_; }
+  /// Samples the estimate left out because the low-speed cap, not the soil,
+  /// set the force (in either world, by the current estimate).
+  std::int64_t estimate_capped() const { return rls_capped_; }
   /// Packets sent that carried model updates (patches + estimates).
   std::int64_t update_packets() const { return counters_.patches + counters_.estimates; }
 
@@ -164,6 +167,7 @@ class RemoteStation {
   double theta_ = 1.0, p_ = 10.0, theta_sent_ = 1.0;
   std::int64_t rls_samples_ = 0;
   std::int64_t rls_outliers_ = 0;
+  std::int64_t rls_capped_ = 0;
   bool estimate_sent_ = false;
   double previous_t_s_ = 0.0;
   bool ticked_ = false;
@@ -317,6 +321,7 @@ struct MmtSummary {
   double force_scale_applied = 1.0;  ///< what the operator applied at the end
   std::int64_t estimate_samples = 0;
   std::int64_t estimate_outliers = 0;  ///< samples the estimate left out (remote's estimate_outliers)
+  std::int64_t estimate_capped = 0;    ///< samples left out where the low-speed cap set the force
   TimingStats operator_compute{}, remote_compute{};
 };
 
