@@ -769,6 +769,18 @@ void TerrainWorld::apply_pile_pressure() {
   for (std::size_t i = 0; i < m.bodies.size(); ++i) {
     btRigidBody& b = *m.bodies[i];
     if (m.held[i] || b.isStaticOrKinematicObject()) continue;
+    SoilView& view = views_[i];
+    const bool asleep = !b.isActive();
+    if (asleep && view.pile_asleep && !view.band_changed) {
+      // Asleep since it was last summed, on soil that has not changed: the
+      // same push, and a sleeping body is only woken by a changed band.
+      if (view.pile_magnitude_n > 0.0) {
+        pending_pile_force_n_ += view.pile_magnitude_n;
+        pending_pile_thrust_n_ = pending_pile_thrust_n_ + view.pile_force_n;
+      }
+      continue;
+    }
+    view.pile_asleep = false;
     const SoilObstacle o = soil_obstacle(int(i));
     if (o.cells.empty()) continue;
     btVector3 lo, hi;
@@ -804,9 +816,12 @@ void TerrainWorld::apply_pile_pressure() {
         magnitude += p;
       }
     }
+    view.pile_asleep = asleep;
+    view.pile_magnitude_n = magnitude;
+    view.pile_force_n = from_bt(force);
     if (!(magnitude > 0.0)) continue;
     pending_pile_force_n_ += magnitude;
-    pending_pile_thrust_n_ = pending_pile_thrust_n_ + from_bt(force);
+    pending_pile_thrust_n_ = pending_pile_thrust_n_ + view.pile_force_n;
     // Static friction carries a thrust below the body's sliding friction on
     // level ground (Bullet multiplies the two friction coefficients): the
     // body would not move, and Bullet's iterative solver lets an awake body

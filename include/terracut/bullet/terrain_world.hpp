@@ -344,6 +344,13 @@ class TerrainWorld {
     std::vector<float> heights_m;  ///< region rows x cols, row-major, metres (capacity reserved)
     /// A sample of the pile band changed since the last apply_pile_pressure.
     bool band_changed = false;
+    /// The pile's push on the body as apply_pile_pressure last found it while
+    /// the body slept (total magnitude, N, and net force, world N): while it
+    /// sleeps on and its band does not change, the same (it reads only the
+    /// band's heights and the body's box), so it is not summed again.
+    bool pile_asleep = false;
+    double pile_magnitude_n = 0.0;
+    Vec3 pile_force_n{};
   };
   std::vector<SoilView> views_;  // one per body
   /// Body i's samples whose triangles reach its box (`reached`, not clipped)
