@@ -194,8 +194,12 @@ class ScaleCorrection final : public StepListener {
     const double rendered_n = std::min(cap_n, applied_ * soil_n);
     // What the update itself changed in the rendered force this tick, device N.
     last_step_n_ = std::fabs(rendered_n - before_n) * scale;
-    if (!(model_n > 0.0)) return {};
-    return model_h * ((rendered_n - model_n) / model_n);
+    // The model's own force scaled by the factor's effect under the cap (a
+    // factor of 1 adds nothing, whatever else the model's force holds: the
+    // drag's viscous part, a vertical motion).
+    const double own_n = std::min(cap_n, soil_n);
+    if (!(model_n > 0.0) || !(own_n > 0.0)) return {};
+    return model_h * (rendered_n / own_n - 1.0);
   }
   /// The device force the factor's change added this tick, N (<= max_step_n).
   double last_step_n() const { return last_step_n_; }
