@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -287,7 +288,7 @@ TEST(Session, TheBucketsLoadResistsItsAcceleration) {
   EXPECT_NEAR(impulse_y, mass * (0.6 - 0.265) / 0.5, 1e-3 * mass);
   EXPECT_NEAR(impulse_z, 0.0, 1e-9);
   // Spread over the filter's time constant, not a single tick.
-  EXPECT_LT(-peak_x, mass * 0.6 * 2.0 * 3.14159265 * haptics::HapticLoop::kAccelerationCutoffHz * 1.01);
+  EXPECT_LT(-peak_x, mass * 0.6 * 2.0 * std::numbers::pi * haptics::HapticLoop::kAccelerationCutoffHz * 1.01);
 }
 
 }  // namespace
