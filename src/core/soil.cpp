@@ -3,6 +3,7 @@
 #include "terracut/core/soil.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -138,6 +139,7 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   tolerance_m_ = float(kToleranceOfLimit * std::min(limit_[0], limit_[1]));
   origin_x_ = spec.origin_m.x;
   origin_z_ = spec.origin_m.z;
+  row_div_ = detail::IndexDivider(std::uint32_t(cols_));
 
   for (int k = 0; k < 8; ++k) {
     offset_[k] = std::int64_t(kNeighbours[k].dr) * cols_ + kNeighbours[k].dc;
@@ -146,7 +148,14 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
 
   const std::size_t n = std::size_t(grid.spec().sample_count());
   queued_.assign(n, 0);
-  near_blade_.assign(n, 0);
+  for (int c = 0; c < cols_; ++c) {
+    queued_[std::size_t(c)] |= kEdge;
+    queued_[std::size_t(std::int64_t(rows_ - 1) * cols_ + c)] |= kEdge;
+  }
+  for (int r = 0; r < rows_; ++r) {
+    queued_[std::size_t(std::int64_t(r) * cols_)] |= kEdge;
+    queued_[std::size_t(std::int64_t(r) * cols_ + cols_ - 1)] |= kEdge;
+  }
   obstacle_.assign(n, 0);
   obstacles_.reserve(16);
   // The per-step scratch sized up front for the blade (its swept rectangle
@@ -247,14 +256,20 @@ void SoilFlow::lowered(std::uint32_t cell, const float* h) {
   // Only the pairs of this cell changed: a neighbour that now stands too
   // steep above it is examined in the next pass (the same test as a pass's).
   activate(cell);
-  const int c = int(cell % std::uint32_t(cols_)), r = int(cell / std::uint32_t(cols_));
-  const bool inside = c > 0 && r > 0 && c < cols_ - 1 && r < rows_ - 1;
   const float hc = h[cell];
+  if (!(queued_[cell] & kEdge)) {
+    // All 8 tested without a branch each; the steep ones then activated.
+    unsigned steep = 0;
+    for (int k = 0; k < 8; ++k)
+      steep |= unsigned(h[std::int64_t(cell) + offset_[k]] - hc - limit8_[k] > tolerance_m_) << k;
+    for (; steep != 0; steep &= steep - 1)
+      activate(std::uint32_t(std::int64_t(cell) + offset_[std::countr_zero(steep)]));
+    return;
+  }
+  const int c = col_of(cell), r = row_of(cell);
   for (int k = 0; k < 8; ++k) {
-    if (!inside) {
-      const int cb = c + kNeighbours[k].dc, rb = r + kNeighbours[k].dr;
-      if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_) continue;
-    }
+    const int cb = c + kNeighbours[k].dc, rb = r + kNeighbours[k].dr;
+    if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_) continue;
     const std::uint32_t b = std::uint32_t(std::int64_t(cell) + offset_[k]);
     if (h[b] - hc - limit8_[k] > tolerance_m_) activate(b);
   }
@@ -333,6 +348,9 @@ void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
   blade_ = {edge.a.x, edge.a.z, d.x, d.z, edge.a.y - spec.origin_m.y, d.y, plan_length > 0.0};
   if (!blade_.present) return;
   const double len2 = plan_length * plan_length;
+  blade_.len2 = d.x * d.x + d.z * d.z;
+  blade_.len = std::sqrt(blade_.len2);
+  blade_.half = 0.5 * (std::abs(d.z) * dx_ + std::abs(d.x) * dz_) / blade_.len;
   const double zlo = std::min(edge.a.z, edge.b.z) - radius, zhi = std::max(edge.a.z, edge.b.z) + radius;
   const int r0 = std::max(0, int(std::floor(to_cells(zlo, spec.origin_m.z, dz_) - 0.5)));
   const int r1 = std::min(rows_ - 1, int(std::ceil(to_cells(zhi, spec.origin_m.z, dz_) - 0.5)));
@@ -357,34 +375,31 @@ void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
       const double s = std::clamp(((x - edge.a.x) * d.x + (z - edge.a.z) * d.z) / len2, 0.0, 1.0);
       const double ex = x - (edge.a.x + d.x * s), ez = z - (edge.a.z + d.z * s);
       if (ex * ex + ez * ez > radius * radius) continue;
-      near_blade_[i] = 1;
+      queued_[i] |= kNearBlade;
       marked_.push_back(i);
     }
   }
 }
 
 void SoilFlow::clear_blade() {
-  for (std::uint32_t i : marked_) near_blade_[i] = 0;
+  for (std::uint32_t i : marked_) queued_[i] &= std::uint8_t(~kNearBlade);
   marked_.clear();
   blade_.present = false;
 }
 
-bool SoilFlow::blade_blocks(std::uint32_t high, std::uint32_t low, float top_m) const {
+bool SoilFlow::blade_blocks(int hc, int hr, int lc, int lr, float top_m) const {
   // Cell centres relative to the edge's first end, in plan.
-  const auto centre = [&](std::uint32_t i, double& x, double& z) {
-    x = (double(i % std::uint32_t(cols_)) + 0.5) * dx_ + origin_x_ - blade_.ax;
-    z = (double(i / std::uint32_t(cols_)) + 0.5) * dz_ + origin_z_ - blade_.az;
-  };
-  double xa, za, xb, zb;
-  centre(high, xa, za);
-  centre(low, xb, zb);
-  const double len2 = blade_.dx * blade_.dx + blade_.dz * blade_.dz;
-  const double len = std::sqrt(len2);
+  const double xa = (double(hc) + 0.5) * dx_ + origin_x_ - blade_.ax;
+  const double za = (double(hr) + 0.5) * dz_ + origin_z_ - blade_.az;
+  const double xb = (double(lc) + 0.5) * dx_ + origin_x_ - blade_.ax;
+  const double zb = (double(lr) + 0.5) * dz_ + origin_z_ - blade_.az;
+  const double len2 = blade_.len2;
+  const double len = blade_.len;
   // Signed distances to the edge's line, and the half width of a cell
-  // across it: a cell closer than that is inside the blade.
+  // across it (blade_.half): a cell closer than that is inside the blade.
   const double da = (blade_.dx * za - blade_.dz * xa) / len;
   const double db = (blade_.dx * zb - blade_.dz * xb) / len;
-  const double half = 0.5 * (std::abs(blade_.dz) * dx_ + std::abs(blade_.dx) * dz_) / len;
+  const double half = blade_.half;
   const bool low_inside = std::abs(db) < half;
   if (!low_inside && (da > 0.0) == (db > 0.0)) return false;  // one side, outside the blade
   // Where along the edge: at the low cell when it is inside the blade, else
@@ -707,66 +722,77 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
   // Cell a sheds half of its steepest excess, shared among its lower
   // neighbours in proportion to their excess (from the heights frozen at
   // the pass's start): its fluxes are appended to the pass's list.
-  const int ca = int(a % std::uint32_t(cols_)), ra = int(a / std::uint32_t(cols_));
+  // One byte holds the cell's flags (border, near the blade, ...).
+  const std::uint8_t flags = queued_[a];
   const float ha = h[a];
   const float tol = tolerance_m_;
   float excess[8];
-  bool outside[8] = {};
-  float max_excess = 0.0f;
-  if (ca > 0 && ra > 0 && ca < cols_ - 1 && ra < rows_ - 1) {
-    // Inside the grid: all 8 neighbours exist. Most examined cells cannot
-    // move: the 8 excesses and their maximum, without a branch, say so.
+  // Bit k: neighbour k is lower by more than its limit and the tolerance;
+  // bit 8 + k: neighbour k lies beyond the grid's edge. The pairs are
+  // tested without a branch each (which of them is steep changes from
+  // cell to cell, so a branch per pair is mispredicted often).
+  unsigned steep = 0, outside = 0;
+  if (!(flags & kEdge)) {
+    // Inside the grid: all 8 neighbours exist.
     for (int k = 0; k < 8; ++k) {
       excess[k] = ha - h[std::int64_t(a) + offset_[k]] - limit8_[k];
-      max_excess = std::max(max_excess, excess[k]);
+      steep |= unsigned(excess[k] > tol) << k;
     }
   } else {
+    const int ca = col_of(a), ra = row_of(a);
     for (int k = 0; k < 8; ++k) {
       const int cb = ca + kNeighbours[k].dc, rb = ra + kNeighbours[k].dr;
       if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_) {
         // Beyond an open edge lies bare ground (height 0) that takes what
         // slides onto it; a wall takes nothing.
-        outside[k] = true;
+        outside |= 1u << k;
         excess[k] = params_.edge == SoilEdge::kOpen ? ha - limit8_[k] : 0.0f;
       } else {
         excess[k] = ha - h[std::int64_t(a) + offset_[k]] - limit8_[k];
       }
-      max_excess = std::max(max_excess, excess[k]);
+      steep |= unsigned(excess[k] > tol) << k;
     }
   }
-  if (!(max_excess > tol)) return 0;
-  const bool blade = blade_.present && near_blade_[a];
+  if (steep == 0) return 0;  // most examined cells cannot move
+  const bool blade = blade_.present && (flags & kNearBlade);
+  // The cell's column and row, for the blade's test only.
+  const int ca = blade ? col_of(a) : 0, ra = blade ? row_of(a) : 0;
   const bool obstacles = !obstacles_.empty();
+  const bool hull = !hull_cells_.empty();
   std::uint32_t lower[8];
   float shed[8];
   int n = 0;
   float top = 0.0f, sum = 0.0f;
-  for (int k = 0; k < 8; ++k) {
+  for (unsigned bits = steep; bits != 0; bits &= bits - 1) {
+    const int k = std::countr_zero(bits);
     const float e = excess[k];
-    if (!(e > tol)) continue;
     std::uint32_t b = kOutside;
-    if (!outside[k]) {
+    if (!(outside & (1u << k))) {
       b = std::uint32_t(std::int64_t(a) + offset_[k]);
-      // The blade is a wall between the cells on its two sides, and soil
-      // does not flow into the cells it passes through. What it holds up
-      // is examined again once it has moved.
-      if (blade && near_blade_[b] && blade_blocks(a, b, ha)) {
-        if (!(queued_[a] & kHeld)) {
-          queued_[a] |= kHeld;
-          held_.push_back(a);
+      if (blade || obstacles || hull) {
+        const std::uint8_t fb = queued_[b];
+        // The blade is a wall between the cells on its two sides, and soil
+        // does not flow into the cells it passes through. What it holds up
+        // is examined again once it has moved.
+        if (blade && (fb & kNearBlade) &&
+            blade_blocks(ca, ra, ca + kNeighbours[k].dc, ra + kNeighbours[k].dr, ha)) {
+          if (!(queued_[a] & kHeld)) {
+            queued_[a] |= kHeld;
+            held_.push_back(a);
+          }
+          continue;
         }
-        continue;
-      }
-      // Nor into a rigid body's footprint (soil under it may slide out).
-      if (obstacles && obstructed(b)) continue;
-      // Nor into a cell under the bucket's hull from higher than the hull's
-      // underside there (a flux never raises a cell above its source).
-      if ((queued_[b] & kHull) && ha > hull_under(b)) {
-        if (!(queued_[a] & kHeld)) {
-          queued_[a] |= kHeld;
-          held_.push_back(a);
+        // Nor into a rigid body's footprint (soil under it may slide out).
+        if (obstacles && obstructed(b)) continue;
+        // Nor into a cell under the bucket's hull from higher than the hull's
+        // underside there (a flux never raises a cell above its source).
+        if ((fb & kHull) && ha > hull_under(b)) {
+          if (!(queued_[a] & kHeld)) {
+            queued_[a] |= kHeld;
+            held_.push_back(a);
+          }
+          continue;
         }
-        continue;
       }
     }
     lower[n] = b;
@@ -804,7 +830,6 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   const HeightGrid::EditLayers layers = grid.edit_layers();
   float* h = layers.height_m;
   const double cell_area = dx_ * dz_;
-  const std::uint32_t cols = std::uint32_t(cols_);
   // The work of the step, in neighbour visits: 8 per cell examined, 1 per
   // flux applied and 8 per source's fall test (its neighbours read again),
   // so that a step's work tracks its time whether it examines or applies.
@@ -867,7 +892,7 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
         pass_highest_h_ = now;
         pass_highest_ = a;
       }
-      const int ca = int(a % cols), ra = int(a / cols);
+      const int ca = col_of(a), ra = row_of(a);
       changed_c0 = std::min(changed_c0, ca);
       changed_c1 = std::max(changed_c1, ca);
       changed_r0 = std::min(changed_r0, ra);

@@ -96,6 +96,31 @@ std::vector<float> column(int n, double radius_cells, float height_m) {
   return h;
 }
 
+TEST(IndexDivider, QuotientsEqualHardwareDivisionForEveryRowLength) {
+  // Every row length a grid can have (1 .. kMaxGridSide), at the numerators
+  // where a rounded reciprocal goes wrong first: each multiple of the
+  // divisor and its neighbours, up to the largest 32-bit index; and every
+  // numerator below 2^20 for the small and power-of-two divisors.
+  std::int64_t checked = 0;
+  for (std::uint32_t d = 1; d <= std::uint32_t(kMaxGridSide); d += (d < 1100 ? 1 : 97)) {
+    const detail::IndexDivider div(d);
+    const std::uint64_t step = std::max<std::uint64_t>(d, (std::uint64_t(1) << 32) / 4096 / d * d);
+    for (std::uint64_t m = 0; m < (std::uint64_t(1) << 32); m += step)
+      for (std::int64_t e : {std::int64_t(-1), std::int64_t(0), std::int64_t(1), std::int64_t(d) - 1}) {
+        const std::int64_t n = std::int64_t(m) + e;
+        if (n < 0 || n > 0xffffffffLL) continue;
+        ASSERT_EQ(div.quotient(std::uint32_t(n)), std::uint32_t(n) / d) << n << " / " << d;
+        ++checked;
+      }
+    ASSERT_EQ(div.quotient(0xffffffffu), 0xffffffffu / d) << d;
+  }
+  for (std::uint32_t d : {1u, 2u, 3u, 7u, 100u, 512u, 4096u, 4111u, 65536u}) {
+    const detail::IndexDivider div(d);
+    for (std::uint32_t n = 0; n < (1u << 20); ++n) ASSERT_EQ(div.quotient(n), n / d) << n << " / " << d;
+  }
+  EXPECT_GT(checked, 1000000);
+}
+
 TEST(SoilFlow, AColumnCollapsesIntoARoundConeAtTheReposeAngle) {
   for (const double repose : {34.0, 45.0}) {
     const int n = 161;

@@ -98,6 +98,35 @@
 
 namespace terracut {
 
+namespace detail {
+
+/// Division of 32-bit cell indices by a fixed row length without a divide
+/// instruction: the quotient is the high word of a 64 x 64-bit product with
+/// ceil(2^64 / d), exact for every 32-bit numerator and every d >= 1
+/// (Lemire, Kaser & Kurz, "Faster remainder by direct computation",
+/// Software: Practice and Experience 49 (2019), theorem 1 with N = 32,
+/// F = 64). The relaxation turns a cell index into its column and row on
+/// every source; a hardware 32-bit division cost about a tenth of a pass.
+class IndexDivider {
+ public:
+  IndexDivider() = default;
+  explicit IndexDivider(std::uint32_t d) : d_(d), magic_(d > 1 ? ~std::uint64_t(0) / d + 1 : 0) {}
+  std::uint32_t quotient(std::uint32_t n) const {
+    if (d_ <= 1) return n;
+    // The high word of magic_ x n from two 32 x 32-bit products (no sum
+    // overflows: (2^32 - 1)^2 + 2^32 < 2^64).
+    const std::uint64_t hi = (magic_ >> 32) * n, lo = ((magic_ & 0xffffffffu) * n) >> 32;
+    return std::uint32_t((hi + lo) >> 32);
+  }
+  std::uint32_t divisor() const { return d_; }
+
+ private:
+  std::uint32_t d_ = 1;
+  std::uint64_t magic_ = 0;
+};
+
+}  // namespace detail
+
 /// What happens to the soil the blade cuts.
 enum class SoilModel {
   kVanish,  ///< it is gone (the paper's model; the default)
@@ -234,7 +263,12 @@ class SoilFlow {
   void wake_held(const Segment* edge);
   void mark_blade(const HeightGrid& grid, const Segment& edge);
   void clear_blade();
-  bool blade_blocks(std::uint32_t high, std::uint32_t low, float top_m) const;
+  /// Whether the blade stops soil at height top_m flowing from cell
+  /// (hc, hr) to its neighbour (lc, lr).
+  bool blade_blocks(int hc, int hr, int lc, int lr, float top_m) const;
+  /// Column and row of cell i.
+  int col_of(std::uint32_t i) const { return int(i - row_div_.quotient(i) * std::uint32_t(cols_)); }
+  int row_of(std::uint32_t i) const { return int(row_div_.quotient(i)); }
   bool pending() const { return !active_.empty() || !next_.empty(); }
   void displace(HeightGrid& grid, const Segment& from, const Segment& to, double bucket_room_m3,
                 SoilStepResult& out);
@@ -250,7 +284,7 @@ class SoilFlow {
   }
   /// The hull's underside over a marked cell (kHull set), metres above the ground.
   float hull_under(std::uint32_t cell) const {
-    return hull_under_[hull_slot(int(cell % std::uint32_t(cols_)), int(cell / std::uint32_t(cols_)))];
+    return hull_under_[hull_slot(col_of(cell), row_of(cell))];
   }
   void run_passes(HeightGrid& grid, SoilStepResult& out);
   std::int64_t examine(std::uint32_t a, const float* h);
@@ -268,15 +302,19 @@ class SoilFlow {
   float tolerance_m_ = 0.0f;
   double origin_x_ = 0.0;
   double origin_z_ = 0.0;
+  detail::IndexDivider row_div_;  // cell index / cols_
   // The 8 neighbours as index offsets and their repose limits (soil.cpp's kNeighbours order).
   std::int64_t offset_[8] = {};
   float limit8_[8] = {};
 
   // The blade of the step, in plan relative to the grid: its first end, its
   // span, and its edge height above the ground at the first end and along it.
+  // len2, len and half (half a cell's width across the edge's line, over
+  // len) are set by mark_blade for blade_blocks.
   struct BladeLine {
     double ax = 0.0, az = 0.0, dx = 0.0, dz = 0.0, ay = 0.0, dy = 0.0;
     bool present = false;
+    double len2 = 0.0, len = 0.0, half = 0.0;
   };
   BladeLine blade_{};
 
@@ -285,6 +323,8 @@ class SoilFlow {
   static constexpr std::uint8_t kHeld = 2;    // in held_
   static constexpr std::uint8_t kDirty = 4;   // in dirty_
   static constexpr std::uint8_t kHull = 8;    // under the bucket's hull (in hull_cells_)
+  static constexpr std::uint8_t kNearBlade = 16;  // within reach of the step's blade (in marked_)
+  static constexpr std::uint8_t kEdge = 32;   // on the grid's border (fewer than 8 neighbours); never cleared
   // A cell the cut, the displacement, the pour or an edit changed while a
   // pass was in progress: the pass's fluxes from or to it are dropped (they
   // came from heights it no longer has; it is examined again anyway).
@@ -312,7 +352,7 @@ class SoilFlow {
   std::uint32_t pass_highest_ = 0;  // the highest cell the pass raised or lowered
   float pass_highest_h_ = -1.0f;
   std::vector<std::uint32_t> next_;    // cells to examine in the next pass (kQueued set)
-  std::vector<std::uint8_t> queued_;   // per cell: kQueued | kHeld
+  std::vector<std::uint8_t> queued_;   // per cell: the flags above (one byte read gives them all)
   // Cells that kept an excess only because the blade stood in the way: they
   // are examined again once the blade has moved (held_edge_ is where it was).
   std::vector<std::uint32_t> held_;
@@ -329,14 +369,13 @@ class SoilFlow {
   Rect hull_rect_{};
   Segment hull_heel_{};
   double hull_cx_ = 0.0, hull_cz_ = 0.0;
-  std::vector<std::uint8_t> near_blade_;  // per cell: 1 within reach of the step's blade
   std::vector<std::uint8_t> obstacle_;    // per cell: 1 + index into obstacles_, 0 for none
   std::vector<SoilObstacle> obstacles_;   // the obstacles, their cells clipped to the grid
   /// True when a body stands over the cell: no soil flows or is pushed into
   /// it, whatever the gap under the body (soil filling the gap would lift
   /// the body from below instead of banking against its side).
   bool obstructed(std::uint32_t cell) const { return obstacle_[cell] != 0; }
-  std::vector<std::uint32_t> marked_;     // cells with near_blade_ set
+  std::vector<std::uint32_t> marked_;     // cells with kNearBlade set
 
   Rect before_rect_{};        // where before_ holds the pre-cut heights
   std::vector<float> before_;  // (rect rows) x (rect cols), row-major
