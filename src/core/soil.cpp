@@ -2,6 +2,10 @@
 // angle of repose. See soil.hpp.
 #include "terracut/core/soil.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -147,14 +151,14 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   }
 
   const std::size_t n = std::size_t(grid.spec().sample_count());
-  queued_.assign(n, 0);
+  queued_.assign(n, CellFlags(0));
   for (int c = 0; c < cols_; ++c) {
-    queued_[std::size_t(c)] |= kEdge;
-    queued_[std::size_t(std::int64_t(rows_ - 1) * cols_ + c)] |= kEdge;
+    set_flag(std::uint32_t(c), kEdge);
+    set_flag(std::uint32_t(std::int64_t(rows_ - 1) * cols_ + c), kEdge);
   }
   for (int r = 0; r < rows_; ++r) {
-    queued_[std::size_t(std::int64_t(r) * cols_)] |= kEdge;
-    queued_[std::size_t(std::int64_t(r) * cols_ + cols_ - 1)] |= kEdge;
+    set_flag(std::uint32_t(std::int64_t(r) * cols_), kEdge);
+    set_flag(std::uint32_t(std::int64_t(r) * cols_ + cols_ - 1), kEdge);
   }
   obstacle_.assign(n, 0);
   obstacles_.reserve(16);
@@ -260,8 +264,20 @@ void SoilFlow::lowered(std::uint32_t cell, const float* h) {
   if (!(queued_[cell] & kEdge)) {
     // All 8 tested without a branch each; the steep ones then activated.
     unsigned steep = 0;
+#if defined(__SSE2__)
+    // As examine's: four pairs to an instruction, the same bits.
+    const float* p = h + cell;
+    const std::int64_t up = offset_[2];
+    const __m128 hb0 = _mm_setr_ps(p[1], p[-1], p[up], p[-up]);
+    const __m128 hb1 = _mm_setr_ps(p[up + 1], p[up - 1], p[1 - up], p[-1 - up]);
+    const __m128 vc = _mm_set1_ps(hc), vt = _mm_set1_ps(tolerance_m_);
+    const __m128 e0 = _mm_sub_ps(_mm_sub_ps(hb0, vc), _mm_loadu_ps(limit8_));
+    const __m128 e1 = _mm_sub_ps(_mm_sub_ps(hb1, vc), _mm_loadu_ps(limit8_ + 4));
+    steep = unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e0, vt))) | unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e1, vt))) << 4;
+#else
     for (int k = 0; k < 8; ++k)
       steep |= unsigned(h[std::int64_t(cell) + offset_[k]] - hc - limit8_[k] > tolerance_m_) << k;
+#endif
     for (; steep != 0; steep &= steep - 1)
       activate(std::uint32_t(std::int64_t(cell) + offset_[std::countr_zero(steep)]));
     return;
@@ -293,7 +309,7 @@ void SoilFlow::wake_held(const Segment* edge) {
       return;
   }
   for (std::uint32_t cell : held_) {
-    queued_[cell] &= std::uint8_t(~kHeld);
+    clear_flag(cell, kHeld);
     activate(cell);
   }
   held_.clear();
@@ -350,7 +366,13 @@ void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
   const double len2 = plan_length * plan_length;
   blade_.len2 = d.x * d.x + d.z * d.z;
   blade_.len = std::sqrt(blade_.len2);
-  blade_.half = 0.5 * (std::abs(d.z) * dx_ + std::abs(d.x) * dz_) / blade_.len;
+  const double half_num = 0.5 * (std::abs(d.z) * dx_ + std::abs(d.x) * dz_);
+  blade_.half = half_num / blade_.len;
+  // Where |nb| is certainly below or above half_num (relative rounding of
+  // the quotients ~1e-16; the margin 1e-12), |nb| / len < half is decided
+  // without dividing (blade_blocks).
+  blade_.half_lo = half_num * (1.0 - 1e-12);
+  blade_.half_hi = half_num * (1.0 + 1e-12);
   const double zlo = std::min(edge.a.z, edge.b.z) - radius, zhi = std::max(edge.a.z, edge.b.z) + radius;
   const int r0 = std::max(0, int(std::floor(to_cells(zlo, spec.origin_m.z, dz_) - 0.5)));
   const int r1 = std::min(rows_ - 1, int(std::ceil(to_cells(zhi, spec.origin_m.z, dz_) - 0.5)));
@@ -375,19 +397,19 @@ void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
       const double s = std::clamp(((x - edge.a.x) * d.x + (z - edge.a.z) * d.z) / len2, 0.0, 1.0);
       const double ex = x - (edge.a.x + d.x * s), ez = z - (edge.a.z + d.z * s);
       if (ex * ex + ez * ez > radius * radius) continue;
-      queued_[i] |= kNearBlade;
+      set_flag(i, kNearBlade);
       marked_.push_back(i);
     }
   }
 }
 
 void SoilFlow::clear_blade() {
-  for (std::uint32_t i : marked_) queued_[i] &= std::uint8_t(~kNearBlade);
+  for (std::uint32_t i : marked_) clear_flag(i, kNearBlade);
   marked_.clear();
   blade_.present = false;
 }
 
-bool SoilFlow::blade_blocks(int hc, int hr, int lc, int lr, float top_m) const {
+inline bool SoilFlow::blade_blocks(int hc, int hr, int lc, int lr, float top_m) const {
   // Cell centres relative to the edge's first end, in plan.
   const double xa = (double(hc) + 0.5) * dx_ + origin_x_ - blade_.ax;
   const double za = (double(hr) + 0.5) * dz_ + origin_z_ - blade_.az;
@@ -395,13 +417,19 @@ bool SoilFlow::blade_blocks(int hc, int hr, int lc, int lr, float top_m) const {
   const double zb = (double(lr) + 0.5) * dz_ + origin_z_ - blade_.az;
   const double len2 = blade_.len2;
   const double len = blade_.len;
-  // Signed distances to the edge's line, and the half width of a cell
-  // across it (blade_.half): a cell closer than that is inside the blade.
-  const double da = (blade_.dx * za - blade_.dz * xa) / len;
-  const double db = (blade_.dx * zb - blade_.dz * xb) / len;
+  // Signed distances to the edge's line (their numerators na, nb over
+  // len), and the half width of a cell across it (blade_.half): a cell
+  // closer than that is inside the blade. Most pairs lie on one side,
+  // outside the blade, and are told so without a division: the sign of
+  // na / len is na's, and |nb| away from the half width's numerator by more
+  // than rounding (blade_.half_lo, half_hi) compares as |nb| / len would.
+  const double na = blade_.dx * za - blade_.dz * xa;
+  const double nb = blade_.dx * zb - blade_.dz * xb;
   const double half = blade_.half;
-  const bool low_inside = std::abs(db) < half;
-  if (!low_inside && (da > 0.0) == (db > 0.0)) return false;  // one side, outside the blade
+  const double q = std::abs(nb);
+  const bool low_inside = q < blade_.half_lo ? true : q > blade_.half_hi ? false : std::abs(nb / len) < half;
+  if (!low_inside && (na > 0.0) == (nb > 0.0)) return false;  // one side, outside the blade
+  const double da = na / len, db = nb / len;
   // Where along the edge: at the low cell when it is inside the blade, else
   // where the pair's segment meets the line.
   double px = xb, pz = zb;
@@ -734,10 +762,25 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
   unsigned steep = 0, outside = 0;
   if (!(flags & kEdge)) {
     // Inside the grid: all 8 neighbours exist.
+#if defined(__SSE2__)
+    // Four pairs to an instruction, in kNeighbours' order, with the same
+    // operations as the scalar form below (the same bits).
+    const float* p = h + a;
+    const std::int64_t up = offset_[2];  // one row along +Z
+    const __m128 hb0 = _mm_setr_ps(p[1], p[-1], p[up], p[-up]);
+    const __m128 hb1 = _mm_setr_ps(p[up + 1], p[up - 1], p[1 - up], p[-1 - up]);
+    const __m128 va = _mm_set1_ps(ha), vt = _mm_set1_ps(tol);
+    const __m128 e0 = _mm_sub_ps(_mm_sub_ps(va, hb0), _mm_loadu_ps(limit8_));
+    const __m128 e1 = _mm_sub_ps(_mm_sub_ps(va, hb1), _mm_loadu_ps(limit8_ + 4));
+    _mm_storeu_ps(excess, e0);
+    _mm_storeu_ps(excess + 4, e1);
+    steep = unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e0, vt))) | unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e1, vt))) << 4;
+#else
     for (int k = 0; k < 8; ++k) {
       excess[k] = ha - h[std::int64_t(a) + offset_[k]] - limit8_[k];
       steep |= unsigned(excess[k] > tol) << k;
     }
+#endif
   } else {
     const int ca = col_of(a), ra = row_of(a);
     for (int k = 0; k < 8; ++k) {
@@ -777,7 +820,7 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
         if (blade && (fb & kNearBlade) &&
             blade_blocks(ca, ra, ca + kNeighbours[k].dc, ra + kNeighbours[k].dr, ha)) {
           if (!(queued_[a] & kHeld)) {
-            queued_[a] |= kHeld;
+            set_flag(a, kHeld);
             held_.push_back(a);
           }
           continue;
@@ -788,7 +831,7 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
         // underside there (a flux never raises a cell above its source).
         if ((fb & kHull) && ha > hull_under(b)) {
           if (!(queued_[a] & kHeld)) {
-            queued_[a] |= kHeld;
+            set_flag(a, kHeld);
             held_.push_back(a);
           }
           continue;
@@ -818,7 +861,7 @@ void SoilFlow::finish_pass(HeightGrid& grid, SoilStepResult& out) {
   }
   pass_gained_m_ = 0.0;
   pass_highest_h_ = -1.0f;
-  for (std::uint32_t cell : dirty_) queued_[cell] &= std::uint8_t(~kDirty);
+  for (std::uint32_t cell : dirty_) clear_flag(cell, kDirty);
   dirty_.clear();
   active_.clear();
   fluxes_.clear();
@@ -848,7 +891,7 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       // The next pass starts from the cells queued for it.
       if (next_.empty()) break;
       active_.swap(next_);
-      for (std::uint32_t a : active_) queued_[a] &= std::uint8_t(~kQueued);
+      for (std::uint32_t a : active_) clear_flag(a, kQueued);
     }
     if (examined_ < active_.size()) {
       const std::size_t can = std::size_t((cap - work) / 8);
@@ -1000,7 +1043,7 @@ void SoilFlow::pour(HeightGrid& grid, const Segment& lip, double volume_m3, Soil
 }
 
 void SoilFlow::clear_hull() {
-  for (std::uint32_t cell : hull_cells_) queued_[cell] &= std::uint8_t(~kHull);
+  for (std::uint32_t cell : hull_cells_) clear_flag(cell, kHull);
   hull_cells_.clear();
   hull_under_.clear();
   hull_rect_ = {};
@@ -1098,7 +1141,7 @@ void SoilFlow::mark_hull(const HeightGrid& grid, const Segment& lip, const Quat&
     for (int c = hull_row_c0_[std::size_t(row - r.r0)]; c < hull_row_c1_[std::size_t(row - r.r0)]; ++c)
       if (hull_under_[hull_slot(c, row)] < std::numeric_limits<float>::infinity()) {
         const auto cell = std::uint32_t(std::int64_t(row) * cols_ + c);
-        queued_[cell] |= kHull;
+        set_flag(cell, kHull);
         hull_cells_.push_back(cell);
       }
 }

@@ -256,7 +256,7 @@ class SoilFlow {
  private:
   void activate(std::uint32_t cell) {
     if (queued_[cell] & kQueued) return;
-    queued_[cell] |= kQueued;
+    set_flag(cell, kQueued);
     next_.push_back(cell);
   }
   void lowered(std::uint32_t cell, const float* h);
@@ -309,12 +309,12 @@ class SoilFlow {
 
   // The blade of the step, in plan relative to the grid: its first end, its
   // span, and its edge height above the ground at the first end and along it.
-  // len2, len and half (half a cell's width across the edge's line, over
-  // len) are set by mark_blade for blade_blocks.
+  // len2, len, half (half a cell's width across the edge's line, over
+  // len) and the bounds half_lo/half_hi are set by mark_blade for blade_blocks.
   struct BladeLine {
     double ax = 0.0, az = 0.0, dx = 0.0, dz = 0.0, ay = 0.0, dy = 0.0;
     bool present = false;
-    double len2 = 0.0, len = 0.0, half = 0.0;
+    double len2 = 0.0, len = 0.0, half = 0.0, half_lo = 0.0, half_hi = 0.0;
   };
   BladeLine blade_{};
 
@@ -330,7 +330,7 @@ class SoilFlow {
   // came from heights it no longer has; it is examined again anyway).
   void dirty(std::uint32_t cell) {
     if (active_.empty() || (queued_[cell] & kDirty)) return;
-    queued_[cell] |= kDirty;
+    set_flag(cell, kDirty);
     dirty_.push_back(cell);
   }
   std::vector<std::uint32_t> dirty_;
@@ -352,7 +352,14 @@ class SoilFlow {
   std::uint32_t pass_highest_ = 0;  // the highest cell the pass raised or lowered
   float pass_highest_h_ = -1.0f;
   std::vector<std::uint32_t> next_;    // cells to examine in the next pass (kQueued set)
-  std::vector<std::uint8_t> queued_;   // per cell: the flags above (one byte read gives them all)
+  // The per-cell flags' byte: an enumeration, not std::uint8_t, because a
+  // store through a character type may alias any object, so each flag
+  // written made the compiler reload the lists' ends and the pass's sums
+  // from memory; an enumeration's stores alias only its own type.
+  enum CellFlags : std::uint8_t {};
+  void set_flag(std::uint32_t cell, std::uint8_t bit) { queued_[cell] = CellFlags(queued_[cell] | bit); }
+  void clear_flag(std::uint32_t cell, std::uint8_t bit) { queued_[cell] = CellFlags(queued_[cell] & ~unsigned(bit)); }
+  std::vector<CellFlags> queued_;   // per cell: the flags above (one byte read gives them all)
   // Cells that kept an excess only because the blade stood in the way: they
   // are examined again once the blade has moved (held_edge_ is where it was).
   std::vector<std::uint32_t> held_;
