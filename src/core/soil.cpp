@@ -802,8 +802,9 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
   const int ca = blade ? col_of(a) : 0, ra = blade ? row_of(a) : 0;
   const bool obstacles = !obstacles_.empty();
   const bool hull = !hull_cells_.empty();
-  std::uint32_t lower[8];
-  float shed[8];
+  // The fluxes are appended with their excess and scaled by the share once
+  // the share is known (the same product as share * excess).
+  const std::size_t first = fluxes_.size();
   int n = 0;
   float top = 0.0f, sum = 0.0f;
   for (unsigned bits = steep; bits != 0; bits &= bits - 1) {
@@ -838,15 +839,14 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
         }
       }
     }
-    lower[n] = b;
-    shed[n] = e;
+    fluxes_.push_back({a, b, e});
     ++n;
     top = std::max(top, e);
     sum += e;
   }
   if (n == 0) return 0;
   const float share = kShedFraction * top / sum;
-  for (int k = 0; k < n; ++k) fluxes_.push_back({a, lower[k], share * shed[k]});
+  for (std::size_t j = first; j < fluxes_.size(); ++j) fluxes_[j].height = share * fluxes_[j].height;
   return n;
 }
 

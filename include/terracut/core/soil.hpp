@@ -91,6 +91,7 @@
 #include <string_view>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "terracut/core/blade.hpp"
@@ -123,6 +124,39 @@ class IndexDivider {
  private:
   std::uint32_t d_ = 1;
   std::uint64_t magic_ = 0;
+};
+
+/// A list of cell indices that can take one on a condition without a
+/// branch (push_if): the relaxation queues a neighbour only when it is not
+/// queued yet, a test whose outcome changes from cell to cell, so a branch
+/// on it was often mispredicted. Storage grows like std::vector's (doubling)
+/// and is kept across clear(); copies are deep.
+class CellList {
+ public:
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  void clear() { size_ = 0; }
+  void reserve(std::size_t n) {
+    if (n > buf_.size()) buf_.resize(n);
+  }
+  void push_back(std::uint32_t cell) { push_if(cell, true); }
+  /// Appends cell when keep is true; either way without a branch on keep.
+  void push_if(std::uint32_t cell, bool keep) {
+    if (size_ == buf_.size()) buf_.resize(buf_.empty() ? 64 : 2 * buf_.size());
+    buf_[size_] = cell;
+    size_ += keep ? 1u : 0u;
+  }
+  std::uint32_t operator[](std::size_t i) const { return buf_[i]; }
+  const std::uint32_t* begin() const { return buf_.data(); }
+  const std::uint32_t* end() const { return buf_.data() + size_; }
+  void swap(CellList& other) noexcept {
+    buf_.swap(other.buf_);
+    std::swap(size_, other.size_);
+  }
+
+ private:
+  std::vector<std::uint32_t> buf_;  // buf_.size() is the capacity
+  std::size_t size_ = 0;
 };
 
 }  // namespace detail
@@ -255,9 +289,9 @@ class SoilFlow {
 
  private:
   void activate(std::uint32_t cell) {
-    if (queued_[cell] & kQueued) return;
-    set_flag(cell, kQueued);
-    next_.push_back(cell);
+    const unsigned f = queued_[cell];
+    queued_[cell] = CellFlags(f | kQueued);
+    next_.push_if(cell, !(f & kQueued));
   }
   void lowered(std::uint32_t cell, const float* h);
   void wake_held(const Segment* edge);
@@ -344,14 +378,14 @@ class SoilFlow {
   // the fluxes found and how many were applied. A pass is examined whole
   // before any of its fluxes is applied (its fluxes come from one state),
   // but both halves may be spread over steps by the work cap.
-  std::vector<std::uint32_t> active_;
+  detail::CellList active_;
   std::size_t examined_ = 0;
   std::vector<Flux> fluxes_;
   std::size_t applied_ = 0;
   double pass_gained_m_ = 0.0;    // height the pass's writes gained by float rounding
   std::uint32_t pass_highest_ = 0;  // the highest cell the pass raised or lowered
   float pass_highest_h_ = -1.0f;
-  std::vector<std::uint32_t> next_;    // cells to examine in the next pass (kQueued set)
+  detail::CellList next_;    // cells to examine in the next pass (kQueued set)
   // The per-cell flags' byte: an enumeration, not std::uint8_t, because a
   // store through a character type may alias any object, so each flag
   // written made the compiler reload the lists' ends and the pass's sums
