@@ -119,6 +119,7 @@ Command add_run_command(CLI::App& app) {
     run_options.progress_label = "terracut run " + scenario.base.name;
     run_options.realtime = opt->realtime;
     const session::RunResult result = session::run_scenario(scenario, run_options);
+    for (const std::string& w : result.warnings) std::cerr << "terracut run: warning: " << w << "\n";
 
     if (!opt->quiet) {
       char line[512];

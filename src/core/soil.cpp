@@ -77,12 +77,56 @@ std::string validate(const SoilFlowParams& p) {
   if (p.model != SoilModel::kVanish && p.model != SoilModel::kFlow)
     return "soil.model must be vanish or flow";
   if (p.edge != SoilEdge::kWall && p.edge != SoilEdge::kOpen) return "soil.edge must be wall or open";
-  if (!(std::isfinite(p.repose_deg) && p.repose_deg > 0.0 && p.repose_deg <= 80.0))
-    return must_be("soil.repose_deg", "in (0, 80] degrees", p.repose_deg);
+  // Below a degree the material is a liquid, out of the model's reach (a
+  // repose of 1e-300 degrees made the tolerance 0, and float noise kept
+  // the cells moving for ever).
+  if (!(std::isfinite(p.repose_deg) && p.repose_deg >= 1.0 && p.repose_deg <= 80.0))
+    return must_be("soil.repose_deg", "in [1, 80] degrees", p.repose_deg);
   if (!(p.max_pair_checks_per_step >= 1000 && p.max_pair_checks_per_step <= 1000000000))
     return must_be("soil.max_pair_checks_per_step", "in [1000, 1e9]",
                    p.max_pair_checks_per_step);
   return {};
+}
+
+double steepest_standing_slope_deg(double cell_x_m, double cell_z_m, double repose_deg) {
+  const double t = std::tan(repose_deg * std::numbers::pi / 180.0);
+  // The tolerance as the relaxation takes it: a fraction of the repose
+  // drop over the shorter cell side, the same for every pair.
+  const double tol = kToleranceOfLimit * t * std::min(cell_x_m, cell_z_m);
+  // The neighbours' directions (from +X toward +Z) and each one's bound on
+  // the plane's slope along its own direction: (t d + tol) / d.
+  struct Dir {
+    double angle, bound;
+  };
+  Dir dirs[8];
+  for (int k = 0; k < 8; ++k) {
+    const double x = kNeighbours[k].dc * cell_x_m, z = kNeighbours[k].dr * cell_z_m;
+    const double d = std::hypot(x, z);
+    dirs[k] = {std::atan2(z, x), (t * d + tol) / d};
+  }
+  std::sort(std::begin(dirs), std::end(dirs), [](const Dir& a, const Dir& b) { return a.angle < b.angle; });
+  // A plane of slope s falling along theta stands while s cos(theta -
+  // angle_k) <= bound_k for every neighbour ahead of it (cos > 0). Its
+  // steepest standing slope over theta peaks where two adjacent
+  // directions' bounds meet: with u = theta - angle_k and g the gap,
+  // bound_k cos(u - g) = bound_k+1 cos(u).
+  const auto standing = [&](double theta) {
+    double s = std::numeric_limits<double>::infinity();
+    for (const Dir& d : dirs) {
+      const double c = std::cos(theta - d.angle);
+      if (c > 1e-12) s = std::min(s, d.bound / c);
+    }
+    return s;
+  };
+  double steepest = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    const Dir& a = dirs[k];
+    const Dir& b = dirs[(k + 1) % 8];
+    const double g = k == 7 ? b.angle + 2.0 * std::numbers::pi - a.angle : b.angle - a.angle;
+    const double u = std::atan2(b.bound - a.bound * std::cos(g), a.bound * std::sin(g));
+    steepest = std::max(steepest, standing(a.angle + u));
+  }
+  return std::atan(steepest) * 180.0 / std::numbers::pi;
 }
 
 double bucket_retained_m3(const BladeSpec& blade, const Quat& orientation, double repose_deg) {

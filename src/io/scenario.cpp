@@ -61,7 +61,7 @@ constexpr yaml::Range kRanges[] = {
     {"terrain.mound.radius_m", 0.0, kMax, Ends::kOpenLow},
     {"terrain.plane.height_m", 0.0, kMax, Ends::kClosed},
     {"cuts[].keyframes[].t_s", 0.0, kMax, Ends::kClosed},
-    {"soil.repose_deg", 0.0, 80.0, Ends::kOpenLow},
+    {"soil.repose_deg", 1.0, 80.0, Ends::kClosed},
     {"soil.max_pair_checks_per_step", 1000, 1e9, Ends::kClosed, true},
     {"reference.mound.radius_m", 0.0, kMax, Ends::kOpenLow},
     {"reference.mound.height_m", 0.0, kMax, Ends::kOpenLow},

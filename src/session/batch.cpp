@@ -43,6 +43,37 @@ Json timing_json(const TimingStats& s) {
               {"mean", s.mean_us}};
 }
 
+}  // namespace
+
+std::vector<std::string> soil_warnings(const SoilFlowParams& soil, const GridSpec& grid,
+                                       std::int64_t final_backlog_cells) {
+  std::vector<std::string> w;
+  if (soil.model != SoilModel::kFlow) return w;
+  if (final_backlog_cells > 0)
+    w.push_back("soil: " + std::to_string(final_backlog_cells) +
+                " cells were still steeper than the angle of repose at the end: the work cap "
+                "(soil.max_pair_checks_per_step = " + std::to_string(soil.max_pair_checks_per_step) +
+                " neighbour visits a step) stopped the relaxation short, so the piles are not settled; "
+                "raise it for an offline run");
+  // Cells far from square leave planes steeper than on square cells
+  // standing (the 8 neighbours' directions leave wider gaps).
+  const double dx = grid.cell_x_m(), dz = grid.cell_z_m();
+  const double here = steepest_standing_slope_deg(dx, dz, soil.repose_deg);
+  const double square = steepest_standing_slope_deg(dx, dx, soil.repose_deg);
+  if (here > square + 0.5) {
+    char line[400];
+    std::snprintf(line, sizeof line,
+                  "soil: cells of %.4g x %.4g m (X x Z) let planes up to %.1f degrees stand between the "
+                  "relaxation's 8 neighbour directions, against %.1f on square cells, for a repose angle of "
+                  "%.4g: use square cells for a repose angle that holds in every direction",
+                  dx, dz, here, square, soil.repose_deg);
+    w.push_back(line);
+  }
+  return w;
+}
+
+namespace {
+
 Json summary_json(const io::Scenario& sc, const RunResult& r) {
   Json inputs;
   inputs["scenario"] = sc.source_path.string();
@@ -145,6 +176,7 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
                    {"wall_s", r.wall_s}};
   if (r.soil) out["timing"]["soil_us"] = timing_json(r.soil->soil_timing);
   if (r.listeners_timing) out["timing"]["listeners_us"] = timing_json(*r.listeners_timing);
+  out["warnings"] = r.warnings;
   return out;
 }
 
@@ -306,6 +338,7 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
     soil.final_backlog_cells = sim.soil()->active_cells();
     soil.soil_timing = timing_stats(soil_s);
     result.soil = soil;
+    result.warnings = soil_warnings(sc.soil, grid.spec(), soil.final_backlog_cells);
   }
 
   io::write_npy(dir / "height.npy", grid.heights(), grid.rows(), grid.cols());

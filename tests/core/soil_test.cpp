@@ -121,6 +121,40 @@ TEST(IndexDivider, QuotientsEqualHardwareDivisionForEveryRowLength) {
   EXPECT_GT(checked, 1000000);
 }
 
+TEST(SoilFlow, TheSteepestStandingPlaneIsWhereTheRelaxationStartsToMove) {
+  // A plane ramp falling along theta, for theta every 0.02 degree over a
+  // quadrant: 0.15 degree above steepest_standing_slope_deg every ramp has
+  // active cells (a pair past its limit: nothing that steep stands), 0.15
+  // degree below it some ramp has none (it stands). On square cells and on
+  // cells of 2:1 and 1:3.
+  for (const double aspect : {1.0, 2.0, 1.0 / 3.0}) {
+    const double dx = 0.01, dz = 0.01 * aspect, repose = 34.0;
+    const double steepest = steepest_standing_slope_deg(dx, dz, repose);
+    EXPECT_GT(steepest, repose);
+    const int n = 16;
+    const auto all_active = [&](double slope_deg) {
+      const double s = std::tan(slope_deg * std::numbers::pi / 180.0);
+      for (int i = 0; i <= 4500; ++i) {
+        const double theta = i * 0.02 * std::numbers::pi / 180.0;
+        std::vector<float> h(std::size_t(n) * n);
+        for (int r = 0; r < n; ++r)
+          for (int c = 0; c < n; ++c)
+            h[std::size_t(r) * n + c] =
+                float(1.0 - s * ((c + 0.5) * dx * std::cos(theta) + (r + 0.5) * dz * std::sin(theta)));
+        HeightGrid g(GridSpec{n, n, n * dx, n * dz, {}, 1.0}, h);
+        if (SoilFlow(flow(repose), g).active_cells() == 0) return false;
+      }
+      return true;
+    };
+    EXPECT_TRUE(all_active(steepest + 0.15)) << "aspect " << aspect;
+    EXPECT_FALSE(all_active(steepest - 0.15)) << "aspect " << aspect;
+  }
+  // The figures the documentation gives (34 degrees).
+  EXPECT_NEAR(steepest_standing_slope_deg(0.01, 0.01, 34.0), 36.6, 0.05);
+  EXPECT_NEAR(steepest_standing_slope_deg(0.01, 0.02, 34.0), 38.8, 0.05);
+  EXPECT_NEAR(steepest_standing_slope_deg(0.04, 0.01, 34.0), 40.9, 0.05);
+}
+
 TEST(SoilFlow, AColumnCollapsesIntoARoundConeAtTheReposeAngle) {
   for (const double repose : {34.0, 45.0}) {
     const int n = 161;
@@ -302,7 +336,10 @@ TEST(SoilFlow, RefusesBadParameters) {
   EXPECT_NE(validate(p).find("soil.repose_deg"), std::string::npos);
   EXPECT_THROW(SoilFlow(p, g), InputError);
   p = flow(81.0);
-  EXPECT_NE(validate(p).find("(0, 80]"), std::string::npos);
+  EXPECT_NE(validate(p).find("[1, 80]"), std::string::npos);
+  p = flow(0.5);
+  EXPECT_NE(validate(p).find("[1, 80]"), std::string::npos);
+  EXPECT_EQ(validate(flow(1.0)), "");
   p = flow(34.0, 10);
   EXPECT_NE(validate(p).find("soil.max_pair_checks_per_step"), std::string::npos);
   EXPECT_EQ(parse_soil_model("flow"), SoilModel::kFlow);

@@ -219,7 +219,9 @@ TEST(ScenarioSoil, TheSoilSectionChoosesTheModel) {
   EXPECT_EQ(sim_params(sc).soil.repose_deg, 40.0);
   // Errors name the file, the line and the field.
   const std::string zero = replace(text, "repose_deg: 40", "repose_deg: 0");
-  expect_error(zero, line_of(zero, "repose_deg: 0"), "soil.repose_deg", "(0, 80]");
+  expect_error(zero, line_of(zero, "repose_deg: 0"), "soil.repose_deg", "[1, 80]");
+  const std::string tiny = replace(text, "repose_deg: 40", "repose_deg: 1e-300");
+  expect_error(tiny, line_of(tiny, "repose_deg: 1e-300"), "soil.repose_deg", "[1, 80]");
   const std::string mud = replace(text, "model: flow", "model: mud");
   expect_error(mud, line_of(mud, "model: mud"), "soil.model", "allowed: vanish, flow");
   EXPECT_EQ(sc.soil.edge, SoilEdge::kWall);

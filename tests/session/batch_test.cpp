@@ -101,6 +101,33 @@ std::vector<std::string> split(const std::string& line) {
   return out;
 }
 
+TEST(SoilWarnings, NameAnUnsettledEndAndCellsTooFarFromSquare) {
+  SoilFlowParams soil;
+  soil.model = SoilModel::kFlow;
+  soil.repose_deg = 34.0;
+  const GridSpec square = grid_of_cells(10, 10, 0.01);
+  EXPECT_TRUE(soil_warnings(soil, square, 0).empty());
+  // Still active at the end: the count and the cap are named.
+  const std::vector<std::string> unsettled = soil_warnings(soil, square, 17);
+  ASSERT_EQ(unsettled.size(), 1u);
+  EXPECT_NE(unsettled[0].find("17 cells"), std::string::npos) << unsettled[0];
+  EXPECT_NE(unsettled[0].find("max_pair_checks_per_step = 50000"), std::string::npos) << unsettled[0];
+  // Cells of 4:1: planes to 40.9 degrees stand, against 36.6 on square cells.
+  GridSpec oblong = square;
+  oblong.size_z_m = 0.4;
+  const std::vector<std::string> rect = soil_warnings(soil, oblong, 0);
+  ASSERT_EQ(rect.size(), 1u);
+  EXPECT_NE(rect[0].find("40.9 degrees"), std::string::npos) << rect[0];
+  EXPECT_NE(rect[0].find("36.6 on square"), std::string::npos) << rect[0];
+  // Nearly square cells (5 %) stand within half a degree of square ones: no warning.
+  GridSpec near = square;
+  near.size_z_m = 0.105;
+  EXPECT_TRUE(soil_warnings(soil, near, 0).empty());
+  // With vanish there is no soil phase to warn about.
+  soil.model = SoilModel::kVanish;
+  EXPECT_TRUE(soil_warnings(soil, oblong, 17).empty());
+}
+
 TEST_F(RunTest, SameScenarioTwiceGivesBitwiseIdenticalOutputs) {
   for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
     const Scenario sc = scenario(rep);

@@ -234,6 +234,19 @@ struct SoilObstacle {
 /// down), zero. 0 without a bucket.
 double bucket_retained_m3(const BladeSpec& blade, const Quat& orientation, double repose_deg);
 
+/// The steepest plane, in degrees, that the relaxation leaves standing on
+/// cells of cell_x_m x cell_z_m for a repose angle of repose_deg. A plane
+/// moves only where its drop toward one of the 8 neighbours passes that
+/// pair's limit (tan(repose) x distance, plus the tolerance); a fall line
+/// between two neighbour directions meets both pairs at a slant, so a
+/// plane there stands steeper than the repose angle. The steepest is where
+/// two angularly adjacent neighbours' bounds meet, in the widest gap: on
+/// square cells (gaps of 45 degrees) 36.6 degrees for 34; on cells of 2:1
+/// (the diagonal 63.4 degrees off the long side) 38.8, on 4:1 40.9. A
+/// cone settles at the repose angle along the 8 directions and up to this
+/// in between.
+double steepest_standing_slope_deg(double cell_x_m, double cell_z_m, double repose_deg);
+
 /// The soil phase's state (kFlow): the active cells and the scratch of the
 /// passes, sized at construction (3 bytes per sample, plus lists for the
 /// blade's footprint and an active set of at least 65536 cells) so that a

@@ -112,12 +112,25 @@ struct RunResult {
   /// The pacer's figures, with RunOptions::realtime.
   std::optional<haptics::LoopStats> realtime;
   std::vector<io::StepRecord> records;  ///< every step, when RunOptions::keep_records
+  /// What the user should know about the result (also summary.json's
+  /// "warnings"): soil left steeper than its repose angle when the work
+  /// cap stopped the relaxation short, cells too far from square for the
+  /// repose angle to hold in every direction (soil_warnings).
+  std::vector<std::string> warnings;
   double wall_s = 0.0;               ///< wall-clock time of the simulation loop, seconds
 };
 
 /// Steps a batch run gives a cut at rate_hz: one at t = i / rate_hz (from
 /// the cut's start, Motion::sample) for i = 0..n, n = round(duration * rate_hz).
 std::int64_t cut_steps(const Motion& motion, double rate_hz);
+
+/// What a user should know about a run's soil (kFlow; none with kVanish):
+/// cells still active at the end (the work cap stopped the relaxation
+/// short), and cells so far from square that planes steeper than on square
+/// cells stand (steepest_standing_slope_deg more than 0.5 degree above
+/// square cells'). One readable line each.
+std::vector<std::string> soil_warnings(const SoilFlowParams& soil, const GridSpec& grid,
+                                       std::int64_t final_backlog_cells);
 
 /// Runs the scenario's sequence and writes the outputs into options.out_dir.
 /// Throws terracut::InputError naming the file or folder when an output cannot
