@@ -1,5 +1,9 @@
 #include "merged_heightfield.hpp"
 
+#include <BulletCollision/CollisionDispatch/btCollisionObject.h>
+#include <BulletCollision/CollisionDispatch/btConvexConcaveCollisionAlgorithm.h>
+#include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -23,18 +27,127 @@ bool report(btTriangleCallback* callback, btVector3* v, int part, int index, btS
   return true;
 }
 
+// Hands Bullet's convex-versus-terrain callback only the triangles a contact
+// can come from (merged_heightfield.hpp, "Far triangles"): a triangle goes on
+// unless the body's oriented bounding box is more than `reach` from it along
+// the triangle's normal or one of the box's axes. Frame: the terrain
+// shape's (the triangles' and the query box's).
+class NearTriangles final : public btTriangleCallback {
+ public:
+  // Sets it up for `callback`'s query over the box [aabb_min, aabb_max];
+  // false when it cannot be culled (not Bullet's convex-versus-concave
+  // callback, or its box is not the body's as this reads it), and then
+  // every triangle must go to `callback` itself.
+  bool init(btTriangleCallback* callback, const btCollisionShape* terrain,
+            const btVector3& aabb_min, const btVector3& aabb_max) {
+    auto* convex = dynamic_cast<btConvexTriangleCallback*>(callback);
+    if (convex == nullptr || convex->m_manifoldPtr == nullptr) return false;
+    const btPersistentManifold& manifold = *convex->m_manifoldPtr;
+    const btCollisionObject* a = manifold.getBody0();
+    const btCollisionObject* b = manifold.getBody1();
+    if (a == nullptr || b == nullptr) return false;
+    if (a->getCollisionShape() == terrain) std::swap(a, b);
+    if (b->getCollisionShape() != terrain || !a->getCollisionShape()->isConvex()) return false;
+    // The body in the terrain's frame, as Bullet's callback places it
+    // (btConvexTriangleCallback::setTimeStepAndCounters): its box there,
+    // widened by the triangles' margin and the query's closest-point
+    // distance, is the query box. Anything else (a compound's child, a
+    // changed Bullet) is not culled.
+    const btTransform pose = b->getWorldTransform().inverse() * a->getWorldTransform();
+    const btCollisionShape& shape = *a->getCollisionShape();
+    btVector3 lo, hi;
+    shape.getAabb(pose, lo, hi);
+    const btVector3 below = lo - aabb_min, above = aabb_max - hi;
+    const btScalar widen = below.x();
+    constexpr btScalar kSame = btScalar(1e-6);  // metres: float rounding of the same sums
+    for (int k = 0; k < 3; ++k)
+      if (!(std::fabs(below[k] - widen) <= kSame && std::fabs(above[k] - widen) <= kSame)) return false;
+    // The shape's local box (margin included) holds the shape: its centre
+    // and axes in the terrain's frame, and its half sizes.
+    btTransform identity;
+    identity.setIdentity();
+    shape.getAabb(identity, lo, hi);
+    centre_ = pose * ((lo + hi) * btScalar(0.5));
+    half_ = (hi - lo) * btScalar(0.5);
+    for (int k = 0; k < 3; ++k) axis_[k] = pose.getBasis().getColumn(k);
+    // A point farther than the contact breaking threshold is dropped by
+    // Bullet; the triangle's margin (and a closest-point query's distance:
+    // `widen`) adds to the reach, and 0.1 mm covers the float rounding of
+    // these sums and of GJK's (its distance is never below the true one).
+    reach_ = std::max(widen, btScalar(0)) + manifold.getContactBreakingThreshold() + btScalar(1e-4);
+    next_ = callback;
+    culled_ = 0;
+    return true;
+  }
+
+  void processTriangle(btVector3* v, int part, int index) override {
+    if (far(v)) {
+      ++culled_;
+      return;
+    }
+    next_->processTriangle(v, part, index);
+  }
+
+  int culled() const { return culled_; }
+
+ private:
+  // Whether the box is more than reach_ from the triangle v along some axis.
+  bool far(const btVector3* v) const {
+    // The triangle's normal: all of it is at one offset along it.
+    btVector3 n = (v[1] - v[0]).cross(v[2] - v[0]);
+    const btScalar length = n.length();
+    if (length > btScalar(1e-12)) {
+      n /= length;
+      const btScalar offset = n.dot(v[0] - centre_);
+      const btScalar radius = std::fabs(n.dot(axis_[0])) * half_.x() +
+                              std::fabs(n.dot(axis_[1])) * half_.y() +
+                              std::fabs(n.dot(axis_[2])) * half_.z();
+      if (std::fabs(offset) - radius > reach_) return true;
+    }
+    // The box's own axes.
+    for (int k = 0; k < 3; ++k) {
+      const btScalar p0 = axis_[k].dot(v[0] - centre_), p1 = axis_[k].dot(v[1] - centre_),
+                     p2 = axis_[k].dot(v[2] - centre_);
+      if (std::min({p0, p1, p2}) - half_[k] > reach_ || -std::max({p0, p1, p2}) - half_[k] > reach_)
+        return true;
+    }
+    return false;
+  }
+
+  btTriangleCallback* next_ = nullptr;
+  btVector3 centre_{0, 0, 0};
+  btVector3 axis_[3]{};
+  btVector3 half_{0, 0, 0};
+  btScalar reach_ = 0;
+  int culled_ = 0;
+};
+
 }  // namespace
 
 MergedHeightfield::MergedHeightfield(int cols, int rows, const float* heights,
-                                     btScalar min_height, btScalar max_height, double tolerance_m)
+                                     btScalar min_height, btScalar max_height, double tolerance_m,
+                                     bool cull_far)
     : btHeightfieldTerrainShape(cols, rows, heights, min_height, max_height, 1, false),
       heights_(heights),
       cols_(cols),
-      tolerance_m_(float(tolerance_m)) {}
+      tolerance_m_(float(tolerance_m)),
+      cull_far_(cull_far) {}
 
 void MergedHeightfield::processAllTriangles(btTriangleCallback* callback,
                                             const btVector3& aabb_min,
                                             const btVector3& aabb_max) const {
+  NearTriangles near;
+  last_culled_ = 0;
+  if (cull_far_ && near.init(callback, this, aabb_min, aabb_max)) {
+    process(&near, aabb_min, aabb_max);
+    last_culled_ = near.culled();
+  } else {
+    process(callback, aabb_min, aabb_max);
+  }
+}
+
+void MergedHeightfield::process(btTriangleCallback* callback, const btVector3& aabb_min,
+                                const btVector3& aabb_max) const {
   if (!(tolerance_m_ > 0.0f)) {
     btHeightfieldTerrainShape::processAllTriangles(callback, aabb_min, aabb_max);
     return;
