@@ -27,6 +27,8 @@ bool report(btTriangleCallback* callback, btVector3* v, int part, int index, btS
   return true;
 }
 
+}  // namespace
+
 // Hands Bullet's convex-versus-terrain callback only the triangles a contact
 // can come from (merged_heightfield.hpp, "Far triangles"): a triangle goes on
 // unless the body's oriented bounding box is more than `reach` from it along
@@ -89,6 +91,22 @@ class NearTriangles final : public btTriangleCallback {
   }
 
   int culled() const { return culled_; }
+  void count_culled(int n) { culled_ += n; }
+
+  // Whether all of the n points p are more than reach_ + slack beyond one
+  // face of the box (along one of its axes, either way).
+  bool beyond_a_face(const btVector3* p, int n, btScalar slack) const {
+    for (int k = 0; k < 3; ++k) {
+      btScalar lo = axis_[k].dot(p[0] - centre_), hi = lo;
+      for (int i = 1; i < n; ++i) {
+        const btScalar d = axis_[k].dot(p[i] - centre_);
+        lo = std::min(lo, d);
+        hi = std::max(hi, d);
+      }
+      if (lo - half_[k] > reach_ + slack || -hi - half_[k] > reach_ + slack) return true;
+    }
+    return false;
+  }
 
  private:
   // Whether the box is more than reach_ from the triangle v along some axis.
@@ -105,13 +123,7 @@ class NearTriangles final : public btTriangleCallback {
       if (std::fabs(offset) - radius > reach_) return true;
     }
     // The box's own axes.
-    for (int k = 0; k < 3; ++k) {
-      const btScalar p0 = axis_[k].dot(v[0] - centre_), p1 = axis_[k].dot(v[1] - centre_),
-                     p2 = axis_[k].dot(v[2] - centre_);
-      if (std::min({p0, p1, p2}) - half_[k] > reach_ || -std::max({p0, p1, p2}) - half_[k] > reach_)
-        return true;
-    }
-    return false;
+    return beyond_a_face(v, 3, 0);
   }
 
   btTriangleCallback* next_ = nullptr;
@@ -121,8 +133,6 @@ class NearTriangles final : public btTriangleCallback {
   btScalar reach_ = 0;
   int culled_ = 0;
 };
-
-}  // namespace
 
 MergedHeightfield::MergedHeightfield(int cols, int rows, const float* heights,
                                      btScalar min_height, btScalar max_height, double tolerance_m,
@@ -139,15 +149,15 @@ void MergedHeightfield::processAllTriangles(btTriangleCallback* callback,
   NearTriangles near;
   last_culled_ = 0;
   if (cull_far_ && near.init(callback, this, aabb_min, aabb_max)) {
-    process(&near, aabb_min, aabb_max);
+    process(&near, &near, aabb_min, aabb_max);
     last_culled_ = near.culled();
   } else {
-    process(callback, aabb_min, aabb_max);
+    process(callback, nullptr, aabb_min, aabb_max);
   }
 }
 
-void MergedHeightfield::process(btTriangleCallback* callback, const btVector3& aabb_min,
-                                const btVector3& aabb_max) const {
+void MergedHeightfield::process(btTriangleCallback* callback, NearTriangles* near,
+                                const btVector3& aabb_min, const btVector3& aabb_max) const {
   if (!(tolerance_m_ > 0.0f)) {
     btHeightfieldTerrainShape::processAllTriangles(callback, aabb_min, aabb_max);
     return;
@@ -179,19 +189,30 @@ void MergedHeightfield::process(btTriangleCallback* callback, const btVector3& a
   // marks fit a fixed array (no allocation, whatever the body's size).
   for (int tj = j_begin; tj < j_end; tj += kTile)
     for (int tx = x_begin; tx < x_end; tx += kTile)
-      merge_tile(callback, tx, std::min(tx + kTile, x_end), tj, std::min(tj + kTile, j_end),
+      merge_tile(callback, near, tx, std::min(tx + kTile, x_end), tj, std::min(tj + kTile, j_end),
                  max_x, max_j, y0, y1);
 }
 
-void MergedHeightfield::merge_tile(btTriangleCallback* callback, int x_begin, int x_end,
-                                   int j_begin, int j_end, int max_x, int max_j, btScalar y0,
-                                   btScalar y1) const {
+void MergedHeightfield::merge_tile(btTriangleCallback* callback, NearTriangles* near,
+                                   int x_begin, int x_end, int j_begin, int j_end, int max_x,
+                                   int max_j, btScalar y0, btScalar y1) const {
   std::array<std::uint8_t, std::size_t(kTile) * kTile> merged{};
   const int width = x_end - x_begin;
   auto mark = [&](int x, int j) -> std::uint8_t& {
     return merged[std::size_t(j - j_begin) * std::size_t(width) + std::size_t(x - x_begin)];
   };
   auto height = [&](int x, int j) { return heights_[std::size_t(j) * std::size_t(cols_) + x]; };
+  // A sample's vertex as getVertex places it (computed the same way here, to
+  // float rounding), for the test of a whole square against the body's box.
+  auto corner = [&](int x, int j) {
+    return btVector3(-m_width / btScalar(2) + btScalar(x), height(x, j) - m_localOrigin.y(),
+                     -m_length / btScalar(2) + btScalar(j)) *
+           m_localScaling;
+  };
+  // Whether a triangle with these heights passes report's height filter.
+  auto in_range = [&](float a, float b, float c) {
+    return !(std::max({a, b, c}) < y0 || std::min({a, b, c}) > y1);
+  };
 
   btVector3 v[3];
   for (int j = j_begin; j < j_end; ++j) {
@@ -209,6 +230,21 @@ void MergedHeightfield::merge_tile(btTriangleCallback* callback, int x_begin, in
       if (!on_plane(x + 1, j + 1)) {
         // Not planar: Bullet's two triangles of the square, as Bullet reports them.
         mark(x, j) = 1;
+        if (near != nullptr) {
+          // Both would be culled when the whole square lies beyond one face
+          // of the body's box (NearTriangles::far tests each triangle's
+          // corners, a subset, the same way): neither is made. 10 um more
+          // covers the rounding of `corner` against getVertex.
+          const btVector3 c[4] = {corner(x, j), corner(x + 1, j), corner(x, j + 1),
+                                  corner(x + 1, j + 1)};
+          if (near->beyond_a_face(c, 4, btScalar(1e-5))) {
+            const int n = (in_range(c[0].y(), c[2].y(), c[1].y()) ? 1 : 0) +
+                          (in_range(c[1].y(), c[2].y(), c[3].y()) ? 1 : 0);
+            near->count_culled(n);
+            last_triangles_ += n;
+            continue;
+          }
+        }
         getVertex(x, j, v[0]);
         getVertex(x, j + 1, v[1]);
         getVertex(x + 1, j, v[2]);

@@ -50,6 +50,8 @@
 
 namespace terracut::bullet::detail {
 
+class NearTriangles;  // the cull of far triangles (merged_heightfield.cpp)
+
 class MergedHeightfield final : public btHeightfieldTerrainShape {
  public:
   /// As btHeightfieldTerrainShape(cols, rows, heights, min, max, 1 (Y up),
@@ -72,14 +74,16 @@ class MergedHeightfield final : public btHeightfieldTerrainShape {
   static constexpr int kTile = 64;   ///< squares per side of a merging tile
   static constexpr int kSplits = 3;  ///< a rectangle spans at most 1/kSplits of the range per side
 
-  // The query itself (merged or Bullet's), to callback.
-  void process(btTriangleCallback* callback, const btVector3& aabb_min,
+  // The query itself (merged or Bullet's), to callback; near: the cull
+  // (callback itself) or null, so that a square beyond the body is skipped
+  // before its triangles are made.
+  void process(btTriangleCallback* callback, NearTriangles* near, const btVector3& aabb_min,
                const btVector3& aabb_max) const;
 
   // Merges and reports the squares [x_begin, x_end) x [j_begin, j_end).
   // Rectangles span at most max_x x max_j squares.
-  void merge_tile(btTriangleCallback* callback, int x_begin, int x_end, int j_begin, int j_end,
-                  int max_x, int max_j, btScalar y0, btScalar y1) const;
+  void merge_tile(btTriangleCallback* callback, NearTriangles* near, int x_begin, int x_end,
+                  int j_begin, int j_end, int max_x, int max_j, btScalar y0, btScalar y1) const;
 
   const float* heights_;
   int cols_;
