@@ -26,6 +26,23 @@
 // do not cross tiles), so the marks of the squares already reported fit a
 // fixed array on the stack: a query allocates nothing. The shape is queried
 // from one thread at a time (the world's stepping thread).
+//
+// Far triangles are not handed to Bullet's narrow phase (`cull_far`). Bullet
+// keeps a triangle's contact only when its GJK distance to the body is within
+// the manifold's contact breaking threshold (btManifoldResult::addContactPoint),
+// and tests every triangle whose bounding box meets the body's axis-aligned
+// box. A body tilted over uneven soil (the rescue's block_b lying on its side
+// on the sand that slid into its trench) has a world box far larger than
+// itself, and most of the triangles in that box lie centimetres below the
+// body: on the rescue with soil that flows they were about three quarters of
+// every GJK run. A triangle is dropped when a separating axis (the
+// triangle's normal or one of the body's own axes) shows the body's oriented
+// bounding box (its shape's local box, margin included) more than the
+// threshold, the triangle's margin and 0.1 mm away from it: GJK's distance is
+// never below the true distance, so Bullet would have added no point for it,
+// and the contacts, and so the bodies' motion, are the same bit for bit. Only
+// Bullet's convex-versus-concave query (btConvexTriangleCallback) is culled;
+// rays and every other query get every triangle.
 #pragma once
 
 #include <BulletCollision/CollisionShapes/btHeightfieldTerrainShape.h>
@@ -33,33 +50,47 @@
 
 namespace terracut::bullet::detail {
 
+class NearTriangles;  // the cull of far triangles (merged_heightfield.cpp)
+
 class MergedHeightfield final : public btHeightfieldTerrainShape {
  public:
   /// As btHeightfieldTerrainShape(cols, rows, heights, min, max, 1 (Y up),
   /// false): float heights, row-major (index = row * cols + col), Y up, no
   /// flipped quad edges. tolerance_m <= 0 reports Bullet's own triangles.
+  /// cull_far: drop the triangles no contact can come from (above).
   MergedHeightfield(int cols, int rows, const float* heights, btScalar min_height,
-                    btScalar max_height, double tolerance_m);
+                    btScalar max_height, double tolerance_m, bool cull_far);
 
   void processAllTriangles(btTriangleCallback* callback, const btVector3& aabb_min,
                            const btVector3& aabb_max) const override;
 
-  /// Triangles reported by the last processAllTriangles, for tests and profiles.
+  /// Triangles reported by the last processAllTriangles (merged path), for
+  /// tests and profiles; those culled as far are counted too.
   int last_triangle_count() const { return last_triangles_; }
+  /// Of the triangles of the last processAllTriangles, those culled as far.
+  int last_culled_count() const { return last_culled_; }
 
  private:
   static constexpr int kTile = 64;   ///< squares per side of a merging tile
   static constexpr int kSplits = 3;  ///< a rectangle spans at most 1/kSplits of the range per side
 
+  // The query itself (merged or Bullet's), to callback; near: the cull
+  // (callback itself) or null, so that a square beyond the body is skipped
+  // before its triangles are made.
+  void process(btTriangleCallback* callback, NearTriangles* near, const btVector3& aabb_min,
+               const btVector3& aabb_max) const;
+
   // Merges and reports the squares [x_begin, x_end) x [j_begin, j_end).
   // Rectangles span at most max_x x max_j squares.
-  void merge_tile(btTriangleCallback* callback, int x_begin, int x_end, int j_begin, int j_end,
-                  int max_x, int max_j, btScalar y0, btScalar y1) const;
+  void merge_tile(btTriangleCallback* callback, NearTriangles* near, int x_begin, int x_end,
+                  int j_begin, int j_end, int max_x, int max_j, btScalar y0, btScalar y1) const;
 
   const float* heights_;
   int cols_;
   float tolerance_m_;
+  bool cull_far_;
   mutable int last_triangles_ = 0;
+  mutable int last_culled_ = 0;
 };
 
 }  // namespace terracut::bullet::detail

@@ -323,11 +323,12 @@ TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& bl
   // the body sits at the terrain's centre in X-Z and at the middle of the
   // height bounds in Y; then sample (c, r) lands at
   // (sample_x(c), origin.y + height, sample_z(r)).
-  // Coplanar squares under a body reach the collision query as one rectangle
+  // Coplanar squares under a body reach the collision query as one rectangle,
+  // and triangles no contact can come from do not reach GJK
   // (merged_heightfield.hpp); the surface and the ray tests are Bullet's own.
   m.terrain_shape = std::make_unique<detail::MergedHeightfield>(
       grid.cols(), grid.rows(), grid.heights(), btScalar(bounds_.min_height_m),
-      btScalar(bounds_.max_height_m), params_.merge_tolerance_m);
+      btScalar(bounds_.max_height_m), params_.merge_tolerance_m, params_.cull_far_triangles);
   m.terrain_shape->setLocalScaling(
       btVector3(btScalar(spec.cell_x_m()), btScalar(1.0), btScalar(spec.cell_z_m())));
   btTransform terrain_pose;

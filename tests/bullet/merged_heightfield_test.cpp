@@ -6,7 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <btBulletDynamicsCommon.h>
+#include <BulletCollision/CollisionDispatch/btConvexConcaveCollisionAlgorithm.h>
 #include <BulletCollision/CollisionShapes/btHeightfieldTerrainShape.h>
+#include <BulletCollision/CollisionShapes/btTriangleShape.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
+#include <BulletCollision/NarrowPhaseCollision/btPointCollector.h>
+#include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
 
 #include <array>
 #include <cmath>
@@ -15,6 +21,7 @@
 #include <random>
 #include <vector>
 
+#include "rescue_runner.hpp"
 #include "terracut/bullet/terrain_world.hpp"
 #include "test_scene.hpp"
 
@@ -257,6 +264,134 @@ TEST(MergedHeightfield, ToleranceIsValidated) {
   EXPECT_NE(validate(p).find("merge_tolerance_m"), std::string::npos);
   p.merge_tolerance_m = 0.0;
   EXPECT_EQ(validate(p), "");
+}
+
+// The triangles that reach Bullet's convex-versus-terrain callback for a
+// body (as btConvexConcaveCollisionAlgorithm queries them), without running
+// the narrow phase on them.
+struct ReachedTriangles final : btConvexTriangleCallback {
+  std::vector<Triangle> triangles;
+  ReachedTriangles(btDispatcher* d, const btCollisionObjectWrapper* convex,
+                   const btCollisionObjectWrapper* terrain)
+      : btConvexTriangleCallback(d, convex, terrain, false) {}
+  void processTriangle(btVector3* t, int, int) override { triangles.push_back({t[0], t[1], t[2]}); }
+};
+
+std::vector<Triangle> reached_by(TerrainWorld& world, int body, btScalar& threshold) {
+  btCollisionObject& b = world.body(body);
+  btCollisionObject& t = world.terrain_body();
+  const btCollisionObjectWrapper bw(nullptr, b.getCollisionShape(), &b, b.getWorldTransform(), -1, -1);
+  const btCollisionObjectWrapper tw(nullptr, t.getCollisionShape(), &t, t.getWorldTransform(), -1, -1);
+  ReachedTriangles reached(world.dynamics_world().getDispatcher(), &bw, &tw);
+  btManifoldResult result(&bw, &tw);
+  const btScalar margin = world.terrain_shape().getMargin();
+  reached.setTimeStepAndCounters(margin, world.dynamics_world().getDispatchInfo(), &bw, &tw, &result);
+  reached.m_manifoldPtr->setBodies(&b, &t);
+  threshold = reached.m_manifoldPtr->getContactBreakingThreshold();
+  world.terrain_shape().processAllTriangles(&reached, reached.getAabbMin(), reached.getAabbMax());
+  reached.clearWrapperData();
+  return reached.triangles;
+}
+
+// GJK's distance between a body and a terrain triangle (the shape's local
+// frame), margins taken off, as Bullet's convex-convex narrow phase finds it.
+double gjk_distance(TerrainWorld& world, int body, const Triangle& tri) {
+  btCollisionObject& b = world.body(body);
+  const btTransform& terrain = world.terrain_body().getWorldTransform();
+  btTriangleShape shape(tri[0], tri[1], tri[2]);
+  shape.setMargin(world.terrain_shape().getMargin());
+  btVoronoiSimplexSolver simplex;
+  btGjkEpaPenetrationDepthSolver epa;
+  btGjkPairDetector gjk(static_cast<const btConvexShape*>(b.getCollisionShape()), &shape, &simplex, &epa);
+  btGjkPairDetector::ClosestPointInput input;
+  input.m_transformA = b.getWorldTransform();
+  input.m_transformB = terrain;
+  btPointCollector out;
+  gjk.getClosestPoints(input, out, nullptr);
+  return out.m_hasResult ? double(out.m_distance) : 1e30;
+}
+
+TEST(MergedHeightfield, FarTrianglesAreCulledOnlyWhereNoContactCanComeFromThem) {
+  // A box tipped over onto rough soil and the trench's wall (the mixed
+  // terrain): the triangles that reach Bullet's narrow phase with the cull
+  // are among those without it, far fewer, and every one left out is more
+  // than the contact breaking threshold from the box by GJK itself. Merged
+  // and with Bullet's own triangles.
+  const GridSpec g = spec(48, 36, 1.2, 0.9, {-0.2, 0.1, 0.4}, 0.4);
+  for (const double tolerance : {1e-5, 0.0}) {
+    for (const Vec3 at : {Vec3{0.9, 0.38, 0.8}, Vec3{0.55, 0.33, 0.7}, Vec3{0.25, 0.39, 0.6}}) {
+      BodySpec b = box("tipped", {0.3, 0.12, 0.2}, 10.0, at);
+      b.rotation_deg = {25.0, 40.0, 70.0};
+      TerrainWorldParams on = merging(tolerance), off = merging(tolerance);
+      off.cull_far_triangles = false;
+      HeightGrid grid_on(g, mixed_heights(g)), grid_off(g, mixed_heights(g));
+      TerrainWorld culled(grid_on, 1000.0, BladeSpec{}, {b}, on);
+      TerrainWorld all(grid_off, 1000.0, BladeSpec{}, {b}, off);
+      btScalar threshold = 0;
+      const std::vector<Triangle> kept = reached_by(culled, 0, threshold);
+      const std::vector<Triangle> every = reached_by(all, 0, threshold);
+      ASSERT_FALSE(every.empty());
+      EXPECT_LT(kept.size(), every.size()) << "tolerance " << tolerance;
+      std::size_t k = 0;  // the kept ones come in the same order
+      int dropped = 0;
+      for (const Triangle& t : every) {
+        if (k < kept.size() && kept[k] == t) {
+          ++k;
+          continue;
+        }
+        ++dropped;
+        EXPECT_GT(gjk_distance(all, 0, t), double(threshold)) << "tolerance " << tolerance;
+      }
+      EXPECT_EQ(k, kept.size());
+      EXPECT_GT(dropped, 0);
+    }
+  }
+}
+
+// Whether two runs' body states and tool forces agree bit for bit at every step.
+void expect_same_runs(const ::terracut::test::BodiesRun& a, const ::terracut::test::BodiesRun& b) {
+  ASSERT_EQ(a.states.size(), b.states.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a.states.size(); ++i) {
+    const BodyState& x = a.states[i];
+    const BodyState& y = b.states[i];
+    const bool same = x.position_m.x == y.position_m.x && x.position_m.y == y.position_m.y &&
+                      x.position_m.z == y.position_m.z && x.orientation.w == y.orientation.w &&
+                      x.orientation.x == y.orientation.x && x.orientation.y == y.orientation.y &&
+                      x.orientation.z == y.orientation.z && x.velocity_m_s.x == y.velocity_m_s.x &&
+                      x.velocity_m_s.y == y.velocity_m_s.y && x.velocity_m_s.z == y.velocity_m_s.z &&
+                      x.angular_velocity_rad_s.x == y.angular_velocity_rad_s.x &&
+                      x.angular_velocity_rad_s.y == y.angular_velocity_rad_s.y &&
+                      x.angular_velocity_rad_s.z == y.angular_velocity_rad_s.z && x.active == y.active;
+    differ += same ? 0 : 1;
+  }
+  EXPECT_EQ(differ, 0u);
+  ASSERT_EQ(a.tool_force_n.size(), b.tool_force_n.size());
+  std::size_t forces_differ = 0;
+  for (std::size_t i = 0; i < a.tool_force_n.size(); ++i) {
+    const Vec3 x = a.tool_force_n[i], y = b.tool_force_n[i];
+    forces_differ += x.x == y.x && x.y == y.y && x.z == y.z ? 0 : 1;
+  }
+  EXPECT_EQ(forces_differ, 0u);
+  EXPECT_EQ(a.final_heights_m, b.final_heights_m);
+}
+
+TEST(MergedHeightfield, CullingFarTrianglesKeepsTheRescueBitForBit) {
+  // The rescue as shipped (soil that flows: block_b lies tilted on the sand
+  // in its trench, where the cull drops most triangles) and with the soil
+  // vanishing: every body state of every step, the plate's force and the
+  // final terrain are the same with and without the cull.
+  for (const SoilModel model : {SoilModel::kFlow, SoilModel::kVanish}) {
+    ::terracut::test::BodiesScenario input =
+        ::terracut::test::load_with_bodies(std::filesystem::path(TERRACUT_SOURCE_DIR) / "scenarios/rescue.yaml");
+    input.base.soil.model = model;
+    TerrainWorldParams off;
+    off.cull_far_triangles = false;
+    const ::terracut::test::BodiesRun culled = ::terracut::test::run_with_bodies(input, {});
+    const ::terracut::test::BodiesRun all = ::terracut::test::run_with_bodies(input, {}, off);
+    SCOPED_TRACE(model == SoilModel::kFlow ? "flow" : "vanish");
+    expect_same_runs(culled, all);
+  }
 }
 
 }  // namespace
