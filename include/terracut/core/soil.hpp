@@ -24,16 +24,20 @@
 // Relaxation. Between a cell and each of its 8 neighbours (axis distance dx
 // or dz, diagonal distance sqrt(dx^2 + dz^2)), the excess is the height
 // difference above tan(repose) x distance. Per pass, a cell whose excess
-// toward some neighbours is above a tolerance (1e-4 of a cell) sheds half
-// of its largest excess, shared among those neighbours in proportion to
-// their excess (the thermal-erosion rule of Musgrave, Kolb & Mace,
-// SIGGRAPH 1989). A pass's fluxes are computed from the heights frozen at
-// its start (Jacobi) and then applied, so the result does not depend on
-// the order of the cells: a mirrored terrain gives the mirrored result (to
-// float rounding), the same inputs the same bits. With the diagonals the repose angle holds along the
-// axes and the diagonals and is about 2 degrees steeper in between (a
-// 4-neighbour stencil makes diagonals about 9 degrees too steep), so a pile
-// poured at a point settles into a round cone.
+// toward some neighbours is above a tolerance (2 % of the repose drop over
+// the shorter cell side) sheds half of its largest excess, shared among
+// those neighbours in proportion to their excess (the thermal-erosion rule
+// of Musgrave, Kolb & Mace, SIGGRAPH 1989). A pass's fluxes are computed
+// from the heights frozen at its start (Jacobi) and then applied, so the
+// result does not depend on the order of the cells: the same inputs give
+// the same bits, and relaxation alone gives a mirrored terrain the
+// mirrored result to float rounding (with a blade cutting, rounding that
+// is not mirror-symmetric tips pairs at their threshold one way: about a
+// millimetre in docs/soil.md's check). With the diagonals the repose angle
+// holds along the axes and the diagonals and on square cells is up to 2.6
+// degrees steeper in between (steepest_standing_slope_deg; a 4-neighbour
+// stencil makes diagonals about 9 degrees too steep), so a pile poured at
+// a point settles into a round cone.
 //
 // Cost follows activity: only cells whose height changed (and, once, at
 // construction, every cell steeper than the repose angle) are examined, and
