@@ -219,6 +219,7 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   active_.reserve(active);
   next_.reserve(active);
   fluxes_.reserve(4 * active);  // up to 8 per cell; 4 covers a collapsing block
+  sources_.reserve(active);
   held_.reserve(footprint);
   dirty_.reserve(footprint);
   if (blade.bucket.enabled()) {
@@ -300,7 +301,7 @@ void SoilFlow::set_obstacles(std::span<const SoilObstacle> obstacles) noexcept {
   }
 }
 
-void SoilFlow::lowered(std::uint32_t cell, const float* h) {
+inline void SoilFlow::lowered(std::uint32_t cell, const float* h) {
   // Only the pairs of this cell changed: a neighbour that now stands too
   // steep above it is examined in the next pass (the same test as a pass's).
   activate(cell);
@@ -846,9 +847,6 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
   const int ca = blade ? col_of(a) : 0, ra = blade ? row_of(a) : 0;
   const bool obstacles = !obstacles_.empty();
   const bool hull = !hull_cells_.empty();
-  // The fluxes are appended with their excess and scaled by the share once
-  // the share is known (the same product as share * excess).
-  const std::size_t first = fluxes_.size();
   int n = 0;
   float top = 0.0f, sum = 0.0f;
   for (unsigned bits = steep; bits != 0; bits &= bits - 1) {
@@ -883,14 +881,13 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
         }
       }
     }
-    fluxes_.push_back({a, b, e});
+    fluxes_.push_back({b, e});
     ++n;
     top = std::max(top, e);
     sum += e;
   }
   if (n == 0) return 0;
-  const float share = kShedFraction * top / sum;
-  for (std::size_t j = first; j < fluxes_.size(); ++j) fluxes_[j].height = share * fluxes_[j].height;
+  sources_.push_back({a, std::uint32_t(n), kShedFraction * top / sum});
   return n;
 }
 
@@ -909,7 +906,8 @@ void SoilFlow::finish_pass(HeightGrid& grid, SoilStepResult& out) {
   dirty_.clear();
   active_.clear();
   fluxes_.clear();
-  examined_ = applied_ = 0;
+  sources_.clear();
+  examined_ = applied_ = applied_sources_ = 0;
   ++out.passes;
 }
 
@@ -947,13 +945,16 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       examined_ = end;
       if (examined_ < active_.size()) break;  // the rest in the next step
     }
-    while (applied_ < fluxes_.size()) {
+    while (applied_sources_ < sources_.size()) {
       // A source's fluxes are contiguous: applied together, then its fall
       // tested against its neighbours.
-      const std::uint32_t a = fluxes_[applied_].from;
-      std::size_t end = applied_;
-      while (end < fluxes_.size() && fluxes_[end].from == a) ++end;
-      const bool stale = (queued_[a] & kDirty) != 0;
+      const std::uint32_t a = sources_[applied_sources_].cell;
+      const std::size_t end = applied_ + sources_[applied_sources_].fluxes;
+      const float share = sources_[applied_sources_].share;
+      // No cell is dirty while dirty_ is empty (most passes: the cut marks
+      // cells only in a pass it interrupts), and then nothing is read for it.
+      const bool any_dirty = !dirty_.empty();
+      const bool stale = any_dirty && (queued_[a] & kDirty) != 0;
       const std::int64_t cost = std::int64_t(end - applied_) + (stale ? 0 : kFallTestVisits);
       if (work + cost > cap) {
         out_of_work = true;
@@ -962,11 +963,13 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       work += cost;
       if (stale) {
         applied_ = end;  // changed since it was examined: examined again
+        ++applied_sources_;
         continue;
       }
       float total = 0.0f;
       for (std::size_t j = applied_; j < end; ++j)
-        if (fluxes_[j].to == kOutside || !(queued_[fluxes_[j].to] & kDirty)) total += fluxes_[j].height;
+        if (!any_dirty || fluxes_[j].to == kOutside || !(queued_[fluxes_[j].to] & kDirty))
+          total += share * fluxes_[j].excess;
       // What the cell can give: never below the floor (the blade may have
       // cut it since the pass was examined).
       const float before = h[a];
@@ -986,8 +989,8 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       changed_r1 = std::max(changed_r1, ra);
       for (; applied_ < end; ++applied_) {
         const Flux& f = fluxes_[applied_];
-        if (f.to != kOutside && (queued_[f.to] & kDirty)) continue;
-        const float give = f.height * scale;
+        if (any_dirty && f.to != kOutside && (queued_[f.to] & kDirty)) continue;
+        const float give = (share * f.excess) * scale;
         if (f.to == kOutside) {
           out.left_over_edge_m3 += double(give) * cell_area;
           gained += double(give);  // what left is no rounding gain
@@ -999,9 +1002,10 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
         activate(f.to);
       }
       pass_gained_m_ += gained;
+      ++applied_sources_;
       lowered(a, h);
     }
-    if (applied_ < fluxes_.size()) break;
+    if (applied_sources_ < sources_.size()) break;
     finish_pass(grid, out);
   }
   out.pair_checks += work;

@@ -385,11 +385,20 @@ class SoilFlow {
     dirty_.push_back(cell);
   }
   std::vector<std::uint32_t> dirty_;
-  // One flux of a pass: `height` metres from cell `from` to cell `to`
-  // (kOutside: over an open edge).
+  // One flux of a pass: share x `excess` metres to cell `to` (kOutside:
+  // over an open edge) from its source, a cell that sheds: a source's
+  // fluxes are contiguous in fluxes_, and sources_ lists the sources in
+  // that order with their counts and their share (the product is formed
+  // where the flux is applied, so the share's division is off the
+  // examination's critical path).
   struct Flux {
-    std::uint32_t from, to;
-    float height;
+    std::uint32_t to;
+    float excess;
+  };
+  struct Source {
+    std::uint32_t cell;
+    std::uint32_t fluxes;
+    float share;
   };
   // The pass in progress: its cells (frozen list), how many were examined,
   // the fluxes found and how many were applied. A pass is examined whole
@@ -399,6 +408,8 @@ class SoilFlow {
   std::size_t examined_ = 0;
   std::vector<Flux> fluxes_;
   std::size_t applied_ = 0;
+  std::vector<Source> sources_;
+  std::size_t applied_sources_ = 0;
   double pass_gained_m_ = 0.0;    // height the pass's writes gained by float rounding
   std::uint32_t pass_highest_ = 0;  // the highest cell the pass raised or lowered
   float pass_highest_h_ = -1.0f;
