@@ -598,6 +598,14 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
           static_cast<std::int64_t>(w->in(range("soil.max_pair_checks_per_step")));
     if (const auto e = soil.get("edge"))
       sc.soil.edge = e->choice({SoilEdge::kWall, SoilEdge::kOpen}, "soil edge");
+    // The flow's settings without a model: the model defaults to vanish,
+    // where they do nothing, which is surely not what was meant (an
+    // explicit 'model: vanish' keeps them, to compare the two).
+    if (!soil.get("model"))
+      for (const char* key : {"repose_deg", "max_pair_checks_per_step", "edge"})
+        if (const auto g = soil.get(key))
+          g->fail(std::string("given without 'model', which defaults to vanish (the cut soil is deleted, nothing "
+                              "slides): add 'model: flow', or 'model: vanish' to keep the soil vanishing"));
   }
   if (bucket_field && sc.soil.model != SoilModel::kFlow)
     bucket_field->fail("a bucket carries the soil it digs, so it needs soil that flows: add 'soil: {model: flow}'");

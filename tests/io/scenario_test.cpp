@@ -222,6 +222,11 @@ TEST(ScenarioSoil, TheSoilSectionChoosesTheModel) {
   expect_error(zero, line_of(zero, "repose_deg: 0"), "soil.repose_deg", "[1, 80]");
   const std::string tiny = replace(text, "repose_deg: 40", "repose_deg: 1e-300");
   expect_error(tiny, line_of(tiny, "repose_deg: 1e-300"), "soil.repose_deg", "[1, 80]");
+  // The flow's settings without a model (which defaults to vanish) are a
+  // mistake, named; with an explicit vanish they are kept.
+  const std::string no_model = replace(text, "  model: flow\n", "");
+  expect_error(no_model, line_of(no_model, "repose_deg: 40"), "soil.repose_deg", "add 'model: flow'");
+  EXPECT_EQ(parse_scenario(replace(text, "model: flow", "model: vanish"), "x.yaml").soil.model, SoilModel::kVanish);
   const std::string mud = replace(text, "model: flow", "model: mud");
   expect_error(mud, line_of(mud, "model: mud"), "soil.model", "allowed: vanish, flow");
   EXPECT_EQ(sc.soil.edge, SoilEdge::kWall);
