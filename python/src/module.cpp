@@ -526,6 +526,7 @@ py::dict run_result_dict(const session::RunResult& r, const io::Scenario& sc) {
     d["final_backlog_cells"] = r.soil->final_backlog_cells;
     out["soil"] = d;
   }
+  out["warnings"] = r.warnings;
   // The per-step records as columns (contact.csv's, with the cut index).
   Columns records(py::ssize_t(r.records.size()),
                   {"t", "x", "y", "z", "qw", "qx", "qy", "qz", "contact_length", "removed_volume",

@@ -51,7 +51,12 @@ def run(scenario, out_dir: Union[str, os.PathLike], realtime: bool = False) -> d
     per-cut figures ("cuts"), step timing ("step_timing", microseconds), and
     "records": contact.csv's columns as numpy arrays (t in s, cut index,
     x, y, z in m, qw..qz, contact_length m, removed_volume m^3,
-    section_area m^2, max_depth m). The GIL is released during the run.
+    section_area m^2, max_depth m). With soil that flows, "soil" (displaced
+    and left-over volumes, passes, final backlog) and "warnings": readable
+    lines, as summary.json's and `terracut run`'s (soil left steeper than its
+    repose angle by the work cap, cells too far from square for the repose
+    angle to hold in every direction); [] when there is nothing to say.
+    The GIL is released during the run.
     """
     from ._terracut import _run
 

@@ -1,12 +1,14 @@
 """Bit-identical to the command line: `terracut run` and the module give the
 same numbers for the same scenario."""
 
+import json
 import os
 import subprocess
 
 import numpy as np
 
 import terracut
+from conftest import small_exp1_dict
 
 FIELDS = ["t", None, "x", "y", "z", "qw", "qx", "qy", "qz", "contact_length", "removed_volume",
           "section_area", "max_depth", "cells_visited"]
@@ -59,6 +61,24 @@ def test_terracut_run_writes_the_clis_files(cli, exp1, tmp_path):
     np.testing.assert_allclose(rec["contact_length"], csv["contact_length"], rtol=1e-8, atol=1e-12)
     assert result["cuts"][0]["name"] == "horizontal"
     assert result["removed_volume_m3"] > 0 and abs(result["volume_error_m3"]) < 1e-9
+
+
+def test_run_returns_the_soils_warnings(tmp_path):
+    # Cells of 4:1 and a work cap too small for the cut: both named; the
+    # same run on square cells with the cap lifted has nothing to say.
+    d = small_exp1_dict()
+    d["terrain"]["resolution"] = [40, 10]
+    d["soil"] = {"model": "flow", "repose_deg": 34, "max_pair_checks_per_step": 1000}
+    result = terracut.run(terracut.Scenario.from_dict(d), tmp_path / "oblong")
+    warnings = result["warnings"]
+    assert len(warnings) == 2, warnings
+    assert "cells were still steeper than the angle of repose" in warnings[0]
+    assert "let planes up to 40.9 degrees stand" in warnings[1]
+    summary = json.loads((tmp_path / "oblong" / "summary.json").read_text())
+    assert summary["warnings"] == warnings
+    d["terrain"]["resolution"] = 20
+    d["soil"]["max_pair_checks_per_step"] = 1000000000
+    assert terracut.run(terracut.Scenario.from_dict(d), tmp_path / "square")["warnings"] == []
 
 
 def test_run_errors_name_the_output(tmp_path, exp1):
