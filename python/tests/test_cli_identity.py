@@ -72,7 +72,7 @@ def test_run_returns_the_soils_warnings(tmp_path):
     result = terracut.run(terracut.Scenario.from_dict(d), tmp_path / "oblong")
     warnings = result["warnings"]
     assert len(warnings) == 2, warnings
-    assert "cells were still steeper than the angle of repose" in warnings[0]
+    assert "the relaxation was not done at the end" in warnings[0]
     assert "let planes up to 40.9 degrees stand" in warnings[1]
     summary = json.loads((tmp_path / "oblong" / "summary.json").read_text())
     assert summary["warnings"] == warnings

@@ -50,11 +50,11 @@ std::vector<std::string> soil_warnings(const SoilFlowParams& soil, const GridSpe
   std::vector<std::string> w;
   if (soil.model != SoilModel::kFlow) return w;
   if (final_backlog_cells > 0)
-    w.push_back("soil: " + std::to_string(final_backlog_cells) +
-                " cells were still steeper than the angle of repose at the end: the work cap "
-                "(soil.max_pair_checks_per_step = " + std::to_string(soil.max_pair_checks_per_step) +
-                " neighbour visits a step) stopped the relaxation short, so the piles are not settled; "
-                "raise it for an offline run");
+    w.push_back("soil: the relaxation was not done at the end (a backlog of " + std::to_string(final_backlog_cells) +
+                " cells to examine and fluxes to apply): the work cap (soil.max_pair_checks_per_step = " +
+                std::to_string(soil.max_pair_checks_per_step) +
+                " neighbour visits a step) stopped it short, so slopes may still stand steeper than the angle "
+                "of repose; raise the cap for an offline run");
   // Cells far from square leave planes steeper than on square cells
   // standing (the 8 neighbours' directions leave wider gaps).
   const double dx = grid.cell_x_m(), dz = grid.cell_z_m();
@@ -65,8 +65,8 @@ std::vector<std::string> soil_warnings(const SoilFlowParams& soil, const GridSpe
     std::snprintf(line, sizeof line,
                   "soil: cells of %.4g x %.4g m (X x Z) let planes up to %.1f degrees stand between the "
                   "relaxation's 8 neighbour directions, against %.1f on square cells, for a repose angle of "
-                  "%.4g: use square cells for a repose angle that holds in every direction",
-                  dx, dz, here, square, soil.repose_deg);
+                  "%.4g: use square cells to keep every direction within %.1f degrees of it",
+                  dx, dz, here, square, soil.repose_deg, square - soil.repose_deg);
     w.push_back(line);
   }
   return w;

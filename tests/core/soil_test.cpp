@@ -97,10 +97,11 @@ std::vector<float> column(int n, double radius_cells, float height_m) {
 }
 
 TEST(IndexDivider, QuotientsEqualHardwareDivisionForEveryRowLength) {
-  // Every row length a grid can have (1 .. kMaxGridSide), at the numerators
-  // where a rounded reciprocal goes wrong first: each multiple of the
-  // divisor and its neighbours, up to the largest 32-bit index; and every
-  // numerator below 2^20 for the small and power-of-two divisors.
+  // Every row length up to 1100 and every 97th up to kMaxGridSide, at the
+  // numerators where a rounded reciprocal goes wrong first: multiples of
+  // the divisor and their neighbours, up to the largest 32-bit index; and
+  // every numerator below 2^20 for a few small, odd and power-of-two
+  // divisors. (The quotient is exact by the theorem; this checks the code.)
   std::int64_t checked = 0;
   for (std::uint32_t d = 1; d <= std::uint32_t(kMaxGridSide); d += (d < 1100 ? 1 : 97)) {
     const detail::IndexDivider div(d);

@@ -110,7 +110,7 @@ TEST(SoilWarnings, NameAnUnsettledEndAndCellsTooFarFromSquare) {
   // Still active at the end: the count and the cap are named.
   const std::vector<std::string> unsettled = soil_warnings(soil, square, 17);
   ASSERT_EQ(unsettled.size(), 1u);
-  EXPECT_NE(unsettled[0].find("17 cells"), std::string::npos) << unsettled[0];
+  EXPECT_NE(unsettled[0].find("a backlog of 17 cells"), std::string::npos) << unsettled[0];
   EXPECT_NE(unsettled[0].find("max_pair_checks_per_step = 50000"), std::string::npos) << unsettled[0];
   // Cells of 4:1: planes to 40.9 degrees stand, against 36.6 on square cells.
   GridSpec oblong = square;

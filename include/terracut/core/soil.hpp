@@ -133,22 +133,28 @@ class IndexDivider {
 /// A list of cell indices that can take one on a condition without a
 /// branch (push_if): the relaxation queues a neighbour only when it is not
 /// queued yet, a test whose outcome changes from cell to cell, so a branch
-/// on it was often mispredicted. Storage grows like std::vector's (doubling)
-/// and is kept across clear(); copies are deep.
+/// on it was often mispredicted. The storage always has a slot beyond the
+/// last element, which push_if writes whether it keeps it or not; it grows
+/// (doubling) only when a kept element fills that slot, so a list reserved
+/// for n cells never allocates while it holds at most n. Kept across
+/// clear(); copies are deep.
 class CellList {
  public:
+  CellList() : buf_(64) {}
   std::size_t size() const { return size_; }
+  /// Elements it holds before it allocates again.
+  std::size_t capacity() const { return buf_.size() - 1; }
   bool empty() const { return size_ == 0; }
   void clear() { size_ = 0; }
   void reserve(std::size_t n) {
-    if (n > buf_.size()) buf_.resize(n);
+    if (n + 1 > buf_.size()) buf_.resize(n + 1);
   }
   void push_back(std::uint32_t cell) { push_if(cell, true); }
   /// Appends cell when keep is true; either way without a branch on keep.
   void push_if(std::uint32_t cell, bool keep) {
-    if (size_ == buf_.size()) buf_.resize(buf_.empty() ? 64 : 2 * buf_.size());
     buf_[size_] = cell;
     size_ += keep ? 1u : 0u;
+    if (size_ == buf_.size()) buf_.resize(2 * buf_.size());
   }
   std::uint32_t operator[](std::size_t i) const { return buf_[i]; }
   const std::uint32_t* begin() const { return buf_.data(); }
@@ -187,7 +193,7 @@ std::string_view to_string(SoilEdge edge);
 struct SoilFlowParams {
   SoilModel model = SoilModel::kVanish;
   /// Angle of repose (the stopping angle of a flowing slope), degrees, in
-  /// (0, 80]. Dry sand about 34, wet sand about 45, saturated 15-30
+  /// [1, 80]. Dry sand about 34, wet sand about 45, saturated 15-30
   /// (Al-Hashemi & Al-Amoudi, Powder Technology 330 (2018) 397).
   double repose_deg = 34.0;
   /// Work cap of one step's relaxation, in neighbour visits, in
@@ -245,14 +251,15 @@ double bucket_retained_m3(const BladeSpec& blade, const Quat& orientation, doubl
 /// between two neighbour directions meets both pairs at a slant, so a
 /// plane there stands steeper than the repose angle. The steepest is where
 /// two angularly adjacent neighbours' bounds meet, in the widest gap: on
-/// square cells (gaps of 45 degrees) 36.6 degrees for 34; on cells of 2:1
-/// (the diagonal 63.4 degrees off the long side) 38.8, on 4:1 40.9. A
+/// square cells (gaps of 45 degrees) 36.6 degrees for 34; on cells twice
+/// as long along Z as along X (the diagonal 63.4 degrees off the X axis,
+/// 26.6 off Z) 38.8, on 4:1 40.9. A
 /// cone settles at the repose angle along the 8 directions and up to this
 /// in between.
 double steepest_standing_slope_deg(double cell_x_m, double cell_z_m, double repose_deg);
 
 /// The soil phase's state (kFlow): the active cells and the scratch of the
-/// passes, sized at construction (3 bytes per sample, plus lists for the
+/// passes, sized at construction (2 bytes per sample, plus lists for the
 /// blade's footprint and an active set of at least 65536 cells) so that a
 /// step allocates nothing (tested in the haptic loop on flowing soil); only
 /// a backlog larger than that grows them.
