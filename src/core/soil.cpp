@@ -58,6 +58,21 @@ constexpr Neighbour kNeighbours[8] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 1},  {0, -1
 
 double to_cells(double v, double origin, double cell) { return (v - origin) / cell; }
 
+#if defined(__SSE2__)
+/// The heights of an inner cell's 8 neighbours (p points at the cell; up is
+/// one row along +Z), in kNeighbours' order: n0 holds k = 0..3, n1 k = 4..7.
+inline void load_neighbours(const float* p, std::int64_t up, __m128& n0, __m128& n1) {
+  n0 = _mm_setr_ps(p[1], p[-1], p[up], p[-up]);
+  n1 = _mm_setr_ps(p[up + 1], p[up - 1], p[1 - up], p[-1 - up]);
+}
+
+/// Bit k set where lane k of (e0, e1) (k = 0..3, 4..7) is above tol.
+inline unsigned above_mask(__m128 e0, __m128 e1, float tol) {
+  const __m128 vt = _mm_set1_ps(tol);
+  return unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e0, vt))) | unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e1, vt))) << 4;
+}
+#endif
+
 
 }  // namespace
 
@@ -311,14 +326,12 @@ inline void SoilFlow::lowered(std::uint32_t cell, const float* h) {
     unsigned steep = 0;
 #if defined(__SSE2__)
     // As examine's: four pairs to an instruction, the same bits.
-    const float* p = h + cell;
-    const std::int64_t up = offset_[2];
-    const __m128 hb0 = _mm_setr_ps(p[1], p[-1], p[up], p[-up]);
-    const __m128 hb1 = _mm_setr_ps(p[up + 1], p[up - 1], p[1 - up], p[-1 - up]);
-    const __m128 vc = _mm_set1_ps(hc), vt = _mm_set1_ps(tolerance_m_);
+    __m128 hb0, hb1;
+    load_neighbours(h + cell, offset_[2], hb0, hb1);
+    const __m128 vc = _mm_set1_ps(hc);
     const __m128 e0 = _mm_sub_ps(_mm_sub_ps(hb0, vc), _mm_loadu_ps(limit8_));
     const __m128 e1 = _mm_sub_ps(_mm_sub_ps(hb1, vc), _mm_loadu_ps(limit8_ + 4));
-    steep = unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e0, vt))) | unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e1, vt))) << 4;
+    steep = above_mask(e0, e1, tolerance_m_);
 #else
     for (int k = 0; k < 8; ++k)
       steep |= unsigned(h[std::int64_t(cell) + offset_[k]] - hc - limit8_[k] > tolerance_m_) << k;
@@ -567,9 +580,9 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
     float v = std::max(0.0f, layers.height_m[cell] + add);
     float over = v > ceiling_m_ ? v - ceiling_m_ : 0.0f;
     write(cell, v - over);
-    out.changed.include(int(cell % cols_), int(cell / cols_));
+    const int c0 = col_of(std::uint32_t(cell)), r0 = row_of(std::uint32_t(cell));
+    out.changed.include(c0, r0);
     activate(std::uint32_t(cell));
-    const int c0 = int(cell % cols_), r0 = int(cell / cols_);
     for (int ring = 1; ring <= kMaxPushCells && over > 0.0f; ++ring)
       for (int dr = -ring; dr <= ring && over > 0.0f; ++dr)
         for (int dc = -ring; dc <= ring && over > 0.0f; dc += (dr == -ring || dr == ring) ? 1 : 2 * ring) {
@@ -718,7 +731,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           const std::int64_t cell_j = ray[j];
           const float old = layers.height_m[cell_j];
           write(cell_j, previous);
-          out.changed.include(int(cell_j % cols_), int(cell_j / cols_));
+          out.changed.include(col_of(std::uint32_t(cell_j)), row_of(std::uint32_t(cell_j)));
           if (previous < old)
             lowered(std::uint32_t(cell_j), layers.height_m);
           else
@@ -764,7 +777,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
         write(u, layers.height_m[u] + add);
         rest -= add;
         level = layers.height_m[u];
-        out.changed.include(int(u % cols_), int(u / cols_));
+        out.changed.include(col_of(std::uint32_t(u)), row_of(std::uint32_t(u)));
         activate(std::uint32_t(u));
       }
       // What did not fit (or, by rounding, came out negative) is settled on
@@ -810,16 +823,14 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
 #if defined(__SSE2__)
     // Four pairs to an instruction, in kNeighbours' order, with the same
     // operations as the scalar form below (the same bits).
-    const float* p = h + a;
-    const std::int64_t up = offset_[2];  // one row along +Z
-    const __m128 hb0 = _mm_setr_ps(p[1], p[-1], p[up], p[-up]);
-    const __m128 hb1 = _mm_setr_ps(p[up + 1], p[up - 1], p[1 - up], p[-1 - up]);
-    const __m128 va = _mm_set1_ps(ha), vt = _mm_set1_ps(tol);
+    __m128 hb0, hb1;
+    load_neighbours(h + a, offset_[2], hb0, hb1);
+    const __m128 va = _mm_set1_ps(ha);
     const __m128 e0 = _mm_sub_ps(_mm_sub_ps(va, hb0), _mm_loadu_ps(limit8_));
     const __m128 e1 = _mm_sub_ps(_mm_sub_ps(va, hb1), _mm_loadu_ps(limit8_ + 4));
     _mm_storeu_ps(excess, e0);
     _mm_storeu_ps(excess + 4, e1);
-    steep = unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e0, vt))) | unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e1, vt))) << 4;
+    steep = above_mask(e0, e1, tol);
 #else
     for (int k = 0; k < 8; ++k) {
       excess[k] = ha - h[std::int64_t(a) + offset_[k]] - limit8_[k];
@@ -862,10 +873,7 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
         // is examined again once it has moved.
         if (blade && (fb & kNearBlade) &&
             blade_blocks(ca, ra, ca + kNeighbours[k].dc, ra + kNeighbours[k].dr, ha)) {
-          if (!(queued_[a] & kHeld)) {
-            set_flag(a, kHeld);
-            held_.push_back(a);
-          }
+          hold(a);
           continue;
         }
         // Nor into a rigid body's footprint (soil under it may slide out).
@@ -873,10 +881,7 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
         // Nor into a cell under the bucket's hull from higher than the hull's
         // underside there (a flux never raises a cell above its source).
         if ((fb & kHull) && ha > hull_under(b)) {
-          if (!(queued_[a] & kHeld)) {
-            set_flag(a, kHeld);
-            held_.push_back(a);
-          }
+          hold(a);
           continue;
         }
       }
@@ -1250,7 +1255,7 @@ void SoilFlow::shoulder(HeightGrid& grid, SoilStepResult& out) {
           last_put = t;
           rest -= add;
           moved = true;
-          out.changed.include(int(t % cols_), int(t / cols_));
+          out.changed.include(col_of(std::uint32_t(t)), row_of(std::uint32_t(t)));
           activate(std::uint32_t(t));
         }
         if (rest <= 0.0f) break;

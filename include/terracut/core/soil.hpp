@@ -318,6 +318,13 @@ class SoilFlow {
     next_.push_if(cell, !(f & kQueued));
   }
   void lowered(std::uint32_t cell, const float* h);
+  /// Marks cell a as held by the blade or the hull (examined again once
+  /// they have moved), once.
+  void hold(std::uint32_t a) {
+    if (queued_[a] & kHeld) return;
+    set_flag(a, kHeld);
+    held_.push_back(a);
+  }
   void wake_held(const Segment* edge);
   void mark_blade(const HeightGrid& grid, const Segment& edge);
   void clear_blade();
