@@ -1,0 +1,119 @@
+#!/usr/bin/python3
+"""Driver of the terracut DEM reference data (LIGGGHTS-PUBLIC 3.8).
+
+  run.py material --seeds 1 2 3          material tests -> results/material.json
+  run.py bed --seed 1                    pour the bulldozing bed of a seed (cached in work/)
+  run.py bulldoze --case NAME --seed 1   one bulldozing run -> results/bulldoze/NAME/seed1/
+  run.py bulldoze --case all --seed 1    every case of a seed
+  run.py summary                         results/bulldoze/summary.csv from the runs present
+  run.py all                             everything, seeds 1 2 3
+  run.py smoke                           every script, a few hundred steps on tiny beds (CI)
+
+LIGGGHTS runs one process at a time under `nice -n 19`; scratch goes to
+validation/dem/work/ (git-ignored).  Use /usr/bin/python3 (numpy, scipy)."""
+
+import argparse
+import os
+import shutil
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "common"))
+sys.path.insert(0, os.path.join(HERE, "material"))
+sys.path.insert(0, os.path.join(HERE, "bulldoze"))
+
+import dem  # noqa: E402
+import material  # noqa: E402
+import bulldoze  # noqa: E402
+
+
+def cmd_material(a):
+    out = material.run_all(a.seeds)
+    for k in ("repose_deg", "bulk_density_kg_per_m3", "internal_friction_peak_deg",
+              "internal_friction_residual_deg", "cohesion_pa", "soil_tool_friction_deg"):
+        print(k, out[k], out[k + "_per_seed"])
+
+
+def cmd_bed(a):
+    info = bulldoze.make_bed(a.seed, force=a.force)
+    print({k: info[k] for k in ("particles", "initial_surface_mean_m", "bulk_density_kg_per_m3", "wall_s")})
+
+
+def cmd_bulldoze(a):
+    cases = list(bulldoze.CASES) if a.case == "all" else [a.case]
+    for c in cases:
+        if c not in bulldoze.CASES:
+            sys.exit("unknown case %s (known: %s)" % (c, ", ".join(bulldoze.CASES)))
+    for c in cases:
+        info = bulldoze.run_case(c, a.seed, force=a.force)
+        for m in info["metrics"]:
+            print(c, a.seed, "%.1f-%.1f m: fx %.1f N fz %.1f N pile %.2e m3 peak %.3f m" % (
+                m["window_start_m"], m["window_end_m"], m["fx_mean_n"], m["fz_mean_n"],
+                m["pile_volume_m3"], m["pile_peak_height_m"]))
+        bulldoze.write_summary()
+
+
+def cmd_summary(a):
+    print(bulldoze.write_summary())
+
+
+def cmd_all(a):
+    material.run_all([1, 2, 3])
+    for s in (1, 2, 3):
+        for c in bulldoze.CASES:
+            bulldoze.run_case(c, s, force=a.force)
+            bulldoze.write_summary()
+
+
+def cmd_smoke(a):
+    """Every LIGGGHTS script and every post-processing step on tiny beds for
+    a few hundred steps.  Exit status non-zero on any failure."""
+    t0 = time.time()
+    sm = os.path.join(dem.WORK, "bulldoze", "smoke")
+    shutil.rmtree(sm, ignore_errors=True)
+    shutil.rmtree(os.path.join(dem.WORK, "material", "smoke"), ignore_errors=True)
+    print("LIGGGHTS", dem.liggghts_version())
+    material.run_all([1], smoke=True)
+    print("material scripts ok (%.1f s)" % (time.time() - t0))
+    for c in ("vertical_w012_d050", "raked45_w012_d050"):
+        info = bulldoze.run_case(c, 1, smoke=True)
+        assert len(info["metrics"]) == 3
+    print("bulldoze scripts ok (%.1f s)" % (time.time() - t0))
+    chk = dem.rayleigh_check()
+    assert chk["ok"], chk
+    print("smoke ok in %.1f s" % (time.time() - t0))
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="cmd", required=True)
+    m = sub.add_parser("material")
+    m.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    m.set_defaults(fn=cmd_material)
+    b = sub.add_parser("bed")
+    b.add_argument("--seed", type=int, required=True)
+    b.add_argument("--force", action="store_true", help="pour again even if cached")
+    b.set_defaults(fn=cmd_bed)
+    b = sub.add_parser("bulldoze")
+    b.add_argument("--case", required=True, help="case name or 'all'")
+    b.add_argument("--seed", type=int, required=True)
+    b.add_argument("--force", action="store_true", help="rerun even if results exist")
+    b.set_defaults(fn=cmd_bulldoze)
+    s = sub.add_parser("summary")
+    s.set_defaults(fn=cmd_summary)
+    s = sub.add_parser("all")
+    s.add_argument("--force", action="store_true")
+    s.set_defaults(fn=cmd_all)
+    s = sub.add_parser("smoke")
+    s.set_defaults(fn=cmd_smoke)
+    a = p.parse_args()
+    try:
+        a.fn(a)
+    except dem.LiggghtsError as e:
+        print(e, file=sys.stderr)
+        sys.exit(2)
+
+
+if __name__ == "__main__":
+    main()
