@@ -241,6 +241,8 @@ def run_case(case, seed, smoke=False, force=False):
     names = {"init": "surface_initial.npy", "p0": "surface_0.npy",
              "p1": "surface_%d.npy" % round(1000 * seg), "p2": "surface_%d.npy" % round(2000 * seg),
              "p3": "surface_%d.npy" % round(3000 * seg)}
+    if smoke:  # tiny pushes would give colliding names
+        names = {k: "surface_smoke_%s.npy" % k for k in names}
     pushes = {"init": None, "p0": 0.0, "p1": seg, "p2": 2 * seg, "p3": 3 * seg}
     grains = {}
     for k, fn in names.items():
@@ -335,7 +337,7 @@ def window_metrics(info, outdir, grains):
     xs = (np.arange(nx) + 0.5) * cell
     ys = (np.arange(ny) + 0.5) * cell
     X, Y = np.meshgrid(xs, ys)
-    h_init = np.load(os.path.join(outdir, "surface_initial.npy")).astype(float)
+    h_init = np.load(os.path.join(outdir, info["surfaces"]["snapshots"]["init"]["file"])).astype(float)
     force = np.genfromtxt(os.path.join(outdir, "force.csv"), delimiter=",", names=True)
     seg = info["motion"]["push_total_m"] / 3
     out = []

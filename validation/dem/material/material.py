@@ -46,7 +46,7 @@ DENSITY = {
     "measure_margin_walls_m": 0.06, "measure_margin_floor_m": 0.02, "measure_margin_top_m": 0.025,
 }
 SHEAR = {
-    "length_x_m": 0.20, "width_y_m": 0.10, "box_z_m": 0.40,
+    "length_x_m": 0.20, "width_y_m": 0.15, "box_z_m": 0.40,
     "insert_z_lo_m": 0.0065, "insert_z_hi_m": 0.30, "insert_volume_fraction": 0.20,
     "settle_chunk_steps": 2000, "settle_max_chunks": 20, "settle_ke_per_grain_j": 1.0e-8,
     "wall_layer_m": 0.014,             # grains with centre within this of the bottom / top form the walls
@@ -60,9 +60,17 @@ SHEAR = {
     "peak_smoothing_m": 0.002,
     "residual_window_m": [0.05, 0.10],
 }
-SOILTOOL = dict(SHEAR, normal_stresses_pa=[500.0, 1500.0, 3000.0], shear_distance_m=0.06,
-                last_window_m=0.03, residual_window_m=[0.02, 0.06])
-
+SOILTOOL = {
+    "frame_x_m": [0.05, 0.25], "width_y_m": 0.15,      # grains held in a fixed steel frame 0.20 x 0.15 m
+    "plate_x_m": [-0.02, 0.30], "plate_cell_m": 0.02,  # steel plate under it, z = 0, moving +x
+    "box_x_m": [-0.05, 0.40], "box_z_m": 0.30,
+    "insert_z_lo_m": 0.0065, "insert_z_hi_m": 0.15, "insert_volume_fraction": 0.20,
+    "settle_chunk_steps": 2000, "settle_max_chunks": 20, "settle_ke_per_grain_j": 1.0e-8,
+    "wall_layer_m": 0.014, "consolidation_s": 0.3,
+    "slide_speed_m_per_s": 0.02, "slide_distance_m": 0.06, "average_steps": 50,
+    "normal_stresses_pa": [500.0, 1500.0, 3000.0],
+    "steady_window_m": [0.02, 0.06],
+}
 SMOKE = {
     "repose": dict(REPOSE, cylinder_radius_m=0.03, cylinder_height_m=0.10, domain_half_width_m=0.08,
                    domain_z_m=0.25, base_layer_z_top_m=0.02, base_settle_steps=50, fill_z_lo_m=0.025,
@@ -75,6 +83,10 @@ SMOKE = {
                   settle_max_chunks=2, consolidation_s=0.005, shear_speed_m_per_s=0.2,
                   shear_distance_m=0.002, last_window_m=0.001, normal_stresses_pa=[1000.0],
                   peak_search_to_m=0.002, peak_smoothing_m=0.0002, residual_window_m=[0.0, 0.002]),
+    "soiltool": dict(SOILTOOL, frame_x_m=[0.02, 0.10], width_y_m=0.06, plate_x_m=[0.0, 0.12],
+                     box_x_m=[-0.02, 0.14], insert_z_hi_m=0.06, settle_chunk_steps=100, settle_max_chunks=1,
+                     consolidation_s=0.005, slide_speed_m_per_s=0.2, slide_distance_m=0.002,
+                     steady_window_m=[0.0, 0.002], normal_stresses_pa=[1000.0]),
 }
 
 
@@ -107,6 +119,9 @@ def write_cylinder_stl(path, R, H, nseg):
 def run_repose(seed, smoke=False):
     P = SMOKE["repose"] if smoke else REPOSE
     wd = _wd("smoke" if smoke else "repose", "seed%d" % seed)
+    c = _cached(os.path.join(wd, "repose.json"), smoke)
+    if c:
+        return c
     os.makedirs(wd, exist_ok=True)
     stl = os.path.join(wd, "cylinder.stl")
     write_cylinder_stl(stl, P["cylinder_radius_m"], P["cylinder_height_m"], P["cylinder_segments"])
@@ -123,14 +138,10 @@ def run_repose(seed, smoke=False):
         "nchunk2": P["settle2_max_chunks"], "ketol": P["settle_ke_per_grain_j"],
         "vlift": vlift, "nlift": nlift,
         "dumpfill": os.path.join(wd, "fill.dump"), "dump": os.path.join(wd, "heap.dump"),
+        "dumpbase": os.path.join(wd, "base.dump"),
     })
     wall = dem.run_liggghts(os.path.join(HERE, "repose.in"), v, wd, "repose")
-    nbase = None
-    for l in open(os.path.join(wd, "screen.repose"), errors="replace"):
-        if l.startswith("BASE "):
-            nbase = int(float(l.split()[1]))
-    d = dem.read_dump(v["dump"])
-    res = heap_angle(d, nbase, P)
+    res = heap_angle(dem.read_dump(v["dump"]), dem.read_dump(v["dumpbase"]), P)
     res.update({"seed": seed, "liggghts_seed_primes": primes, "wall_s": wall, "lift_speed_m_per_s": vlift})
     if not smoke:
         dem.log_cost("material_repose", "seed%d" % seed, wall, "%d heap grains" % res["heap_grains"])
@@ -138,17 +149,15 @@ def run_repose(seed, smoke=False):
     return res
 
 
-def heap_angle(d, nbase, P):
-    """Flank angle: base grains are ids 1..nbase.  Heights are measured from
+def heap_angle(d, base, P):
+    """Flank angle of the heap grains d above the frozen base grains.  Heights are measured from
     the base surface (mean top of the base grains).  In each of P['sectors']
     azimuthal sectors, the upper envelope max(z + r) is taken in radial bins;
     bins whose envelope lies between 20 % and 80 % of the heap height are
     fitted by least squares h = a - tan(theta) rho; the angle is the mean over
     sectors."""
-    ids = d["id"].astype(int)
-    isbase = ids <= nbase
-    zb = float((d["z"][isbase] + d["radius"][isbase]).mean())
-    x, y, z, r = (d[k][~isbase] for k in ("x", "y", "z", "radius"))
+    zb = float((base["z"] + base["radius"]).mean())
+    x, y, z, r = (d[k] for k in ("x", "y", "z", "radius"))
     rho = np.hypot(x, y)
     top = z + r - zb
     H = float(top.max())
@@ -183,7 +192,7 @@ def heap_angle(d, nbase, P):
         "repose_deg": float(np.mean(angles)) if angles else float("nan"),
         "repose_sector_std_deg": float(np.std(angles)) if angles else float("nan"),
         "sectors": prof, "heap_height_m": H, "base_surface_z_m": zb,
-        "heap_grains": int((~isbase).sum()), "base_grains": int(isbase.sum()),
+        "heap_grains": int(len(x)), "base_grains": int(len(base["x"])),
     }
 
 
@@ -191,6 +200,9 @@ def heap_angle(d, nbase, P):
 def run_density(seed, smoke=False):
     P = SMOKE["density"] if smoke else DENSITY
     wd = _wd("smoke" if smoke else "density", "seed%d" % seed)
+    c = _cached(os.path.join(wd, "density.json"), smoke)
+    if c:
+        return c
     v, primes = dem.material_vars(seed, 3)
     restart, dump = os.path.join(wd, "bed.restart"), os.path.join(wd, "bed.dump")
     v.update({
@@ -222,13 +234,26 @@ def run_density(seed, smoke=False):
 
 
 # ------------------------------------------------------------ shear cells
-def run_shear_cell(seed, sigma, rough, smoke=False):
-    """rough=1: internal friction; rough=0: soil-tool (steel plate)."""
-    P = SMOKE["shear"] if smoke else (SHEAR if rough else SOILTOOL)
-    kind = "shear" if rough else "soiltool"
+def _cached(path, smoke):
+    if not smoke and os.path.exists(path):
+        with open(path) as f:
+            return json.load(f)
+    return None
+
+
+def run_shear_cell(seed, sigma, rough=1, smoke=False):
+    """Periodic plane shear cell (internal friction).  shear.in also has a
+    smooth-floor variant (rough=0), not used for the results: with the
+    sample's weight on the plate the cell then shears under the lid at low
+    load instead of sliding on the plate (see run_soiltool)."""
+    P = SMOKE["shear"] if smoke else SHEAR
+    kind = "shear" if rough else "shear_smooth"
     wd = _wd("smoke" if smoke else kind, "seed%d_s%04d" % (seed, int(sigma)))
     if smoke:
         wd = _wd("smoke", "%s_seed%d" % (kind, seed))
+    c = _cached(os.path.join(wd, "result.json"), smoke)
+    if c:
+        return c
     os.makedirs(wd, exist_ok=True)
     v, primes = dem.material_vars(seed, 4 if rough else 5)
     dt = dem.TIMESTEP_S
@@ -330,6 +355,78 @@ def velocity_profile(da, db, dt_ab, vdrive, P, grp):
             "mass_above_band_kg": max(0.0, mass_above - grp["mtop"])}
 
 
+# -------------------------------------------------------------- soil-tool
+def write_plate_stl(path, x0, x1, y0, y1, cell):
+    nx = max(1, int(round((x1 - x0) / cell)))
+    ny = max(1, int(round((y1 - y0) / cell)))
+    xs, ys = np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1)
+    with open(path, "w") as f:
+        f.write("solid plate\n")
+        for i in range(nx):
+            for j in range(ny):
+                a, b, c, d = ((xs[i], ys[j]), (xs[i + 1], ys[j]), (xs[i + 1], ys[j + 1]), (xs[i], ys[j + 1]))
+                for tri in ((a, b, c), (a, c, d)):
+                    f.write("  facet normal 0 0 1\n    outer loop\n")
+                    for q in tri:
+                        f.write("      vertex %.9e %.9e 0.0\n" % q)
+                    f.write("    endloop\n  endfacet\n")
+        f.write("endsolid plate\n")
+
+
+def run_soiltool(seed, sigma, smoke=False):
+    P = SMOKE["soiltool"] if smoke else SOILTOOL
+    wd = _wd("smoke", "soiltool_seed%d" % seed) if smoke else _wd("soiltool", "seed%d_s%04d" % (seed, int(sigma)))
+    c = _cached(os.path.join(wd, "result.json"), smoke)
+    if c:
+        return c
+    os.makedirs(wd, exist_ok=True)
+    Ly = P["width_y_m"]
+    stl = os.path.join(wd, "plate.stl")
+    write_plate_stl(stl, P["plate_x_m"][0], P["plate_x_m"][1], -0.01, Ly + 0.01, P["plate_cell_m"])
+    v, primes = dem.material_vars(seed, 5)
+    dt = dem.TIMESTEP_S
+    navg = P["average_steps"]
+    ncons = _steps(P["consolidation_s"])
+    nsl = _steps(P["slide_distance_m"] / P["slide_speed_m_per_s"])
+    vs = P["slide_distance_m"] / (nsl * dt)
+    v.update({
+        "bxlo": P["box_x_m"][0], "bxhi": P["box_x_m"][1], "byhi": Ly + 0.02, "zbox": P["box_z_m"],
+        "platestl": stl, "fx0": P["frame_x_m"][0], "fx1": P["frame_x_m"][1], "Ly": Ly,
+        "zinslo": P["insert_z_lo_m"], "zinshi": P["insert_z_hi_m"], "vf": P["insert_volume_fraction"],
+        "chunk": P["settle_chunk_steps"], "nchunk": P["settle_max_chunks"], "ketol": P["settle_ke_per_grain_j"],
+        "layer": P["wall_layer_m"], "sigma": sigma, "ncons": ncons, "vshear": vs, "navg": navg, "nshear": nsl,
+        "outfile": os.path.join(wd, "plate.txt"),
+    })
+    wall = dem.run_liggghts(os.path.join(HERE, "soiltool.in"), v, wd, "soiltool")
+    grp = None
+    for l in open(os.path.join(wd, "screen.soiltool"), errors="replace"):
+        if l.startswith("GROUPS"):
+            p = l.split()
+            grp = {p[i]: float(p[i + 1]) for i in range(1, len(p) - 1, 2)}
+    rows = np.loadtxt(v["outfile"], comments="#", ndmin=2)   # step fx fy fz zlid
+    s0 = rows[0, 0] - navg
+    u = (rows[:, 0] - s0 - (navg - 1) / 2.0) * dt * vs
+    w = (u >= P["steady_window_m"][0]) & (u <= P["steady_window_m"][1])
+    fx, fz = rows[w, 1], rows[w, 3]
+    A = (P["frame_x_m"][1] - P["frame_x_m"][0]) * Ly
+    with np.errstate(invalid="ignore", divide="ignore"):  # a smoke run may not touch the plate yet
+        tan_d = float(abs(fx.mean()) / abs(fz.mean()))
+        ratio_std = float(np.std(fx / fz))
+        ratio = rows[:, 1] / rows[:, 3]
+    res = {"seed": seed, "sigma_applied_pa": sigma, "sigma_normal_pa": float(abs(fz.mean()) / A),
+           "tan_delta": tan_d, "delta_deg": math.degrees(math.atan(tan_d)),
+           "tan_delta_window_std": ratio_std, "plate_fx_mean_n": float(fx.mean()),
+           "plate_fz_mean_n": float(fz.mean()), "slide_speed_m_per_s": vs, "groups": grp,
+           "liggghts_seed_primes": primes, "wall_s": wall}
+    np.savetxt(os.path.join(wd, "ratio_u.txt"), np.column_stack([u, ratio]),
+               header="u_m fx/fz", fmt="%.6g")
+    if not smoke:
+        dem.log_cost("material_soiltool", "seed%d/sigma%d" % (seed, sigma), wall,
+                     "%d grains" % int(grp["ntop"] + grp["msample"] / 1.37e-3))
+    dem.write_json(os.path.join(wd, "result.json"), res)
+    return res
+
+
 # ----------------------------------------------------------------- driver
 def mohr_coulomb(sig, tau):
     sig, tau = np.asarray(sig), np.asarray(tau)
@@ -345,8 +442,8 @@ def run_all(seeds, smoke=False, outpath=None):
         den[s] = run_density(s, smoke)
         sh[s] = [run_shear_cell(s, sg, 1, smoke)
                  for sg in (SMOKE["shear"] if smoke else SHEAR)["normal_stresses_pa"]]
-        st[s] = [run_shear_cell(s, sg, 0, smoke)
-                 for sg in ([1000.0] if smoke else SOILTOOL["normal_stresses_pa"])]
+        st[s] = [run_soiltool(s, sg, smoke)
+                 for sg in (SMOKE["soiltool"] if smoke else SOILTOOL)["normal_stresses_pa"]]
     return assemble(seeds, rep, den, sh, st, time.time() - t0, smoke, outpath)
 
 
@@ -362,7 +459,7 @@ def assemble(seeds, rep, den, sh, st, wall_total, smoke=False, outpath=None):
                                    "struck off at 0.12 m) in a 0.30 x 0.30 m steel box; solid fraction by "
                                    "Monte-Carlo points in a box 0.06 m from the walls, 0.02 m above the "
                                    "floor and 0.025 m below the mean surface, times the grain density"),
-        "internal_friction": ("periodic plane shear cell (0.20 x 0.10 m, periodic in x and y, ~0.08 m of "
+        "internal_friction": ("periodic plane shear cell (0.20 x 0.15 m, periodic in x and y, ~0.08 m of "
                               "grains): the bottom grain layer is driven along x at 0.02 m/s, the top grain "
                               "layer is a rough lid under constant normal load that moves only vertically; "
                               "tau = x-force on the lid / area; normal stress on the shear band = load + lid "
@@ -372,10 +469,11 @@ def assemble(seeds, rep, den, sh, st, wall_total, smoke=False, outpath=None):
                               "fit tau = c + sigma tan(phi) over the normal stresses; chosen over a split "
                               "box because it has no side-wall friction, no area correction and reaches "
                               "the critical state"),
-        "soil_tool_friction_deg": ("the same cell with the driven bottom layer replaced by a smooth steel "
-                                   "(blade material) floor moving at 0.02 m/s; tan(delta) = shear / normal "
-                                   "stress on the plate (load + lid + sample weight) averaged over steady "
-                                   "sliding (20-60 mm), mean over the normal stresses"),
+        "soil_tool_friction_deg": ("grains (~0.05 m deep) held in a fixed steel frame 0.20 x 0.15 m, pressed by "
+                                   "a rough grain lid under a constant load, on a steel plate (the blade's "
+                                   "material) sliding under them at 0.02 m/s; tan(delta) = |Fx| / |Fz| of the "
+                                   "force the grains exert on the plate, averaged over steady sliding "
+                                   "(20-60 mm); mean over the normal stresses"),
     }}
     out["seeds"] = list(seeds)
     R = [rep[s]["repose_deg"] for s in seeds]
@@ -402,13 +500,10 @@ def assemble(seeds, rep, den, sh, st, wall_total, smoke=False, outpath=None):
         "mobilised_residual_deg": math.degrees(math.atan(r["mu_residual"]))} for r in sh[s]] for s in seeds}
     d = []
     for s in seeds:
-        d.append(float(np.mean([math.degrees(math.atan(r["mu_residual"])) for r in st[s]])))
+        d.append(float(np.mean([r["delta_deg"] for r in st[s]])))
     out.update(_ms("soil_tool_friction_deg", d))
-    out["soil_tool_tests"] = {str(s): [{"sigma_applied_pa": r["sigma_applied_pa"],
-                                        "sigma_normal_pa": r["sigma_normal_pa"],
-                                        "tan_delta": r["mu_residual"],
-                                        "delta_deg": math.degrees(math.atan(r["mu_residual"])),
-                                        "tan_delta_window_std": r["mu_residual_window_std"]}
+    out["soil_tool_tests"] = {str(s): [{k: r[k] for k in ("sigma_applied_pa", "sigma_normal_pa", "tan_delta",
+                                                          "delta_deg", "tan_delta_window_std")}
                                        for r in st[s]] for s in seeds}
     out["repose_tests"] = {str(s): {k: rep[s][k] for k in ("repose_deg", "repose_sector_std_deg",
                                                            "heap_height_m", "heap_grains")} for s in seeds}
