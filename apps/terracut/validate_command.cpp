@@ -51,7 +51,7 @@ double deg(double radians) { return radians / kDeg; }
 SoilFlowParams flow_params(double repose_deg) {
   SoilFlowParams p;
   p.model = SoilModel::kFlow;
-  p.repose_deg = repose_deg;
+  p.material.repose_deg = repose_deg;
   return p;  // the default work cap, as a scenario gets it
 }
 

@@ -37,7 +37,7 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
       representation_(scenario.base.representation),
       blade_length_m_(scenario.base.blade.length_m),
       bucket_(scenario.base.blade.bucket),
-      repose_deg_(scenario.base.soil.repose_deg),
+      repose_deg_(scenario.base.soil.material.repose_deg),
       initial_(io::build_initial_heights(scenario.base)) {
   // Transits between cuts rise above everything the blade could touch.
   float max_h = 0.0f;
@@ -112,7 +112,7 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
       link_ = std::make_unique<net::MemoryLink>(mmt.to_remote, mmt.to_operator);
       operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, link_->a(), 1u, oo);
       remote_ = std::make_unique<session::RemoteStation>(
-          *remote_scenario_, mmt, operator_->rig().loop().force_model(),
+          *remote_scenario_, mmt, op.base.soil.material,
           operator_->simulation().grid(), link_->b(), 2u, session::RemoteOptions{false});
     }
     mmt_live_.emulated_rtt_s.store(mmt.to_remote.delay_s + mmt.to_operator.delay_s);

@@ -64,6 +64,8 @@ ViewerApp::ViewerApp(ViewerOptions options, session::Scenario scenario)
   pending_resolution_[0] = base_scenario_.base.resolution.cols;
   pending_resolution_[1] = base_scenario_.base.resolution.rows;
   pending_haptics_ = haptics_;
+  pending_material_ = base_scenario_.base.soil.material;
+  pending_rake_deg_ = base_scenario_.base.blade.rake_angle_deg;
   style_.color = options_.color;
   camera_.mode = options_.camera;
 }
@@ -247,7 +249,11 @@ void ViewerApp::apply_model_changes() {
   try {
     io::Resolution res{pending_resolution_[0], pending_resolution_[1]};
     io::apply_overrides(sc.base, res, pending_representation_, std::nullopt);
-    // The loop's own check (InputError naming the field, or a refused rendering).
+    sc.base.soil.material = pending_material_;
+    sc.base.blade.rake_angle_deg = pending_rake_deg_;
+    // The simulation's check (the material with the rake) and the loop's own
+    // (InputError naming the field, or a refused rendering).
+    if (const std::string e = validate(io::sim_params(sc.base)); !e.empty()) throw InputError(e);
     const haptics::LoopParams check(pending_haptics_, sc.base.blade);
     close_session();
     scenario_ = sc;

@@ -200,7 +200,9 @@ class ViewerApp {
   Representation pending_representation_ = Representation::kSurface;
   int pending_resolution_[2] = {0, 0};
   haptics::HapticSettings pending_haptics_;
-  int pending_soil_ = 0;  // index of SoilPreset
+  int pending_soil_ = -1;  // index of the SoilPreset chosen; -1: the scenario's own material
+  SoilMaterial pending_material_{};  // the soil's material for the next session
+  double pending_rake_deg_ = 90.0;   // the blade's rake for the next session
   std::string panel_error_;
 
   // Display toggles.

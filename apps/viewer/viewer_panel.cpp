@@ -238,8 +238,10 @@ void ViewerApp::draw_tool_section() {
   auto tenth = [](double deg) { return std::round(deg * 10.0) / 10.0 + 0.0; };
   ImGui::Text("yaw %.1f deg   tilt %.1f deg", tenth(r.yaw_deg), tenth(r.tilt_deg));
   if (driver_->bucket().enabled()) {
-    const double holds = bucket_retained_m3({driver_->blade_length_m(), driver_->bucket()}, l.pose.orientation,
-                                            driver_->repose_deg());
+    BladeSpec blade;
+    blade.length_m = driver_->blade_length_m();
+    blade.bucket = driver_->bucket();
+    const double holds = bucket_retained_m3(blade, l.pose.orientation, driver_->repose_deg());
     ImGui::Text("bucket %.2f l of %.2f l it holds now", l.bucket_load_m3 * 1e3, holds * 1e3);
   }
   if (driver_->device().source() == ToolSource::kMouse && r.depth_m <= 0.0)
@@ -389,15 +391,19 @@ void ViewerApp::draw_force_model_params() {
   ImGui::SetNextItemWidth(-110);
   if (ImGui::SliderFloat("viscous Ns/m2", &visc, 0.0f, 5000.0f, "%.0f"))
     fp.contact_drag.viscous_n_s_per_m2 = visc;
-  const char* soils[] = {"dry_sand", "loose_sand", "clay"};
+  // The soil's material: a preset's (or the scenario's own), and the blade's rake.
+  const char* soils[] = {"scenario's", "dry_sand", "loose_sand", "clay", "gravel"};
+  int soil = pending_soil_ + 1;
   ImGui::SetNextItemWidth(-110);
-  if (ImGui::Combo("soil", &pending_soil_, soils, 3))
-    fp.earthmoving.soil = soil_preset(SoilPreset(pending_soil_));
-  float rake = float(fp.earthmoving.rake_angle_rad / kDegToRad);
+  if (ImGui::Combo("soil", &soil, soils, 5)) {
+    pending_soil_ = soil - 1;
+    pending_material_ = pending_soil_ < 0 ? base_scenario_.base.soil.material
+                                          : soil_preset(SoilPreset(pending_soil_));
+  }
+  float rake = float(pending_rake_deg_);
   ImGui::SetNextItemWidth(-110);
-  if (ImGui::SliderFloat("rake deg", &rake, 20.0f, 160.0f, "%.0f"))
-    fp.earthmoving.rake_angle_rad = rake * kDegToRad;
-  ImGui::Checkbox("push-in resistance", &fp.penetration.enabled);
+  if (ImGui::SliderFloat("rake deg", &rake, 20.0f, 160.0f, "%.0f")) pending_rake_deg_ = rake;
+  ImGui::Checkbox("push-in resistance", &fp.penetration_enabled);
   ImGui::SameLine();
   ImGui::Checkbox("twist resistance", &fp.twist_enabled);
   ImGui::Checkbox("surface spring", &fp.surface_enabled);

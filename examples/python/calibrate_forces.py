@@ -31,11 +31,14 @@ def model(params, width, depth, rake):
     """Horizontal FEE force (N) for soil params = (cohesion Pa, friction deg)."""
     cohesion, phi = params
     soil = {"unit_weight_n_per_m3": UNIT_WEIGHT, "cohesion_pa": cohesion, "adhesion_pa": 0.0,
-            "internal_friction_deg": phi, "soil_tool_friction_deg": 2 * phi / 3, "surcharge_pa": 0.0}
+            "internal_friction_deg": phi, "soil_tool_friction_deg": 2 * phi / 3}
     out = np.empty_like(width)
     for r in np.unique(rake):  # one call per rake angle, arrays inside
         sel = rake == r
-        out[sel] = terracut.earthmoving_force(width[sel], depth[sel], soil=soil, rake_angle_deg=r)["horizontal_n"]
+        # The table's blades are wide against their depths: the 2-D equation
+        # (side_failure=False) that made the synthetic table.
+        out[sel] = terracut.earthmoving_force(width[sel], depth[sel], soil=soil, rake_angle_deg=r,
+                                              side_failure=False)["horizontal_n"]
     return out
 
 

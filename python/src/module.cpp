@@ -298,23 +298,21 @@ void time_pose(double t_s, const BladePose& p, double* out) {
 // The columns of batched steps (Simulation.step(poses), Simulation.run()).
 class StepColumns {
  public:
-  StepColumns(py::ssize_t n, bool with_cut)
-      : columns_(n,
-                 {"t", "x", "y", "z", "qw", "qx", "qy", "qz", "contact_length", "section_area",
-                  "max_depth", "removed_volume", "displaced_volume", "listener_fx",
-                  "listener_fy", "listener_fz", "step_s"},
-                 int_names(with_cut)) {}
+  StepColumns(py::ssize_t n, bool with_cut) : columns_(n, double_names(), int_names(with_cut)) {}
 
   // Row i from a finished step; cut: the cut's index (with_cut only).
   void fill(py::ssize_t i, const StepOutput& o, std::int64_t cut = -1) {
-    double d[kTimePose + 9];
+    double d[kTimePose + kOwn + kMaxForce];
     time_pose(o.t_s, o.pose, d);
-    const double rest[] = {o.contact.length_m,        o.contact.section_area_m2,
-                           o.contact.max_depth_m,     o.cut.removed_volume_m3,
-                           o.soil.displaced_volume_m3, o.listener_force_world_n.x,
-                           o.listener_force_world_n.y, o.listener_force_world_n.z,
-                           o.timers.total_s};
+    const double rest[kOwn] = {o.contact.length_m,        o.contact.section_area_m2,
+                               o.contact.max_depth_m,     o.cut.removed_volume_m3,
+                               o.soil.displaced_volume_m3, o.listener_force_world_n.x,
+                               o.listener_force_world_n.y, o.listener_force_world_n.z,
+                               o.timers.total_s};
     std::copy(std::begin(rest), std::end(rest), d + kTimePose);
+    // The physical force, as force.csv has it (session::force_columns()).
+    std::size_t k = kTimePose + kOwn;
+    for (const session::ForceColumn& c : session::force_columns()) d[k++] = c.get(o);
     const std::int64_t n[] = {o.step,       o.contact.cells_visited + o.cut.cells_visited,
                               o.substeps,   o.changed.c0,
                               o.changed.r0, o.changed.c1,
@@ -325,6 +323,16 @@ class StepColumns {
   py::dict dict() const { return columns_.dict(); }
 
  private:
+  static constexpr std::size_t kOwn = 9;
+  static constexpr std::size_t kMaxForce = 64;
+  static std::vector<const char*> double_names() {
+    std::vector<const char*> names = {"t", "x", "y", "z", "qw", "qx", "qy", "qz", "contact_length",
+                                      "section_area", "max_depth", "removed_volume",
+                                      "displaced_volume", "listener_fx", "listener_fy",
+                                      "listener_fz", "step_s"};
+    for (const session::ForceColumn& c : session::force_columns()) names.push_back(c.name);
+    return names;
+  }
   static std::vector<const char*> int_names(bool with_cut) {
     std::vector<const char*> names = {"step",       "cells_visited", "substeps",  "changed_c0",
                                       "changed_r0", "changed_c1",    "changed_r1"};
@@ -553,66 +561,98 @@ py::dict run_result_dict(const session::RunResult& r, const io::Scenario& sc) {
 // Forces
 // ---------------------------------------------------------------------------
 
-// A soil given as a preset name or a dict of SoilParams fields (angles in
-// degrees); unknown keys are refused by name.
-SoilParams soil_arg(py::handle obj) {
-  if (py::isinstance<py::str>(obj)) {
-    const std::string name = obj.cast<std::string>();
+// A soil material given as a preset name or a dict of SoilMaterial fields
+// (the scenario's soil: keys: angles in degrees, a preset's values replaced
+// by the fields given); unknown keys are refused by name.
+SoilMaterial material_arg(py::handle obj) {
+  const auto preset_of = [](const std::string& name) {
     auto preset = parse_soil_preset(name);
     if (!preset)
-      throw InputError("soil: unknown preset '" + name + "' (dry_sand, loose_sand or clay)");
+      throw InputError("soil: unknown preset '" + name + "' (dry_sand, loose_sand, clay or gravel)");
     return soil_preset(*preset);
-  }
+  };
+  if (py::isinstance<py::str>(obj)) return preset_of(obj.cast<std::string>());
   if (!py::isinstance<py::dict>(obj)) throw InputError("soil: expected a preset name or a dict");
-  SoilParams soil = soil_preset(SoilPreset::kDrySand);
-  for (auto [key, value] : obj.cast<py::dict>()) {
+  const py::dict d = obj.cast<py::dict>();
+  SoilMaterial m = d.contains("preset") ? preset_of(py::str(d["preset"])) : SoilMaterial{};
+  for (auto [key, value] : d) {
     const std::string k = py::str(key);
     if (k == "preset") continue;
+    if (k == "surcharge_pa")
+      throw InputError("soil.surcharge_pa: a surcharge is a load, not the soil's: give it as "
+                       "earthmoving_force(..., surcharge_pa=...)");
     double v = 0.0;
     try {
       v = value.cast<double>();
     } catch (py::cast_error&) {
       throw InputError("soil." + k + ": expected a number");
     }
-    if (k == "unit_weight_n_per_m3") soil.unit_weight_n_per_m3 = v;
-    else if (k == "cohesion_pa") soil.cohesion_pa = v;
-    else if (k == "adhesion_pa") soil.adhesion_pa = v;
-    else if (k == "internal_friction_deg") soil.internal_friction_rad = v * kDeg;
-    else if (k == "soil_tool_friction_deg") soil.soil_tool_friction_rad = v * kDeg;
-    else if (k == "surcharge_pa") soil.surcharge_pa = v;
+    if (k == "unit_weight_n_per_m3") m.unit_weight_n_per_m3 = v;
+    else if (k == "density_kg_per_m3") m.unit_weight_n_per_m3 = v * kStandardGravity_m_per_s2;
+    else if (k == "cohesion_pa") m.cohesion_pa = v;
+    else if (k == "adhesion_pa") m.adhesion_pa = v;
+    else if (k == "internal_friction_deg") m.internal_friction_deg = v;
+    else if (k == "soil_tool_friction_deg") m.soil_tool_friction_deg = v;
+    else if (k == "repose_deg") m.repose_deg = v;
     else
       throw InputError("soil." + k +
-                       ": unknown field (unit_weight_n_per_m3, cohesion_pa, adhesion_pa, "
-                       "internal_friction_deg, soil_tool_friction_deg, surcharge_pa, preset)");
+                       ": unknown field (preset, unit_weight_n_per_m3, density_kg_per_m3, "
+                       "cohesion_pa, adhesion_pa, internal_friction_deg, soil_tool_friction_deg, "
+                       "repose_deg)");
   }
-  if (std::string e = validate(soil); !e.empty()) throw InputError("soil: " + e);
-  return soil;
+  if (std::string e = validate(m); !e.empty()) throw InputError("soil." + e);
+  return m;
 }
 
-py::dict soil_dict(const SoilParams& s) {
+py::dict material_dict(const SoilMaterial& s) {
   py::dict d;
   d["unit_weight_n_per_m3"] = s.unit_weight_n_per_m3;
+  d["density_kg_per_m3"] = s.density_kg_per_m3();
   d["cohesion_pa"] = s.cohesion_pa;
   d["adhesion_pa"] = s.adhesion_pa;
-  d["internal_friction_deg"] = s.internal_friction_rad / kDeg;
-  d["soil_tool_friction_deg"] = s.soil_tool_friction_rad / kDeg;
-  d["surcharge_pa"] = s.surcharge_pa;
+  d["internal_friction_deg"] = s.internal_friction_deg;
+  d["soil_tool_friction_deg"] = s.soil_tool_friction_deg;
+  d["repose_deg"] = s.repose_deg;
+  return d;
+}
+
+// The physical force of a step as a dict (world N tuples; force.csv's parts).
+py::dict tool_force_dict(const StepOutput& o) {
+  const ToolForce& f = o.force;
+  py::dict d;
+  d["total_n"] = tuple3(f.total_n);
+  d["cutting_n"] = tuple3(f.cutting_n);
+  d["surcharge_n"] = tuple3(f.surcharge_n);
+  d["penetration_n"] = tuple3(f.penetration_n);
+  d["twist_n"] = tuple3(f.twist_n);
+  d["twist_torque_n_m"] = f.twist_torque_n_m;
+  d["load_n"] = tuple3(f.load_n);
+  d["bodies_n"] = tuple3(f.bodies_n);
+  d["cut_depth_m"] = f.cut_depth_m;
+  d["cut_width_m"] = f.engaged_width_m;
+  d["pile_height_m"] = f.pile_m;
+  d["surcharge_pa"] = f.surcharge_pa;
+  d["beta_rad"] = f.earthmoving.beta_rad;
+  d["velocity_m_per_s"] = tuple3(o.motion.velocity_m_per_s);
   return d;
 }
 
 // earthmoving_force over arrays of widths and depths (broadcast by numpy).
 py::dict earthmoving_arrays(py::object width, py::object depth, py::object soil,
-                            double rake_angle_deg) {
+                            double rake_angle_deg, double surcharge_pa, bool side_failure) {
   EarthmovingParams params;
-  params.soil = soil_arg(soil);
-  params.rake_angle_rad = rake_angle_deg * kDeg;
+  params.soil = material_arg(soil);
+  params.rake_angle_deg = rake_angle_deg;
+  params.side_failure = side_failure;
+  if (!(std::isfinite(surcharge_pa) && surcharge_pa >= 0.0))
+    throw InputError(must_be("surcharge_pa", "finite and >= 0", surcharge_pa));
   if (std::string e = validate(params); !e.empty()) throw InputError(e);
   py::module_ np = py::module_::import("numpy");
   py::tuple both = np.attr("broadcast_arrays")(doubles(width, "width_m"), doubles(depth, "depth_m"));
   auto w = doubles(np.attr("ascontiguousarray")(both[0]), "width_m");
   auto d = doubles(np.attr("ascontiguousarray")(both[1]), "depth_m");
   std::vector<py::ssize_t> shape(w.shape(), w.shape() + w.ndim());
-  py::array_t<double> total(shape), horizontal(shape), vertical(shape), beta(shape);
+  py::array_t<double> total(shape), horizontal(shape), vertical(shape), beta(shape), side(shape);
   const py::ssize_t n = w.size();
   {
     const double* pw = w.data();
@@ -621,13 +661,15 @@ py::dict earthmoving_arrays(py::object width, py::object depth, py::object soil,
     double* ph = horizontal.mutable_data();
     double* pv = vertical.mutable_data();
     double* pb = beta.mutable_data();
+    double* ps = side.mutable_data();
     py::gil_scoped_release release;
     for (py::ssize_t i = 0; i < n; ++i) {
-      const EarthmovingResult r = earthmoving_force(params, pw[i], pd[i]);
+      const EarthmovingResult r = earthmoving_force(params, pw[i], pd[i], surcharge_pa);
       pt[i] = r.total_n;
       ph[i] = r.horizontal_n;
       pv[i] = r.vertical_n;
       pb[i] = r.beta_rad;
+      ps[i] = r.side_total_n;
     }
   }
   py::dict out;
@@ -635,6 +677,7 @@ py::dict earthmoving_arrays(py::object width, py::object depth, py::object soil,
   out["horizontal_n"] = horizontal;
   out["vertical_n"] = vertical;
   out["beta_rad"] = beta;
+  out["side_total_n"] = side;
   return out;
 }
 
@@ -644,11 +687,12 @@ py::dict force_output_dict(const ForceOutput& o) {
   d["device_n"] = tuple3(o.device_n);
   d["cutting_n"] = tuple3(o.cutting_n);
   d["surface_n"] = tuple3(o.surface_n);
-  d["engaged_width_m"] = o.engaged_width_m;
+  d["penetration_n"] = tuple3(o.penetration_n);
+  d["load_n"] = tuple3(o.load_n);
+  d["bodies_n"] = tuple3(o.bodies_n);
   d["penetration_m"] = o.surface.penetration_m;
   d["in_contact"] = o.surface.in_contact;
   d["proxy_m"] = tuple3(o.surface.proxy_m);
-  d["beta_rad"] = o.earthmoving.beta_rad;
   return d;
 }
 
@@ -801,6 +845,12 @@ reader's message, "FILE:LINE: field: what".)doc")
           }, "Force of the step listeners (the rigid bodies) on the tool, world N.")
       .def_property_readonly("step_s", [](const StepResult& r) { return r.out.timers.total_s; },
                              "Wall-clock time of the step in C++, s.")
+      .def_property_readonly("force", [](const StepResult& r) { return tool_force_dict(r.out); },
+                             "The physical force on the tool (world N): total_n and its parts "
+                             "cutting_n, surcharge_n, penetration_n, twist_n, load_n, bodies_n, "
+                             "twist_torque_n_m, and what it was computed from (cut_depth_m, "
+                             "cut_width_m, pile_height_m, surcharge_pa, beta_rad, "
+                             "velocity_m_per_s): terracut run's force.csv.")
       .def("__repr__", [](const StepResult& r) {
             std::ostringstream s;
             s << "<StepResult step " << r.out.step << " t " << r.out.t_s << " s contact "
@@ -829,7 +879,8 @@ one thread at a time.)doc")
       .def_static("from_heights", [](py::object heights, std::pair<double, double> size_m,
                                      py::object origin_m, const std::string& representation,
                                      double rate_hz, double blade_length_m,
-                                     const std::string& soil_model, double repose_deg) {
+                                     const std::string& soil_model, py::object soil,
+                                     double rake_angle_deg) {
             auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(heights);
             if (!a || a.ndim() != 2)
               throw InputError("heights: expected a 2-D (rows, cols) array of metres");
@@ -845,18 +896,20 @@ one thread at a time.)doc")
             auto model = parse_soil_model(soil_model);
             if (!model) throw InputError("soil_model: must be 'vanish' or 'flow', got '" + soil_model + "'");
             p.soil.model = *model;
-            p.soil.repose_deg = repose_deg;
+            p.soil.material = material_arg(soil);
+            p.blade.rake_angle_deg = rake_angle_deg;
             if (std::string e = validate(p); !e.empty()) throw InputError(e);
             std::vector<float> h(a.data(), a.data() + a.size());
             return std::make_unique<PySimulation>(p, std::move(h));
           }, py::arg("heights"), py::arg("size_m") = std::make_pair(1.0, 1.0),
           py::arg("origin_m") = py::make_tuple(0.0, 0.0, 0.0), py::arg("representation") = "surface",
           py::arg("rate_hz") = 1000.0, py::arg("blade_length_m") = 1.0,
-          py::arg("soil_model") = "vanish", py::arg("repose_deg") = 34.0,
+          py::arg("soil_model") = "vanish", py::arg("soil") = "dry_sand", py::arg("rake_angle_deg") = 90.0,
           "A simulation over a (rows, cols) array of heights in metres (copied): size_m = "
           "(size_x, size_z) metres, origin_m the origin corner (y = ground), representation "
           "'surface' or 'columns', rate_hz the step rate (Hz), blade_length_m metres, "
-          "soil_model 'vanish' or 'flow' with repose_deg degrees.")
+          "soil_model 'vanish' or 'flow', soil the material (a preset name or a dict of the soil: "
+          "section's keys), rake_angle_deg the blade's rake (degrees, 90 vertical).")
       .def_property_readonly("heights", [](py::object self) {
             auto& s = self.cast<PySimulation&>();
             return layer_view(self, s.sim().grid().heights(), s.sim().grid());
@@ -1080,56 +1133,68 @@ substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
       "passivity J), and the per-tick files in out_dir when given.");
 
   // --- Forces ----------------------------------------------------------------
-  m.def("soil_preset", [](const std::string& name) { return soil_dict(soil_arg(py::str(name))); },
+  m.def("soil_preset", [](const std::string& name) { return material_dict(material_arg(py::str(name))); },
         py::arg("name"),
-        "A built-in soil ('dry_sand', 'loose_sand', 'clay'; sources in docs/forces.md) as a "
-        "dict: unit_weight_n_per_m3 (N/m^3), cohesion_pa, adhesion_pa (Pa), "
-        "internal_friction_deg, soil_tool_friction_deg (degrees), surcharge_pa (Pa).");
+        "A built-in soil material ('dry_sand', 'loose_sand', 'clay', 'gravel'; sources in "
+        "docs/forces.md) as a dict: unit_weight_n_per_m3 (N/m^3), density_kg_per_m3, "
+        "cohesion_pa, adhesion_pa (Pa), internal_friction_deg, soil_tool_friction_deg, "
+        "repose_deg (degrees): the keys of a scenario's soil: section.");
   m.def("earthmoving_force", &earthmoving_arrays, py::arg("width_m"), py::arg("depth_m"),
-        py::arg("soil") = "dry_sand", py::arg("rake_angle_deg") = 90.0,
-        "The Fundamental Earthmoving Equation (McKyes) for blades of engaged width width_m "
-        "(m) at cutting depth depth_m (m), arrays broadcast: total_n (N, the soil's resultant "
-        "on the face), horizontal_n (N, resisting motion), vertical_n (N, positive pushing "
-        "the blade down), beta_rad (failure-plane angle, rad). soil: a preset name or a dict "
-        "as soil_preset() gives (missing keys: dry sand's); rake_angle_deg: blade face from "
-        "the horizontal, degrees (90: vertical).");
+        py::arg("soil") = "dry_sand", py::arg("rake_angle_deg") = 90.0, py::arg("surcharge_pa") = 0.0,
+        py::arg("side_failure") = true,
+        "The cutting force (McKyes' earthmoving equation with McKyes & Ali's side crescents "
+        "unless side_failure is False) for blades of engaged width width_m (m) at cutting depth "
+        "depth_m (m), arrays broadcast, with a surcharge surcharge_pa (Pa) on the soil ahead: "
+        "total_n (N, the soil's resultant on the face), horizontal_n (N, resisting motion), "
+        "vertical_n (N, positive pushing the blade down), beta_rad (failure-plane angle, rad), "
+        "side_total_n (N, the crescents' part of total_n). soil: a preset name or a dict as "
+        "soil_preset() gives (missing keys: dry sand's); rake_angle_deg: blade face from the "
+        "horizontal, degrees (90: vertical).");
 
-  py::class_<ForceModel>(m, "ForceModel", R"doc(The haptic force model of a scenario's haptics: section.
+  py::class_<ForceModel>(m, "ForceModel", R"doc(The haptic rendering of a scenario's haptics: section.
 
-World forces in newtons on the tool; device_n = world_n * force_scale. Built
-once (validated and checked against the device's limits), then compute() is
-a pure function of one sample.)doc")
+It renders the physical force of a step (StepResult.force) on a device: the
+cutting model, the low-speed damper, the device's gain, the surface proxy,
+the carried load's inertia; world_n in newtons, device_n = world_n *
+force_scale. Built once (validated and checked against the device's
+limits), then compute() is a pure function of one sample. It never changes
+the physical force.)doc")
       .def(py::init([](const PyScenario& s) {
              const haptics::HapticSettings h =
                  haptics::with_derived_fields(s.s->haptics, s.base().blade.length_m);
              return ForceModel(h.forces);
            }), py::arg("scenario"))
-      .def("compute", [](const ForceModel& f, py::object velocity, double contact_length_m,
-                         double cut_depth_m, py::object edge_direction, py::object device_point_m,
-                         double surface_y_m, double surcharge_pa) {
+      .def("compute", [](const ForceModel& f, const StepResult& step, py::object velocity,
+                         py::object acceleration, py::object yaw_rate, py::object device_point_m,
+                         double surface_y_m) {
             ForceInput in;
-            in.velocity_m_per_s = vec3(velocity, "velocity_m_per_s");
-            in.contact_length_m = contact_length_m;
-            in.cut_depth_m = cut_depth_m;
-            in.edge_direction = vec3(edge_direction, "edge_direction");
-            in.device_point_m = vec3(device_point_m, "device_point_m");
+            in.physical = step.out.force;
+            in.velocity_m_per_s = velocity.is_none() ? step.out.motion.velocity_m_per_s
+                                                     : vec3(velocity, "velocity_m_per_s");
+            in.acceleration_m_per_s2 = acceleration.is_none()
+                                           ? step.out.motion.acceleration_m_per_s2
+                                           : vec3(acceleration, "acceleration_m_per_s2");
+            in.yaw_rate_rad_per_s = yaw_rate.is_none() ? step.out.motion.yaw_rate_rad_per_s
+                                                       : yaw_rate.cast<double>();
+            in.contact_length_m = step.out.contact.length_m;
+            in.device_point_m = device_point_m.is_none() ? step.out.pose.position_m
+                                                         : vec3(device_point_m, "device_point_m");
             in.surface_y_m = surface_y_m;
-            in.surcharge_pa = surcharge_pa;
             return force_output_dict(f.compute(in));
-          }, py::arg("velocity_m_per_s"), py::arg("contact_length_m"), py::arg("cut_depth_m") = 0.0,
-          py::arg("edge_direction") = py::make_tuple(0.0, 0.0, 0.0),
-          py::arg("device_point_m") = py::make_tuple(0.0, 1e9, 0.0), py::arg("surface_y_m") = 0.0,
-          py::arg("surcharge_pa") = 0.0,
-          "One force sample: tool velocity (world m/s), contact length (m), cut depth (m), "
-          "edge direction, device point (world m; the default is far above the surface) and "
-          "the surface's Y below it (m), surcharge (Pa). Returns world_n, device_n, cutting_n, "
-          "surface_n (N tuples), engaged_width_m, penetration_m, in_contact, proxy_m, beta_rad.")
+          }, py::arg("step"), py::arg("velocity_m_per_s") = py::none(),
+          py::arg("acceleration_m_per_s2") = py::none(), py::arg("yaw_rate_rad_per_s") = py::none(),
+          py::arg("device_point_m") = py::none(), py::arg("surface_y_m") = -1e9,
+          "The rendering of one step's physical force: at the step's own motion unless a "
+          "(device's, filtered) velocity (world m/s), acceleration (m/s^2) or yaw rate (rad/s) "
+          "is given; the surface proxy at device_point_m (default the blade centre) over "
+          "surface_y_m (world m; the default is far below, no proxy force). Returns world_n, "
+          "device_n, cutting_n, surface_n, penetration_n, load_n, bodies_n (N tuples), "
+          "penetration_m, in_contact, proxy_m.")
       .def_property_readonly("cutting_model", [](const ForceModel& f) {
             return std::string(to_string(f.params().cutting));
           })
       .def_property_readonly("force_scale", [](const ForceModel& f) { return f.params().force_scale; },
                              "Device newtons per world newton.")
-      .def_property_readonly("soil", [](const ForceModel& f) { return soil_dict(f.params().earthmoving.soil); })
       .def_property_readonly("limited", [](const ForceModel& f) { return f.rendering().any_limited(); },
                              "True when the device check lowered a stiffness or damping.");
 

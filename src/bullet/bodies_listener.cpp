@@ -11,11 +11,14 @@ namespace terracut::bullet {
 BodiesListener::BodiesListener(Simulation& sim, std::vector<BodySpec> bodies,
                                const BodiesListenerOptions& options)
     : sim_(sim), bodies_(std::move(bodies)), options_(options) {
-  // Soil that flows banks against the bodies and presses on them, with the
-  // soil's angle of repose as the pile's friction angle.
-  if (const SoilFlow* soil = sim_.soil()) {
+  // Soil that flows banks against the bodies and presses on them: the
+  // simulation's soil material gives the pile's unit weight, and its angle
+  // of repose is the loose pile's friction angle.
+  if (sim_.soil()) {
+    const SoilMaterial& material = sim_.params().soil.material;
     options_.world.pile.enabled = true;
-    options_.world.pile.friction_angle_deg = soil->params().repose_deg;
+    options_.world.pile.unit_weight_n_per_m3 = material.unit_weight_n_per_m3;
+    options_.world.pile.friction_angle_deg = material.repose_deg;
   }
   world_ = std::make_unique<TerrainWorld>(sim, bodies_, options_.world);
   // Shapes and sizes never change: kept for the viewer's frames.

@@ -8,6 +8,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/core/soil_ahead.hpp"
 
 namespace terracut {
 
@@ -58,10 +59,32 @@ std::string validate(const SimParams& params) {
     if (params.soil.model != SoilModel::kFlow)
       return "blade.bucket: a bucket carries soil, so it needs soil model flow (soil: {model: flow})";
   }
+  if (!(std::isfinite(params.blade.edge_thickness_m) && params.blade.edge_thickness_m > 0.0))
+    return must_be("blade.edge_thickness_m", "finite and > 0", params.blade.edge_thickness_m);
   if (params.representation != Representation::kColumns &&
       params.representation != Representation::kSurface)
     return "representation must be columns or surface";
-  return validate(params.soil);
+  if (std::string e = validate(params.soil); !e.empty()) return e;
+  // The blade's rake with the material: a planar failure wedge must exist.
+  EarthmovingParams cut;
+  cut.soil = params.soil.material;
+  cut.rake_angle_deg = params.blade.rake_angle_deg;
+  if (std::string e = validate(cut); !e.empty()) {
+    if (e.starts_with("rake_angle_deg")) return "blade." + e;
+    return e;
+  }
+  return {};
+}
+
+ToolForceParams tool_force_params(const SimParams& params) {
+  ToolForceParams t;
+  t.earthmoving.soil = params.soil.material;
+  t.earthmoving.rake_angle_deg = params.blade.rake_angle_deg;
+  t.edge_thickness_m = params.blade.edge_thickness_m;
+  t.blade_length_m = params.blade.length_m;
+  t.representation = params.representation;
+  t.piles = params.soil.model == SoilModel::kFlow;
+  return t;
 }
 
 static const SimParams& checked(const SimParams& params) {
@@ -70,7 +93,10 @@ static const SimParams& checked(const SimParams& params) {
 }
 
 Simulation::Simulation(const SimParams& params, std::vector<float> initial_heights_m)
-    : params_(checked(params)), grid_(params.grid, std::move(initial_heights_m)) {
+    : params_(checked(params)),
+      grid_(params.grid, std::move(initial_heights_m)),
+      tool_params_(tool_force_params(params_)),
+      lookahead_m_(depth_lookahead_m(params_.grid)) {
   if (params_.soil.model == SoilModel::kFlow) soil_ = std::make_unique<SoilFlow>(params_.soil, grid_, params_.blade);
 }
 
@@ -92,9 +118,33 @@ const StepOutput& Simulation::begin_step(const BladePose& pose) {
   out_.changed = {};
   out_.substeps = 0;
   out_.listener_force_world_n = {};
+  out_.force = {};
   out_.timers = {};
-  out_.timers.contact_s = now_s() - begin_clock_s_;
   if (!valid) has_previous_ = false;
+  // The tool's motion over the step: its poses' change times the rate
+  // (none at the first step of a stroke).
+  out_.motion = {};
+  velocity_valid_ = has_previous_;
+  if (has_previous_) {
+    const double rate = params_.rate_hz;
+    out_.motion.velocity_m_per_s = (out_.pose.position_m - previous_pose_.position_m) * rate;
+    if (has_previous_velocity_)
+      out_.motion.acceleration_m_per_s2 = (out_.motion.velocity_m_per_s - previous_velocity_m_per_s_) * rate;
+    const Vec3 v = out_.motion.velocity_m_per_s;
+    const double speed_xz = std::hypot(v.x, v.z);
+    if (speed_xz >= kRestSpeed_m_per_s) heading_ = Vec3{v.x / speed_xz, 0.0, v.z / speed_xz};
+    // The edge's heading about +Y (Ry(a) X = (cos a, 0, -sin a)); a vertical
+    // edge has none.
+    const Vec3 now = rotate(out_.pose.orientation, Vec3{1.0, 0.0, 0.0});
+    const Vec3 before = rotate(previous_pose_.orientation, Vec3{1.0, 0.0, 0.0});
+    if (std::hypot(now.x, now.z) > 1e-6 && std::hypot(before.x, before.z) > 1e-6) {
+      const double turn = std::remainder(std::atan2(-now.z, now.x) - std::atan2(-before.z, before.x),
+                                         2.0 * std::numbers::pi);
+      out_.motion.yaw_rate_rad_per_s = turn * rate;
+    }
+  }
+  out_.motion.heading = heading_;
+  out_.timers.contact_s = now_s() - begin_clock_s_;
   return out_;
 }
 
@@ -153,14 +203,25 @@ const StepOutput& Simulation::finish_step() {
     out_.timers.soil_s = soil_end - cut_end;
   }
 
+  // The soil's physical force on the tool, from the terrain the step leaves.
+  const double bucket_load_m3 = soil_ ? out_.soil.bucket_load_m3 : 0.0;
+  out_.force = soil_force_on_tool(tool_params_, grid_, out_.edge, out_.pose.position_m, out_.motion,
+                                  bucket_load_m3, lookahead_m_);
+  const double force_end = now_s();
+  out_.timers.force_s = force_end - soil_end;
+  previous_velocity_m_per_s_ = out_.motion.velocity_m_per_s;
+  has_previous_velocity_ = velocity_valid_;
+
   // The listeners see the finished step (its cut and changed rectangle) and
   // may push on the tool.
   Vec3 listener_force{};
   for (StepListener* listener : listeners_) listener_force = listener_force + listener->on_step(out_);
   out_.listener_force_world_n = listener_force;
+  out_.force.bodies_n = listener_force;
+  out_.force.total_n = out_.force.total_n + listener_force;
   in_step_ = false;
   const double end = now_s();
-  out_.timers.listeners_s = end - soil_end;
+  out_.timers.listeners_s = end - force_end;
   out_.timers.total_s = end - begin_clock_s_;
   return out_;
 }
@@ -173,6 +234,8 @@ void Simulation::include_changed(const Rect& rect) {
 
 void Simulation::lift() {
   has_previous_ = false;
+  has_previous_velocity_ = false;
+  heading_ = {};
   for (StepListener* listener : listeners_) listener->on_lift();
 }
 
@@ -201,6 +264,8 @@ void Simulation::reset() {
     soil_->set_ceiling(ceiling);
   }
   has_previous_ = false;
+  has_previous_velocity_ = false;
+  heading_ = {};
   in_step_ = false;
   step_count_ = 0;
   removed_volume_m3_ = 0.0;

@@ -92,11 +92,10 @@ std::string validate(const SoilFlowParams& p) {
   if (p.model != SoilModel::kVanish && p.model != SoilModel::kFlow)
     return "soil.model must be vanish or flow";
   if (p.edge != SoilEdge::kWall && p.edge != SoilEdge::kOpen) return "soil.edge must be wall or open";
-  // Below a degree the material is a liquid, out of the model's reach (a
-  // repose of 1e-300 degrees made the tolerance 0, and float noise kept
-  // the cells moving for ever).
-  if (!(std::isfinite(p.repose_deg) && p.repose_deg >= 1.0 && p.repose_deg <= 80.0))
-    return must_be("soil.repose_deg", "in [1, 80] degrees", p.repose_deg);
+  // The material's ranges (material.hpp): below a degree of repose the
+  // material is a liquid, out of the model's reach (a repose of 1e-300
+  // degrees made the tolerance 0, and float noise kept the cells moving).
+  if (std::string m = validate(p.material); !m.empty()) return "soil." + m;
   if (!(p.max_pair_checks_per_step >= 1000 && p.max_pair_checks_per_step <= 1000000000))
     return must_be("soil.max_pair_checks_per_step", "in [1000, 1e9]",
                    p.max_pair_checks_per_step);
@@ -195,7 +194,7 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   const GridSpec& spec = grid.spec();
   dx_ = spec.cell_x_m();
   dz_ = spec.cell_z_m();
-  const double slope = std::tan(params.repose_deg * std::numbers::pi / 180.0);
+  const double slope = std::tan(params.material.repose_deg * std::numbers::pi / 180.0);
   limit_[0] = slope * dx_;
   limit_[1] = slope * dz_;
   limit_[2] = slope * std::hypot(dx_, dz_);
@@ -550,7 +549,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   // never skips a cell).
   const double step = std::min(dx_ / std::max(std::abs(nx), 1e-9), dz_ / std::max(std::abs(nz), 1e-9));
   // The repose drop over one such cell.
-  const double limit_step = std::tan(params_.repose_deg * std::numbers::pi / 180.0) * step *
+  const double limit_step = std::tan(params_.material.repose_deg * std::numbers::pi / 180.0) * step *
                             std::hypot(nx, nz);
   const double along_motion = nx * mx + nz * mz;
   const bool moving = std::abs(along_motion) > 0.01 * cell;
@@ -1026,7 +1025,7 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   SoilStepResult out;
   double room = 0.0, holds = 0.0;
   if (blade_spec_.bucket.enabled()) {
-    holds = bucket_retained_m3(blade_spec_, orientation, params_.repose_deg);
+    holds = bucket_retained_m3(blade_spec_, orientation, params_.material.repose_deg);
     // It takes soil in only while its lip leads: moving toward its opening
     // (the blade frame's -Z, in plan).
     const Vec3 opening = rotate(orientation, {0.0, 0.0, -1.0});

@@ -15,7 +15,7 @@ void write_haptics_csv(std::ostream& out, const std::vector<LoopRecord>& records
         line, sizeof line,
         "%.9g,%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
         "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%d,%d,%d,%d,%.9g,%.9g,%.9g,"
-        "%.9g,%.9g\n",
+        "%.9g,%.9g,%.9g,%.9g,%.9g\n",
         r.t_s, static_cast<long long>(r.tick), r.device_position_m.x, r.device_position_m.y,
         r.device_position_m.z, r.tool.position_m.x, r.tool.position_m.y, r.tool.position_m.z,
         r.tool.orientation.w, r.tool.orientation.x, r.tool.orientation.y, r.tool.orientation.z,
@@ -25,7 +25,8 @@ void write_haptics_csv(std::ostream& out, const std::vector<LoopRecord>& records
         r.force_device_n.x, r.force_device_n.y, r.force_device_n.z,
         bit(kFlagClamped), bit(kFlagRateLimited), bit(kFlagWatchdog), bit(kFlagRamping),
         bit(kFlagNonfinite), bit(kFlagBadSample), bit(kFlagSilent), bit(kFlagMissedDeadline),
-        r.period_s, r.compute_s, r.penetration_force_n, r.twist_torque_n_m, r.yaw_rate_rad_per_s);
+        r.period_s, r.compute_s, r.penetration_force_n, r.twist_torque_n_m, r.yaw_rate_rad_per_s,
+        r.physical_force_world_n.x, r.physical_force_world_n.y, r.physical_force_world_n.z);
     out << line;
   }
 }

@@ -10,7 +10,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
-#include "terracut/haptics/cut_depth.hpp"
+#include "terracut/core/surface.hpp"
 #include "terracut/haptics/pacer.hpp"
 
 namespace terracut::haptics {
@@ -56,7 +56,6 @@ HapticLoop::HapticLoop(const LoopParams& params, Simulation& sim, Quat default_o
     fixed_orientation_ = quat_from_euler_deg(*settings.tool_rotation_deg);
     has_fixed_orientation_ = true;
   }
-  lookahead_m_ = depth_lookahead_m(sim_.grid().spec());
   if (settings.velocity_cutoff_hz > 0.0)
     filter_rc_s_ = 1.0 / (2.0 * std::numbers::pi * settings.velocity_cutoff_hz);
   if (options_.snapshot) {
@@ -103,7 +102,9 @@ void HapticLoop::step1(double t_s) noexcept {
     has_previous_tool_ = false;  // start the estimate afresh
     return;
   }
-  if (tick_flags_ & kFlagReconnected) sim_.lift();  // the handle may be anywhere: no sweep
+  // The handle may be anywhere after a reconnection, and a lifted tool
+  // starts a new stroke: no sweep from the previous pose.
+  if (tick_flags_ & (kFlagReconnected | kFlagLifted)) sim_.lift();
   const BladePose pose = tool_pose();
   estimate_velocity(pose, t_s);
   sim_.begin_step(pose);
@@ -114,6 +115,7 @@ void HapticLoop::step1(double t_s) noexcept {
 bool HapticLoop::read_device(double t_s) noexcept {
   DeviceSample fresh = sample_;
   fresh.reconnected = false;
+  fresh.lifted = false;
   if (!device_.read(t_s, fresh)) {
     ++counters_.silent_ticks;
     tick_flags_ |= kFlagSilent;
@@ -133,6 +135,10 @@ bool HapticLoop::read_device(double t_s) noexcept {
   trips_at_newest_sample_ = safety_.counters().watchdog_trips;
   has_sample_ = true;
   last_sample_t_s_ = t_s;
+  if (fresh.lifted) {
+    tick_flags_ |= kFlagLifted;
+    has_previous_tool_ = false;  // a new stroke: the velocity estimate starts afresh
+  }
   if (fresh.reconnected) {
     ++counters_.reconnects;
     tick_flags_ |= kFlagReconnected;
@@ -146,9 +152,12 @@ bool HapticLoop::read_device(double t_s) noexcept {
 // device, or the default.
 BladePose HapticLoop::tool_pose() const noexcept {
   BladePose pose;
-  pose.position_m = workspace_.to_world(sample_.position_m);
+  pose.position_m = sample_.has_world_pose ? sample_.world_pose.position_m
+                                           : workspace_.to_world(sample_.position_m);
   if (has_fixed_orientation_)
     pose.orientation = fixed_orientation_;
+  else if (sample_.has_world_pose)
+    pose.orientation = sample_.world_pose.orientation;
   else if (sample_.has_orientation)
     pose.orientation = workspace_.orientation_to_world(sample_.orientation);
   else
@@ -203,12 +212,10 @@ void HapticLoop::estimate_velocity(const BladePose& pose, double t_s) noexcept {
 
 const LoopRecord& HapticLoop::step2(double period_s, double compute_s,
                                     bool missed_deadline) noexcept {
-  // Cut (and the simulation's listeners: e.g. the rigid bodies), then the
-  // force in the world from the contact, the motion and the listeners.
+  // Cut, soil and the physical force (and the simulation's listeners: e.g.
+  // the rigid bodies), then its rendering at the device's motion.
   const StepOutput& out = stepped_ ? sim_.finish_step() : not_stepped_;
-  const CutLoad load = stepped_ ? cut_load(out) : CutLoad{};
-  const double depth_m = load.depth_m;
-  const ForceOutput force = stepped_ ? world_force(out, load) : ForceOutput{};
+  const ForceOutput force = stepped_ ? rendered_force(out) : ForceOutput{};
 
   // Safety: a bad sample or no sample yet asks for zero force (shrinking to
   // zero is immediate); the watchdog looks at the last good sample's time.
@@ -232,62 +239,34 @@ const LoopRecord& HapticLoop::step2(double period_s, double compute_s,
   command.t_s = t_s_;
   device_.write(command);
 
-  LoopRecord& r = write_record(out, force, depth_m, command, period_s, compute_s);
+  LoopRecord& r = write_record(out, force, command, period_s, compute_s);
   if (options_.snapshot) publish_frame(out, force, command, period_s, compute_s);
   return r;
 }
 
-// The force models' world force plus the listeners' (e.g. rigid bodies
-// pushing the blade's plate), both scaled to the device the same way.
-ForceOutput HapticLoop::world_force(const StepOutput& out, const CutLoad& load) const noexcept {
+// The step's physical force rendered at the device's (filtered) motion: the
+// cutting model, the low-speed damper, the device's gain, the surface proxy,
+// the carried load's filtered inertia (ForceModel::compute).
+ForceOutput HapticLoop::rendered_force(const StepOutput& out) const noexcept {
   const HapticSettings& settings = params_.settings();
   ForceInput in;
+  in.physical = out.force;
   in.velocity_m_per_s = velocity_m_per_s_;
+  in.acceleration_m_per_s2 = acceleration_m_per_s2_;
+  in.yaw_rate_rad_per_s = yaw_rate_rad_per_s_;
   in.contact_length_m = out.contact.length_m;
-  in.cut_depth_m = load.depth_m;
-  in.surcharge_pa = load.surcharge_pa;
-  in.cut_width_m = load.width_m;
-  in.edge_direction = out.edge.b - out.edge.a;
   in.device_point_m = out.pose.position_m;
   in.surface_y_m = settings.surface_reference == SurfaceReference::kGround
                        ? sim_.grid().spec().origin_m.y
                        : surface_y_m(sim_.grid(), sim_.params().representation,
                                      out.pose.position_m.x, out.pose.position_m.z);
-  // What penetration and twist read: how deep the edge sits in the soil
-  // beside it, and which parts of it a turn drives into soil.
-  const ForceModelParams& fp = params_.force_model().params();
-  in.blade_length_m = fp.max_contact_length_m;
-  if (fp.cutting != CuttingModel::kNone) {
-    if (fp.penetration.enabled) {
-      const Embedment emb =
-          embedment(sim_.grid(), sim_.params().representation, out.edge, lookahead_m_);
-      in.embedment_depth_m = emb.depth_m;
-      in.embedded_length_m = emb.length_m;
-    }
-    if (fp.twist_enabled && yaw_rate_rad_per_s_ != 0.0) {
-      in.yaw_rate_rad_per_s = yaw_rate_rad_per_s_;
-      in.twist = twist_engagement(sim_.grid(), sim_.params().representation, out.edge,
-                                  out.pose.position_m, yaw_rate_rad_per_s_, lookahead_m_,
-                                  in.twist_depth_m);
-    }
-  }
-  ForceOutput force = params_.force_model().compute(in);
-  // The soil a bucket carries weighs on it (unit weight x volume, straight
-  // down) and resists its acceleration (its mass, weight / g, x -a).
-  const double load_n = params_.force_model().params().earthmoving.soil.unit_weight_n_per_m3 *
-                        out.soil.bucket_load_m3;
-  if (!sim_.listeners().empty() || load_n > 0.0) {
-    const Vec3 inertia_n = acceleration_m_per_s2_ * (-load_n / kGravityM_s2);
-    force.world_n = force.world_n + out.listener_force_world_n + Vec3{0.0, -load_n, 0.0} + inertia_n;
-    force.device_n = force.world_n * params_.force_model().params().force_scale;
-  }
-  return force;
+  return params_.force_model().compute(in);
 }
 
 // The tick's record (last_, and the ring of kept records).
 LoopRecord& HapticLoop::write_record(const StepOutput& out, const ForceOutput& force,
-                                     double cut_depth_m, const DeviceCommand& command,
-                                     double period_s, double compute_s) noexcept {
+                                     const DeviceCommand& command, double period_s,
+                                     double compute_s) noexcept {
   const Vec3 body_force = stepped_ ? out.listener_force_world_n : Vec3{};
   LoopRecord& r = last_;
   r.tick = counters_.ticks;
@@ -295,7 +274,8 @@ LoopRecord& HapticLoop::write_record(const StepOutput& out, const ForceOutput& f
   r.device_position_m = device_position_m_;
   r.tool = stepped_ ? out.pose : sim_.last().pose;
   r.contact_length_m = out.contact.length_m;
-  r.cut_depth_m = cut_depth_m;
+  r.cut_depth_m = stepped_ ? out.force.cut_depth_m : 0.0;
+  r.physical_force_world_n = stepped_ ? out.force.total_n : Vec3{};
   r.removed_volume_m3 = out.cut.removed_volume_m3;
   r.velocity_m_per_s = velocity_m_per_s_;
   r.force_world_n = force.world_n;
@@ -342,23 +322,6 @@ void HapticLoop::publish_frame(const StepOutput& out, const ForceOutput& force,
   f.period_s = period_s;
   fill_bodies(f, options_.bodies);
   x.publish(sim_.grid());
-}
-
-HapticLoop::CutLoad HapticLoop::cut_load(const StepOutput& out) const noexcept {
-  if (out.contact.length_m <= 0.0) return {};
-  if (params_.settings().cut_depth == CutDepthMeasure::kSection)
-    return {out.contact.section_area_m2 / out.contact.length_m, 0.0, -1.0};
-  if (sim_.params().soil.model != SoilModel::kFlow) {
-    const CutAhead ahead = cut_ahead(sim_.grid(), sim_.params().representation, out.edge,
-                                     velocity_m_per_s_, lookahead_m_);
-    return {ahead.depth_m, 0.0, ahead.width_m};
-  }
-  // Soil that flows: the pile the blade pushes is not depth of cut but a
-  // surcharge on the failure wedge (q = unit weight x pile height).
-  const SoilAhead ahead = soil_ahead(sim_.grid(), sim_.params().representation, out.edge,
-                                     velocity_m_per_s_, lookahead_m_);
-  const double unit_weight = params_.force_model().params().earthmoving.soil.unit_weight_n_per_m3;
-  return {ahead.depth_m, unit_weight * ahead.pile_m, ahead.width_m};
 }
 
 void HapticLoop::record(const LoopRecord& r) noexcept {

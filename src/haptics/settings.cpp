@@ -36,16 +36,6 @@ std::optional<SurfaceReference> parse_surface_reference(std::string_view name) {
   return std::nullopt;
 }
 
-std::string_view to_string(CutDepthMeasure measure) {
-  return measure == CutDepthMeasure::kAhead ? "ahead" : "section";
-}
-
-std::optional<CutDepthMeasure> parse_cut_depth_measure(std::string_view name) {
-  if (name == "ahead") return CutDepthMeasure::kAhead;
-  if (name == "section") return CutDepthMeasure::kSection;
-  return std::nullopt;
-}
-
 namespace {
 
 // The ranges of HapticSettings' own numbers (forces and safety have theirs,
@@ -91,8 +81,6 @@ std::string validate(const HapticSettings& s) {
   if (s.surface_reference != SurfaceReference::kGround &&
       s.surface_reference != SurfaceReference::kTerrain)
     return "surface_reference must be ground or terrain";
-  if (s.cut_depth != CutDepthMeasure::kAhead && s.cut_depth != CutDepthMeasure::kSection)
-    return "cut_depth must be ahead or section";
   if (std::string f = validate(s.forces); !f.empty()) return "forces." + f;
   if (std::string f = validate(s.safety); !f.empty()) return "safety." + f;
   if (s.safety.max_force_n > s.forces.device.max_force_n)

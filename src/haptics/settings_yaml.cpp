@@ -4,7 +4,6 @@
 #include "terracut/haptics/settings_yaml.hpp"
 
 #include <fstream>
-#include <numbers>
 #include <sstream>
 #include <string_view>
 
@@ -15,34 +14,12 @@ namespace terracut::haptics {
 namespace yaml = io::yaml;
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
-// An angle given in degrees in the file, kept in radians.
-void read_angle_deg(const yaml::Map& map, std::string_view key, double& out_rad) {
-  if (const auto f = map.get(key)) out_rad = f->number() * kDeg;
-}
-
-SoilParams soil_preset_of(const yaml::Field& f) {
-  return soil_preset(f.choice({SoilPreset::kDrySand, SoilPreset::kLooseSand, SoilPreset::kClay}));
-}
-
-// `soil:` is a preset's name, or a mapping of a preset and fields replacing its values.
-void parse_soil(const yaml::Map& earthmoving, SoilParams& soil) {
-  const auto f = earthmoving.get("soil");
-  if (!f) return;
-  if (f->is_scalar()) {
-    soil = soil_preset_of(*f);
-    return;
-  }
-  const yaml::Map s(*f, {"preset", "unit_weight_n_per_m3", "cohesion_pa", "adhesion_pa",
-                         "internal_friction_deg", "soil_tool_friction_deg", "surcharge_pa"});
-  if (const auto preset = s.get("preset")) soil = soil_preset_of(*preset);
-  s.read_number("unit_weight_n_per_m3", soil.unit_weight_n_per_m3);
-  s.read_number("cohesion_pa", soil.cohesion_pa);
-  s.read_number("adhesion_pa", soil.adhesion_pa);
-  read_angle_deg(s, "internal_friction_deg", soil.internal_friction_rad);
-  read_angle_deg(s, "soil_tool_friction_deg", soil.soil_tool_friction_rad);
-  s.read_number("surcharge_pa", soil.surcharge_pa);
+// A key of the old layout, where a field that moved is named: its new home.
+void moved(const yaml::Map& map, std::string_view key, std::string_view to) {
+  if (const auto f = map.get(key))
+    f->fail("moved to " + std::string(to) +
+            " (the soil's material and the blade's shape are written once, for every force and "
+            "program: docs/scenario-format.md)");
 }
 
 void parse_forces(const yaml::Map& f, ForceModelParams& p) {
@@ -51,11 +28,13 @@ void parse_forces(const yaml::Map& f, ForceModelParams& p) {
         {CuttingModel::kNone, CuttingModel::kContactDrag, CuttingModel::kEarthmoving});
   f.read_number("force_scale", p.force_scale);
   f.read_number("low_speed_damping_n_s_per_m", p.low_speed_damping_n_s_per_m);
-  f.read_boolean("project_width_on_motion", p.project_width_on_motion);
+  if (const auto g = f.get("project_width_on_motion"))
+    g->fail("removed: the cutting force always takes the engaged width across the motion (a blade "
+            "sliding along its own edge cuts nothing)");
   f.read_boolean("twist_enabled", p.twist_enabled);
   const yaml::Map pen = f.section("penetration", {"enabled", "edge_thickness_m"});
-  pen.read_boolean("enabled", p.penetration.enabled);
-  pen.read_number("edge_thickness_m", p.penetration.edge_thickness_m);
+  pen.read_boolean("enabled", p.penetration_enabled);
+  moved(pen, "edge_thickness_m", "blade.edge_thickness_m");
   if (const auto policy = f.get("policy"))
     p.policy = policy->choice({LimitPolicy::kClamp, LimitPolicy::kRefuse});
 
@@ -64,8 +43,10 @@ void parse_forces(const yaml::Map& f, ForceModelParams& p) {
   drag.read_number("viscous_n_s_per_m2", p.contact_drag.viscous_n_s_per_m2);
 
   const yaml::Map em = f.section("earthmoving", {"soil", "rake_angle_deg"});
-  parse_soil(em, p.earthmoving.soil);
-  read_angle_deg(em, "rake_angle_deg", p.earthmoving.rake_angle_rad);
+  moved(em, "soil", "the top-level soil: section (soil.preset, soil.unit_weight_n_per_m3, "
+                    "soil.internal_friction_deg, soil.cohesion_pa, soil.soil_tool_friction_deg, "
+                    "soil.adhesion_pa)");
+  moved(em, "rake_angle_deg", "blade.rake_angle_deg");
 
   const yaml::Map surface =
       f.section("surface", {"enabled", "stiffness_n_per_m", "damping_n_s_per_m"});
@@ -81,14 +62,6 @@ void parse_forces(const yaml::Map& f, ForceModelParams& p) {
   dev.read_number("inherent_damping_n_s_per_m", p.device.inherent_damping_n_s_per_m);
 }
 
-// The file's name for a field of validate()'s messages: angles are radians
-// in the structs and degrees in the file.
-std::string file_field(std::string field) {
-  const std::string rad = "_rad";
-  if (field.size() > rad.size() && field.compare(field.size() - rad.size(), rad.size(), rad) == 0)
-    field.replace(field.size() - rad.size(), rad.size(), "_deg");
-  return field;
-}
 
 }  // namespace
 
@@ -120,7 +93,8 @@ HapticSettings parse_haptics(const YAML::Node& node, const std::string& file) {
   if (const auto f = top.get("surface_reference"))
     s.surface_reference = f->choice({SurfaceReference::kGround, SurfaceReference::kTerrain});
   if (const auto f = top.get("cut_depth"))
-    s.cut_depth = f->choice({CutDepthMeasure::kAhead, CutDepthMeasure::kSection});
+    f->fail("removed: the depth of cut is the physical force's, the undisturbed soil ahead of the "
+            "edge (the step's force.cut_depth_m)");
 
   parse_forces(top.section("forces", {"cutting", "force_scale", "low_speed_damping_n_s_per_m",
                                       "project_width_on_motion", "twist_enabled", "penetration",
@@ -154,7 +128,7 @@ HapticSettings parse_haptics(const YAML::Node& node, const std::string& file) {
   // message starts with the field's path ("hand.mass_kg must be ...").
   if (const std::string problem = validate(s); !problem.empty()) {
     const yaml::Problem p = yaml::split_problem(problem);
-    root.fail_at(file_field(p.path), p.what);
+    root.fail_at(p.path, p.what);
   }
   return s;
 }

@@ -51,6 +51,8 @@ constexpr double kMax = yaml::kMaxMagnitude;
 constexpr yaml::Range kRanges[] = {
     {"rate_hz", 0.0, 1e6, Ends::kOpenLow},
     {"blade.length_m", 0.0, kMax, Ends::kOpenLow},
+    {"blade.rake_angle_deg", 0.0, 180.0, Ends::kOpen},
+    {"blade.edge_thickness_m", 0.0, kMax, Ends::kOpenLow},
     {"blade.bucket.depth_m", 0.0, kMax, Ends::kOpenLow},
     {"blade.bucket.height_m", 0.0, kMax, Ends::kOpenLow},
     {"terrain.size_m[0]", 0.0, kMax, Ends::kOpenLow},
@@ -61,7 +63,6 @@ constexpr yaml::Range kRanges[] = {
     {"terrain.mound.radius_m", 0.0, kMax, Ends::kOpenLow},
     {"terrain.plane.height_m", 0.0, kMax, Ends::kClosed},
     {"cuts[].keyframes[].t_s", 0.0, kMax, Ends::kClosed},
-    {"soil.repose_deg", 1.0, 80.0, Ends::kClosed},
     {"soil.max_pair_checks_per_step", 1000, 1e9, Ends::kClosed, true},
     {"reference.mound.radius_m", 0.0, kMax, Ends::kOpenLow},
     {"reference.mound.height_m", 0.0, kMax, Ends::kOpenLow},
@@ -105,6 +106,30 @@ void read_xz(const Map& map, std::string_view key, double& x_m, double& z_m) {
     x_m = v[0];
     z_m = v[1];
   }
+}
+
+// The soil's material: a preset's values (dry sand's without one), each
+// replaced by a field given; density or unit weight, not both.
+void read_material(const Map& soil, SoilMaterial& m) {
+  if (const auto p = soil.get("preset"))
+    m = soil_preset(p->choice({SoilPreset::kDrySand, SoilPreset::kLooseSand, SoilPreset::kClay,
+                               SoilPreset::kGravel},
+                              "soil preset"));
+  const auto in = [&](std::string_view key, double& out) {
+    if (const auto f = soil.get(key)) out = f->in(find_range(material_ranges(), key));
+  };
+  in("unit_weight_n_per_m3", m.unit_weight_n_per_m3);
+  if (const auto f = soil.get("density_kg_per_m3")) {
+    if (soil.get("unit_weight_n_per_m3"))
+      f->fail("give the density or the unit weight (= density x 9.81), not both");
+    m.unit_weight_n_per_m3 =
+        f->in(find_range(material_ranges(), "density_kg_per_m3")) * kStandardGravity_m_per_s2;
+  }
+  in("internal_friction_deg", m.internal_friction_deg);
+  in("cohesion_pa", m.cohesion_pa);
+  in("soil_tool_friction_deg", m.soil_tool_friction_deg);
+  in("adhesion_pa", m.adhesion_pa);
+  in("repose_deg", m.repose_deg);
 }
 
 bool valid_cut_name(const std::string& name) {
@@ -521,8 +546,11 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     sc.rate_hz = f->in(range("rate_hz"));
   }
 
-  const Map blade(top.require("blade"), {"length_m", "bucket"});
+  const Map blade(top.require("blade"), {"length_m", "rake_angle_deg", "edge_thickness_m", "bucket"});
   sc.blade.length_m = blade.require("length_m").in(range("blade.length_m"));
+  if (const auto f = blade.get("rake_angle_deg")) sc.blade.rake_angle_deg = f->in(range("blade.rake_angle_deg"));
+  if (const auto f = blade.get("edge_thickness_m"))
+    sc.blade.edge_thickness_m = f->in(range("blade.edge_thickness_m"));
   const std::optional<Field> bucket_field = blade.get("bucket");
   if (const auto& b = bucket_field) {
     // A bucket behind the edge (blade.hpp, BucketSpec): its floor and back.
@@ -587,12 +615,16 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     top_field.fail(what);
   }
 
-  // What happens to the cut soil (soil.hpp): vanish, or flow to the repose angle.
+  // The soil: its material (material.hpp: a preset, then fields replacing
+  // its values) and what happens to the cut soil (soil.hpp): vanish, or flow
+  // to the repose angle.
   if (const auto f = top.get("soil")) {
-    const Map soil(*f, {"model", "repose_deg", "max_pair_checks_per_step", "edge"});
+    const Map soil(*f, {"model", "preset", "unit_weight_n_per_m3", "density_kg_per_m3",
+                        "internal_friction_deg", "cohesion_pa", "soil_tool_friction_deg", "adhesion_pa",
+                        "repose_deg", "max_pair_checks_per_step", "edge"});
     if (const auto m = soil.get("model"))
       sc.soil.model = m->choice({SoilModel::kVanish, SoilModel::kFlow}, "soil model");
-    if (const auto a = soil.get("repose_deg")) sc.soil.repose_deg = a->in(range("soil.repose_deg"));
+    read_material(soil, sc.soil.material);
     if (const auto w = soil.get("max_pair_checks_per_step"))
       sc.soil.max_pair_checks_per_step =
           static_cast<std::int64_t>(w->in(range("soil.max_pair_checks_per_step")));

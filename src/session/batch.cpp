@@ -31,8 +31,9 @@ using Json = nlohmann::ordered_json;
 
 // Removes the named outputs from the folder (ignoring ones that do not exist).
 void remove_outputs(const std::filesystem::path& dir) {
-  for (const char* name : {"contact.csv", "height.npy", "removed.npy", "height.png", "removed.png",
-                           "summary.json", "bodies.csv", "deposited.npy", "deposited.png"}) {
+  for (const char* name : {"contact.csv", "force.csv", "height.npy", "removed.npy", "height.png",
+                           "removed.png", "summary.json", "bodies.csv", "deposited.npy",
+                           "deposited.png"}) {
     std::error_code ec;
     std::filesystem::remove(dir / name, ec);
   }
@@ -43,7 +44,115 @@ Json timing_json(const TimingStats& s) {
               {"mean", s.mean_us}};
 }
 
+// The force columns' readers (a table of plain functions: no capture).
+#define TERRACUT_FORCE(field, part) [](const StepOutput& o) { return o.force.field.part; }
+constexpr ForceColumn kForceColumns[] = {
+    {"fx", "N", TERRACUT_FORCE(total_n, x)},
+    {"fy", "N", TERRACUT_FORCE(total_n, y)},
+    {"fz", "N", TERRACUT_FORCE(total_n, z)},
+    {"cutting_x", "N", TERRACUT_FORCE(cutting_n, x)},
+    {"cutting_y", "N", TERRACUT_FORCE(cutting_n, y)},
+    {"cutting_z", "N", TERRACUT_FORCE(cutting_n, z)},
+    {"surcharge_x", "N", TERRACUT_FORCE(surcharge_n, x)},
+    {"surcharge_y", "N", TERRACUT_FORCE(surcharge_n, y)},
+    {"surcharge_z", "N", TERRACUT_FORCE(surcharge_n, z)},
+    {"penetration_y", "N", TERRACUT_FORCE(penetration_n, y)},
+    {"twist_x", "N", TERRACUT_FORCE(twist_n, x)},
+    {"twist_z", "N", TERRACUT_FORCE(twist_n, z)},
+    {"twist_torque", "N m", [](const StepOutput& o) { return o.force.twist_torque_n_m; }},
+    {"load_x", "N", TERRACUT_FORCE(load_n, x)},
+    {"load_y", "N", TERRACUT_FORCE(load_n, y)},
+    {"load_z", "N", TERRACUT_FORCE(load_n, z)},
+    {"bodies_x", "N", TERRACUT_FORCE(bodies_n, x)},
+    {"bodies_y", "N", TERRACUT_FORCE(bodies_n, y)},
+    {"bodies_z", "N", TERRACUT_FORCE(bodies_n, z)},
+    {"cut_depth", "m", [](const StepOutput& o) { return o.force.cut_depth_m; }},
+    {"cut_width", "m", [](const StepOutput& o) { return o.force.engaged_width_m; }},
+    {"pile_height", "m", [](const StepOutput& o) { return o.force.pile_m; }},
+    {"vx", "m/s", [](const StepOutput& o) { return o.motion.velocity_m_per_s.x; }},
+    {"vy", "m/s", [](const StepOutput& o) { return o.motion.velocity_m_per_s.y; }},
+    {"vz", "m/s", [](const StepOutput& o) { return o.motion.velocity_m_per_s.z; }},
+};
+#undef TERRACUT_FORCE
+
+// force.csv: t, cut and the force columns, one row per step.
+class ForceCsv {
+ public:
+  explicit ForceCsv(const std::filesystem::path& path) : file_(path, header()) {}
+  void row(const StepOutput& out, const std::string& cut_name) {
+    line_.clear();
+    for (const ForceColumn& c : kForceColumns) {
+      char cell[32];
+      std::snprintf(cell, sizeof cell, ",%.9g", c.get(out));
+      line_ += cell;
+    }
+    file_.row({out.t_s, cut_name + line_});
+  }
+  void close() { file_.close(); }
+
+ private:
+  static std::string header() {
+    std::string h = "t,cut";
+    for (const ForceColumn& c : kForceColumns) h += std::string(",") + c.name;
+    return h;
+  }
+  io::CsvFile file_;
+  std::string line_;
+};
+
+// A cut's force statistics, summed step by step.
+class ForceStats {
+ public:
+  void add(const ToolForce& f) {
+    const Vec3 t = f.total_n;
+    const double h = std::hypot(t.x, t.z);
+    sum_ = sum_ + t;
+    sum_h_ += h;
+    sum_pile_h_ += std::hypot(f.surcharge_n.x, f.surcharge_n.z);
+    out_.peak_horizontal_n = std::max(out_.peak_horizontal_n, h);
+    if (std::abs(t.y) > std::abs(out_.peak_vertical_n)) out_.peak_vertical_n = t.y;
+    ++n_;
+  }
+  CutForceStats result() const {
+    CutForceStats r = out_;
+    if (n_ > 0) {
+      r.mean_n = sum_ * (1.0 / double(n_));
+      r.mean_horizontal_n = sum_h_ / double(n_);
+      r.mean_vertical_n = r.mean_n.y;
+      r.mean_surcharge_horizontal_n = sum_pile_h_ / double(n_);
+    }
+    return r;
+  }
+
+ private:
+  CutForceStats out_{};
+  Vec3 sum_{};
+  double sum_h_ = 0.0, sum_pile_h_ = 0.0;
+  std::int64_t n_ = 0;
+};
+
+Json force_json(const CutForceStats& f) {
+  return Json{{"mean_n", {f.mean_n.x, f.mean_n.y, f.mean_n.z}},
+              {"mean_horizontal_n", f.mean_horizontal_n},
+              {"peak_horizontal_n", f.peak_horizontal_n},
+              {"mean_vertical_n", f.mean_vertical_n},
+              {"peak_vertical_n", f.peak_vertical_n},
+              {"mean_surcharge_horizontal_n", f.mean_surcharge_horizontal_n}};
+}
+
+Json material_json(const SoilMaterial& m) {
+  return Json{{"unit_weight_n_per_m3", m.unit_weight_n_per_m3},
+              {"density_kg_per_m3", m.density_kg_per_m3()},
+              {"internal_friction_deg", m.internal_friction_deg},
+              {"cohesion_pa", m.cohesion_pa},
+              {"soil_tool_friction_deg", m.soil_tool_friction_deg},
+              {"adhesion_pa", m.adhesion_pa},
+              {"repose_deg", m.repose_deg}};
+}
+
 }  // namespace
+
+std::span<const ForceColumn> force_columns() { return kForceColumns; }
 
 std::vector<std::string> soil_warnings(const SoilFlowParams& soil, const GridSpec& grid,
                                        std::int64_t final_backlog_cells) {
@@ -58,15 +167,15 @@ std::vector<std::string> soil_warnings(const SoilFlowParams& soil, const GridSpe
   // Cells far from square leave planes steeper than on square cells
   // standing (the 8 neighbours' directions leave wider gaps).
   const double dx = grid.cell_x_m(), dz = grid.cell_z_m();
-  const double here = steepest_standing_slope_deg(dx, dz, soil.repose_deg);
-  const double square = steepest_standing_slope_deg(dx, dx, soil.repose_deg);
+  const double here = steepest_standing_slope_deg(dx, dz, soil.material.repose_deg);
+  const double square = steepest_standing_slope_deg(dx, dx, soil.material.repose_deg);
   if (here > square + 0.5) {
     char line[400];
     std::snprintf(line, sizeof line,
                   "soil: cells of %.4g x %.4g m (X x Z) let planes up to %.1f degrees stand between the "
                   "relaxation's 8 neighbour directions, against %.1f on square cells, for a repose angle of "
                   "%.4g: use square cells to keep every direction within %.1f degrees of it",
-                  dx, dz, here, square, soil.repose_deg, square - soil.repose_deg);
+                  dx, dz, here, square, soil.material.repose_deg, square - soil.material.repose_deg);
     w.push_back(line);
   }
   return w;
@@ -110,6 +219,8 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
   inputs["representation"] = std::string(to_string(sc.representation));
   inputs["rate_hz"] = sc.rate_hz;
   inputs["blade_length_m"] = sc.blade.length_m;
+  inputs["blade_rake_angle_deg"] = sc.blade.rake_angle_deg;
+  inputs["soil_material"] = material_json(sc.soil.material);
   inputs["sequence"] = sc.sequence_names();
   Json cuts = Json::array();
   for (const Motion& m : sc.cuts)
@@ -135,16 +246,17 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
                        {"steps", c.steps},
                        {"peak_contact_m", c.peak_contact_m},
                        {"mean_contact_m", c.mean_contact_m},
-                       {"removed_volume_m3", c.removed_volume_m3}});
+                       {"removed_volume_m3", c.removed_volume_m3},
+                       {"force", force_json(c.force)}});
   out["cuts"] = per_cut;
-  out["outputs"] = {{"contact_csv", "contact.csv"}, {"height_npy", "height.npy"},
+  out["outputs"] = {{"contact_csv", "contact.csv"}, {"force_csv", "force.csv"}, {"height_npy", "height.npy"},
                     {"removed_npy", "removed.npy"}, {"height_png", "height.png"},
                     {"removed_png", "removed.png"}};
   // The only content that differs between two runs of the same scenario.
   if (r.soil) {
     const SoilRunStats& s = *r.soil;
     out["soil"] = {{"model", "flow"},
-                   {"repose_deg", sc.soil.repose_deg},
+                   {"repose_deg", sc.soil.material.repose_deg},
                    {"edge", std::string(to_string(sc.soil.edge))},
                    {"volume_m3",
                     {{"initial", r.initial_volume_m3},
@@ -161,7 +273,7 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
     if (sc.blade.bucket.enabled())
       out["soil"]["bucket"] = {{"depth_m", sc.blade.bucket.depth_m},
                                {"height_m", sc.blade.bucket.height_m},
-                               {"level_capacity_m3", bucket_retained_m3(sc.blade, Quat{}, sc.soil.repose_deg)},
+                               {"level_capacity_m3", bucket_retained_m3(sc.blade, Quat{}, sc.soil.material.repose_deg)},
                                {"taken_in_m3", s.bucket_in_m3},
                                {"poured_m3", s.poured_m3},
                                {"max_load_m3", s.max_bucket_load_m3},
@@ -255,6 +367,7 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
   if (options.realtime) pacer.emplace(haptics::PacerSettings{.rate_hz = sc.rate_hz});
 
   io::ContactCsvWriter csv(dir / "contact.csv");
+  ForceCsv force_csv(dir / "force.csv");
   Progress progress(options, total_steps);
   const Clock::time_point loop_start = Clock::now();
   std::int64_t done = 0;
@@ -267,6 +380,7 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
     stats.duration_s = motion.duration_s();
     stats.steps = steps_of_cut[k];
     double contact_sum = 0.0;
+    ForceStats force;
 
     // Each cut is a separate stroke: nothing is swept from the previous cut's end.
     sim.lift();
@@ -288,6 +402,8 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
       rec.contact = out.contact;
       rec.removed_volume_m3 = out.cut.removed_volume_m3;
       csv.row(rec, motion.name, out.contact.cells_visited + out.cut.cells_visited);
+      force_csv.row(out, motion.name);
+      force.add(out.force);
       if (i == 0) stats.start_t_s = out.t_s;
       stats.peak_contact_m = std::max(stats.peak_contact_m, out.contact.length_m);
       contact_sum += out.contact.length_m;
@@ -313,12 +429,14 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
       progress.maybe_report(done, motion.name);
     }
     stats.mean_contact_m = stats.steps > 0 ? contact_sum / double(stats.steps) : 0.0;
+    stats.force = force.result();
     result.removed_volume_m3 += stats.removed_volume_m3;
     result.cuts.push_back(stats);
   }
   result.wall_s = std::chrono::duration<double>(Clock::now() - loop_start).count();
   progress.finish(done);
   csv.close();
+  force_csv.close();
 
   // Final state, conservation and timing.
   const HeightGrid& grid = sim.grid();

@@ -25,18 +25,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The cut the script and sim devices follow: the one named in
-// haptics.cut, else the first cut of the scenario's sequence; nullptr when
-// there is no such cut.
-const Motion* find_followed_cut(const io::Scenario& sc, const std::string& name) {
-  if (!name.empty()) {
-    const int index = sc.find_cut(name);
-    return index < 0 ? nullptr : &sc.cuts[std::size_t(index)];
-  }
-  if (!sc.sequence.empty()) return &sc.cuts[std::size_t(sc.sequence.front())];
-  return sc.cuts.empty() ? nullptr : &sc.cuts.front();
-}
-
 // JSON text of a string: quoted, with quotes, backslashes and control
 // characters escaped.
 std::string json_string(const std::string& text) {
@@ -78,6 +66,43 @@ std::string json_percentiles(const TimePercentiles& s) {
 }
 
 }  // namespace
+
+DevicePath followed_path(const Scenario& scenario, const HapticSettings& settings,
+                         const std::string& source) {
+  const io::Scenario& sc = scenario.base;
+  std::vector<Motion> strokes;
+  if (!settings.cut.empty()) {
+    const int index = sc.find_cut(settings.cut);
+    if (index < 0)
+      throw InputError(source + ": haptics.cut: no cut named '" + settings.cut + "' in the scenario");
+    strokes.push_back(sc.cuts[std::size_t(index)]);
+  } else {
+    for (int index : sc.sequence) strokes.push_back(sc.cuts[std::size_t(index)]);
+  }
+  if (strokes.empty())
+    throw InputError(source + ": haptics.cut: the " + std::string(to_string(settings.device)) +
+                     " device follows a cut, and the scenario has none");
+  // A hand cannot jump from one stroke's end to the next one's start.
+  if (settings.device == DeviceKind::kSim) strokes.resize(1);
+  return DevicePath(std::move(strokes), settings.rate_hz, Workspace(settings.workspace));
+}
+
+std::unique_ptr<Device> make_device(const Scenario& scenario, const HapticSettings& settings,
+                                    int udp_port, const std::string& source) {
+  switch (settings.device) {
+    case DeviceKind::kScript:
+      return std::make_unique<ScriptDevice>(followed_path(scenario, settings, source));
+    case DeviceKind::kSim:
+      return std::make_unique<SimHandDevice>(SimHand(settings.hand,
+                                                     settings.forces.device.inherent_damping_n_s_per_m,
+                                                     followed_path(scenario, settings, source),
+                                                     settings.rate_hz));
+    case DeviceKind::kUdp:
+      // A real device through the bridge (docs/bridge-protocol.md).
+      return std::make_unique<UdpDevice>(settings.udp.address, udp_port);
+  }
+  throw InputError(source + ": haptics.device: unknown device");
+}
 
 // ---------------------------------------------------------------------------
 // Building
@@ -136,39 +161,20 @@ HapticSession::HapticSession(const Scenario& input, const SessionOptions& option
   }
   const HapticSettings& valid = params->settings();
 
-  // The path the script and sim devices follow, and the default orientation.
-  const Motion* cut = find_followed_cut(sc, valid.cut);
-  if (!valid.cut.empty() && !cut)
-    throw InputError(source_.string() + ": haptics.cut: no cut named '" + valid.cut +
-                     "' in the scenario");
-  if (!cut && kind_ != DeviceKind::kUdp)
-    throw InputError(source_.string() + ": haptics.cut: the " + std::string(to_string(kind_)) +
-                     " device follows a cut, and the scenario has none");
-  cut_name_ = cut ? cut->name : "";
-  const Quat default_orientation = cut ? cut->keyframes.front().pose.orientation : Quat{};
-  const double path_s = cut ? cut->duration_s() : 0.0;
+  // The device, and the path the script and sim devices follow: its length
+  // and its first orientation (the default one).
+  device_ = make_device(input, valid, port, source_.string());
+  std::optional<DevicePath> path;
+  if (kind_ != DeviceKind::kUdp) path.emplace(followed_path(input, valid, source_.string()));
+  cut_name_ = path ? path->strokes().front().name : "";
+  const Quat default_orientation = path ? path->strokes().front().keyframes.front().pose.orientation : Quat{};
+  const double path_s = path ? path->duration_s() : 0.0;
   duration_s_ =
       valid.duration_s.value_or(kind_ == DeviceKind::kUdp ? 30.0 : path_s + valid.settle_s);
   if (!(duration_s_ > 0.0))
     throw InputError(source_.string() +
                      ": haptics.duration_s: the session would last 0 s (the cut has one keyframe "
                      "and settle_s is 0); give duration_s or --duration");
-
-  // The device.
-  const Workspace workspace(valid.workspace);
-  switch (kind_) {
-    case DeviceKind::kScript:
-      device_ = std::make_unique<ScriptDevice>(DevicePath(*cut, workspace));
-      break;
-    case DeviceKind::kSim:
-      device_ = std::make_unique<SimHandDevice>(
-          SimHand(valid.hand, valid.forces.device.inherent_damping_n_s_per_m,
-                  DevicePath(*cut, workspace), valid.rate_hz));
-      break;
-    case DeviceKind::kUdp:
-      device_ = std::make_unique<UdpDevice>(valid.udp.address, port);
-      break;
-  }
 
   // The world and the loop.
   RigOptions ro;

@@ -100,13 +100,12 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
   const Scenario remote = load_remote_scenario(op);
   const auto [address, port] =
       o.endpoint.empty() ? std::pair{s.address, s.port} : parse_endpoint(o.endpoint, "--listen", s.address);
-  const haptics::LoopParams nominal(op.haptics, op.base.blade);
   const World local(op);  // the operator's initial terrain: what the deadband compares against
   auto link = net::EnetEndpoint::listen(address, port, s.to_operator);
   // The records go to remote.csv as they are made: a live session has no set end.
   RemoteOptions options;
   options.keep_records = false;
-  RemoteStation station(remote, s, nominal.force_model(), local.simulation().grid(), *link,
+  RemoteStation station(remote, s, op.base.soil.material, local.simulation().grid(), *link,
                         std::uint32_t(Clock::now().time_since_epoch().count()), options);
   std::filesystem::create_directories(o.out);
   StationCsv csv = StationCsv::remote_csv(o.out / "remote.csv");

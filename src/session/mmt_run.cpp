@@ -17,16 +17,6 @@
 namespace terracut::session {
 namespace {
 
-const Motion* followed_cut(const Scenario& sc) {
-  const io::Scenario& b = sc.base;
-  if (!sc.haptics.cut.empty()) {
-    const int i = b.find_cut(sc.haptics.cut);
-    return i < 0 ? nullptr : &b.cuts[std::size_t(i)];
-  }
-  if (!b.sequence.empty()) return &b.cuts[std::size_t(b.sequence.front())];
-  return b.cuts.empty() ? nullptr : &b.cuts.front();
-}
-
 double rms(const std::vector<double>& v) {
   if (v.empty()) return 0.0;
   double s = 0.0;
@@ -44,33 +34,13 @@ std::ofstream open_out(const std::filesystem::path& p) {
 }  // namespace
 
 double operator_duration_s(const Scenario& op) {
-  const Motion* cut = followed_cut(op);
   if (op.haptics.duration_s) return *op.haptics.duration_s;
   if (op.haptics.device == haptics::DeviceKind::kUdp) return 30.0;  // as terracut haptics
-  if (!cut) throw InputError(op.base.source_path.string() + ": haptics.cut: the operator's device follows a cut, and the scenario has none");
-  return cut->duration_s() + op.haptics.settle_s;
+  return followed_path(op, op.haptics, op.base.source_path.string()).duration_s() + op.haptics.settle_s;
 }
 
 std::unique_ptr<haptics::Device> make_operator_device(const Scenario& op) {
-  if (op.haptics.device == haptics::DeviceKind::kUdp)
-    // A real device through the bridge (docs/bridge-protocol.md).
-    return std::make_unique<haptics::UdpDevice>(op.haptics.udp.address, op.haptics.udp.port);
-  const Motion* cut = followed_cut(op);
-  if (!cut)
-    throw InputError(op.base.source_path.string() +
-                     ": haptics.cut: the operator's device follows a cut, and the scenario has none");
-  const haptics::Workspace ws(op.haptics.workspace);
-  switch (op.haptics.device) {
-    case haptics::DeviceKind::kScript:
-      return std::make_unique<haptics::ScriptDevice>(haptics::DevicePath(*cut, ws));
-    case haptics::DeviceKind::kSim:
-      return std::make_unique<haptics::SimHandDevice>(
-          haptics::SimHand(op.haptics.hand, op.haptics.forces.device.inherent_damping_n_s_per_m,
-                           haptics::DevicePath(*cut, ws), op.haptics.rate_hz));
-    case haptics::DeviceKind::kUdp:
-      break;  // above
-  }
-  throw InputError(op.base.source_path.string() + ": haptics.device: unknown device");
+  return make_device(op, op.haptics, op.haptics.udp.port, op.base.source_path.string());
 }
 
 namespace {
@@ -172,8 +142,7 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
   device_ = make_operator_device(*op_);
   link_ = std::make_unique<net::MemoryLink>(settings_.to_remote, settings_.to_operator);
   operator_ = std::make_unique<OperatorStation>(*op_, settings_, *device_, link_->a(), 1u);
-  remote_ = std::make_unique<RemoteStation>(*remote_scn_, settings_,
-                                            operator_->rig().loop().force_model(),
+  remote_ = std::make_unique<RemoteStation>(*remote_scn_, settings_, op_->base.soil.material,
                                             operator_->simulation().grid(), link_->b(), 2u);
   rate_hz_ = operator_->rate_hz();
   // After the path: a round trip, a sensing period and a blend for the last

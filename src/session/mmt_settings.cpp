@@ -94,7 +94,8 @@ void MmtReader::read(const YAML::Node& value, const std::string& file) {
     s.remote_scenario = p.is_absolute() ? p : std::filesystem::path(file).parent_path() / p;
   }
   if (const auto f = remote.get("soil"))
-    s.remote_soil = f->choice({SoilPreset::kDrySand, SoilPreset::kLooseSand, SoilPreset::kClay});
+    s.remote_soil = f->choice({SoilPreset::kDrySand, SoilPreset::kLooseSand, SoilPreset::kClay,
+                               SoilPreset::kGravel});
   remote.read_number("follower_speed_m_per_s", s.follower_speed_m_per_s);
   remote.read_number("follower_time_constant_s", s.follower_time_constant_s);
   remote.read_number("sense_period_s", s.sense_period_s);
@@ -170,7 +171,7 @@ Scenario load_remote_scenario(const Scenario& op) {
     throw InputError(op.base.source_path.string() + ": mmt.remote.scenario: " + e.what());
   }
   remote.mmt.reset();
-  if (s.remote_soil) remote.haptics.forces.earthmoving.soil = soil_preset(*s.remote_soil);
+  if (s.remote_soil) remote.base.soil.material = soil_preset(*s.remote_soil);
   // Both stations speak of the same samples: the grids must agree.
   const GridSpec a = io::grid_spec(op.base), b = io::grid_spec(remote.base);
   if (a.cols != b.cols || a.rows != b.rows || a.size_x_m != b.size_x_m ||

@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include "terracut/core/error.hpp"
-#include "terracut/haptics/cut_depth.hpp"
 #include "terracut/haptics/workspace.hpp"
 #include "terracut/session/mmt.hpp"
 
@@ -218,10 +217,12 @@ class ScaleCorrection final : public StepListener {
 // ---------------------------------------------------------------------------
 
 RemoteStation::RemoteStation(const Scenario& remote, const MmtSettings& settings,
-                             const ForceModel& nominal, const HeightGrid& operator_initial,
+                             const SoilMaterial& nominal, const HeightGrid& operator_initial,
                              net::Endpoint& link, std::uint32_t session,
                              const RemoteOptions& options)
-    : settings_(settings), nominal_(nominal), link_(link), session_(session), options_(options) {
+    : settings_(settings), link_(link), session_(session), options_(options) {
+  nominal_.soil = nominal;
+  nominal_.rake_angle_deg = remote.base.blade.rake_angle_deg;
   const haptics::LoopParams params = loop_params(remote);
   device_ = std::make_unique<FollowerDevice>(params.settings().workspace,
                                              settings_.follower_speed_m_per_s,
@@ -301,40 +302,19 @@ Rect RemoteStation::window_around(Vec3 p) const {
   return w;
 }
 
-// Recursive least squares of one factor: measured horizontal force =
-// factor x the operator's model's horizontal cutting force at the same cut
-// (contact, depth, velocity). Forces are taken in units of 100 N.
-void RemoteStation::update_estimate(const haptics::LoopRecord& r) {
-  if (!settings_.estimate || r.contact_length_m <= 0.0 || r.cut_depth_m <= 0.0) return;
-  ForceInput in;
-  in.velocity_m_per_s = r.velocity_m_per_s;
-  in.contact_length_m = r.contact_length_m;
-  in.cut_depth_m = r.cut_depth_m;
-  in.edge_direction = simulation().last().edge.b - simulation().last().edge.a;
-  in.device_point_m = r.tool.position_m;
-  in.surface_y_m = simulation().grid().spec().origin_m.y;
-  if (simulation().params().soil.model == SoilModel::kFlow) {
-    // The pile ahead weighs on the wedge in the operator's model too.
-    const haptics::SoilAhead ahead = haptics::soil_ahead(
-        simulation().grid(), simulation().params().representation, simulation().last().edge,
-        r.velocity_m_per_s, haptics::depth_lookahead_m(simulation().grid().spec()));
-    in.surcharge_pa = nominal_.params().earthmoving.soil.unit_weight_n_per_m3 * ahead.pile_m;
-  }
-  const ForceOutput nominal = nominal_.compute(in);
-  const double x = length(horizontal(nominal.cutting_n)) / 100.0;
-  const double y = length(horizontal(r.force_world_n)) / 100.0;
+// Recursive least squares of one factor: the remote's physical horizontal
+// cutting force (its earthmoving H, the pile's surcharge in it) = factor x
+// the operator's material's H at the same cut (width, depth, pile). Forces
+// in units of 100 N. The physical force is never capped or rendered, so
+// every sample with a cut counts.
+void RemoteStation::update_estimate(const haptics::LoopRecord&) {
+  const ToolForce& f = simulation().last().force;
+  if (!settings_.estimate || !(f.engaged_width_m > 0.0) || !(f.cut_depth_m > 0.0)) return;
+  const EarthmovingResult nominal = earthmoving_force(
+      nominal_, f.engaged_width_m, f.cut_depth_m, nominal_.soil.unit_weight_n_per_m3 * f.pile_m);
+  const double x = nominal.horizontal_n / 100.0;
+  const double y = f.earthmoving.horizontal_n / 100.0;
   if (!(x > 0.01) || !std::isfinite(y)) return;  // below 1 N the ratio says little
-  // The low-speed cap (ForceModelParams::low_speed_damping_n_s_per_m) holds
-  // the soil's force at c |v| in both worlds below H / c: there both read
-  // c |v| whatever the soil, and the sample, fitted, pulls the factor toward
-  // 1 (a tool slowed by a loaded machine made it 1.01). A sample counts only
-  // where the cap stands clear of the soil's force in both models, the
-  // remote's at the current estimate (kMargin for the estimate's error).
-  constexpr double kMargin = 1.1;
-  if (!(nominal.cutting_cap_n > kMargin * std::max(theta_, 1.0) * nominal.cutting_uncapped_n)) {
-    ++rls_capped_;
-    return;
-  }
   // Once it has settled, a sample more than kOutlier times off the estimate
   // is something no soil does (the plate striking a rock: Bullet's impact
   // is a hundred times the cut): left out, or it would be carried into the

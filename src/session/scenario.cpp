@@ -86,6 +86,7 @@ std::span<const Range> scenario_ranges() {
   static const RangeTable table = [] {
     RangeTable t;
     t.add("", io::scenario_ranges());
+    t.add("soil.", material_ranges());
     t.add("haptics.", haptics::haptic_settings_ranges());
     t.add("haptics.forces.", force_ranges());
     t.add("haptics.safety.", safety_ranges());

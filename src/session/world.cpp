@@ -33,9 +33,6 @@ World::World(const Scenario& scenario, const WorldOptions& options) {
 #ifdef TERRACUT_HAVE_BULLET
   bullet::BodiesListenerOptions bo;
   bo.csv_path = options.bodies_csv;
-  // Piles press on the bodies with the scenario's soil's unit weight, the
-  // one the earthmoving force uses (one source; validated with it).
-  bo.world.pile.unit_weight_n_per_m3 = scenario.haptics.forces.earthmoving.soil.unit_weight_n_per_m3;
   bodies_ = std::make_unique<bullet::BodiesListener>(*sim_, scenario.bodies, bo);
 #else
   throw InputError(bodies_unavailable_message());

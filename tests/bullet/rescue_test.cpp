@@ -127,7 +127,7 @@ void Rescue::undercut_block_tips_into_the_trench() {
   // may lie on one wall: its mean slope across the box understates it.
   const double slope_deg =
       input_.soil.model == SoilModel::kFlow
-          ? input_.soil.repose_deg
+          ? input_.soil.material.repose_deg
           : std::atan((soil_hi - soil_lo) / (2.0 * std::max(reach.x, reach.z))) * 180.0 / std::numbers::pi;
   EXPECT_NEAR(tilt_deg(end.orientation), 90.0, 5.0 + slope_deg);
   EXPECT_LT(end.position_m.x, run.state(0, block).position_m.x);  // towards the trench (-X)

@@ -367,7 +367,7 @@ TEST(Simulation, EditHeightsWakesTheSoilFlow) {
   SimParams p;
   p.grid = test::square_spec(21, 21);  // cells of 1/21 m
   p.soil.model = SoilModel::kFlow;
-  p.soil.repose_deg = 34.0;
+  p.soil.material.repose_deg = 34.0;
   Simulation sim(p, std::vector<float>(21 * 21, 0.0f));
   const float spike = 0.2f;
   sim.edit_heights({10, 10, 11, 11}, std::vector<float>{spike});

@@ -28,7 +28,7 @@ TEST(SoilAllocation, ARampSteepEverywhereRelaxesWithoutAllocating) {
     HeightGrid grid(grid_of_cells(n, n, cell), h);
     SoilFlowParams p;
     p.model = SoilModel::kFlow;
-    p.repose_deg = 34.0;
+    p.material.repose_deg = 34.0;
     p.max_pair_checks_per_step = 2000;  // passes spread over steps
     SoilFlow flow(p, grid);
     ASSERT_EQ(flow.active_cells(), std::int64_t(n) * n);

@@ -29,7 +29,7 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 SoilFlowParams flow(double repose_deg, std::int64_t checks = 200000) {
   SoilFlowParams p;
   p.model = SoilModel::kFlow;
-  p.repose_deg = repose_deg;
+  p.material.repose_deg = repose_deg;
   p.max_pair_checks_per_step = checks;
   return p;
 }

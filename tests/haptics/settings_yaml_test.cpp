@@ -62,12 +62,8 @@ haptics:
     cutting: earthmoving
     force_scale: 0.01
     low_speed_damping_n_s_per_m: 80
-    project_width_on_motion: false
     policy: refuse
     contact_drag: {drag_n_per_m: 300, viscous_n_s_per_m2: 2}
-    earthmoving:
-      soil: {preset: clay, cohesion_pa: 5000, internal_friction_deg: 20}
-      rake_angle_deg: 60
     surface: {enabled: false, stiffness_n_per_m: 9000, damping_n_s_per_m: 3}
     device: {max_force_n: 6, max_stiffness_n_per_m: 2000, max_damping_n_s_per_m: 10,
              inherent_damping_n_s_per_m: 2}
@@ -91,17 +87,9 @@ haptics:
   EXPECT_EQ(s.forces.cutting, CuttingModel::kEarthmoving);
   EXPECT_EQ(s.forces.force_scale, 0.01);
   EXPECT_EQ(s.forces.low_speed_damping_n_s_per_m, 80.0);
-  EXPECT_FALSE(s.forces.project_width_on_motion);
   EXPECT_EQ(s.forces.policy, LimitPolicy::kRefuse);
   EXPECT_EQ(s.forces.contact_drag.drag_n_per_m, 300.0);
   EXPECT_EQ(s.forces.contact_drag.viscous_n_s_per_m2, 2.0);
-  // The clay preset with two fields replaced; angles converted to radians.
-  const SoilParams clay = soil_preset(SoilPreset::kClay);
-  EXPECT_EQ(s.forces.earthmoving.soil.unit_weight_n_per_m3, clay.unit_weight_n_per_m3);
-  EXPECT_EQ(s.forces.earthmoving.soil.adhesion_pa, clay.adhesion_pa);
-  EXPECT_EQ(s.forces.earthmoving.soil.cohesion_pa, 5000.0);
-  EXPECT_NEAR(s.forces.earthmoving.soil.internal_friction_rad, 20 * kDeg, 1e-15);
-  EXPECT_NEAR(s.forces.earthmoving.rake_angle_rad, 60 * kDeg, 1e-15);
   EXPECT_FALSE(s.forces.surface_enabled);
   EXPECT_EQ(s.forces.surface.stiffness_n_per_m, 9000.0);
   EXPECT_EQ(s.forces.device.max_force_n, 6.0);
@@ -117,11 +105,23 @@ haptics:
   EXPECT_EQ(s.udp.port, 50001);
 }
 
-TEST(HapticsYaml, SoilPresetByName) {
-  const HapticSettings s = parse("haptics:\n  forces:\n    earthmoving:\n      soil: loose_sand\n");
-  const SoilParams loose = soil_preset(SoilPreset::kLooseSand);
-  EXPECT_EQ(s.forces.earthmoving.soil.cohesion_pa, loose.cohesion_pa);
-  EXPECT_EQ(s.forces.earthmoving.soil.internal_friction_rad, loose.internal_friction_rad);
+// A file of the old layout, where the soil's material and the blade's shape
+// were haptic settings, is refused at the field, naming where it went.
+TEST(HapticsYaml, TheOldLayoutNamesTheNewField) {
+  EXPECT_NE(error_of("haptics:\n  forces:\n    earthmoving:\n      soil: loose_sand\n")
+                .find("test.yaml:4: haptics.forces.earthmoving.soil: moved to the top-level soil: section"),
+            std::string::npos);
+  EXPECT_NE(error_of("haptics:\n  forces:\n    earthmoving:\n      rake_angle_deg: 60\n")
+                .find("haptics.forces.earthmoving.rake_angle_deg: moved to blade.rake_angle_deg"),
+            std::string::npos);
+  EXPECT_NE(error_of("haptics:\n  forces:\n    penetration: {edge_thickness_m: 0.01}\n")
+                .find("moved to blade.edge_thickness_m"),
+            std::string::npos);
+  EXPECT_NE(error_of("haptics:\n  cut_depth: section\n").find("haptics.cut_depth: removed"),
+            std::string::npos);
+  EXPECT_NE(error_of("haptics:\n  forces:\n    project_width_on_motion: false\n")
+                .find("project_width_on_motion: removed"),
+            std::string::npos);
 }
 
 TEST(HapticsYaml, ErrorsNameFileLineAndField) {
@@ -142,8 +142,8 @@ TEST(HapticsYaml, ErrorsNameFileLineAndField) {
       error_of("haptics:\n  device: falcon\n")
           .find("test.yaml:2: haptics.device: unknown value 'falcon'; allowed: script, sim, udp"),
       std::string::npos);
-  EXPECT_NE(error_of("haptics:\n  forces: {earthmoving: {soil: peat}}\n")
-                .find("allowed: dry_sand, loose_sand, clay"),
+  EXPECT_NE(error_of("haptics:\n  forces: {cutting: drag}\n")
+                .find("allowed: none, contact_drag, earthmoving"),
             std::string::npos);
   // Out of range (found by validate), reported at the field's line.
   EXPECT_NE(error_of("haptics:\n  hand:\n    mass_kg: 0.1\n    stiffness_n_per_m: -5\n")
@@ -151,12 +151,10 @@ TEST(HapticsYaml, ErrorsNameFileLineAndField) {
             std::string::npos);
   EXPECT_NE(error_of("haptics:\n  rate_hz: 5\n").find("test.yaml:2: haptics.rate_hz: must be"),
             std::string::npos);
-  // Nested force fields keep their path; radians are named as degrees.
-  EXPECT_NE(
-      error_of("haptics:\n  forces:\n    earthmoving:\n      soil:\n        "
-               "internal_friction_deg: 95\n")
-          .find("test.yaml:5: haptics.forces.earthmoving.soil.internal_friction_deg: must be"),
-      std::string::npos);
+  // Nested force fields keep their path.
+  EXPECT_NE(error_of("haptics:\n  forces:\n    surface:\n      stiffness_n_per_m: -1\n")
+                .find("test.yaml:4: haptics.forces.surface.stiffness_n_per_m: must be"),
+            std::string::npos);
   // safety.max_force_n above the device's maximum.
   EXPECT_NE(error_of("haptics:\n  safety: {max_force_n: 9}\n")
                 .find("haptics.safety.max_force_n: must not exceed forces.device.max_force_n"),
@@ -169,7 +167,7 @@ TEST(HapticsYaml, ErrorsNameFileLineAndField) {
   // A fraction where a whole number is needed.
   EXPECT_NE(error_of("haptics:\n  hand: {substeps: 2.5}\n").find("expected a whole number"),
             std::string::npos);
-  EXPECT_NE(error_of("haptics:\n  forces: {project_width_on_motion: maybe}\n")
+  EXPECT_NE(error_of("haptics:\n  forces: {twist_enabled: maybe}\n")
                 .find("expected true or false"),
             std::string::npos);
 }

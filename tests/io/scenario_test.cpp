@@ -215,8 +215,8 @@ TEST(ScenarioSoil, TheSoilSectionChoosesTheModel) {
   const std::string text = kGood + "soil:\n  model: flow\n  repose_deg: 40\n";
   const Scenario sc = parse_scenario(text, "x.yaml");
   EXPECT_EQ(sc.soil.model, SoilModel::kFlow);
-  EXPECT_EQ(sc.soil.repose_deg, 40.0);
-  EXPECT_EQ(sim_params(sc).soil.repose_deg, 40.0);
+  EXPECT_EQ(sc.soil.material.repose_deg, 40.0);
+  EXPECT_EQ(sim_params(sc).soil.material.repose_deg, 40.0);
   // Errors name the file, the line and the field.
   const std::string zero = replace(text, "repose_deg: 40", "repose_deg: 0");
   expect_error(zero, line_of(zero, "repose_deg: 0"), "soil.repose_deg", "[1, 80]");

@@ -104,7 +104,7 @@ std::vector<std::string> split(const std::string& line) {
 TEST(SoilWarnings, NameAnUnsettledEndAndCellsTooFarFromSquare) {
   SoilFlowParams soil;
   soil.model = SoilModel::kFlow;
-  soil.repose_deg = 34.0;
+  soil.material.repose_deg = 34.0;
   const GridSpec square = grid_of_cells(10, 10, 0.01);
   EXPECT_TRUE(soil_warnings(soil, square, 0).empty());
   // Still active at the end: the count and the cap are named.

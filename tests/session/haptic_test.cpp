@@ -231,7 +231,7 @@ TEST(Session, TheOperatorFeelsTheWeightOfTheBucketsLoad) {
   HapticSession s(sc, o);
   s.run();
   const Simulation& sim = s.loop().simulation();
-  const double unit_weight = s.loop().force_model().params().earthmoving.soil.unit_weight_n_per_m3;
+  const double unit_weight = sim.params().soil.material.unit_weight_n_per_m3;
   const double initial_m3 = 2.0 * 2.0 * 0.3;
   double carry_y = 0.0, carry_xz = 0.0;
   int n = 0;

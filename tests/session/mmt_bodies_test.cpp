@@ -136,8 +136,7 @@ TEST(MmtBodies, BuriedBodiesAreCheckedAgainstTheTerrainWithTheirLine) {
     EXPECT_NE(std::string(e.what()).find("is not under the soil"), std::string::npos) << e.what();
   }
   // Soil that flows is refused with a buried body, by the same line.
-  const std::string flow = test::replace(text, "representation: surface",
-                                         "representation: surface\nsoil:\n  model: flow");
+  const std::string flow = test::replace(text, "soil:\n", "soil:\n  model: flow\n");
   try {
     parse_scenario(flow, file);
     FAIL() << "accepted a buried body in flowing soil";

@@ -35,7 +35,7 @@ Scenario trench_with_remote(const std::string& name, double remote_height_m,
   std::ostringstream h;
   h << "height_m: " << remote_height_m;
   remote = test::replace(remote, "height_m: 0.3", h.str());
-  remote = test::replace(remote, "soil: dry_sand", "soil: " + remote_soil);
+  remote = test::replace(remote, "preset: dry_sand", "preset: " + remote_soil);
   std::ofstream(dir / "remote.yaml") << remote;
   Scenario sc = load_scenario(kTrench);
   sc.mmt->remote_scenario = dir / "remote.yaml";
@@ -135,11 +135,13 @@ TEST(Mmt, ForceStepAtUpdatesStaysUnderTheBound) {
   EXPECT_LE(s.max_update_step_n, 0.005 + 1e-12);
   // The bound held and still the factor got where it was going.
   EXPECT_NEAR(s.force_scale_applied, s.force_scale_final, 1e-9);
-  // Without the bound, the same updates step the force by more.
+  // Without the bound, the same updates step the force by more (by less
+  // than the factor's change alone would: where the low-speed damper caps
+  // the rendered force, the factor under it changes nothing).
   sc.mmt->max_update_step_n = 100.0;
   MmtRun unbounded(sc);
   unbounded.run();
-  EXPECT_GT(unbounded.summary().max_update_step_n, 10 * 0.005);
+  EXPECT_GT(unbounded.summary().max_update_step_n, 2 * 0.005);
 }
 
 TEST(Mmt, DirectReflectionFailsWithDelayMmtHolds) {
@@ -160,13 +162,12 @@ TEST(Mmt, DirectReflectionFailsWithDelayMmtHolds) {
 
 TEST(Mmt, TheSoilEstimateDoesNotDependOnTheToolsSpeed) {
   // The trench cut at its speed (1 m/s along the drag) and at half of it:
-  // below H / c the low-speed cap (500 N s/m) holds both worlds' force at
-  // c |v| whatever the soil, at 8 cm even at 1 m/s for the clay (527 N),
-  // and at half speed for the sand too. The estimate takes its samples only
-  // where the soil sets the force, so both runs find the same factor, the
-  // clay's over the sand's where the cut is shallow enough for the soil to
-  // show (at least their ratio at the full 8 cm, 1.19); fitted to the
-  // capped samples it read 1.12 at speed and about 1 at half speed.
+  // below H / c the low-speed cap (500 N s/m) holds both worlds' rendered
+  // force at c |v| whatever the soil. The estimate reads the remote's
+  // physical force, which no cap touches, so both runs find the same
+  // factor: the clay's over the sand's (at least their ratio at the full
+  // 8 cm). Fitted to the capped force it read 1.12 at speed and about 1 at
+  // half speed.
   Scenario slow = load_scenario(kTrench);
   for (Motion& cut : slow.base.cuts)
     for (Keyframe& k : cut.keyframes)
@@ -182,8 +183,8 @@ TEST(Mmt, TheSoilEstimateDoesNotDependOnTheToolsSpeed) {
                             earthmoving_force(sand, 0.4, 0.08).horizontal_n;
   EXPECT_GT(a.force_scale_final, 0.98 * full_depth);
   EXPECT_NEAR(b.force_scale_final, a.force_scale_final, 0.05 * a.force_scale_final);
-  EXPECT_GT(a.estimate_capped, a.estimate_samples);  // most of the drag is capped
-  EXPECT_GT(b.estimate_capped, a.estimate_capped);
+  EXPECT_EQ(a.estimate_capped, 0);  // the physical force is never capped
+  EXPECT_EQ(b.estimate_capped, 0);
   // The operator's force follows the remote's where the cap holds both:
   // the factor scales the soil's force under the cap, not the cap.
   EXPECT_LT(b.force_error_rms_mmt_n, 0.2 * b.force_rms_remote_n);
@@ -209,7 +210,7 @@ struct Pair {
         device(make_operator_device(sc)),
         link(settings.to_remote, settings.to_operator),
         op(sc, settings, *device, link.a(), 1u),
-        remote(remote_sc, settings, op.rig().loop().force_model(), op.simulation().grid(),
+        remote(remote_sc, settings, sc.base.soil.material, op.simulation().grid(),
                link.b(), 2u) {}
   MmtSettings settings;
   Scenario remote_sc;

@@ -64,6 +64,7 @@ import json, sys
 work = sys.argv[1]
 op = json.load(open(f"{work}/operator/summary.json"))
 rm = json.load(open(f"{work}/remote/summary.json"))
+single = json.load(open(f"{work}/single/summary.json"))
 ok = True
 def check(cond, what):
     global ok
@@ -78,7 +79,11 @@ check(op["estimates"] >= 1, f"operator applied {op['estimates']} estimates")
 check(op["rejected"]["reordered"] > 0, "no reordered measurement was rejected")
 check(op["traffic"]["emulated_losses"] > 0, "no loss was emulated operator -> remote")
 check(rm["peer_sessions"] == 1 and rm["connections"] == 1, "one operator session")
-check(abs(rm["force_scale"] - 1.0) > 0.02, f"remote estimate {rm['force_scale']}")
+# The remote's estimate of its soil, from its physical force, as the one-process
+# run finds it (the same cut; the two-process run's tool lags in real time).
+check(rm["estimate"]["samples"] > 500, f"remote estimate from {rm['estimate']['samples']} samples")
+one = single["estimate"]["force_scale"]
+check(abs(rm["force_scale"] - one) < 0.05 * one, f"remote estimate {rm['force_scale']}, one process {one}")
 rows = open(f"{work}/operator/operator.csv").read().splitlines()
 check(len(rows) > 3000, f"operator.csv has {len(rows)} rows")
 rows = open(f"{work}/remote/remote.csv").read().splitlines()

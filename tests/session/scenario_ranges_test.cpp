@@ -33,7 +33,7 @@ namespace {
 // Every section whose fields have a range, with a mound terrain...
 constexpr const char* kMound = R"(
 rate_hz: 100
-blade: {length_m: 0.5, bucket: {depth_m: 0.2, height_m: 0.1}}
+blade: {length_m: 0.5, rake_angle_deg: 60, edge_thickness_m: 0.02, bucket: {depth_m: 0.2, height_m: 0.1}}
 terrain:
   generator: mound
   resolution: 12
@@ -45,7 +45,9 @@ cuts:
     keyframes:
       - {t_s: 0.0, position_m: [0.1, 0.2, 0.4]}
       - {t_s: 1.0, position_m: [1.1, 0.2, 0.4]}
-soil: {model: flow, repose_deg: 30, max_pair_checks_per_step: 100000}
+soil: {model: flow, preset: dry_sand, unit_weight_n_per_m3: 16000, cohesion_pa: 0, adhesion_pa: 0,
+       internal_friction_deg: 30, soil_tool_friction_deg: 20, repose_deg: 30,
+       max_pair_checks_per_step: 100000}
 reference: {mound: {centre_m: [0.6, 0.4], radius_m: 0.35, height_m: 0.3}}
 haptics:
   rate_hz: 10000
@@ -56,12 +58,7 @@ haptics:
   forces:
     force_scale: 0.02
     low_speed_damping_n_s_per_m: 60
-    penetration: {edge_thickness_m: 0.02}
     contact_drag: {drag_n_per_m: 400, viscous_n_s_per_m2: 0}
-    earthmoving:
-      soil: {preset: dry_sand, unit_weight_n_per_m3: 16000, cohesion_pa: 0, adhesion_pa: 0,
-             internal_friction_deg: 30, soil_tool_friction_deg: 20, surcharge_pa: 0}
-      rake_angle_deg: 60
     surface: {stiffness_n_per_m: 10000, damping_n_s_per_m: 1}
     device: {max_force_n: 8, max_stiffness_n_per_m: 3000, max_damping_n_s_per_m: 20,
              inherent_damping_n_s_per_m: 1.5}
@@ -85,8 +82,10 @@ mmt:
   udp: {port: 47100}
   link_id: 1234
 )";
-// ...and a plane terrain, for the plane's own fields.
+// ...and a plane terrain, for the plane's own fields (and the soil's
+// density, which the mound's soil gives as a unit weight: not both).
 constexpr const char* kPlane = R"(
+soil: {density_kg_per_m3: 1650}
 blade: {length_m: 0.5}
 terrain:
   generator: plane
@@ -247,22 +246,24 @@ TEST(ScenarioRanges, TheTableCoversEverySectionAndTheBasesHoldEveryPath) {
                          [&](const Range& r) { return r.path.starts_with(prefix); });
   };
   EXPECT_EQ(count("haptics.forces."), std::ssize(force_ranges()));
+  EXPECT_EQ(count("soil.") - 1, std::ssize(material_ranges()));  // and the flow's work cap
   EXPECT_EQ(count("haptics.safety."), std::ssize(safety_ranges()));
   EXPECT_EQ(count("bodies[]."), std::ssize(body_ranges()));
   EXPECT_EQ(count("mmt."), std::ssize(mmt_ranges()) + std::ssize(net::link_ranges()));
   EXPECT_EQ(std::ssize(scenario_ranges()),
-            std::ssize(io::scenario_ranges()) + std::ssize(haptics::haptic_settings_ranges()) +
+            std::ssize(io::scenario_ranges()) + std::ssize(material_ranges()) +
+                std::ssize(haptics::haptic_settings_ranges()) +
                 std::ssize(force_ranges()) + std::ssize(safety_ranges()) +
                 std::ssize(body_ranges()) + std::ssize(mmt_ranges()) +
                 std::ssize(net::link_ranges()));
 }
 
-// An angle is radians in its struct and degrees in the file.
+// Angles are degrees in the file and in the soil's material record.
 TEST(ScenarioRanges, AnglesAreInDegreesInTheFile) {
-  const Range& phi = find_range(scenario_ranges(), "haptics.forces.earthmoving.soil.internal_friction_deg");
+  const Range& phi = find_range(scenario_ranges(), "soil.internal_friction_deg");
   EXPECT_NEAR(phi.hi, 90.0, 1e-12);
-  EXPECT_THROW(find_range(scenario_ranges(), "haptics.forces.earthmoving.soil.internal_friction_rad"),
-               std::logic_error);
+  EXPECT_NEAR(find_range(scenario_ranges(), "blade.rake_angle_deg").hi, 180.0, 1e-12);
+  EXPECT_THROW(find_range(scenario_ranges(), "soil.internal_friction_rad"), std::logic_error);
 }
 
 // The table as docs/scenario-format.md shows it.

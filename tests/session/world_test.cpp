@@ -1,6 +1,6 @@
 // The world a run builds from a scenario (session::World): the piles of
-// soil that flows press on the bodies with the scenario's own soil, the
-// unit weight the earthmoving force uses (haptics.forces.earthmoving.soil).
+// soil that flows press on the bodies with the scenario's own soil material
+// (soil:), the one every force reads.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -26,9 +26,10 @@ std::string rock_push_text() { return test::read_text(kRockPush); }
 
 #ifdef TERRACUT_HAVE_BULLET
 // The unit weight the piles of scenarios/rock_push.yaml (soil: flow, a rock)
-// press with when its earthmoving soil is `soil`.
-double pile_unit_weight(const std::string& soil) {
-  const std::string text = test::replace(rock_push_text(), "soil: dry_sand", "soil: " + soil);
+// press with when its soil material is `material` (the soil: section's
+// preset line replaced).
+double pile_unit_weight(const std::string& material) {
+  const std::string text = test::replace(rock_push_text(), "preset: dry_sand", material);
   const World world(parse_scenario(text, kRockPush));
   EXPECT_NE(world.bodies_listener(), nullptr);
   const bullet::PilePressureSpec& pile = world.bodies_listener()->world().params().pile;
@@ -37,9 +38,9 @@ double pile_unit_weight(const std::string& soil) {
 }
 
 TEST(World, PilesPressWithTheScenariosSoilUnitWeight) {
-  EXPECT_EQ(pile_unit_weight("dry_sand"), soil_preset(SoilPreset::kDrySand).unit_weight_n_per_m3);
-  EXPECT_EQ(pile_unit_weight("clay"), soil_preset(SoilPreset::kClay).unit_weight_n_per_m3);
-  EXPECT_EQ(pile_unit_weight("{preset: dry_sand, unit_weight_n_per_m3: 18000}"), 18000.0);
+  EXPECT_EQ(pile_unit_weight("preset: dry_sand"), soil_preset(SoilPreset::kDrySand).unit_weight_n_per_m3);
+  EXPECT_EQ(pile_unit_weight("preset: clay"), soil_preset(SoilPreset::kClay).unit_weight_n_per_m3);
+  EXPECT_EQ(pile_unit_weight("unit_weight_n_per_m3: 18000"), 18000.0);
 }
 #endif
 

@@ -492,7 +492,7 @@ int run_mmt_soak(const MmtSoakOptions& o) {
   session::RemoteOptions remote_options;
   remote_options.keep_records = false;
   session::OperatorStation operator_station(op, s, checker, op_side, 1u, op_options);
-  session::RemoteStation remote_station(remote_scn, s, operator_station.rig().loop().force_model(),
+  session::RemoteStation remote_station(remote_scn, s, op.base.soil.material,
                                         operator_station.simulation().grid(), remote_side, 2u,
                                         remote_options);
 

@@ -96,9 +96,9 @@ struct ToolPlateSpec {
 struct PilePressureSpec {
   bool enabled = false;                   ///< false: no earth pressure (soil that vanishes)
   /// gamma: unit weight of the piled soil, N/m^3, in (0, 1e9] (the range of
-  /// SoilParams::unit_weight_n_per_m3). Default: dry sand, as SoilParams'
-  /// dry_sand preset (Das). A scenario's run sets it from the scenario's
-  /// soil, haptics.forces.earthmoving.soil (session::World).
+  /// SoilMaterial::unit_weight_n_per_m3). Default: dry sand, as SoilMaterial's
+  /// dry_sand preset (Das). BodiesListener sets it from the simulation's
+  /// soil material.
   double unit_weight_n_per_m3 = 16.25e3;
   /// phi: friction angle of the piled (loose) soil, degrees, in (0, 80]; a
   /// loose cohesionless pile's is about its angle of repose.

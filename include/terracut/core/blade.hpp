@@ -29,6 +29,15 @@ struct BucketSpec {
 /// Blade parameters; read-only during a run.
 struct BladeSpec {
   double length_m = 1.0;  ///< length of the cutting edge, metres, > 0
+  /// Rake angle of the blade's face from the horizontal, degrees, in
+  /// (0, 180): 90 is a vertical plate; below 90 the edge leads and the face
+  /// leans back over the soil it lifts. The cutting force's alpha
+  /// (earthmoving.hpp); the cut itself is the edge's sweep whatever the rake.
+  double rake_angle_deg = 90.0;
+  /// Thickness of the cutting edge, metres, > 0: the width of the strip the
+  /// soil bears under it when it is pushed down (penetration.hpp). A 2 cm
+  /// steel cutting edge by default.
+  double edge_thickness_m = 0.02;
   BucketSpec bucket{};    ///< a bucket behind the edge (soil model flow only)
 };
 

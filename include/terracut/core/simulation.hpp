@@ -7,10 +7,12 @@
 //      contact that caused it.
 //   2. finish_step(): the region the edge swept since the previous pose is
 //      cut; with SoilModel::kFlow the cut soil is put down ahead of the
-//      blade and slopes relax to the angle of repose (soil.hpp); then every
+//      blade and slopes relax to the angle of repose (soil.hpp); the soil's
+//      physical force on the tool is computed from the terrain it leaves
+//      and the tool's motion over the step (tool_force.hpp); then every
 //      StepListener added (step_listener.hpp: the rigid-body
 //      world, recorders, ...) sees the step's output and the rectangle it
-//      changed, and may put a force on the tool.
+//      changed, and may put a force on the tool, which joins the force.
 // step(pose) does both. A step allocates nothing (nor may its listeners).
 #pragma once
 
@@ -23,6 +25,7 @@
 #include "terracut/core/cut.hpp"
 #include "terracut/core/soil.hpp"
 #include "terracut/core/step_listener.hpp"
+#include "terracut/core/tool_force.hpp"
 
 namespace terracut {
 
@@ -36,7 +39,9 @@ struct SimParams {
   /// more than this fraction of a cell is split into sub-steps (slerp), so a
   /// fast rotation still sweeps its true arc. In (0, 1].
   double max_arc_error_cells = 0.25;
-  /// What happens to the soil the blade cuts (soil.hpp); kVanish by default.
+  /// The soil (the scenario's `soil:` section): its material, which every
+  /// force and the flow read, and what happens to what the blade cuts
+  /// (soil.hpp); kVanish by default.
   SoilFlowParams soil{};
 };
 
@@ -48,6 +53,7 @@ struct StepTimers {
   double contact_s = 0.0;
   double cut_s = 0.0;
   double soil_s = 0.0;       ///< displacement and relaxation (kFlow)
+  double force_s = 0.0;      ///< the physical force on the tool (tool_force.hpp)
   double listeners_s = 0.0;  ///< all step listeners together (e.g. the Bullet world)
   double total_s = 0.0;
 };
@@ -69,6 +75,15 @@ struct StepOutput {
   /// Sum of the step listeners' forces on the tool (StepListener::on_step),
   /// world N; zero without listeners.
   Vec3 listener_force_world_n{};
+  /// The tool's motion over the step, from the previous pose to this one
+  /// (zero at the first step of a stroke, after lift()).
+  ToolMotion motion{};
+  /// The physical force on the tool, world N, with its parts
+  /// (tool_force.hpp): the soil's, from the terrain after the cut and the
+  /// soil phase and the motion above, and the listeners' (force.bodies_n,
+  /// filled after they ran; total_n includes it). Nothing a haptic device
+  /// renders changes it.
+  ToolForce force{};
   StepTimers timers{};
 };
 
@@ -150,6 +165,12 @@ class Simulation {
   double begin_clock_s_ = 0.0;
   std::vector<StepListener*> listeners_;
   std::unique_ptr<SoilFlow> soil_;  // kFlow only
+  ToolForceParams tool_params_{};   // derived from params_ once
+  double lookahead_m_ = 0.0;        // where the soil ahead is read (depth_lookahead_m)
+  Vec3 previous_velocity_m_per_s_{};
+  bool has_previous_velocity_ = false;
+  bool velocity_valid_ = false;  // this step's motion came from a previous pose
+  Vec3 heading_{};               // the stroke's latest horizontal direction of motion
 };
 
 }  // namespace terracut

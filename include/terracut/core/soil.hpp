@@ -100,6 +100,7 @@
 
 #include "terracut/core/blade.hpp"
 #include "terracut/core/grid.hpp"
+#include "terracut/core/material.hpp"
 
 namespace terracut {
 
@@ -189,13 +190,15 @@ enum class SoilEdge {
 /// "wall" or "open".
 std::string_view to_string(SoilEdge edge);
 
-/// Soil parameters; read-only during a run.
+/// The soil: its material and what happens to what the blade cuts (the
+/// scenario's `soil:` section); read-only during a run.
 struct SoilFlowParams {
   SoilModel model = SoilModel::kVanish;
-  /// Angle of repose (the stopping angle of a flowing slope), degrees, in
-  /// [1, 80]. Dry sand about 34, wet sand about 45, saturated 15-30
-  /// (Al-Hashemi & Al-Amoudi, Powder Technology 330 (2018) 397).
-  double repose_deg = 34.0;
+  /// The soil's material (material.hpp): the flow relaxes slopes to its
+  /// angle of repose (the stopping angle of a flowing slope: dry sand about
+  /// 34 degrees, wet sand about 45, saturated 15-30; Al-Hashemi &
+  /// Al-Amoudi, Powder Technology 330 (2018) 397); the forces read the rest.
+  SoilMaterial material{};
   /// Work cap of one step's relaxation, in neighbour visits, in
   /// [1000, 1e9]: 8 per cell examined, 1 per flux applied, 8 per fallen
   /// cell's test of its neighbours. A step never does more; the rest is

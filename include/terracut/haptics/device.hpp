@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "terracut/core/blade.hpp"
 #include "terracut/core/math.hpp"
 
 namespace terracut::haptics {
@@ -28,6 +29,16 @@ struct DeviceSample {
   /// The device reconnected with this sample (a new bridge session): the
   /// loop begins a new soft start.
   bool reconnected = false;
+  /// The tool was lifted out of the soil before this sample (between two
+  /// strokes of a scripted sequence): nothing is swept from the previous
+  /// pose, as a batch run lifts it between cuts (Simulation::lift).
+  bool lifted = false;
+  /// A scripted device knows the world pose its handle stands for: the loop
+  /// takes it as it is instead of mapping the handle through the workspace
+  /// (whose round trip rounds), so a scripted session steps exactly the
+  /// poses a batch run steps. Real devices leave it unset.
+  bool has_world_pose = false;
+  BladePose world_pose{};
   /// When the device measured the sample on its own clock, seconds (any
   /// origin, never going back within a session); NaN when the device does
   /// not say. The loop estimates the velocity from these times when it has

@@ -14,7 +14,7 @@ inline constexpr const char* kHapticsCsvColumns =
     "t,tick,dev_x,dev_y,dev_z,tool_x,tool_y,tool_z,qw,qx,qy,qz,contact_length,cut_depth,"
     "removed_volume,vel_x,vel_y,vel_z,fw_x,fw_y,fw_z,fb_x,fb_y,fb_z,fd_x,fd_y,fd_z,clamped,"
     "rate_limited,watchdog,ramping,nonfinite,bad_sample,silent,missed_deadline,period,compute,"
-    "f_penetration,twist_torque,yaw_rate";
+    "f_penetration,twist_torque,yaw_rate,fp_x,fp_y,fp_z";
 
 /// Writes records as haptics.csv text (kHapticsCsvColumns, then one row per record).
 void write_haptics_csv(std::ostream& out, const std::vector<LoopRecord>& records);

@@ -2,9 +2,10 @@
 //
 //   step1: read the device -> map its workspace to the world -> set the tool
 //          pose -> Simulation::begin_step (contact before the cut)
-//   step2: Simulation::finish_step (swept cut, then the simulation's step
-//          listeners: e.g. rigid bodies, whose force on the tool joins the
-//          force) -> ForceModel::compute (+ the listeners' force) ->
+//   step2: Simulation::finish_step (swept cut, soil, the physical force on
+//          the tool, then the simulation's step listeners: e.g. rigid
+//          bodies, whose force joins it) -> ForceModel::compute (the
+//          physical force rendered at the device's filtered motion) ->
 //          SafetyLimiter::update -> map the force to the device -> write ->
 //          record -> feed the snapshot exchange (optional)
 //
@@ -62,6 +63,9 @@ inline constexpr std::uint32_t kFlagSilent = 64u;
 inline constexpr std::uint32_t kFlagMissedDeadline = 128u;
 /// The device reconnected this tick (a new soft start began).
 inline constexpr std::uint32_t kFlagReconnected = 256u;
+/// The device's sample starts a new stroke (DeviceSample::lifted): the
+/// simulation was lifted, nothing swept from the previous pose.
+inline constexpr std::uint32_t kFlagLifted = 512u;
 
 /// One tick, as recorded (one row of haptics.csv).
 struct LoopRecord {
@@ -70,11 +74,15 @@ struct LoopRecord {
   Vec3 device_position_m{};       ///< device handle, device frame, metres (last good sample)
   BladePose tool{};               ///< tool pose, world
   double contact_length_m = 0.0;  ///< blade length in soil, metres (before the cut)
-  double cut_depth_m = 0.0;  ///< depth given to the earthmoving model, metres (0 without contact)
+  double cut_depth_m = 0.0;  ///< depth of undisturbed soil ahead of the edge (the physical force's), metres
   double removed_volume_m3 = 0.0;  ///< volume cut this tick, m^3
   Vec3 velocity_m_per_s{};         ///< estimated tool velocity, world m/s
-  /// World force on the tool, world N: the force models' (cutting + surface)
-  /// plus the step listeners' (body_force_world_n).
+  /// The physical force on the tool, world N (StepOutput::force.total_n):
+  /// what the soil and the bodies do, whatever the device renders.
+  Vec3 physical_force_world_n{};
+  /// The rendered force in world newtons, before force_scale: the physical
+  /// force under the device's low-speed damper and gain, plus the surface
+  /// proxy (ForceOutput::world_n); the step listeners' part is body_force_world_n.
   Vec3 force_world_n{};
   /// The step listeners' part of force_world_n (e.g. rigid bodies pushing
   /// the blade's plate: StepOutput::listener_force_world_n), world N; zero
@@ -265,16 +273,8 @@ class HapticLoop {
   BladePose tool_pose() const noexcept;
   void estimate_velocity(const BladePose& pose, double t_s) noexcept;
   // step2's phases.
-  /// What the earthmoving model is given: the depth of cut, m, and the
-  /// surcharge of a pile ahead, Pa (soil flow only; 0 otherwise).
-  struct CutLoad {
-    double depth_m = 0.0;
-    double surcharge_pa = 0.0;
-    double width_m = -1.0;  // the edge length with soil ahead; negative: the contact length
-  };
-  CutLoad cut_load(const StepOutput& out) const noexcept;
-  ForceOutput world_force(const StepOutput& out, const CutLoad& load) const noexcept;
-  LoopRecord& write_record(const StepOutput& out, const ForceOutput& force, double cut_depth_m,
+  ForceOutput rendered_force(const StepOutput& out) const noexcept;
+  LoopRecord& write_record(const StepOutput& out, const ForceOutput& force,
                            const DeviceCommand& command, double period_s,
                            double compute_s) noexcept;
   void publish_frame(const StepOutput& out, const ForceOutput& force,
@@ -292,7 +292,6 @@ class HapticLoop {
   Quat fixed_orientation_{};
   bool has_fixed_orientation_ = false;
   double filter_rc_s_ = 0.0;  // low-pass time constant, 0 = off
-  double lookahead_m_ = 0.0;  // depth_lookahead_m of the grid
 
   // State.
   bool started_ = false;

@@ -75,20 +75,6 @@ enum class SurfaceReference {
 std::string_view to_string(SurfaceReference reference);
 std::optional<SurfaceReference> parse_surface_reference(std::string_view name);
 
-/// How the loop measures the cut depth d given to the earthmoving model.
-enum class CutDepthMeasure {
-  /// The material depth ahead of the edge along its horizontal motion
-  /// (terracut/haptics/cut_depth.hpp): steady for a steady cut. The default.
-  kAhead,
-  /// ContactResult::section_area_m2 / length_m at the edge. On the surface
-  /// representation it falls to nearly zero once per cell crossed (the
-  /// samples behind the edge are already cut): a sawtooth force.
-  kSection,
-};
-/// "ahead" or "section".
-std::string_view to_string(CutDepthMeasure measure);
-std::optional<CutDepthMeasure> parse_cut_depth_measure(std::string_view name);
-
 /// The simulated operator hand of the `sim` device: a point mass held by the
 /// device, pulled by a spring-damper toward a target that moves along the
 /// cut's path; the rendered force acts on it. Device units and frame.
@@ -142,8 +128,8 @@ struct HapticSettings {
   /// Hz, finite, >= 0 and below rate_hz / 2; 0 disables the filter.
   double velocity_cutoff_hz = 100.0;
   SurfaceReference surface_reference = SurfaceReference::kGround;
-  CutDepthMeasure cut_depth = CutDepthMeasure::kAhead;
-  /// Force models and device limits. forces.workspace_scale and
+  /// The rendering of the physical force on the device, and the device's
+  /// limits (core/forces.hpp). forces.workspace_scale and
   /// forces.loop_rate_hz are derived (from workspace.scale and rate_hz) and
   /// forces.max_contact_length_m from the blade length when the loop is built.
   ForceModelParams forces{};

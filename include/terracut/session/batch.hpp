@@ -5,6 +5,9 @@
 //   contact.csv   one row per step (io/recording.hpp):
 //                 t,cut,x,y,z,qw,qx,qy,qz,contact_length,removed_volume,
 //                 section_area,max_depth,cells_visited
+//   force.csv     one row per step: t,cut and the physical force on the tool
+//                 (force_columns(): the total and its parts, world N, and
+//                 what it was computed from)
 //   height.npy    float32 (rows, cols) final heights, metres
 //   removed.npy   float32 (rows, cols) removed material, metres
 //   height.png    16-bit grey, pixel = height / full_scale_m
@@ -25,6 +28,7 @@
 #include <filesystem>
 #include <iosfwd>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -38,8 +42,32 @@ namespace terracut::session {
 /// The file names every run writes into the output folder, in writing order
 /// (summary.json last, so its presence means the run completed). A run with
 /// bodies also writes bodies.csv.
-inline constexpr const char* kRunOutputFiles[] = {"contact.csv", "height.npy", "removed.npy",
-                                                  "height.png",  "removed.png", "summary.json"};
+inline constexpr const char* kRunOutputFiles[] = {"contact.csv", "force.csv",   "height.npy",
+                                                  "removed.npy", "height.png",  "removed.png",
+                                                  "summary.json"};
+
+/// One column of the per-step physical force (StepOutput::force): its name
+/// in force.csv and in Python's step columns, its unit, and how it is read.
+struct ForceColumn {
+  const char* name;
+  const char* unit;
+  double (*get)(const StepOutput& out);
+};
+/// The force columns, in order: fx, fy, fz (the total, world N), the parts
+/// (cutting_*, surcharge_*, penetration_y, twist_x, twist_z, twist_torque,
+/// load_*, bodies_*), the cut it was computed from (cut_depth, cut_width,
+/// pile_height, m) and the tool's velocity over the step (vx, vy, vz, m/s).
+std::span<const ForceColumn> force_columns();
+
+/// A cut's physical force over its steps (StepOutput::force.total_n).
+struct CutForceStats {
+  Vec3 mean_n{};                  ///< mean force vector, world N
+  double mean_horizontal_n = 0.0;  ///< mean |horizontal part|, N
+  double peak_horizontal_n = 0.0;  ///< largest |horizontal part|, N
+  double mean_vertical_n = 0.0;    ///< mean vertical part (+ up), N
+  double peak_vertical_n = 0.0;    ///< the vertical part of largest magnitude (signed), N
+  double mean_surcharge_horizontal_n = 0.0;  ///< mean |horizontal| of the pile's part, N
+};
 
 /// How to run.
 struct RunOptions {
@@ -72,6 +100,7 @@ struct CutStats {
   double peak_contact_m = 0.0;     ///< largest contact length, metres
   double mean_contact_m = 0.0;     ///< mean contact length over its steps, metres
   double removed_volume_m3 = 0.0;  ///< volume it cut, m^3
+  CutForceStats force{};           ///< the physical force on the tool
 };
 
 /// What the soil phase did over a run (SoilModel::kFlow).

@@ -26,10 +26,29 @@
 #include "terracut/haptics/settings.hpp"
 #include "terracut/haptics/device.hpp"
 #include "terracut/haptics/loop.hpp"
+#include "terracut/haptics/script_device.hpp"
 #include "terracut/session/scenario.hpp"
 #include "terracut/session/world.hpp"
 
 namespace terracut::session {
+
+/// The path a scripted or simulated device follows (`terracut haptics`, the
+/// MMT operator): the cut named by haptics.cut, or else every cut of the
+/// scenario's sequence, played as `terracut run` steps them (the tool
+/// lifted between them) by the script device; the sim hand, a hand that
+/// cannot jump between strokes, follows only the first. source: the name
+/// errors give. Throws InputError "SOURCE: haptics.cut: ..." when the cut
+/// named is not in the scenario or the scenario has none.
+haptics::DevicePath followed_path(const Scenario& scenario, const haptics::HapticSettings& settings,
+                                  const std::string& source);
+
+/// The device of settings.device over the scenario (the one factory every
+/// program uses): script or sim along followed_path, or the UDP bridge at
+/// settings.udp (udp_port: the port to bind, 0 for any free one). Throws
+/// InputError as followed_path.
+std::unique_ptr<haptics::Device> make_device(const Scenario& scenario,
+                                             const haptics::HapticSettings& settings, int udp_port,
+                                             const std::string& source);
 
 /// How a rig is built.
 struct RigOptions {

@@ -107,11 +107,11 @@ struct RemoteOptions {
 class RemoteStation {
  public:
   /// remote: the remote world (load_remote_scenario); nominal: the
-  /// operator's force model (the soil estimate is against it); mirror: the
+  /// operator's soil material (the soil estimate is against it); mirror: the
   /// operator's initial heights (what the deadband compares against).
   /// Throws InputError naming the field.
   RemoteStation(const Scenario& remote, const MmtSettings& settings,
-                const ForceModel& nominal, const HeightGrid& operator_initial,
+                const SoilMaterial& nominal, const HeightGrid& operator_initial,
                 net::Endpoint& link, std::uint32_t session, const RemoteOptions& options = {});
   ~RemoteStation();
   /// One tick at station time t_s. Allocates nothing in steady state once
@@ -148,7 +148,7 @@ class RemoteStation {
   Rect window_around(Vec3 p) const;
 
   MmtSettings settings_;
-  ForceModel nominal_;
+  EarthmovingParams nominal_;  // the operator's material, with the remote's blade
   net::Endpoint& link_;
   std::uint32_t session_;
   std::unique_ptr<FollowerDevice> device_;

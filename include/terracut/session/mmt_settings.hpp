@@ -20,7 +20,7 @@ struct MmtSettings {
   /// The remote world: a scenario file (resolved against the operator's
   /// scenario's folder); empty: the operator's own scenario.
   std::filesystem::path remote_scenario;
-  /// Replaces the remote's haptics.forces.earthmoving.soil when given.
+  /// Replaces the remote's soil material (its scenario's soil:) when given.
   std::optional<SoilPreset> remote_soil;
   /// Largest speed of the remote tool following the commands, m/s, (0, 100].
   double follower_speed_m_per_s = 1.5;

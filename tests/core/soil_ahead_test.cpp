@@ -1,14 +1,16 @@
-// The depth of cut and the pile ahead of a moving edge (cut_depth.hpp): the
+// The depth of cut and the pile ahead of a moving edge (soil_ahead.hpp): the
 // depth reads the uncut soil ahead, a pile pushed by the blade counts as a
 // surcharge height, not as depth.
-#include "terracut/haptics/cut_depth.hpp"
+#include "terracut/core/soil_ahead.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-namespace terracut::haptics {
+#include "terracut/core/surface.hpp"
+
+namespace terracut {
 namespace {
 
 TEST(CutDepth, WithoutAPileTheDepthIsTheDepthAhead) {
@@ -17,9 +19,54 @@ TEST(CutDepth, WithoutAPileTheDepthIsTheDepthAhead) {
   const Vec3 v{0.0, 0.0, 0.5};
   const double look = depth_lookahead_m(g.spec());
   const SoilAhead a = soil_ahead(g, Representation::kSurface, edge, v, look);
-  EXPECT_NEAR(a.depth_m, depth_ahead_m(g, Representation::kSurface, edge, v, look), 1e-12);
   EXPECT_NEAR(a.depth_m, 0.05, 1e-6);
+  EXPECT_NEAR(a.width_m, 0.4, 1e-9);
   EXPECT_EQ(a.pile_m, 0.0);
+}
+
+// Parts at different depths sum as one uniform cut with the same section
+// (sum of d) and the same sum of d^2: an edge tilted across a flat layer,
+// its depth falling linearly from 0.1 m at one end to 0 at the other.
+TEST(CutDepth, PartsOfDifferentDepthsSumAsTheSameSectionAndWeight) {
+  HeightGrid g(grid_of_cells(100, 100, 0.01), std::vector<float>(100 * 100, 0.2f));
+  const Segment edge{{0.3, 0.1, 0.4}, {0.7, 0.2, 0.4}};
+  const double look = depth_lookahead_m(g.spec());
+  const SoilAhead a = soil_ahead(g, Representation::kSurface, edge, {0.0, 0.0, 1.0}, look);
+  // n = ceil(L / cell) parts of length L / n, depth 0.1 (1 - (i + 0.5) / n) each.
+  const int n = int(std::ceil(length(edge.b - edge.a) / 0.01));
+  const double part = length(edge.b - edge.a) / n;
+  double s1 = 0.0, s2 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double d = 0.1 * (1.0 - (i + 0.5) / n);
+    s1 += d;
+    s2 += d * d;
+  }
+  EXPECT_NEAR(a.depth_m, s2 / s1, 1e-6);
+  EXPECT_NEAR(a.width_m, part * s1 * s1 / s2, 1e-6);
+  EXPECT_NEAR(a.width_m * a.depth_m, part * s1, 1e-7);              // the section
+  EXPECT_NEAR(a.width_m * a.depth_m * a.depth_m, part * s2, 1e-8);  // the weight's d^2 w
+}
+
+// A part coming into the soil at zero depth changes the cut continuously:
+// an edge lowered through the surface by tiny steps never jumps.
+TEST(CutDepth, TheCutIsContinuousAsPartsEnterTheSoil) {
+  HeightGrid g(grid_of_cells(100, 100, 0.01), std::vector<float>(100 * 100, 0.2f));
+  const double look = depth_lookahead_m(g.spec());
+  double previous_section = 0.0, previous_weight = 0.0;
+  // A tilted edge whose low end enters at y = 0.2 first.
+  for (int k = 0; k <= 200; ++k) {
+    const double y = 0.21 - 1e-4 * k;
+    const Segment edge{{0.3, y, 0.4}, {0.7, y + 0.02, 0.4}};
+    const SoilAhead a = soil_ahead(g, Representation::kSurface, edge, {0.0, 0.0, 1.0}, look);
+    const double section = a.width_m * a.depth_m, weight = section * a.depth_m;
+    // Each step lowers every part by 1e-4 m: the section grows by at most
+    // that over the whole edge, the weight by at most 2 d 1e-4 over it.
+    EXPECT_LE(section - previous_section, 0.4 * 1e-4 * 1.0001) << k;
+    EXPECT_LE(weight - previous_weight, 0.4 * 2.0 * 0.02 * 1e-4 * 1.0001 + 1e-12) << k;
+    EXPECT_GE(section, previous_section);
+    previous_section = section;
+    previous_weight = weight;
+  }
 }
 
 TEST(CutDepth, APileAheadIsNotDepthButSurchargeHeight) {
@@ -38,8 +85,8 @@ TEST(CutDepth, APileAheadIsNotDepthButSurchargeHeight) {
   const SoilAhead a = soil_ahead(g, Representation::kSurface, edge, v, look);
   EXPECT_NEAR(a.depth_m, 0.05, 1e-6);  // below the undisturbed surface
   EXPECT_NEAR(a.pile_m, 0.1, 1e-6);
-  // depth_ahead_m alone would read the pile as depth.
-  EXPECT_NEAR(depth_ahead_m(g, Representation::kSurface, edge, v, look), 0.15, 1e-6);
+  // The current surface alone would read the pile as depth.
+  EXPECT_NEAR(surface_y_m(g, Representation::kSurface, 0.5, 0.4 + look) - 0.15, 0.15, 1e-6);
   // No horizontal motion: nothing ahead.
   EXPECT_EQ(soil_ahead(g, Representation::kSurface, edge, {0.0, -1.0, 0.0}, look).depth_m, 0.0);
 }
@@ -113,4 +160,4 @@ TEST(TwistEngagement, OnlyTheSideThatMovesIntoSoilIsEngaged) {
 }
 
 }  // namespace
-}  // namespace terracut::haptics
+}  // namespace terracut

@@ -1,5 +1,9 @@
-// The depth of material ahead of a moving cutting edge: the `d` of the
-// earthmoving equation.
+// What the soil presents to the edge: the depth of undisturbed soil ahead
+// of a moving edge (the `d` of the earthmoving equation) and the pile over
+// its failure wedge, how deep the edge sits in the soil beside it
+// (penetration), and which parts of it a turn drives into soil (twist).
+// Pure readings of the height grid, for the step's tool force
+// (tool_force.hpp).
 //
 // Why not section_area / length: the contact is measured against the
 // terrain as the previous steps left it, and those steps have already
@@ -15,52 +19,37 @@
 
 #include "terracut/core/blade.hpp"
 #include "terracut/core/contact.hpp"
-#include "terracut/core/forces.hpp"
+#include "terracut/core/twist.hpp"
 #include "terracut/core/grid.hpp"
 
-namespace terracut::haptics {
+namespace terracut {
 
 /// Distance ahead of the edge at which the uncut terrain is read: 1.5 cell
 /// diagonals, so that every sample the reading interpolates lies ahead of
 /// the edge whatever the direction of motion.
 double depth_lookahead_m(const GridSpec& spec);
 
-/// Mean depth of material ahead of the edge, metres (>= 0): the edge is
-/// divided into n equal parts (n = edge length / smallest cell side, in
-/// [2, 64]); at each part's centre p the depth is
-///   surface_y_m(p + u * lookahead) - p.y
-/// with u the unit horizontal (X-Z) direction of motion; the mean is over the
-/// parts where that depth is positive (0 when none is). A motion without a
-/// horizontal part (|v_xz| == 0) or a non-finite input gives 0. Allocates nothing.
-double depth_ahead_m(const HeightGrid& grid, Representation representation, const Segment& edge,
-                     Vec3 velocity_m_per_s, double lookahead_m) noexcept;
-
-/// The depth ahead (depth_ahead_m) with the length of edge it was read over.
-struct CutAhead {
-  double depth_m = 0.0;
-  /// The 3-D length of the parts of the edge with soil ahead of them, m,
-  /// >= 0: the earthmoving model's width. The contact length would do in a
-  /// steady cut, but on the surface representation the contact drops to
-  /// almost nothing for a tick or a few whenever a rising blade's edge passes
-  /// above the interpolated surface between a sample it cut lower and the
-  /// next (a flicker as the blade leaves the soil); the soil ahead is steady.
-  double width_m = 0.0;
-};
-CutAhead cut_ahead(const HeightGrid& grid, Representation representation, const Segment& edge,
-                   Vec3 velocity_m_per_s, double lookahead_m) noexcept;
-
-/// The soil ahead of the edge when soil flows (SoilModel::kFlow), where the
-/// surface ahead may be a pile the blade pushes.
+/// The soil ahead of a moving edge: the edge is divided into n equal parts
+/// (n = edge length / smallest cell side, in [2, 64]); at each part's
+/// centre p the depth of undisturbed soil is read one lookahead ahead along
+/// the horizontal direction of motion u,
+///   d = min(current, initial surface)(p + u lookahead) - p.y
+/// (against the lower of the two surfaces, so a pile the blade pushes is
+/// not depth of cut), and parts with d > 0 are engaged. The lookahead
+/// reads soil no sample of which the edge has cut yet, so a steady cut
+/// gives a steady depth on either representation (the surface at the edge
+/// is the trench it made). The parts are summed as one uniform cut with the
+/// same sum of d (the section: cohesion, surcharge) and of d^2 (the weight):
+/// depth = sum d^2 / sum d, width = (part length) (sum d)^2 / sum d^2, so a
+/// part coming into or out of the soil at zero depth changes nothing.
 struct SoilAhead {
-  /// Depth of the undisturbed soil ahead, metres (>= 0): depth_ahead_m's
-  /// reading taken against the lower of the current and the initial
-  /// surface, so a pile does not count as depth of cut.
+  /// The cut's equivalent depth, metres (>= 0).
   double depth_m = 0.0;
   /// Mean height of soil piled above the initial surface over the failure
-  /// wedge ahead (from the lookahead on, over wedge_per_depth x the local
-  /// depth), metres (>= 0).
+  /// wedge ahead (from the lookahead on, over wedge_per_depth x the part's
+  /// depth), weighted by the parts' depths, metres (>= 0).
   double pile_m = 0.0;
-  /// The 3-D length of the edge with undisturbed soil ahead, m (as CutAhead::width_m).
+  /// The cut's equivalent width: the 3-D length of edge it acts on, m (>= 0).
   double width_m = 0.0;
 };
 
@@ -69,10 +58,11 @@ struct SoilAhead {
 /// a sand's phi of 35 degrees.
 inline constexpr double kWedgeLengthPerDepth = 2.0;
 
-/// The depth and the pile ahead of the edge (see SoilAhead), sampled as
-/// depth_ahead_m samples it; at each part of the edge the pile is averaged
-/// over up to 64 points along the motion from the lookahead to
-/// wedge_per_depth x that part's depth beyond it. Allocates nothing.
+/// The depth, width and pile ahead of the edge (see SoilAhead); at each part
+/// of the edge the pile is averaged over up to 64 points along the motion
+/// from the lookahead to wedge_per_depth x that part's depth beyond it (no
+/// pile read with wedge_per_depth 0). A motion without a horizontal part or
+/// a non-finite input gives zeros. Allocates nothing.
 SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, const Segment& edge,
                      Vec3 velocity_m_per_s, double lookahead_m,
                      double wedge_per_depth = kWedgeLengthPerDepth) noexcept;
@@ -80,7 +70,8 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
 /// How deep an edge sits in the soil beside it: what the penetration model
 /// (core/forces.hpp) is given.
 struct Embedment {
-  /// Mean, over the parts of the edge below the soil beside them, of
+  /// The equivalent depth (as SoilAhead's) of the parts of the edge below
+  /// the soil beside them, each part's depth
   ///   (surface_y_m(p + n * lookahead) + surface_y_m(p - n * lookahead)) / 2 - p.y
   /// with n the unit horizontal normal of the edge (its two faces), metres,
   /// >= 0. The soil beside the edge, not at it: the cut has already lowered
@@ -88,11 +79,11 @@ struct Embedment {
   /// edge's own height (the trench it made). A vertical edge reads four
   /// sides (+-X, +-Z).
   double depth_m = 0.0;
-  /// The 3-D length of those parts, metres, >= 0.
+  /// Their equivalent length (3-D), metres, >= 0.
   double length_m = 0.0;
 };
 
-/// The embedment of the edge (see Embedment), over n parts as depth_ahead_m
+/// The embedment of the edge (see Embedment), over n parts as soil_ahead
 /// divides the edge. A non-finite input gives zeros. Allocates nothing.
 Embedment embedment(const HeightGrid& grid, Representation representation, const Segment& edge,
                     double lookahead_m) noexcept;
@@ -108,4 +99,4 @@ TwistEngagement twist_engagement(const HeightGrid& grid, Representation represen
                                  const Segment& edge, Vec3 centre, double yaw_rate_rad_per_s,
                                  double lookahead_m, double& mean_depth_m) noexcept;
 
-}  // namespace terracut::haptics
+}  // namespace terracut

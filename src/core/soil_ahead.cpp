@@ -1,45 +1,37 @@
-#include "terracut/haptics/cut_depth.hpp"
+#include "terracut/core/soil_ahead.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "terracut/core/forces.hpp"
+#include "terracut/core/surface.hpp"
 
-namespace terracut::haptics {
+namespace terracut {
 
 double depth_lookahead_m(const GridSpec& spec) {
   return 1.5 * std::hypot(spec.cell_x_m(), spec.cell_z_m());
 }
 
-double depth_ahead_m(const HeightGrid& grid, Representation representation, const Segment& edge,
-                     Vec3 velocity_m_per_s, double lookahead_m) noexcept {
-  return cut_ahead(grid, representation, edge, velocity_m_per_s, lookahead_m).depth_m;
+namespace {
+
+// The number of parts an edge is read at.
+int edge_parts(const GridSpec& spec, const Segment& edge) {
+  const double cell = std::min(spec.cell_x_m(), spec.cell_z_m());
+  return std::clamp(static_cast<int>(std::ceil(length(edge.b - edge.a) / cell)), 2, 64);
 }
 
-CutAhead cut_ahead(const HeightGrid& grid, Representation representation, const Segment& edge,
-                   Vec3 velocity_m_per_s, double lookahead_m) noexcept {
-  const double speed_xz = std::hypot(velocity_m_per_s.x, velocity_m_per_s.z);
-  if (!(speed_xz > 0.0) || !std::isfinite(speed_xz) || !is_finite(edge.a) || !is_finite(edge.b) ||
-      !std::isfinite(lookahead_m))
-    return {};
-  const Vec3 ahead = Vec3{velocity_m_per_s.x, 0.0, velocity_m_per_s.z} * (lookahead_m / speed_xz);
-  const GridSpec& spec = grid.spec();
-  const double cell = std::min(spec.cell_x_m(), spec.cell_z_m());
-  const int n = std::clamp(static_cast<int>(std::ceil(length(edge.b - edge.a) / cell)), 2, 64);
-  double sum = 0.0;
-  int engaged = 0;
-  for (int i = 0; i < n; ++i) {
-    const Vec3 p = lerp(edge.a, edge.b, (i + 0.5) / n);
-    const Vec3 q = p + ahead;
-    const double depth = surface_y_m(grid, representation, q.x, q.z) - p.y;
-    if (depth > 0.0) {
-      sum += depth;
-      ++engaged;
-    }
-  }
-  if (engaged == 0) return {};
-  return {sum / engaged, length(edge.b - edge.a) * engaged / n};
+// The depth and length of a uniform cut equivalent to the parts' depths d_i
+// (each of length `part`): the same sum of d (the cut's section, on which the
+// cohesive and surcharge terms grow) and of d^2 (on which the weight term
+// grows): depth = sum d^2 / sum d, length = part (sum d)^2 / sum d^2. A part
+// at zero depth adds nothing to either, so the force stays continuous as
+// parts come into or out of the soil; a uniform cut is itself.
+void equivalent_cut(double sum_d, double sum_d2, double part, double& depth_m, double& length_m) {
+  if (!(sum_d > 0.0) || !(sum_d2 > 0.0)) return;
+  depth_m = sum_d2 / sum_d;
+  length_m = part * sum_d * sum_d / sum_d2;
 }
+
+}  // namespace
 
 SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, const Segment& edge,
                      Vec3 velocity_m_per_s, double lookahead_m, double wedge_per_depth) noexcept {
@@ -51,10 +43,9 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
   const Vec3 u = Vec3{velocity_m_per_s.x, 0.0, velocity_m_per_s.z} * (1.0 / speed_xz);
   const GridSpec& spec = grid.spec();
   const double cell = std::min(spec.cell_x_m(), spec.cell_z_m());
-  const int n = std::clamp(static_cast<int>(std::ceil(length(edge.b - edge.a) / cell)), 2, 64);
+  const int n = edge_parts(spec, edge);
   const double ground = spec.origin_m.y;
-  double depth_sum = 0.0, pile_sum = 0.0;
-  int engaged = 0;
+  double sum_d = 0.0, sum_d2 = 0.0, sum_pile_d = 0.0;
   for (int i = 0; i < n; ++i) {
     const Vec3 p = lerp(edge.a, edge.b, (i + 0.5) / n);
     // The depth at the lookahead, below the undisturbed surface.
@@ -63,9 +54,10 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
     const double before = surface_height_m(spec, grid.initial(), representation, q.x, q.z);
     const double depth = ground + std::min(now, before) - p.y;
     if (!(depth > 0.0)) continue;
-    ++engaged;
-    depth_sum += depth;
+    sum_d += depth;
+    sum_d2 += depth * depth;
     // The pile over the wedge: soil above the initial surface ahead.
+    if (!(wedge_per_depth > 0.0)) continue;
     const double reach_m = wedge_per_depth * depth;
     const int reach_points = std::clamp(static_cast<int>(std::ceil(reach_m / cell)), 1, 64);
     double pile = 0.0;
@@ -74,25 +66,13 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
       pile += std::max(0.0, surface_height_m(grid, representation, r.x, r.z) -
                                 surface_height_m(spec, grid.initial(), representation, r.x, r.z));
     }
-    pile_sum += pile / reach_points;
+    // Weighted by the part's depth: the surcharge acts on q d w.
+    sum_pile_d += depth * pile / reach_points;
   }
-  if (engaged > 0) {
-    out.depth_m = depth_sum / engaged;
-    out.pile_m = pile_sum / engaged;
-    out.width_m = length(edge.b - edge.a) * engaged / n;
-  }
+  equivalent_cut(sum_d, sum_d2, length(edge.b - edge.a) / n, out.depth_m, out.width_m);
+  if (sum_d > 0.0) out.pile_m = sum_pile_d / sum_d;
   return out;
 }
-
-namespace {
-
-// The number of parts depth_ahead_m divides an edge into.
-int edge_parts(const GridSpec& spec, const Segment& edge) {
-  const double cell = std::min(spec.cell_x_m(), spec.cell_z_m());
-  return std::clamp(static_cast<int>(std::ceil(length(edge.b - edge.a) / cell)), 2, 64);
-}
-
-}  // namespace
 
 Embedment embedment(const HeightGrid& grid, Representation representation, const Segment& edge,
                     double lookahead_m) noexcept {
@@ -116,8 +96,7 @@ Embedment embedment(const HeightGrid& grid, Representation representation, const
     side_count = 4;
   }
   const int n = edge_parts(grid.spec(), edge);
-  double sum = 0.0;
-  int engaged = 0;
+  double sum_d = 0.0, sum_d2 = 0.0;
   for (int i = 0; i < n; ++i) {
     const Vec3 p = lerp(edge.a, edge.b, (i + 0.5) / n);
     double beside = 0.0;
@@ -125,14 +104,11 @@ Embedment embedment(const HeightGrid& grid, Representation representation, const
       beside += surface_y_m(grid, representation, p.x + sides[k].x, p.z + sides[k].z);
     const double depth = beside / side_count - p.y;
     if (depth > 0.0) {
-      sum += depth;
-      ++engaged;
+      sum_d += depth;
+      sum_d2 += depth * depth;
     }
   }
-  if (engaged > 0) {
-    out.depth_m = sum / engaged;
-    out.length_m = length(e) * engaged / n;
-  }
+  equivalent_cut(sum_d, sum_d2, length(e) / n, out.depth_m, out.length_m);
   return out;
 }
 
@@ -170,4 +146,4 @@ TwistEngagement twist_engagement(const HeightGrid& grid, Representation represen
   return out;
 }
 
-}  // namespace terracut::haptics
+}  // namespace terracut
