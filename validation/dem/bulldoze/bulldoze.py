@@ -399,13 +399,6 @@ def write_summary():
     path = os.path.join(RES, "summary.csv")
     os.makedirs(RES, exist_ok=True)
     with open(path, "w", newline="") as f:
-        f.write("# one row per case x seed x 0.1 m push window; rows with seed=mean/std are across seeds "
-                "(std: sample standard deviation, n_seeds rows). Forces: grains on blade, N, LIGGGHTS frame "
-                "(fx<0 resists the push). pile_volume_m3: net rise of the upper-envelope surface over the "
-                "initial one, summed over the region ahead of the tip line (plus over a raked plate), at the "
-                "window end. pile_grain_volume_m3: solid volume of grains there with centre above the mean "
-                "initial surface. pile_peak_height_m: max surface height there above the mean initial surface. "
-                "swept_volume_m3: blade width x depth x push at window end.\n")
         wr = csv.writer(f)
         wr.writerow(["case", "seed", "window_start_m", "window_end_m", "fx_mean_n", "fy_mean_n", "fz_mean_n",
                      "pile_volume_m3", "pile_grain_volume_m3", "pile_peak_height_m", "swept_volume_m3",
