@@ -13,6 +13,7 @@ packages=(
   python3 python3-numpy python3-matplotlib gnuplot-nox
   pybind11-dev python3-dev python3-pytest python3-scipy python3-distributed python3-dask
   clang libclang-rt-14-dev
+  liggghts
 )
 
 missing=()

@@ -57,7 +57,7 @@ if [[ $step != test ]]; then
     -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1" -DCMAKE_C_FLAGS_SANITIZE="-O1" \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 \
     -DTERRACUT_BUILD_BENCH=OFF -DTERRACUT_BUILD_VIEWER=OFF -DCMAKE_CXX_FLAGS="$flags" \
-    -DTERRACUT_TEST_SUITES="core;io;haptics;net;bullet;session;apps;fuzz;soak;python" -DTERRACUT_PROGRAM_CXX_FLAGS=-O0 \
+    -DTERRACUT_TEST_SUITES="core;io;haptics;net;bullet;session;validation;apps;fuzz;soak;python" -DTERRACUT_PROGRAM_CXX_FLAGS=-O0 \
     -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=$sanitizers" \
     -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=$sanitizers" \
     -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=$sanitizers" >/dev/null

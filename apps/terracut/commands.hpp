@@ -21,5 +21,6 @@ Command add_run_command(CLI::App& app);
 Command add_heightmap_command(CLI::App& app);
 Command add_reproduce_command(CLI::App& app);
 Command add_validate_command(CLI::App& app);
+Command add_calibrate_command(CLI::App& app);
 
 }  // namespace terracut::cli

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   const terracut::cli::Command heightmap = terracut::cli::add_heightmap_command(app);
   const terracut::cli::Command reproduce = terracut::cli::add_reproduce_command(app);
   const terracut::cli::Command validate = terracut::cli::add_validate_command(app);
+  const terracut::cli::Command calibrate = terracut::cli::add_calibrate_command(app);
   const terracut::cli::Command haptics = terracut::cli::add_haptics_command(app);
   const terracut::cli::Command mmt = terracut::cli::add_mmt_command(app);
 
@@ -59,6 +60,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("heightmap")) return heightmap();
     if (app.got_subcommand("reproduce")) return reproduce();
     if (app.got_subcommand("validate")) return validate();
+    if (app.got_subcommand("calibrate")) return calibrate();
     if (app.got_subcommand("haptics")) return haptics();
     if (app.got_subcommand("mmt")) return mmt();
   } catch (const terracut::InputError& e) {
@@ -71,6 +73,6 @@ int main(int argc, char** argv) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
   }
-  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, validate, haptics, mmt)\n";
+  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, validate, calibrate, haptics, mmt)\n";
   return 2;
 }

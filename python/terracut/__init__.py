@@ -33,6 +33,8 @@ from ._terracut import (  # noqa: F401
     Simulation,
     StepResult,
     bodies_available,
+    calibrate_record,
+    calibrate_tests,
     earthmoving_force,
     soil_preset,
 )
@@ -88,6 +90,6 @@ from .sweep import SweepResult, register_override, sweep  # noqa: E402,F401
 __all__ = [
     "run_mmt",
     "ForceModel", "InputError", "SafetyLimiter", "Scenario", "Simulation", "StepResult",
-    "SweepResult", "bodies_available", "earthmoving_force", "from_dict", "load_mapping",
-    "register_override", "run", "soil_preset", "sweep",
+    "SweepResult", "bodies_available", "calibrate_record", "calibrate_tests", "earthmoving_force",
+    "from_dict", "load_mapping", "register_override", "run", "soil_preset", "sweep",
 ]

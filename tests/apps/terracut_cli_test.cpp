@@ -101,7 +101,7 @@ void expect_clean_failure(const Result& r, const std::vector<std::string>& fragm
 TEST_F(CliTest, HelpOfEveryCommandSucceedsAndDescribesTheOptions) {
   const Result top = terracut({"--help"});
   EXPECT_EQ(top.code, 0);
-  for (const char* word : {"run", "heightmap", "reproduce", "validate", "Exit codes"})
+  for (const char* word : {"run", "heightmap", "reproduce", "validate", "calibrate", "Exit codes"})
     EXPECT_NE(top.out.find(word), std::string::npos) << word;
 
   const Result run = terracut({"run", "--help"});
@@ -439,6 +439,49 @@ TEST_F(CliTest, ValidateWritesItsOutputsAndEveryCheckPasses) {
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(report.find("FAIL"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(out / "checks.csv").find("FAIL"), std::string::npos);
+}
+
+// Calibration from material tests (docs/validation.md, "Calibration"): the
+// fitted fields with their uncertainties on stdout, calibration.json and a
+// soil.yaml that a scenario takes as its soil: section.
+TEST_F(CliTest, CalibrateFromTestsWritesASoilSectionAScenarioTakes) {
+  const fs::path tests = write("tests.json", R"({"bulk_density_kg_per_m3": [1500, 1520],
+      "repose_deg": [31, 33], "plate": [{"sigma_pa": 2000, "tau_pa": 900}],
+      "shear": [{"sigma_pa": 1000, "tau_pa": 900}, {"sigma_pa": 3000, "tau_pa": 2300},
+                {"sigma_pa": 5000, "tau_pa": 3700}]})");
+  const fs::path out = dir_ / "cal";
+  const Result r = terracut({"calibrate", "--tests", tests.string(), "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* word : {"internal_friction_deg", "cohesion_pa", "uncertainty", "soil:"})
+    EXPECT_NE(r.out.find(word), std::string::npos) << word;
+  ASSERT_TRUE(fs::exists(out / "calibration.json"));
+  const std::string soil = slurp(out / "soil.yaml");
+  // tau = 200 + 0.7 sigma exactly: phi = atan(0.7) = 34.9920 degrees.
+  EXPECT_NE(soil.find("internal_friction_deg: 34.992"), std::string::npos) << soil;
+  EXPECT_NE(soil.find("cohesion_pa: 200"), std::string::npos) << soil;
+  // The section in a scenario: `terracut run` takes it.
+  const fs::path sc = write("calibrated.yaml", "terrain:\n  generator: plane\n  resolution: 64\n"
+                                               "  size_m: [1.0, 1.0]\n  full_scale_m: 0.2\n"
+                                               "blade:\n  length_m: 0.3\n" + soil +
+                                               "cuts:\n  - name: c\n    keyframes:\n"
+                                               "      - {t_s: 0.0, position_m: [0.5, 0.15, 0.2]}\n"
+                                               "      - {t_s: 0.2, position_m: [0.5, 0.15, 0.4]}\n");
+  const Result run = terracut({"run", sc.string(), "--out", (dir_ / "run").string(), "--quiet"});
+  EXPECT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(slurp(dir_ / "run" / "summary.json").find("34.99"), std::string::npos);
+}
+
+TEST_F(CliTest, CalibrateRefusesBadInputNamingIt) {
+  expect_clean_failure(terracut({"calibrate"}), {"give --tests FILE or --record FILE --scenario FILE"});
+  expect_clean_failure(terracut({"calibrate", "--record", write("r.csv", "x\n").string()}), {"needs --scenario"});
+  expect_clean_failure(terracut({"calibrate", "--record", write("r.csv", "t_s,x\n").string(), "--scenario",
+                                 scenario("mound_generator.yaml")}),
+                       {"r.csv:1: expected the header"});
+  expect_clean_failure(terracut({"calibrate", "--tests", write("t.json", R"({"shear": [{"sigma_pa": 1000, "tau_pa": 5}]})").string()}),
+                       {"shear: the Mohr-Coulomb line needs tests at two normal stresses"});
+  expect_clean_failure(terracut({"calibrate", "--tests", (dir_ / "absent.json").string()}), {"absent.json: cannot be read"});
+  const Result both = terracut({"calibrate", "--tests", "a", "--record", "b"});
+  EXPECT_EQ(both.code, 2) << both.err;
 }
 
 }  // namespace
