@@ -15,6 +15,9 @@ profiles.csv and cases.csv) and receives:
                          before the push
   soil_dem_piles.png     per case, the soil ahead of the blade (net rise) at
                          each 0.1 m: DEM mean +- scatter, terracut, +-15 %
+  soil_dem_maps.png      per case (its first seed), the surface's change after
+                         the whole push seen from above: the DEM's, terracut's,
+                         and their difference (DIR/dem/maps/*.npy)
 
 Exit codes: 0 done; 2 bad arguments or input folder; 3 numpy or matplotlib missing.
 Needs Debian's python3-numpy and python3-matplotlib.
@@ -124,6 +127,35 @@ def piles(out_dir):
     FILES.save(fig, out_dir, "soil_dem_piles.png", "terracut against a DEM: the soil ahead of the blade")
 
 
+def maps(out_dir):
+    folder = os.path.join(out_dir, "dem", "maps")
+    if not os.path.isdir(folder):
+        return
+    stems = sorted({f[: -len("_initial.npy")] for f in os.listdir(folder) if f.endswith("_initial.npy")})
+    firsts = {}
+    for stem in stems:
+        case = stem.rsplit("_seed", 1)[0]
+        firsts.setdefault(case, stem)
+    if not firsts:
+        return
+    fig, axes = plt.subplots(len(firsts), 3, figsize=(15, 3.3 * len(firsts)), squeeze=False)
+    cell = 0.005  # m, the DEM's surface grid (validation/dem/README.md)
+    for row, (case, stem) in zip(axes, sorted(firsts.items())):
+        init = np.load(os.path.join(folder, stem + "_initial.npy"))
+        dem = np.load(os.path.join(folder, stem + "_dem.npy")) - init
+        tc = np.load(os.path.join(folder, stem + "_terracut.npy")) - init
+        lim = max(np.abs(dem).max(), np.abs(tc).max()) * 1e3
+        extent = [0, init.shape[1] * cell, 0, init.shape[0] * cell]
+        for ax, field, title in zip(row, (dem, tc, tc - dem),
+                                    ("DEM", "terracut", "terracut - DEM")):
+            im = ax.imshow(field * 1e3, origin="lower", extent=extent, cmap="RdBu_r", vmin=-lim, vmax=lim)
+            ax.set_title(f"{case} ({stem.rsplit('_', 1)[1]}): {title}", fontsize=9)
+            ax.set_xlabel("x along the push (m)")
+            ax.set_ylabel("y across (m)")
+        fig.colorbar(im, ax=row[2], label="change of the surface (mm)")
+    FILES.save(fig, out_dir, "soil_dem_maps.png", "terracut against a DEM: the surface after the push, from above")
+
+
 def main(argv):
     out_dir, FILES.quiet = parse_folder_args(argv, __doc__)
     if not os.path.isfile(os.path.join(out_dir, "dem", "cases.csv")):
@@ -131,6 +163,7 @@ def main(argv):
     force(out_dir)
     profiles(out_dir)
     piles(out_dir)
+    maps(out_dir)
     return 0
 
 

@@ -8,6 +8,7 @@
 
 #include "report_files.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/io/image.hpp"
 #include "terracut/validation/calibrate.hpp"
 #include "terracut/validation/dem.hpp"
 
@@ -111,6 +112,17 @@ DemSection run_dem_section(const fs::path& results_dir, const fs::path& out_dir,
       force << run.case_name << "," << run.seed << ",terracut," << tc.push_m[i + every / 2] << ","
             << fx / double(every) << "," << fz / double(every) << "\n";
     }
+    // The surfaces after the whole push, for the maps (float32, rows along
+    // the DEM's y): the DEM's, terracut's, and the bed before the push.
+    const int last_mm = int(std::lround(run.push_total_m * 1000.0));
+    if (run.surface_at_push_mm.count(last_mm) && tc.surface_at_push_mm.count(last_mm)) {
+      const fs::path maps = dir / "maps";
+      create_output_folder(maps);
+      const std::string stem = run.case_name + "_seed" + std::to_string(run.seed);
+      io::write_npy(maps / (stem + "_initial.npy"), run.surface_initial.data(), run.rows, run.cols);
+      io::write_npy(maps / (stem + "_dem.npy"), run.surface_at_push_mm.at(last_mm).data(), run.rows, run.cols);
+      io::write_npy(maps / (stem + "_terracut.npy"), tc.surface_at_push_mm.at(last_mm).data(), run.rows, run.cols);
+    }
     const double yc = 0.5 * (run.blade_y_from_m + run.blade_y_to_m);
     const std::vector<double> init = centre_line(run.surface_initial, run.rows, run.cols, run.cell_m, yc);
     for (const auto& [mm, grid] : run.surface_at_push_mm) {
@@ -131,7 +143,7 @@ DemSection run_dem_section(const fs::path& results_dir, const fs::path& out_dir,
 
   const std::vector<CaseSummary> cases = summarize(comparisons, tests.mean_grain_diameter_m);
   std::ofstream cases_csv(dir / "cases.csv");
-  cases_csv << "case,seeds,start_m,end_m,dem_fx_n,dem_fx_std_n,terracut_fx_n,force_error,force_met,"
+  cases_csv << "case,seeds,start_m,end_m,dem_fx_n,dem_fx_std_n,terracut_fx_n,force_error,force_met,dem_fz_n,terracut_fz_n,"
                "dem_pile_m3,dem_pile_std_m3,terracut_pile_m3,pile_error,pile_met,dem_peak_m,terracut_peak_m,"
                "profile_rms_m,profile_met\n";
   md << "Each case with the DEM's mean +- its scatter over the seeds (sample standard deviation) and "
@@ -143,19 +155,22 @@ DemSection run_dem_section(const fs::path& results_dir, const fs::path& out_dir,
      << " times faster.\n\n";
   for (const CaseSummary& c : cases) {
     md << "### " << c.case_name << " (" << c.seeds << " seed" << (c.seeds == 1 ? "" : "s") << ")\n\n"
-       << "| push (m) | DEM force (N) | terracut (N) | error | target | DEM ahead (l) | terracut (l) | error | "
-          "target | DEM peak (mm) | terracut (mm) | centre line RMS (mm) | target |\n"
-       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+       << "| push (m) | DEM force (N) | terracut (N) | error | target | vertical, DEM / terracut (N, + up) | "
+          "DEM ahead (l) | terracut (l) | error | target | DEM peak (mm) | terracut (mm) | centre line RMS (mm) | "
+          "target |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const CaseSummary::Window& w : c.windows) {
       md << "| " << fmt("%.1f", w.start_m) << "-" << fmt("%.1f", w.end_m) << " | " << fmt("%.1f", w.dem_fx_n)
          << " +- " << fmt("%.1f", w.dem_fx_std_n) << " | " << fmt("%.1f", w.terracut_fx_n) << " | "
-         << pct(w.force_error) << " | " << verdict(w.force_met) << " | " << fmt("%.2f", w.dem_pile_m3 * 1e3)
+         << pct(w.force_error) << " | " << verdict(w.force_met) << " | " << fmt("%.1f", w.dem_fz_n) << " / "
+         << fmt("%.1f", w.terracut_fz_n) << " | " << fmt("%.2f", w.dem_pile_m3 * 1e3)
          << " +- " << fmt("%.2f", w.dem_pile_std_m3 * 1e3) << " | " << fmt("%.2f", w.terracut_pile_m3 * 1e3)
          << " | " << pct(w.pile_error) << " | " << verdict(w.pile_met) << " | " << fmt("%.1f", w.dem_peak_m * 1e3)
          << " | " << fmt("%.1f", w.terracut_peak_m * 1e3) << " | " << fmt("%.1f", w.profile_rms_m * 1e3) << " | "
          << verdict(w.profile_met) << " |\n";
       cases_csv << c.case_name << "," << c.seeds << "," << w.start_m << "," << w.end_m << "," << w.dem_fx_n << ","
                 << w.dem_fx_std_n << "," << w.terracut_fx_n << "," << w.force_error << "," << int(w.force_met) << ","
+                << w.dem_fz_n << "," << w.terracut_fz_n << ","
                 << w.dem_pile_m3 << "," << w.dem_pile_std_m3 << "," << w.terracut_pile_m3 << "," << w.pile_error
                 << "," << int(w.pile_met) << "," << w.dem_peak_m << "," << w.terracut_peak_m << ","
                 << w.profile_rms_m << "," << int(w.profile_met) << "\n";
@@ -173,9 +188,9 @@ DemSection run_dem_section(const fs::path& results_dir, const fs::path& out_dir,
   }
   md << "Targets met: " << section.met << " of " << section.targets << ". Figures: `soil_dem_force.png` "
         "(force against the distance pushed), `soil_dem_profiles.png` (the centre line), "
-        "`soil_dem_piles.png` (the soil ahead of the blade).\n\n"
+        "`soil_dem_piles.png` (the soil ahead of the blade), `soil_dem_maps.png` (the surfaces after the push).\n\n"
      << "![force against distance pushed](soil_dem_force.png)\n\n![centre lines](soil_dem_profiles.png)\n\n"
-        "![the soil ahead of the blade](soil_dem_piles.png)\n";
+        "![the soil ahead of the blade](soil_dem_piles.png)\n\n![the surfaces after the push](soil_dem_maps.png)\n";
   section.markdown = md.str();
   return section;
 }

@@ -375,11 +375,13 @@ std::vector<CaseSummary> summarize(const std::vector<RunComparison>& runs, doubl
     std::size_t nw = rs.front()->windows.size();
     for (const RunComparison* r : rs) nw = std::min(nw, r->windows.size());
     for (std::size_t k = 0; k < nw; ++k) {
-      std::vector<double> dfx, tfx, dpile, tpile, dpeak, tpeak, prof;
+      std::vector<double> dfx, tfx, dfz, tfz, dpile, tpile, dpeak, tpeak, prof;
       for (const RunComparison* r : rs) {
         const WindowComparison& w = r->windows[k];
         dfx.push_back(w.dem_fx_n);
         tfx.push_back(w.terracut_fx_n);
+        dfz.push_back(w.dem_fz_n);
+        tfz.push_back(w.terracut_fz_n);
         dpile.push_back(w.dem_pile_m3);
         tpile.push_back(w.terracut_pile_m3);
         dpeak.push_back(w.dem_peak_m);
@@ -398,6 +400,8 @@ std::vector<CaseSummary> summarize(const std::vector<RunComparison>& runs, doubl
       w.dem_pile_std_m3 = p.std;
       w.terracut_pile_m3 = stats_of(tpile).mean;
       w.pile_met = within(w.terracut_pile_m3, p, kPileTarget, w.pile_error);
+      w.dem_fz_n = stats_of(dfz).mean;
+      w.terracut_fz_n = stats_of(tfz).mean;
       w.dem_peak_m = stats_of(dpeak).mean;
       w.terracut_peak_m = stats_of(tpeak).mean;
       w.profile_rms_m = stats_of(prof).mean;

@@ -135,6 +135,7 @@ struct CaseSummary {
     bool force_met = false;
     double dem_pile_m3 = 0.0, dem_pile_std_m3 = 0.0, terracut_pile_m3 = 0.0, pile_error = 0.0;
     bool pile_met = false;
+    double dem_fz_n = 0.0, terracut_fz_n = 0.0;  ///< mean vertical force (+ up), informative
     double dem_peak_m = 0.0, terracut_peak_m = 0.0;
     double profile_rms_m = 0.0;
     bool profile_met = false;
