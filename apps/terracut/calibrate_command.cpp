@@ -50,7 +50,13 @@ void write(const validation::Calibration& c, const std::string& source, const fs
   nlohmann::ordered_json j;
   j["source"] = source;
   for (const validation::FittedField& f : c.fields)
-    j["fields"].push_back({{"name", f.name}, {"value", f.value}, {"uncertainty", f.uncertainty}, {"how", f.how}});
+    // An undetermined uncertainty (+inf) is null, and says so.
+    j["fields"].push_back({{"name", f.name},
+                           {"value", f.value},
+                           {"uncertainty", std::isfinite(f.uncertainty) ? nlohmann::ordered_json(f.uncertainty)
+                                                                        : nlohmann::ordered_json(nullptr)},
+                           {"uncertainty_determined", std::isfinite(f.uncertainty)},
+                           {"how", f.how}});
   j["material"] = {{"unit_weight_n_per_m3", c.material.unit_weight_n_per_m3},
                    {"internal_friction_deg", c.material.internal_friction_deg},
                    {"cohesion_pa", c.material.cohesion_pa},
