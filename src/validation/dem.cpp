@@ -215,6 +215,12 @@ DemMaterialTests read_dem_material(const fs::path& json) {
 }
 
 
+DemRun read_dem_run(const fs::path& run_dir) {
+  if (!fs::exists(run_dir / "run.json"))
+    throw InputError(run_dir.string() + ": not a DEM run (no run.json; validation/dem/README.md)");
+  return read_run(run_dir);
+}
+
 std::vector<DemRun> read_dem_runs(const fs::path& results_dir) {
   std::vector<DemRun> runs;
   const fs::path root = results_dir / "bulldoze";
@@ -230,9 +236,10 @@ std::vector<DemRun> read_dem_runs(const fs::path& results_dir) {
   return runs;
 }
 
-TerracutRun run_terracut(const DemRun& dem, const SoilMaterial& material, double rate_hz) {
+DemReplay dem_replay(const DemRun& dem, const SoilMaterial& material, double rate_hz) {
+  DemReplay r;
   // The DEM's grid as the terrain: DEM x -> X (columns), y -> Z (rows).
-  SimParams p;
+  SimParams& p = r.params;
   p.grid.cols = dem.cols;
   p.grid.rows = dem.rows;
   p.grid.size_x_m = dem.cols * dem.cell_m;
@@ -245,43 +252,85 @@ TerracutRun run_terracut(const DemRun& dem, const SoilMaterial& material, double
   p.soil.model = SoilModel::kFlow;
   p.soil.material = material;
   p.soil.max_pair_checks_per_step = 1000000000;  // an offline comparison: the converged model
-  Simulation sim(p, dem.surface_initial);
+  r.heights = dem.surface_initial;
 
   // The edge along Z (the DEM's y), centred on the blade's span.
   const double z_centre = 0.5 * (dem.blade_y_from_m + dem.blade_y_to_m);
   const Quat along_z = quat_from_euler_deg({0.0, -90.0, 0.0});
   const auto pose = [&](double x, double y) { return BladePose{{x, y, z_centre}, along_z}; };
-  TerracutRun out;
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::clock_t c0 = std::clock();
   // Lowering: from the DEM's start to the push's start, at its speed.
   const double lx = dem.tip_x_start_m - dem.lowering_start_x_m, ly = dem.tip_z_start_m - dem.lowering_start_z_m;
   const double lower_m = std::hypot(lx, ly);
-  const std::int64_t n_lower = std::max<std::int64_t>(1, std::llround(lower_m / dem.lowering_speed_m_per_s * rate_hz));
+  const std::int64_t n_lower =
+      std::max<std::int64_t>(1, std::llround(lower_m / dem.lowering_speed_m_per_s * rate_hz));
   for (std::int64_t i = 0; i <= n_lower; ++i) {
     const double f = double(i) / double(n_lower);
-    sim.step(pose(dem.lowering_start_x_m + f * lx, dem.lowering_start_z_m + f * ly));
+    r.poses.push_back(pose(dem.lowering_start_x_m + f * lx, dem.lowering_start_z_m + f * ly));
   }
   const std::int64_t n_hold = std::llround(dem.hold_s * rate_hz);
-  for (std::int64_t i = 0; i < n_hold; ++i) sim.step(pose(dem.tip_x_start_m, dem.tip_z_start_m));
+  for (std::int64_t i = 0; i < n_hold; ++i) r.poses.push_back(pose(dem.tip_x_start_m, dem.tip_z_start_m));
+  // The push, along +X at the DEM's speed.
+  r.push_first = r.poses.size();
+  const std::int64_t n_push = std::llround(dem.push_total_m / dem.push_speed_m_per_s * rate_hz);
+  for (std::int64_t i = 1; i <= n_push; ++i)
+    r.poses.push_back(pose(dem.tip_x_start_m + dem.push_speed_m_per_s * double(i) / rate_hz, dem.tip_z_start_m));
+  return r;
+}
+
+ForceRecord dem_force_record(const DemRun& dem, const DemReplay& replay) {
+  ForceRecord rec;
+  const double rate = replay.params.rate_hz;
+  std::size_t k = 0;  // the DEM row at or after the step's push
+  for (std::size_t i = 0; i < replay.poses.size(); ++i) {
+    rec.t_s.push_back(double(i) / rate);
+    rec.pose.push_back(replay.poses[i]);
+    Vec3 f{};
+    if (i >= replay.push_first) {
+      // The DEM's 2.5 ms means, linear between their centres (held past
+      // the first and the last), in terracut's frame (DEM y -> Z, z -> Y).
+      const double pushed = dem.push_speed_m_per_s * double(i - replay.push_first + 1) / rate;
+      while (k < dem.push_m.size() && dem.push_m[k] < pushed) ++k;
+      double fx, fy, fz;
+      if (k == 0 || k == dem.push_m.size()) {
+        const std::size_t at = k == 0 ? 0 : dem.push_m.size() - 1;
+        fx = dem.fx_n[at], fy = dem.fy_n[at], fz = dem.fz_n[at];
+      } else {
+        const double w = (pushed - dem.push_m[k - 1]) / (dem.push_m[k] - dem.push_m[k - 1]);
+        fx = (1 - w) * dem.fx_n[k - 1] + w * dem.fx_n[k];
+        fy = (1 - w) * dem.fy_n[k - 1] + w * dem.fy_n[k];
+        fz = (1 - w) * dem.fz_n[k - 1] + w * dem.fz_n[k];
+      }
+      f = {fx, fz, fy};
+    }
+    rec.force_n.push_back(f);
+  }
+  return rec;
+}
+
+TerracutRun run_terracut(const DemRun& dem, const SoilMaterial& material, double rate_hz) {
+  const DemReplay replay = dem_replay(dem, material, rate_hz);
+  Simulation sim(replay.params, replay.heights);
+  TerracutRun out;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t c0 = std::clock();
+  for (std::size_t i = 0; i < replay.push_first; ++i) sim.step(replay.poses[i]);
   const auto grid_copy = [&] {
     return std::vector<float>(sim.grid().heights(), sim.grid().heights() + sim.grid().spec().sample_count());
   };
   out.surface_at_push_mm[0] = grid_copy();
-  // The push, along +X at the DEM's speed; snapshots at every 0.1 m.
+  // The push; snapshots at every window's end.
   const auto p0 = std::chrono::steady_clock::now();
-  const std::int64_t n_push = std::llround(dem.push_total_m / dem.push_speed_m_per_s * rate_hz);
-  int next_mm = 100;
-  for (std::int64_t i = 1; i <= n_push; ++i) {
-    const double pushed = dem.push_speed_m_per_s * double(i) / rate_hz;
-    const StepOutput& o = sim.step(pose(dem.tip_x_start_m + pushed, dem.tip_z_start_m));
+  int next_mm = int(std::lround(kDemWindow_m * 1000.0));
+  for (std::size_t i = replay.push_first; i < replay.poses.size(); ++i) {
+    const double pushed = dem.push_speed_m_per_s * double(i - replay.push_first + 1) / rate_hz;
+    const StepOutput& o = sim.step(replay.poses[i]);
     out.push_m.push_back(pushed);
     out.fx_n.push_back(o.force.total_n.x);
     out.fy_n.push_back(o.force.total_n.z);  // the DEM's y is terracut's Z
     out.fz_n.push_back(o.force.total_n.y);
     if (pushed >= next_mm * 1e-3 - 0.25 * dem.push_speed_m_per_s / rate_hz) {
       out.surface_at_push_mm[next_mm] = grid_copy();
-      next_mm += 100;
+      next_mm += int(std::lround(kDemWindow_m * 1000.0));
     }
   }
   const auto t1 = std::chrono::steady_clock::now();

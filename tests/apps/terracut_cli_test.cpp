@@ -521,7 +521,7 @@ TEST_F(CliTest, CalibrateFromARecordGivesTheSoilThatMadeIt) {
 }
 
 TEST_F(CliTest, CalibrateRefusesBadInputNamingIt) {
-  expect_clean_failure(terracut({"calibrate"}), {"give --tests FILE or --record FILE --scenario FILE"});
+  expect_clean_failure(terracut({"calibrate"}), {"give --tests FILE, --record FILE --scenario FILE, or --dem-run DIR"});
   expect_clean_failure(terracut({"calibrate", "--record", write("r.csv", "x\n").string()}), {"needs --scenario"});
   expect_clean_failure(terracut({"calibrate", "--record", write("r.csv", "t_s,x\n").string(), "--scenario",
                                  scenario("mound_generator.yaml")}),

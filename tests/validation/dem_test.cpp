@@ -154,6 +154,32 @@ TEST(Compare, ErrorsAreTheDifferencesTheyName) {
   EXPECT_NEAR(s[0].speedup, dem.wall_s / tc.wall_s, 1e-9 * s[0].speedup);
 }
 
+// A DEM run is a force record along its replay's poses: a "DEM" made of
+// terracut's own push with one material gives that material back from
+// another (the friction alone: one depth cannot tell it from cohesion).
+TEST(DemForceRecord, AReplayOfTerracutsOwnPushGivesItsMaterialBack) {
+  DemRun dem = flat_run();
+  const TerracutRun tc = run_terracut(dem, sand());
+  dem.push_m = tc.push_m;
+  dem.fx_n = tc.fx_n;
+  dem.fy_n = tc.fy_n;
+  dem.fz_n = tc.fz_n;
+  SoilMaterial start = sand();
+  start.internal_friction_deg = 25.0;
+  const DemReplay replay = dem_replay(dem, start);
+  const ForceRecord rec = dem_force_record(dem, replay);
+  ASSERT_EQ(rec.t_s.size(), replay.poses.size());
+  EXPECT_EQ(length(rec.force_n[replay.push_first - 1]), 0.0);  // no record before the push
+  // The DEM's x, y, z are terracut's X, Z, Y.
+  EXPECT_EQ(rec.force_n.back().x, tc.fx_n.back());
+  EXPECT_EQ(rec.force_n.back().y, tc.fz_n.back());
+  RecordFit fit;
+  fit.fields = {"internal_friction_deg"};
+  fit.from_t_s = double(replay.push_first) / replay.params.rate_hz;
+  const Calibration cal = calibrate_from_force_record(replay.params, replay.heights, rec, fit);
+  EXPECT_NEAR(cal.material.internal_friction_deg, sand().internal_friction_deg, 0.02);
+}
+
 // Without surfaces at a window's end, its surface targets are not judged
 // (and not counted as met).
 TEST(Compare, AWindowWithoutSurfacesIsNotJudged) {

@@ -18,6 +18,8 @@
 #include <vector>
 
 #include "terracut/core/material.hpp"
+#include "terracut/core/simulation.hpp"
+#include "terracut/validation/calibrate.hpp"
 
 namespace terracut::validation {
 
@@ -84,6 +86,27 @@ struct DemRun {
 /// push does not fit its bed, a missing surface (one per kDemWindow_m of
 /// push) or a force record that does not cover the push.
 std::vector<DemRun> read_dem_runs(const std::filesystem::path& results_dir);
+
+/// One run's folder (results/bulldoze/<case>/seed<k>). Throws as read_dem_runs.
+DemRun read_dem_run(const std::filesystem::path& run_dir);
+
+/// A DEM run replayed in terracut: the simulation's parameters (the bed's
+/// grid, the blade, soil that flows with the material given, the
+/// relaxation uncapped), the bed, and the blade's pose at every step at
+/// rate_hz: the lowering, the hold, the push (from push_first on).
+struct DemReplay {
+  SimParams params;
+  std::vector<float> heights;
+  std::vector<BladePose> poses;
+  std::size_t push_first = 0;
+};
+DemReplay dem_replay(const DemRun& run, const SoilMaterial& material, double rate_hz = 1000.0);
+
+/// The DEM run as a force record along the replay's poses (calibrate.hpp):
+/// the DEM's force during the push, linear between its 2.5 ms means, in
+/// terracut's frame; zero before the push (fit with from_t_s at the push's
+/// start: push_first / rate).
+ForceRecord dem_force_record(const DemRun& run, const DemReplay& replay);
 
 /// terracut on a DEM run: the same bed surface (the DEM's initial upper
 /// envelope as the heights, its 5 mm cells), the blade (width, rake, a thin
