@@ -358,21 +358,25 @@ namespace {
 // Net rise over the initial surface in the DEM's pile region at a tip line
 // x = tip_x_m: the cells at or ahead of it (all across) and, for a raked
 // blade, the cells over its plate (from the rear top edge, rear_offset_m
-// behind the tip, within the blade's span), m^3; and the highest point
-// there above the mean initial surface, m.
+// behind the tip, within the blade's span) whose surface lies above the
+// plate, the soil carried on its face (validation/dem/bulldoze/bulldoze.py,
+// window_metrics), m^3; and the highest point there above the mean initial
+// surface, m.
 void pile_ahead(const std::vector<float>& now, const DemRun& dem, double tip_x_m, double& volume_m3,
                 double& peak_m) {
   volume_m3 = 0.0;
   peak_m = 0.0;
   const double yc = 0.5 * (dem.blade_y_from_m + dem.blade_y_to_m);
+  const double tan_rake = dem.rake_deg < 89.999 ? std::tan(dem.rake_deg * std::numbers::pi / 180.0) : 0.0;
   for (int j = 0; j < dem.rows; ++j)
     for (int i = 0; i < dem.cols; ++i) {
       const double x = (i + 0.5) * dem.cell_m, y = (j + 0.5) * dem.cell_m;
+      const std::size_t k = std::size_t(j) * dem.cols + i;
       const bool ahead = x >= tip_x_m;
       const bool over_plate = x >= tip_x_m + dem.rear_offset_m && x < tip_x_m &&
-                              std::abs(y - yc) <= 0.5 * dem.blade_width_m;
+                              std::abs(y - yc) <= 0.5 * dem.blade_width_m &&
+                              double(now[k]) > dem.tip_z_start_m + (tip_x_m - x) * tan_rake;
       if (!ahead && !over_plate) continue;
-      const std::size_t k = std::size_t(j) * dem.cols + i;
       volume_m3 += (double(now[k]) - double(dem.surface_initial[k])) * dem.cell_m * dem.cell_m;
       peak_m = std::max(peak_m, double(now[k]) - dem.initial_surface_mean_m);
     }
