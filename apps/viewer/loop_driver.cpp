@@ -138,6 +138,13 @@ const haptics::HapticLoop& LoopDriver::loop() const {
   return operator_ ? operator_->rig().loop() : rig_->loop();
 }
 
+std::string LoopDriver::realtime_line() const {
+  if (operator_)
+    return "real-time: not asked (teleoperation: the stations tick on the viewer's own thread, "
+           "normal scheduling)";
+  return loop().realtime_status().message;
+}
+
 void LoopDriver::start() {
   if (started_) return;
   started_ = true;
