@@ -29,6 +29,8 @@ PYBIND11_MODULE(_terracut, m) {
       "throughout (metres, seconds, newtons); world frame right-handed, Y up, ground plane X-Z.";
 
   py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+  // The version `terracut --version` prints (the project's, CMakeLists.txt).
+  m.attr("__version__") = TERRACUT_VERSION;
 
   m.def("bodies_available", &session::bodies_available,
         "True when this build has the rigid-body engine (Bullet).");

@@ -123,6 +123,13 @@ std::optional<Representation> representation_arg(py::handle obj) {
 }
 
 void bind_scenario(py::module_& m) {
+  m.def("_parse_resolution", [](const std::string& text) {
+        const io::Resolution r = io::parse_resolution(text, "resolution");
+        return py::make_tuple(r.cols, r.rows);
+      }, py::arg("text"),
+      "The command line's --resolution text, 'N' or 'COLSxROWS', as (cols, rows); "
+      "InputError naming 'resolution' when it is not one.");
+
   m.def("_yaml_to_python", [](const std::string& text, const std::string& source) {
         try {
           return yaml_to_python(YAML::Load(text));
