@@ -413,10 +413,7 @@ substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
              "previous pose.")
       .def("reset", [](PySimulation& self) {
             auto lock = self.claim();
-            self.sim().reset();
-            // Whoever caches heights (the Bullet world) hears of the whole grid.
-            const Rect all{0, 0, self.sim().grid().cols(), self.sim().grid().rows()};
-            for (StepListener* listener : self.sim().listeners()) listener->on_edit(all);
+            self.sim().reset();  // tells the listeners (the Bullet world) itself
           }, "Restores the initial terrain, time and counters. Rigid bodies keep their poses and "
              "are woken over the restored terrain.")
       .def("save", [](PySimulation& self, const std::filesystem::path& dir, std::optional<double> full_scale_m) {

@@ -272,12 +272,33 @@ struct TerrainWorld::Impl {
 
 TerrainWorld::TerrainWorld(Simulation& sim, std::vector<BodySpec> bodies,
                            const TerrainWorldParams& params)
-    : TerrainWorld(sim.grid(), sim.params().rate_hz, sim.params().blade, std::move(bodies),
-                   params) {}
+    : TerrainWorld(sim.grid(), &sim, nullptr, sim.params().rate_hz, sim.params().blade,
+                   std::move(bodies), params) {}
 
 TerrainWorld::TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& blade,
                            std::vector<BodySpec> bodies, const TerrainWorldParams& params)
-    : grid_(grid), params_(checked(params)), blade_(blade), specs_(std::move(bodies)) {
+    : TerrainWorld(grid, nullptr, &grid, rate_hz, blade, std::move(bodies), params) {}
+
+void TerrainWorld::lower_sample(std::int64_t i, float height_m) {
+  if (owner_) owner_->lower_sample(i, height_m);
+  else bare_->lower(i, height_m);
+}
+
+void TerrainWorld::move_height(std::int64_t from, std::int64_t to, float amount_m) {
+  if (owner_) {
+    owner_->move_height(from, to, amount_m);
+  } else {
+    float* h = bare_->edit_layers().height_m;
+    h[from] -= amount_m;
+    h[to] += amount_m;
+  }
+}
+
+TerrainWorld::TerrainWorld(const HeightGrid& grid, Simulation* owner, HeightGrid* bare,
+                           double rate_hz, const BladeSpec& blade, std::vector<BodySpec> bodies,
+                           const TerrainWorldParams& params)
+    : grid_(grid), owner_(owner), bare_(bare), params_(checked(params)), blade_(blade),
+      specs_(std::move(bodies)) {
   // Settings: everything is checked here so the step can trust it.
   if (!(std::isfinite(rate_hz) && rate_hz > 0.0 && rate_hz <= 1e6))
     throw InputError(must_be("rate_hz", "in (0, 1e6]", rate_hz));
@@ -471,7 +492,7 @@ void TerrainWorld::terrain_changed(const Rect& changed) {
       const std::int64_t i = grid_.index(col, row);
       if (h[i] > max_h) {
         bounds_.highest_clamped_m = std::max(bounds_.highest_clamped_m, double(h[i]));
-        grid_.lower(i, max_h);
+        lower_sample(i, max_h);
         ++clamped;
       }
     }
@@ -712,7 +733,7 @@ void TerrainWorld::shed_rings() {
       if (col >= o.cells.c0 && col < o.cells.c1 && row >= o.cells.r0 && row < o.cells.r1) return true;
     return false;
   };
-  float* h = grid_.edit_layers().height_m;
+  const float* h = grid_.heights();
   const float ceiling = float(bounds_.max_height_m);
   const float tolerance = float(params_.pile.shed_tolerance_m);
   Rect changed{};
@@ -739,15 +760,13 @@ void TerrainWorld::shed_rings() {
         if (dc == 0 && dr == 0) continue;  // under the body: its support
         const int tc = col + dc, tr = row + dr;
         if (tc < 0 || tc >= grid_.cols() || tr < 0 || tr >= grid_.rows() || obstructed(tc, tr)) continue;
-        float& from = h[grid_.index(col, row)];
-        float& to = h[grid_.index(tc, tr)];
+        const std::int64_t from = grid_.index(col, row), to = grid_.index(tc, tr);
         // Soil within the tolerance of what stays is left (a resting body
         // settles by fractions of a micrometre).
-        if (!(from - keep > tolerance)) continue;
-        const float move = std::min(from - keep, ceiling - to);
+        if (!(h[from] - keep > tolerance)) continue;
+        const float move = std::min(h[from] - keep, ceiling - h[to]);
         if (!(move > 0.0f)) continue;
-        from -= move;
-        to += move;
+        move_height(from, to, move);
         pending_shed_m3_ += double(move) * grid_.spec().cell_area_m2();
         changed.include(col, row);
         changed.include(tc, tr);
@@ -908,7 +927,7 @@ void TerrainWorld::release(int i) {
          std::min(pit.r1 + 1, grid_.rows())};
   const float floor_h = float(double(lo.y()) - grid_.spec().origin_m.y);
   for (int row = pit.r0; row < pit.r1; ++row)
-    for (int col = pit.c0; col < pit.c1; ++col) grid_.lower(grid_.index(col, row), floor_h);
+    for (int col = pit.c0; col < pit.c1; ++col) lower_sample(grid_.index(col, row), floor_h);
   // Dynamic from now on: out of the world and back, so that the broadphase
   // gives it the dynamic body's collision groups (Bullet allocates its new
   // pairs here, once per release).

@@ -214,17 +214,22 @@ struct WorldStepInfo {
 
 class TerrainWorld {
  public:
-  /// Builds the world over `grid` (which must outlive the world and keep its
-  /// heights array: HeightGrid guarantees that). rate_hz is the simulation's
-  /// fixed rate (Bullet advances 1 / rate_hz per step); blade gives the tool
-  /// plate's length. Throws terracut::InputError naming the bad field when
-  /// params or bodies are invalid, or the grid has fewer than 2 samples along
-  /// a side (Bullet's heightfield needs 2 x 2).
-  TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& blade,
-               std::vector<BodySpec> bodies, const TerrainWorldParams& params = {});
-  /// The same over a simulation's grid, rate and blade.
+  /// Builds the world over a simulation's grid, rate and blade. The
+  /// simulation owns the heights: the world reads them in place and changes
+  /// them only through it (Simulation::lower_sample, move_height), from its
+  /// listener's callbacks (BodiesListener). It must outlive the world.
+  /// Throws terracut::InputError naming the bad field when params or bodies
+  /// are invalid, or the grid has fewer than 2 samples along a side
+  /// (Bullet's heightfield needs 2 x 2).
   TerrainWorld(Simulation& sim, std::vector<BodySpec> bodies,
                const TerrainWorldParams& params = {});
+  /// The same over a bare grid that no simulation owns (tests, tools): the
+  /// world changes its heights itself. `grid` must outlive the world and
+  /// keep its heights array (HeightGrid guarantees that). rate_hz is the
+  /// fixed rate (Bullet advances 1 / rate_hz per step); blade gives the tool
+  /// plate's length.
+  TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& blade,
+               std::vector<BodySpec> bodies, const TerrainWorldParams& params = {});
   ~TerrainWorld();
   TerrainWorld(const TerrainWorld&) = delete;
   TerrainWorld& operator=(const TerrainWorld&) = delete;
@@ -301,7 +306,17 @@ class TerrainWorld {
  private:
   struct Impl;
 
-  HeightGrid& grid_;
+  TerrainWorld(const HeightGrid& grid, Simulation* owner, HeightGrid* bare, double rate_hz,
+               const BladeSpec& blade, std::vector<BodySpec> bodies,
+               const TerrainWorldParams& params);
+  // The only two edits the world makes to the heights: through the
+  // simulation that owns them, or on the bare grid it was given.
+  void lower_sample(std::int64_t i, float height_m);
+  void move_height(std::int64_t from, std::int64_t to, float amount_m);
+
+  const HeightGrid& grid_;  // read in place (Bullet's heightfield too)
+  Simulation* owner_ = nullptr;  // the simulation that owns grid_, or
+  HeightGrid* bare_ = nullptr;   // grid_ itself when no simulation owns it
   TerrainWorldParams params_;
   BladeSpec blade_;
   std::vector<BodySpec> specs_;
