@@ -39,12 +39,17 @@ py::dict calibration_dict(const validation::Calibration& c) {
 // Material tests from a path (read_material_tests) or a dict of the same
 // keys as the general JSON form.
 validation::MaterialTests tests_arg(py::handle obj) {
-  if (!py::isinstance<py::dict>(obj)) return validation::read_material_tests(obj.cast<std::filesystem::path>());
+  if (!py::isinstance<py::dict>(obj)) {
+    if (!py::isinstance<py::str>(obj) && !py::hasattr(obj, "__fspath__"))
+      throw InputError("tests: expected a JSON file's path or a dict of test results");
+    return validation::read_material_tests(obj.cast<std::filesystem::path>());
+  }
   validation::MaterialTests t;
   for (auto [key, value] : obj.cast<py::dict>()) {
     const std::string k = py::str(key);
     if (k == "bulk_density_kg_per_m3" || k == "repose_deg") {
       const auto a = doubles(value, k.c_str());
+      if (a.ndim() > 1) throw InputError(k + ": expected a list of numbers");
       std::vector<double>& out = k == "repose_deg" ? t.repose_deg : t.bulk_density_kg_per_m3;
       for (py::ssize_t i = 0; i < a.size(); ++i) {
         if (!std::isfinite(a.data()[i])) throw InputError(k + ": a value is not finite");
@@ -84,8 +89,9 @@ void bind_calibration(py::module_& m) {
   m.def("calibrate_record", [](const PyScenario& sc, py::object t_s, py::object poses, py::object force_n,
                                std::vector<std::string> fit, double window_s, double from_s, int max_iterations) {
         validation::ForceRecord rec;
-        if (!t_s.is_none() && poses.is_none() && force_n.is_none() && !py::isinstance<py::array>(t_s) &&
-            !py::isinstance<py::list>(t_s)) {
+        if (poses.is_none() && force_n.is_none()) {
+          if (!py::isinstance<py::str>(t_s) && !py::hasattr(t_s, "__fspath__"))
+            throw InputError("t_s: a record's CSV path, or times with poses and force_n");
           rec = validation::read_force_record(t_s.cast<std::filesystem::path>());
         } else {
           const auto t = doubles(t_s, "t_s");
