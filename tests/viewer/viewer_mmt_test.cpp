@@ -98,6 +98,18 @@ TEST(ViewerMmt, RemotePatchesReachTheDrawnLocalModel) {
 }
 
 
+// The window prints how the loop is scheduled: in MMT the stations tick on
+// the driver's own thread, and that is said (it printed an empty line).
+TEST(ViewerMmt, TheRealTimeLineSaysHowTheStationsAreScheduled) {
+  const session::Scenario sc = session::load_scenario(kTrench);
+  DriverOptions o;
+  o.paced = false;
+  o.mmt = true;
+  LoopDriver d(sc, viewer_settings(sc.haptics), o, nullptr);
+  EXPECT_EQ(d.realtime_line().rfind("real-time: ", 0), 0u) << d.realtime_line();
+  EXPECT_NE(d.realtime_line().find("stations"), std::string::npos) << d.realtime_line();
+}
+
 TEST(ViewerMmt, AScenarioWithoutAnMmtSectionIsRefusedByName) {
   const session::Scenario sc =
       session::load_scenario(fs::path(TERRACUT_SOURCE_DIR) / "scenarios" / "trench_dry_sand.yaml");
