@@ -132,6 +132,18 @@ TEST_F(CliTest, HelpOfEveryCommandSucceedsAndDescribesTheOptions) {
                            "conservation/volume.csv", "soil_cone.png", "degrees", "m^3",
                            "microseconds", "Exit code"})
     EXPECT_NE(val.out.find(word), std::string::npos) << word;
+  // Its checks are numbered as report.md's sections: cone, slopes,
+  // bulldozing, conservation, bucket, speed.
+  {
+    std::size_t at = 0;
+    int number = 1;
+    for (const char* section : {"cone", "slopes", "bulldozing", "conservation", "bucket", "speed"}) {
+      const std::string line = "  " + std::to_string(number++) + " " + section;
+      const std::size_t found = val.out.find(line, at);
+      EXPECT_NE(found, std::string::npos) << "validate --help lacks '" << line << "' after the previous check";
+      if (found != std::string::npos) at = found;
+    }
+  }
 
   EXPECT_EQ(terracut({"--version"}).code, 0);
 }
@@ -193,6 +205,21 @@ cuts:
   EXPECT_NEAR(last_y[1], first_y[1], 0.002);
   EXPECT_NEAR(last_x[1], 0.85, 0.002);
   EXPECT_NE(slurp(out / "summary.json").find("\"bodies\""), std::string::npos);
+}
+
+// What the device check lowers is said once, when the session is built,
+// and kept in summary.json's warnings (experiment 1's surface and cutting
+// damping exceed a Falcon's).
+TEST_F(CliTest, HapticsSaysEachDeviceCheckWarningOnce) {
+  const fs::path out = dir_ / "exp1";
+  const Result r = terracut({"haptics", scenario("paper_experiment1.yaml"), "--device", "script",
+                             "--no-plot", "--quiet", "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string line = "terracut haptics: warning: cutting damping";
+  const std::size_t first = r.err.find(line);
+  ASSERT_NE(first, std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find(line, first + 1), std::string::npos) << "said twice:\n" << r.err;
+  EXPECT_NE(slurp(out / "summary.json").find("cutting damping"), std::string::npos);
 }
 
 // `terracut haptics` on a scenario with bodies: the Bullet world is stepped
@@ -325,7 +352,10 @@ TEST_F(CliTest, BadOptionsAreReported) {
   expect_clean_failure(terracut({"run", sc, "--out", out, "--representation", "voxels"}),
                        {"--representation"}, 2);
   expect_clean_failure(terracut({"run", sc}), {"--out"}, 2);
-  expect_clean_failure(terracut({}), {"subcommand"}, 2);
+  expect_clean_failure(terracut({}), {"subcommand", "run, heightmap"}, 2);
+  // A word that is no subcommand is named, with the real ones listed.
+  expect_clean_failure(terracut({"frobnicate"}),
+                       {"unknown subcommand 'frobnicate'", "run, heightmap, reproduce, validate"}, 2);
   // An unknown option is named first, before the required ones it hides.
   expect_clean_failure(terracut({"run", "--bogus"}), {"unknown option", "--bogus"}, 2);
   expect_clean_failure(terracut({"run", sc, "--bogus"}), {"--bogus"}, 2);
