@@ -106,10 +106,10 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
       udp_ = session::connect_operator_link(mmt, options.remote, "--remote",
                                             options.connect_timeout_s);
       const auto id = std::uint32_t(std::chrono::steady_clock::now().time_since_epoch().count());
-      operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, *udp_, id, oo);
+      operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, *udp_.endpoint, id, oo);
     } else {
       remote_scenario_ = std::make_unique<session::Scenario>(session::load_remote_scenario(op));
-      link_ = std::make_unique<net::MemoryLink>(mmt.to_remote, mmt.to_operator);
+      link_ = std::make_unique<net::EmulatedLink>(mmt.to_remote, mmt.to_operator);
       operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, link_->a(), 1u, oo);
       remote_ = std::make_unique<session::RemoteStation>(
           *remote_scenario_, mmt, operator_->rig().loop().force_model(),
@@ -175,7 +175,7 @@ void LoopDriver::lockstep_main() {
       std::this_thread::sleep_for(std::chrono::microseconds(200));
       continue;
     }
-    if (udp_)
+    if (udp_.endpoint)
       std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
                                                 std::chrono::duration<double>(double(i) / rate_hz())));
     tick(i);
@@ -191,6 +191,7 @@ void LoopDriver::tick(std::int64_t i) {
   const double period = 1.0 / rate_hz();
   const double t_s = double(i) * period;
   if (operator_) {
+    if (link_) link_->release(t_s);
     operator_->tick(t_s);
     if (remote_) remote_->tick(t_s);
     publish_mmt();
@@ -235,7 +236,7 @@ void LoopDriver::publish_mmt() {
     return c.datagrams > 0 ? double(c.lost) / double(c.datagrams) : 0.0;
   };
   // With the remote in another process, its sender's losses are its own.
-  m.loss_to_remote.store(loss(udp_ ? udp_->emulator() : link_->a().emulator()),
+  m.loss_to_remote.store(loss(udp_.endpoint ? udp_.endpoint->emulator() : link_->a().emulator()),
                          std::memory_order_relaxed);
   m.loss_to_operator.store(link_ ? loss(link_->b().emulator()) : 0.0, std::memory_order_relaxed);
   m.patches.store(oc.patches, std::memory_order_relaxed);

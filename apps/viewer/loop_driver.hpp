@@ -50,6 +50,7 @@
 #include "terracut/net/transport.hpp"
 #include "terracut/session/haptic.hpp"
 #include "terracut/session/mmt.hpp"
+#include "terracut/session/mmt_process.hpp"
 #include "viewer_device.hpp"
 
 namespace terracut::viewer {
@@ -180,8 +181,8 @@ class LoopDriver {
   std::unique_ptr<session::HapticRig> rig_;  // after the device, which it uses
   // MMT: the remote world, the link and the two stations (instead of rig_).
   std::unique_ptr<session::Scenario> remote_scenario_;
-  std::unique_ptr<net::MemoryLink> link_;
-  std::unique_ptr<net::Endpoint> udp_;  // DriverOptions::remote: the link to the other process
+  std::unique_ptr<net::EmulatedLink> link_;
+  session::UdpLink udp_;  // DriverOptions::remote: the link to the other process
   std::unique_ptr<session::OperatorStation> operator_;
   std::unique_ptr<session::RemoteStation> remote_;
   MmtLive mmt_live_;

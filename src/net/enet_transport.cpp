@@ -45,18 +45,16 @@ constexpr std::size_t kChannels = 2;
 }  // namespace
 
 struct EnetEndpoint::State {
-  explicit State(const LinkConditions& c) : emulator(c) {}
   ~State() {
     if (host) enet_host_destroy(host);
     enet_release();
   }
-  LinkEmulator emulator;
   ENetHost* host = nullptr;
   ENetPeer* peer = nullptr;  // the connected peer, or null
   bool connected = false;
   std::int64_t connections = 0;
   std::int64_t dropped_unconnected = 0;
-  HeldQueue held;  // tag: the Channel
+  HeldQueue held;  // waiting for a peer; tag: the Channel
 };
 
 EnetEndpoint::EnetEndpoint(std::unique_ptr<State> state) : s_(std::move(state)) {}
@@ -80,10 +78,9 @@ void never_throttle(ENetPeer* peer) {
 }
 }  // namespace
 
-std::unique_ptr<EnetEndpoint> EnetEndpoint::listen(const std::string& address, int port,
-                                                   const LinkConditions& sending) {
+std::unique_ptr<EnetEndpoint> EnetEndpoint::listen(const std::string& address, int port) {
   enet_acquire();
-  auto state = std::make_unique<State>(sending);
+  auto state = std::make_unique<State>();
   const ENetAddress a = make_address(address, port, "--listen");
   state->host = enet_host_create(&a, 4, kChannels, 0, 0);
   if (!state->host)
@@ -92,10 +89,9 @@ std::unique_ptr<EnetEndpoint> EnetEndpoint::listen(const std::string& address, i
   return std::unique_ptr<EnetEndpoint>(new EnetEndpoint(std::move(state)));
 }
 
-std::unique_ptr<EnetEndpoint> EnetEndpoint::connect(const std::string& address, int port,
-                                                    const LinkConditions& sending) {
+std::unique_ptr<EnetEndpoint> EnetEndpoint::connect(const std::string& address, int port) {
   enet_acquire();
-  auto state = std::make_unique<State>(sending);
+  auto state = std::make_unique<State>();
   if (port < 1) throw InputError("--connect: port must be in [1, 65535], got " + std::to_string(port));
   const ENetAddress remote = make_address(address, port, "--connect");
   state->host = enet_host_create(nullptr, 1, kChannels, 0, 0);
@@ -108,9 +104,7 @@ std::unique_ptr<EnetEndpoint> EnetEndpoint::connect(const std::string& address, 
 void EnetEndpoint::send(Channel channel, const std::uint8_t* data, std::size_t size, double now_s) {
   ++traffic_.sent;
   traffic_.sent_bytes += std::int64_t(size);
-  const auto release_at = s_->emulator.schedule(now_s, channel == Channel::kReliable);
-  if (!release_at) return;
-  s_->held.hold(*release_at, static_cast<std::uint8_t>(channel), data, size);
+  s_->held.hold(now_s, static_cast<std::uint8_t>(channel), data, size);
   release(now_s);
 }
 
@@ -165,7 +159,6 @@ void EnetEndpoint::receive(double now_s, Inbox& out) {
   release(now_s);
 }
 
-const LinkEmulator& EnetEndpoint::emulator() const { return s_->emulator; }
 void EnetEndpoint::reserve_in_flight(std::size_t datagrams, std::size_t bytes) {
   s_->held.reserve(datagrams, bytes);
 }

@@ -19,7 +19,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-nlohmann::ordered_json station_json(const StationCounters& c, const net::Endpoint& e,
+nlohmann::ordered_json station_json(const StationCounters& c, const net::EmulatedEndpoint& e,
                                     double duration_s) {
   nlohmann::ordered_json j;
   j["duration_s"] = duration_s;
@@ -74,12 +74,13 @@ std::pair<std::string, int> parse_endpoint(const std::string& text, const std::s
   return {address.value_or(default_address), *port};
 }
 
-std::unique_ptr<net::Endpoint> connect_operator_link(const MmtSettings& s,
-                                                     const std::string& endpoint,
-                                                     const std::string& option, double timeout_s) {
+UdpLink connect_operator_link(const MmtSettings& s, const std::string& endpoint,
+                              const std::string& option, double timeout_s) {
   const auto [address, port] =
       endpoint.empty() ? std::pair{s.address, s.port} : parse_endpoint(endpoint, option, s.address);
-  auto link = net::EnetEndpoint::connect(address, port, s.to_remote);
+  UdpLink udp;
+  udp.carrier = net::EnetEndpoint::connect(address, port);
+  net::EnetEndpoint* link = udp.carrier.get();
   // Wait for the connection before the loop starts.
   const auto start = Clock::now();
   net::Inbox none;
@@ -90,7 +91,8 @@ std::unique_ptr<net::Endpoint> connect_operator_link(const MmtSettings& s,
     link->receive(0.0, none);
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
-  return link;
+  udp.endpoint = std::make_unique<net::EmulatedEndpoint>(*udp.carrier, s.to_remote);
+  return udp;
 }
 
 int run_remote_process(const Scenario& op, const ProcessOptions& o) {
@@ -102,16 +104,18 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
       o.endpoint.empty() ? std::pair{s.address, s.port} : parse_endpoint(o.endpoint, "--listen", s.address);
   const haptics::LoopParams nominal(op.haptics, op.base.blade);
   const World local(op);  // the operator's initial terrain: what the deadband compares against
-  auto link = net::EnetEndpoint::listen(address, port, s.to_operator);
+  auto carrier = net::EnetEndpoint::listen(address, port);
+  net::EmulatedEndpoint emulated(*carrier, s.to_operator);
+  net::EmulatedEndpoint* link = &emulated;
   // The records go to remote.csv as they are made: a live session has no set end.
   RemoteOptions options;
   options.keep_records = false;
-  RemoteStation station(remote, s, nominal.force_model(), local.simulation().grid(), *link,
+  RemoteStation station(remote, s, nominal.force_model(), local.simulation().grid(), emulated,
                         std::uint32_t(Clock::now().time_since_epoch().count()), options);
   std::filesystem::create_directories(o.out);
   StationCsv csv = StationCsv::remote_csv(o.out / "remote.csv");
   if (o.log)
-    *o.log << "terracut mmt: remote listening on " << address << ":" << link->port() << std::endl;
+    *o.log << "terracut mmt: remote listening on " << address << ":" << carrier->port() << std::endl;
   const double max_s = o.remote_max_s > 0.0 ? o.remote_max_s : operator_duration_s(op) + 10.0;
   double last_command_s = -1.0;
   std::int64_t accepted = 0;
@@ -131,7 +135,7 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
   csv.finish();
   nlohmann::ordered_json j = station_json(station.counters(), *link, duration);
   j["role"] = "remote";
-  j["connections"] = link->connections();
+  j["connections"] = carrier->connections();
   j["force_scale"] = station.force_scale();
   j["estimate"] = {{"samples", station.estimate_samples()},
                    {"outliers_left_out", station.estimate_outliers()},
@@ -149,8 +153,8 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
   const MmtSettings s = apply_overrides(*op.mmt, o.overrides);
   const auto [address, port] =
       o.endpoint.empty() ? std::pair{s.address, s.port} : parse_endpoint(o.endpoint, "--connect", s.address);
-  std::unique_ptr<net::Endpoint> link =
-      connect_operator_link(s, o.endpoint, "--connect", o.connect_timeout_s);
+  UdpLink udp = connect_operator_link(s, o.endpoint, "--connect", o.connect_timeout_s);
+  net::EmulatedEndpoint* link = udp.endpoint.get();
   std::unique_ptr<haptics::Device> device = make_operator_device(op);
   // The records go to operator.csv as they are made: a live session's
   // duration is the user's.

@@ -170,7 +170,7 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
                      ": haptics.device: a real device over udp runs in real time: run the "
                      "stations as two processes (--role remote / --role operator)");
   device_ = make_operator_device(*op_);
-  link_ = std::make_unique<net::MemoryLink>(settings_.to_remote, settings_.to_operator);
+  link_ = std::make_unique<net::EmulatedLink>(settings_.to_remote, settings_.to_operator);
   operator_ = std::make_unique<OperatorStation>(*op_, settings_, *device_, link_->a(), 1u);
   remote_ = std::make_unique<RemoteStation>(*remote_scn_, settings_,
                                             operator_->rig().loop().force_model(),
@@ -180,7 +180,7 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
   // updates to land, and on a lossy link three retransmissions more.
   const net::LinkConditions& back = settings_.to_operator;
   const bool lossy = back.loss > 0.0 || back.burst.p_good_to_bad > 0.0;
-  const double retransmit_s = back.retransmit_s.value_or(2.0 * back.delay_s + 0.02);
+  const double retransmit_s = net::retransmit_timeout_s(back, net::emulated_round_trip_s(back));
   const double duration = overrides.duration_s.value_or(
       operator_duration_s(*op_) + settings_.to_remote.delay_s + back.delay_s +
       settings_.sense_period_s + settings_.blend_s + 0.2 + (lossy ? 3.0 * retransmit_s : 0.0));
@@ -198,6 +198,7 @@ MmtRun::~MmtRun() = default;
 
 void MmtRun::tick() {
   const double t = double(tick_) / rate_hz_;
+  link_->release(t);
   operator_->tick(t);
   remote_->tick(t);
   ++tick_;

@@ -67,7 +67,7 @@ std::size_t patch_samples(const MmtSettings& s, const GridSpec& g) {
 // How long a datagram sent one way can be held in flight, s: the delay, the
 // jitter, a hold-back and, for a reliable one, three retransmissions.
 double in_flight_s(const net::LinkConditions& c) {
-  const double retransmit_s = c.retransmit_s.value_or(2.0 * c.delay_s + 0.02);
+  const double retransmit_s = net::retransmit_timeout_s(c, net::emulated_round_trip_s(c));
   return c.delay_s + c.jitter_s + c.reorder_delay_s + 3.0 * retransmit_s;
 }
 

@@ -1,6 +1,7 @@
-// The transports: the in-memory link delivers by emulated arrival time; the
-// ENet link carries both channels over one loopback UDP port, and junk sent
-// to that port breaks nothing.
+// The transports: the in-memory link delivers in sending order, and with the
+// emulator in front of it (a decorator) by emulated arrival time; the ENet
+// link carries both channels over one loopback UDP port, the emulator in
+// front of it loses at the sender, and junk sent to that port breaks nothing.
 #include "terracut/net/transport.hpp"
 
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 #include <thread>
 
 #include "terracut/core/error.hpp"
+#include "terracut/net/emulated_link.hpp"
 #include "terracut/net/enet_transport.hpp"
 
 namespace terracut::net {
@@ -68,23 +70,42 @@ TEST(Inbox, KeepsItsBuffersAcrossClear) {
   EXPECT_EQ(n, a.size() + b.size());
 }
 
-TEST(MemoryLink, DeliversAtTheArrivalTime) {
+TEST(MemoryLink, DeliversAtOnceInSendingOrder) {
+  MemoryLink link;
+  for (int i = 0; i < 5; ++i) {
+    const auto d = bytes(std::uint8_t(i), 3 + std::size_t(i));
+    link.a().send(i % 2 ? Channel::kReliable : Channel::kUnreliable, d.data(), d.size(), 1.0 - i);
+  }
+  std::vector<std::vector<std::uint8_t>> got;
+  link.b().receive(0.0, got);
+  ASSERT_EQ(got.size(), 5u);
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(got[std::size_t(i)], bytes(std::uint8_t(i), 3 + std::size_t(i)));
+  got.clear();
+  link.a().receive(0.0, got);
+  EXPECT_TRUE(got.empty());
+}
+
+TEST(EmulatedLink, DeliversAtTheArrivalTime) {
   LinkConditions ab;
   ab.delay_s = 0.05;
   LinkConditions ba;
   ba.delay_s = 0.1;
-  MemoryLink link(ab, ba);
+  EmulatedLink link(ab, ba);
   const auto d = bytes(1);
   link.a().send(Channel::kUnreliable, d.data(), d.size(), 0.0);
   link.b().send(Channel::kReliable, d.data(), d.size(), 0.0);
   std::vector<std::vector<std::uint8_t>> got;
+  link.release(0.049);
   link.b().receive(0.049, got);
   EXPECT_TRUE(got.empty());
+  link.release(0.05);
   link.b().receive(0.05, got);
   ASSERT_EQ(got.size(), 1u);
   got.clear();
+  link.release(0.099);
   link.a().receive(0.099, got);
   EXPECT_TRUE(got.empty());
+  link.release(0.1);
   link.a().receive(0.1, got);
   EXPECT_EQ(got.size(), 1u);
   EXPECT_EQ(link.a().traffic().sent, 1);
@@ -92,16 +113,17 @@ TEST(MemoryLink, DeliversAtTheArrivalTime) {
   EXPECT_EQ(link.b().traffic().received, 1);
 }
 
-TEST(MemoryLink, JitterDeliversInArrivalOrder) {
+TEST(EmulatedLink, JitterDeliversInArrivalOrder) {
   LinkConditions ab;
   ab.delay_s = 0.02;
   ab.jitter_s = 0.01;
-  MemoryLink link(ab, {});
+  EmulatedLink link(ab, {});
   for (int i = 0; i < 200; ++i) {
     const auto d = bytes(std::uint8_t(i));
     link.a().send(Channel::kUnreliable, d.data(), d.size(), i * 0.001);
   }
   std::vector<std::vector<std::uint8_t>> got;
+  link.release(1.0);
   link.b().receive(1.0, got);
   ASSERT_EQ(got.size(), 200u);
   int out_of_order = 0;
@@ -125,9 +147,9 @@ bool pump(EnetEndpoint& a, EnetEndpoint& b, std::vector<std::vector<std::uint8_t
 }
 
 TEST(EnetLink, BothChannelsOverOneLoopbackPort) {
-  auto server = EnetEndpoint::listen("127.0.0.1", 0, {});
+  auto server = EnetEndpoint::listen("127.0.0.1", 0);
   ASSERT_GT(server->port(), 0);
-  auto client = EnetEndpoint::connect("127.0.0.1", server->port(), {});
+  auto client = EnetEndpoint::connect("127.0.0.1", server->port());
   std::vector<std::vector<std::uint8_t>> at_server, at_client;
   ASSERT_TRUE(pump(*server, *client, at_server, at_client,
                    [&] { return server->connected() && client->connected(); }));
@@ -146,19 +168,22 @@ TEST(EnetLink, BothChannelsOverOneLoopbackPort) {
   }
 }
 
-TEST(EnetLink, EmulatedLossAtTheSender) {
-  auto server = EnetEndpoint::listen("127.0.0.1", 0, {});
+TEST(EnetLink, TheEmulatorInFrontLosesAtTheSender) {
+  auto server = EnetEndpoint::listen("127.0.0.1", 0);
   LinkConditions lossy;
   lossy.loss = 0.5;
   lossy.seed = 3;
-  auto client = EnetEndpoint::connect("127.0.0.1", server->port(), lossy);
+  auto client = EnetEndpoint::connect("127.0.0.1", server->port());
+  EmulatedEndpoint emulated(*client, lossy);
   std::vector<std::vector<std::uint8_t>> at_server, at_client;
   ASSERT_TRUE(pump(*server, *client, at_server, at_client, [&] { return client->connected(); }));
   for (int i = 0; i < 400; ++i) {
     const auto d = bytes(1);
-    client->send(Channel::kUnreliable, d.data(), d.size(), 0.0);
+    emulated.send(Channel::kUnreliable, d.data(), d.size(), 0.0);
   }
-  const std::int64_t expected = 400 - client->emulator().counters().lost;
+  EXPECT_EQ(emulated.traffic().sent, 400);
+  const std::int64_t expected = 400 - emulated.emulator().counters().lost;
+  EXPECT_EQ(client->traffic().sent, expected);
   ASSERT_TRUE(pump(*server, *client, at_server, at_client,
                    [&] { return std::int64_t(at_server.size()) >= expected; }));
   // Half are lost (4 sigma of a binomial(400, 0.5) is 40).
@@ -166,7 +191,7 @@ TEST(EnetLink, EmulatedLossAtTheSender) {
 }
 
 TEST(EnetLink, JunkOnThePortBreaksNothing) {
-  auto server = EnetEndpoint::listen("127.0.0.1", 0, {});
+  auto server = EnetEndpoint::listen("127.0.0.1", 0);
   // Raw UDP junk, not ENet: ENet's own checks drop it.
   const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
   ASSERT_GE(fd, 0);
@@ -181,7 +206,7 @@ TEST(EnetLink, JunkOnThePortBreaksNothing) {
   }
   ::close(fd);
   std::vector<std::vector<std::uint8_t>> at_server, at_client;
-  auto client = EnetEndpoint::connect("127.0.0.1", server->port(), {});
+  auto client = EnetEndpoint::connect("127.0.0.1", server->port());
   ASSERT_TRUE(pump(*server, *client, at_server, at_client, [&] { return server->connected(); }));
   EXPECT_TRUE(at_server.empty());
   const auto d = bytes(9);
@@ -191,10 +216,10 @@ TEST(EnetLink, JunkOnThePortBreaksNothing) {
 }
 
 TEST(EnetLink, BadAddressesAreNamed) {
-  EXPECT_THROW(EnetEndpoint::listen("not-an-ip", 0, {}), InputError);
-  EXPECT_THROW(EnetEndpoint::connect("127.0.0.1", 0, {}), InputError);
-  auto a = EnetEndpoint::listen("127.0.0.1", 0, {});
-  EXPECT_THROW(EnetEndpoint::listen("127.0.0.1", a->port(), {}), InputError);
+  EXPECT_THROW(EnetEndpoint::listen("not-an-ip", 0), InputError);
+  EXPECT_THROW(EnetEndpoint::connect("127.0.0.1", 0), InputError);
+  auto a = EnetEndpoint::listen("127.0.0.1", 0);
+  EXPECT_THROW(EnetEndpoint::listen("127.0.0.1", a->port()), InputError);
 }
 
 }  // namespace

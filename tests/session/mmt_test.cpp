@@ -214,7 +214,7 @@ struct Pair {
   MmtSettings settings;
   Scenario remote_sc;
   std::unique_ptr<haptics::Device> device;
-  net::MemoryLink link;
+  net::EmulatedLink link;
   OperatorStation op;
   RemoteStation remote;
 };

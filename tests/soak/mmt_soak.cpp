@@ -56,6 +56,7 @@
 #include "terracut/core/wire.hpp"
 #include "terracut/haptics/script_device.hpp"
 #include "terracut/haptics/workspace.hpp"
+#include "terracut/net/emulated_link.hpp"
 #include "terracut/net/enet_transport.hpp"
 #include "terracut/net/messages.hpp"
 #include "terracut/session/mmt.hpp"
@@ -106,7 +107,6 @@ class HostileEndpoint final : public net::Endpoint {
   void send(net::Channel channel, const std::uint8_t* data, std::size_t size, double now_s) override {
     inner_.send(channel, data, size, now_s);
   }
-  const net::LinkEmulator& emulator() const override { return inner_.emulator(); }
 
   using net::Endpoint::receive;
   void receive(double now_s, net::Inbox& out) override {
@@ -459,13 +459,14 @@ int run_mmt_soak(const MmtSoakOptions& o) {
   const double rate_hz = op.haptics.rate_hz;
   CheckingDevice checker(hand, op.haptics.safety, rate_hz);
 
-  std::unique_ptr<net::MemoryLink> memory;
+  std::unique_ptr<net::EmulatedLink> memory;
   std::unique_ptr<net::EnetEndpoint> enet_remote, enet_operator;
+  std::unique_ptr<net::EmulatedEndpoint> emulated_remote, emulated_operator;
   net::Endpoint* op_link = nullptr;
   net::Endpoint* remote_link = nullptr;
   if (enet) {
-    enet_remote = net::EnetEndpoint::listen("127.0.0.1", 0, s.to_operator);
-    enet_operator = net::EnetEndpoint::connect("127.0.0.1", enet_remote->port(), s.to_remote);
+    enet_remote = net::EnetEndpoint::listen("127.0.0.1", 0);
+    enet_operator = net::EnetEndpoint::connect("127.0.0.1", enet_remote->port());
     std::vector<std::vector<std::uint8_t>> none;
     const double start = wall_s();
     while (!enet_operator->connected() || !enet_remote->connected()) {
@@ -474,10 +475,12 @@ int run_mmt_soak(const MmtSoakOptions& o) {
       enet_remote->receive(0.0, none);
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
-    op_link = enet_operator.get();
-    remote_link = enet_remote.get();
+    emulated_remote = std::make_unique<net::EmulatedEndpoint>(*enet_remote, s.to_operator);
+    emulated_operator = std::make_unique<net::EmulatedEndpoint>(*enet_operator, s.to_remote);
+    op_link = emulated_operator.get();
+    remote_link = emulated_remote.get();
   } else {
-    memory = std::make_unique<net::MemoryLink>(s.to_remote, s.to_operator);
+    memory = std::make_unique<net::EmulatedLink>(s.to_remote, s.to_operator);
     op_link = &memory->a();
     remote_link = &memory->b();
   }
@@ -531,6 +534,7 @@ int run_mmt_soak(const MmtSoakOptions& o) {
       raw.send(enet_remote->port(), rng);
       raw.send(enet_operator->port(), rng);
     }
+    if (memory) memory->release(t);
     operator_station.tick(t);
     remote_station.tick(t);
     last_tick_s = t;

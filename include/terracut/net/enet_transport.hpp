@@ -22,12 +22,10 @@ class EnetEndpoint final : public Endpoint {
  public:
   /// The remote side: binds address:port (IPv4 text, port 0 = any free port).
   /// Throws InputError naming the address when it cannot be bound.
-  static std::unique_ptr<EnetEndpoint> listen(const std::string& address, int port,
-                                              const LinkConditions& sending);
+  static std::unique_ptr<EnetEndpoint> listen(const std::string& address, int port);
   /// The operator side: connects to address:port (the connection completes
   /// while receive() is called). Throws InputError naming a bad address.
-  static std::unique_ptr<EnetEndpoint> connect(const std::string& address, int port,
-                                               const LinkConditions& sending);
+  static std::unique_ptr<EnetEndpoint> connect(const std::string& address, int port);
   ~EnetEndpoint() override;
 
   void send(Channel channel, const std::uint8_t* data, std::size_t size, double now_s) override;
@@ -35,7 +33,6 @@ class EnetEndpoint final : public Endpoint {
   /// the emulator has released by now_s.
   void receive(double now_s, Inbox& out) override;
   using Endpoint::receive;
-  const LinkEmulator& emulator() const override;
   void reserve_in_flight(std::size_t datagrams, std::size_t bytes) override;
 
   /// The bound UDP port.

@@ -36,6 +36,7 @@
 #include "terracut/core/stats.hpp"
 #include "terracut/haptics/device.hpp"
 #include "terracut/io/scenario.hpp"
+#include "terracut/net/emulated_link.hpp"
 #include "terracut/net/emulator.hpp"
 #include "terracut/net/messages.hpp"
 #include "terracut/net/transport.hpp"
@@ -348,7 +349,7 @@ class MmtRun {
   const MmtSettings& settings() const { return settings_; }
   OperatorStation& operator_station() { return *operator_; }
   RemoteStation& remote_station() { return *remote_; }
-  net::MemoryLink& link() { return *link_; }
+  net::EmulatedLink& link() { return *link_; }
   /// RMS of local - remote heights over the worked region, sampled every 50 ms: (t, rms).
   const std::vector<std::pair<double, double>>& terrain_error() const { return terrain_error_; }
 
@@ -357,7 +358,7 @@ class MmtRun {
   MmtSettings settings_;
   std::unique_ptr<Scenario> op_, remote_scn_;
   std::unique_ptr<haptics::Device> device_;
-  std::unique_ptr<net::MemoryLink> link_;
+  std::unique_ptr<net::EmulatedLink> link_;
   std::unique_ptr<OperatorStation> operator_;
   std::unique_ptr<RemoteStation> remote_;
   std::int64_t tick_ = 0, total_ticks_ = 0;

@@ -11,6 +11,8 @@
 #include <memory>
 #include <string>
 
+#include "terracut/net/emulated_link.hpp"
+#include "terracut/net/enet_transport.hpp"
 #include "terracut/session/mmt.hpp"
 
 namespace terracut::session {
@@ -35,14 +37,20 @@ struct ProcessOptions {
 std::pair<std::string, int> parse_endpoint(const std::string& text, const std::string& option,
                                            const std::string& default_address);
 
+/// A station's UDP link: the ENet carrier, and the emulator of the
+/// scenario's conditions in front of it (what the station sends through).
+struct UdpLink {
+  std::unique_ptr<net::EnetEndpoint> carrier;
+  std::unique_ptr<net::EmulatedEndpoint> endpoint;
+};
+
 /// The operator's UDP link: connects to the remote station at endpoint
 /// ("ADDR:PORT" or "PORT"; empty: mmt.udp) with the to_remote conditions at
 /// the sender, and waits up to timeout_s for the connection. option names
 /// the command-line option in errors. Throws InputError (bad text, no
 /// answer in time).
-std::unique_ptr<net::Endpoint> connect_operator_link(const MmtSettings& s,
-                                                     const std::string& endpoint,
-                                                     const std::string& option, double timeout_s);
+UdpLink connect_operator_link(const MmtSettings& s, const std::string& endpoint,
+                              const std::string& option, double timeout_s);
 
 /// Runs the remote station (returns the exit code, 0). Throws InputError.
 int run_remote_process(const Scenario& op, const ProcessOptions& options);
