@@ -1,22 +1,11 @@
-// The transports: the in-memory link delivers in sending order, and with the
-// emulator in front of it (a decorator) by emulated arrival time; the ENet
-// link carries both channels over one loopback UDP port, the emulator in
-// front of it loses at the sender, and junk sent to that port breaks nothing.
+// The in-memory transport delivers in sending order, and with the emulator
+// in front of it (a decorator) by emulated arrival time; the pooled queues.
+// The ENet carrier's tests: enet_transport_test.cpp.
 #include "terracut/net/transport.hpp"
 
 #include <gtest/gtest.h>
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
-#include <chrono>
-#include <thread>
-
-#include "terracut/core/error.hpp"
 #include "terracut/net/emulated_link.hpp"
-#include "terracut/net/enet_transport.hpp"
 
 namespace terracut::net {
 namespace {
@@ -129,97 +118,6 @@ TEST(EmulatedLink, JitterDeliversInArrivalOrder) {
   int out_of_order = 0;
   for (std::size_t i = 1; i < got.size(); ++i) out_of_order += got[i][0] < got[i - 1][0];
   EXPECT_GT(out_of_order, 10);
-}
-
-// Services both ENet endpoints until pred holds or 3 s of wall time pass.
-template <class Pred>
-bool pump(EnetEndpoint& a, EnetEndpoint& b, std::vector<std::vector<std::uint8_t>>& at_a,
-          std::vector<std::vector<std::uint8_t>>& at_b, Pred pred) {
-  const auto start = std::chrono::steady_clock::now();
-  while (std::chrono::steady_clock::now() - start < std::chrono::seconds(3)) {
-    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    a.receive(now, at_a);
-    b.receive(now, at_b);
-    if (pred()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  return false;
-}
-
-TEST(EnetLink, BothChannelsOverOneLoopbackPort) {
-  auto server = EnetEndpoint::listen("127.0.0.1", 0);
-  ASSERT_GT(server->port(), 0);
-  auto client = EnetEndpoint::connect("127.0.0.1", server->port());
-  std::vector<std::vector<std::uint8_t>> at_server, at_client;
-  ASSERT_TRUE(pump(*server, *client, at_server, at_client,
-                   [&] { return server->connected() && client->connected(); }));
-  // Reliable messages arrive all and in order; unreliable ones over loopback too.
-  for (int i = 0; i < 50; ++i) {
-    const auto d = bytes(std::uint8_t(i), 100 + i);
-    client->send(Channel::kReliable, d.data(), d.size(), 0.0);
-    server->send(Channel::kUnreliable, d.data(), d.size(), 0.0);
-  }
-  ASSERT_TRUE(pump(*server, *client, at_server, at_client,
-                   [&] { return at_server.size() >= 50 && at_client.size() >= 45; }));
-  ASSERT_EQ(at_server.size(), 50u);
-  for (int i = 0; i < 50; ++i) {
-    EXPECT_EQ(at_server[std::size_t(i)].size(), std::size_t(100 + i));
-    EXPECT_EQ(at_server[std::size_t(i)][0], std::uint8_t(i));
-  }
-}
-
-TEST(EnetLink, TheEmulatorInFrontLosesAtTheSender) {
-  auto server = EnetEndpoint::listen("127.0.0.1", 0);
-  LinkConditions lossy;
-  lossy.loss = 0.5;
-  lossy.seed = 3;
-  auto client = EnetEndpoint::connect("127.0.0.1", server->port());
-  EmulatedEndpoint emulated(*client, lossy);
-  std::vector<std::vector<std::uint8_t>> at_server, at_client;
-  ASSERT_TRUE(pump(*server, *client, at_server, at_client, [&] { return client->connected(); }));
-  for (int i = 0; i < 400; ++i) {
-    const auto d = bytes(1);
-    emulated.send(Channel::kUnreliable, d.data(), d.size(), 0.0);
-  }
-  EXPECT_EQ(emulated.traffic().sent, 400);
-  const std::int64_t expected = 400 - emulated.emulator().counters().lost;
-  EXPECT_EQ(client->traffic().sent, expected);
-  ASSERT_TRUE(pump(*server, *client, at_server, at_client,
-                   [&] { return std::int64_t(at_server.size()) >= expected; }));
-  // Half are lost (4 sigma of a binomial(400, 0.5) is 40).
-  EXPECT_NEAR(double(at_server.size()), 200.0, 40.0);
-}
-
-TEST(EnetLink, JunkOnThePortBreaksNothing) {
-  auto server = EnetEndpoint::listen("127.0.0.1", 0);
-  // Raw UDP junk, not ENet: ENet's own checks drop it.
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  ASSERT_GE(fd, 0);
-  sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_port = htons(std::uint16_t(server->port()));
-  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  for (int i = 0; i < 200; ++i) {
-    std::uint8_t junk[64];
-    for (std::size_t k = 0; k < sizeof junk; ++k) junk[k] = std::uint8_t(i * 31 + k * 7);
-    ::sendto(fd, junk, std::size_t(1 + i % 64), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
-  }
-  ::close(fd);
-  std::vector<std::vector<std::uint8_t>> at_server, at_client;
-  auto client = EnetEndpoint::connect("127.0.0.1", server->port());
-  ASSERT_TRUE(pump(*server, *client, at_server, at_client, [&] { return server->connected(); }));
-  EXPECT_TRUE(at_server.empty());
-  const auto d = bytes(9);
-  client->send(Channel::kReliable, d.data(), d.size(), 0.0);
-  ASSERT_TRUE(pump(*server, *client, at_server, at_client, [&] { return !at_server.empty(); }));
-  EXPECT_EQ(at_server.front()[0], 9);
-}
-
-TEST(EnetLink, BadAddressesAreNamed) {
-  EXPECT_THROW(EnetEndpoint::listen("not-an-ip", 0), InputError);
-  EXPECT_THROW(EnetEndpoint::connect("127.0.0.1", 0), InputError);
-  auto a = EnetEndpoint::listen("127.0.0.1", 0);
-  EXPECT_THROW(EnetEndpoint::listen("127.0.0.1", a->port()), InputError);
 }
 
 }  // namespace
