@@ -14,6 +14,7 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitError = 1;     ///< bad input, a failed run or an unwritable output;
                                          ///< validate: a check failed
 inline constexpr int kExitNoFigures = 3; ///< reproduce, validate: results written, figures could not be made
+inline constexpr int kExitLinkLost = 4;  ///< mmt --role: the link to the other station died (outputs written)
 
 using Command = std::function<int()>;
 

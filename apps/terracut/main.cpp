@@ -23,7 +23,8 @@ int main(int argc, char** argv) {
       "Units are SI (metres, seconds). World frame: right-handed, Y up, ground plane X-Z;\n"
       "heightmap column index runs along +X, row index along +Z.\n"
       "Exit codes: 0 success; 1 bad input or failed output (validate: a check failed);\n"
-      "2 bad command line; 3 (reproduce, validate) results written but figures not made.\n"
+      "2 bad command line; 3 (reproduce, validate) results written but figures not made;\n"
+      "4 (mmt --role) the link to the other station died, outputs written.\n"
       "Scenario format: docs/scenario-format.md. Experiments: docs/experiments.md.\n"
       "The soil's physical checks (terracut validate): docs/validation.md.");
 
@@ -33,6 +34,7 @@ int main(int argc, char** argv) {
   const terracut::cli::Command validate = terracut::cli::add_validate_command(app);
   const terracut::cli::Command haptics = terracut::cli::add_haptics_command(app);
   const terracut::cli::Command mmt = terracut::cli::add_mmt_command(app);
+  const terracut::cli::Command key = terracut::cli::add_key_command(app);
 
   try {
     app.parse(argc, argv);
@@ -61,6 +63,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("validate")) return validate();
     if (app.got_subcommand("haptics")) return haptics();
     if (app.got_subcommand("mmt")) return mmt();
+    if (app.got_subcommand("key")) return key();
   } catch (const terracut::InputError& e) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
@@ -71,6 +74,6 @@ int main(int argc, char** argv) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
   }
-  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, validate, haptics, mmt)\n";
+  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, validate, haptics, mmt, key)\n";
   return 2;
 }

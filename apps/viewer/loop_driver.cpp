@@ -89,9 +89,7 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
   ro.loop.lock_memory = false;  // the viewer's GL driver allocates; locking all memory is not ours
   ro.loop.snapshot = exchange_.get();
   if (options.mmt) {
-    if (!scenario_.mmt)
-      throw InputError(scenario_.base.source_path.string() +
-                       ": --mmt: the scenario has no mmt: section (docs/teleoperation.md)");
+    if (!scenario_.mmt) throw InputError("--mmt: " + session::no_mmt_section(scenario_));
     // The operator station runs the loop with the viewer's settings; the
     // remote world is the scenario's mmt.remote.
     session::Scenario op = scenario_;
@@ -103,9 +101,9 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
     if (!options.remote.empty()) {
       // The remote is another process; a new session id each start, as
       // `terracut mmt --role operator` has it.
+      const std::uint32_t id = session::new_station_id();
       udp_ = session::connect_operator_link(mmt, options.remote, "--remote",
-                                            options.connect_timeout_s);
-      const auto id = std::uint32_t(std::chrono::steady_clock::now().time_since_epoch().count());
+                                            options.connect_timeout_s, options.key, id);
       operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, *udp_.endpoint, id, oo);
     } else {
       remote_scenario_ = std::make_unique<session::Scenario>(session::load_remote_scenario(op));
@@ -164,9 +162,14 @@ void LoopDriver::stop() {
   started_ = false;
 }
 
+void LoopDriver::end_session() {
+  if (udp_.carrier && !started_) udp_.carrier->end_session(0.5);
+}
+
 void LoopDriver::lockstep_main() {
   // A remote in another process runs on the wall clock: each tick waits for
-  // its time (t = i / rate from the start), or the operator would run ahead.
+  // its time (i / rate from the start), or the operator would run ahead, and
+  // its time is the wall clock's (the round trip it measures is real).
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
   std::int64_t i = 0;
@@ -175,10 +178,13 @@ void LoopDriver::lockstep_main() {
       std::this_thread::sleep_for(std::chrono::microseconds(200));
       continue;
     }
-    if (udp_.endpoint)
+    if (udp_.endpoint) {
       std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
                                                 std::chrono::duration<double>(double(i) / rate_hz())));
-    tick(i);
+      tick_at(i, std::chrono::duration<double>(Clock::now() - start).count());
+    } else {
+      tick(i);
+    }
     ++i;
     ticks_done_.store(i);  // after step2 published the tick's frame
   }
@@ -186,10 +192,11 @@ void LoopDriver::lockstep_main() {
 
 // Tick i at t = i / rate exactly, as HapticLoop::run_deterministic does: the
 // loop, or the operator station and then the remote.
-void LoopDriver::tick(std::int64_t i) {
+void LoopDriver::tick(std::int64_t i) { tick_at(i, double(i) / rate_hz()); }
+
+void LoopDriver::tick_at(std::int64_t i, double t_s) {
   using Clock = std::chrono::steady_clock;
   const double period = 1.0 / rate_hz();
-  const double t_s = double(i) * period;
   if (operator_) {
     if (link_) link_->release(t_s);
     operator_->tick(t_s);
@@ -204,15 +211,20 @@ void LoopDriver::tick(std::int64_t i) {
 }
 
 // MMT in real time: both stations ticked at the loop rate by absolute
-// deadlines (a late tick is not made up twice: the deadline moves on).
+// deadlines (a late tick is not made up twice: the deadline moves on), at
+// the wall clock's time since the start: a drawing thread that slows the
+// ticks does not slow the stations' clock, so the round trip measured is
+// the real one (it read 68 ms for a 100 ms emulated round trip when the
+// station's time was the ticks counted).
 void LoopDriver::paced_mmt_main() {
   using Clock = std::chrono::steady_clock;
   const auto period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / rate_hz()));
-  Clock::time_point deadline = Clock::now();
+  const Clock::time_point start = Clock::now();
+  Clock::time_point deadline = start;
   std::int64_t i = 0;
   while (lockstep_running_.load(std::memory_order_relaxed)) {
-    tick(i);
+    tick_at(i, std::chrono::duration<double>(Clock::now() - start).count());
     ++i;
     ticks_done_.store(i);
     deadline += period;
@@ -231,6 +243,13 @@ void LoopDriver::publish_mmt() {
   m.force_error_rms_n.store(std::sqrt(error_ms_n2_), std::memory_order_relaxed);
   m.remote_force_n.store(length(r.remote_force_world_n), std::memory_order_relaxed);
   m.rtt_s.store(operator_->rtt_s(), std::memory_order_relaxed);
+  m.command_loss.store(operator_->command_loss_recent(), std::memory_order_relaxed);
+  if (udp_.carrier) {
+    const net::EnetCounters& c = udp_.carrier->counters();
+    m.udp_dropped.store(c.dropped_unknown_source + c.dropped_oversize + c.kernel_dropped,
+                        std::memory_order_relaxed);
+    m.peers_refused.store(c.refused_total(), std::memory_order_relaxed);
+  }
   auto loss = [](const net::LinkEmulator& e) {
     const net::EmulatorCounters& c = e.counters();
     return c.datagrams > 0 ? double(c.lost) / double(c.datagrams) : 0.0;

@@ -68,12 +68,13 @@ ViewerApp::ViewerApp(ViewerOptions options, session::Scenario scenario)
   camera_.mode = options_.camera;
 }
 
-ViewerApp::~ViewerApp() { close_session(); }
+ViewerApp::~ViewerApp() { close_session(true); }
 
 void ViewerApp::open_session(const DriverOptions& driver_options) {
   driver_options_ = driver_options;
   driver_options_.mmt = options_.mmt;
   driver_options_.remote = options_.remote;
+  driver_options_.key = options_.key;
   driver_ = std::make_unique<LoopDriver>(scenario_, haptics_, driver_options_, &timing_);
   const GridSpec& spec = driver_->spec();
   const std::vector<float>& initial = driver_->initial_heights();
@@ -152,8 +153,9 @@ void ViewerApp::print_realtime_line() {
   std::cerr << "terracut-viewer: " << driver_->loop().realtime_status().message << "\n";
 }
 
-void ViewerApp::close_session() {
+void ViewerApp::close_session(bool end_remote) {
   if (driver_) driver_->stop();
+  if (driver_ && end_remote) driver_->end_session();
   driver_.reset();
   terrain_.reset();
 }
@@ -378,7 +380,7 @@ int ViewerApp::run_window() {
                "%.1f frames/s while drawing\n",
                static_cast<long long>(drawn), open_s, static_cast<long long>(iterations),
                drawing_s > 0.0 ? double(drawn) / drawing_s : 0.0);
-  close_session();
+  close_session(true);
   window_fb_.reset();
   shutdown_imgui(true);
   shapes_.reset();

@@ -50,7 +50,7 @@ int ViewerApp::run_headless() {
                   static_cast<long long>(driver_->ticks_done()));
     }
   }
-  close_session();
+  close_session(true);
   shutdown_imgui(false);
   shapes_.reset();
   return status;

@@ -299,7 +299,7 @@ class HostileEndpoint final : public net::Endpoint {
         inject(std::move(base), net::Reject::kBadMagic, out);
         break;
       case 4:
-        wire::put_u16(base.data() + 4, std::uint16_t(2 + pick(100)));
+        wire::put_u16(base.data() + 4, std::uint16_t(net::kVersion + 1 + pick(100)));
         repair_crc(base);
         inject(std::move(base), net::Reject::kBadVersion, out);
         break;
@@ -397,22 +397,6 @@ class HostileEndpoint final : public net::Endpoint {
   Last last_[net::kMessageTypeCount];
 };
 
-// The operator's hand: the scenario's cut, over and over (the script device
-// at the time modulo the path's period).
-class RepeatingScript final : public haptics::Device {
- public:
-  explicit RepeatingScript(haptics::DevicePath path) : period_s_(path.duration_s() + 0.5), script_(std::move(path)) {}
-  std::string_view kind() const override { return "script"; }
-  bool read(double t_s, haptics::DeviceSample& out) noexcept override {
-    return script_.read(std::fmod(std::max(t_s, 0.0), period_s_), out);
-  }
-  void write(const haptics::DeviceCommand& c) noexcept override { script_.write(c); }
-
- private:
-  double period_s_;
-  haptics::ScriptDevice script_;
-};
-
 // Random bytes to a UDP port (ENet must drop them before they reach a station).
 class RawUdpSender {
  public:
@@ -452,12 +436,11 @@ int run_mmt_soak(const MmtSoakOptions& o) {
   op.haptics.safety.rise_time_s = std::min(op.haptics.safety.rise_time_s, 0.2);
   const session::Scenario remote_scn = session::load_remote_scenario(op);
 
-  const haptics::Workspace ws(op.haptics.workspace);
   const io::Scenario& b = op.base;
-  const Motion& cut = b.cuts[std::size_t(b.sequence.empty() ? 0 : b.sequence.front())];
-  RepeatingScript hand{haptics::DevicePath(cut, ws)};
+  // The operator's hand: the scenario's cut, over and over.
+  const std::unique_ptr<haptics::Device> hand = session::make_operator_device(op, true);
   const double rate_hz = op.haptics.rate_hz;
-  CheckingDevice checker(hand, op.haptics.safety, rate_hz);
+  CheckingDevice checker(*hand, op.haptics.safety, rate_hz);
 
   std::unique_ptr<net::EmulatedLink> memory;
   std::unique_ptr<net::EnetEndpoint> enet_remote, enet_operator;
@@ -465,8 +448,14 @@ int run_mmt_soak(const MmtSoakOptions& o) {
   net::Endpoint* op_link = nullptr;
   net::Endpoint* remote_link = nullptr;
   if (enet) {
-    enet_remote = net::EnetEndpoint::listen("127.0.0.1", 0);
-    enet_operator = net::EnetEndpoint::connect("127.0.0.1", enet_remote->port());
+    // An authenticated session (secure.hpp) under a key of the seed's.
+    net::EnetOptions eo;
+    std::mt19937 key_rng(o.seed);
+    for (auto& b : eo.key.bytes) b = std::uint8_t(key_rng());
+    eo.station_id = 2u;
+    enet_remote = net::EnetEndpoint::listen("127.0.0.1", 0, eo);
+    eo.station_id = 1u;
+    enet_operator = net::EnetEndpoint::connect("127.0.0.1", enet_remote->port(), eo);
     std::vector<std::vector<std::uint8_t>> none;
     const double start = wall_s();
     while (!enet_operator->connected() || !enet_remote->connected()) {
