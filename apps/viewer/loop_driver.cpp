@@ -98,6 +98,7 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
     session::OperatorOptions oo;
     oo.snapshot = exchange_.get();
     oo.keep_records = false;
+    oo.wall_clock = !options.remote.empty();
     if (!options.remote.empty()) {
       // The remote is another process; a new session id each start, as
       // `terracut mmt --role operator` has it.
@@ -178,13 +179,10 @@ void LoopDriver::lockstep_main() {
       std::this_thread::sleep_for(std::chrono::microseconds(200));
       continue;
     }
-    if (udp_.endpoint) {
+    if (udp_.endpoint)
       std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
                                                 std::chrono::duration<double>(double(i) / rate_hz())));
-      tick_at(i, std::chrono::duration<double>(Clock::now() - start).count());
-    } else {
-      tick(i);
-    }
+    tick(i);
     ++i;
     ticks_done_.store(i);  // after step2 published the tick's frame
   }
@@ -192,11 +190,10 @@ void LoopDriver::lockstep_main() {
 
 // Tick i at t = i / rate exactly, as HapticLoop::run_deterministic does: the
 // loop, or the operator station and then the remote.
-void LoopDriver::tick(std::int64_t i) { tick_at(i, double(i) / rate_hz()); }
-
-void LoopDriver::tick_at(std::int64_t i, double t_s) {
+void LoopDriver::tick(std::int64_t i) {
   using Clock = std::chrono::steady_clock;
   const double period = 1.0 / rate_hz();
+  const double t_s = double(i) * period;
   if (operator_) {
     if (link_) link_->release(t_s);
     operator_->tick(t_s);
@@ -210,27 +207,23 @@ void LoopDriver::tick_at(std::int64_t i, double t_s) {
   rig_->loop().step2(i == 0 ? 0.0 : period, compute, false);
 }
 
-// MMT in real time: both stations ticked at the loop rate by absolute
-// deadlines (a late tick is not made up twice: the deadline moves on), at
-// the wall clock's time since the start: a drawing thread that slows the
-// ticks does not slow the stations' clock, so the round trip measured is
-// the real one (it read 68 ms for a 100 ms emulated round trip when the
-// station's time was the ticks counted).
+// MMT in real time: both stations ticked at the loop rate, tick i at t =
+// i / rate due at that time after the start; far behind (10 periods), the
+// missed ticks are skipped and t jumps to the wall clock's, never drifting
+// behind it (the stations' time held still while the drawing thread slowed
+// the ticks, and the measured round trip read 68 ms for 100 ms emulated).
 void LoopDriver::paced_mmt_main() {
   using Clock = std::chrono::steady_clock;
-  const auto period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(1.0 / rate_hz()));
   const Clock::time_point start = Clock::now();
-  Clock::time_point deadline = start;
   std::int64_t i = 0;
   while (lockstep_running_.load(std::memory_order_relaxed)) {
-    tick_at(i, std::chrono::duration<double>(Clock::now() - start).count());
+    tick(i);
     ++i;
     ticks_done_.store(i);
-    deadline += period;
-    const Clock::time_point now = Clock::now();
-    if (deadline < now - 10 * period) deadline = now;  // far behind: start again from now
-    std::this_thread::sleep_until(deadline);
+    const double now_s = std::chrono::duration<double>(Clock::now() - start).count();
+    if (now_s > double(i + 10) / rate_hz()) i = std::int64_t(now_s * rate_hz());
+    std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
+                                              std::chrono::duration<double>(double(i) / rate_hz())));
   }
 }
 

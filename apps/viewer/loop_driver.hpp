@@ -177,7 +177,6 @@ class LoopDriver {
   void lockstep_main();
   void paced_mmt_main();
   void tick(std::int64_t i);  // tick i (t = i / rate) of the loop or of both stations
-  void tick_at(std::int64_t i, double t_s);
   void publish_mmt();
 
   session::Scenario scenario_;  // the Tour points into its cuts

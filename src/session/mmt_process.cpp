@@ -93,29 +93,29 @@ void write_json(const std::filesystem::path& p, const nlohmann::ordered_json& j)
   if (!out) throw InputError(p.string() + ": cannot be written");
 }
 
-// Ticks at the rate on the wall clock until done(t) says so. Tick i is due
-// at i / rate from the start; a station more than 10 periods late skips the
-// ticks it missed. t is the wall clock since the start when the tick
-// begins: a station's time is the wall clock's, so the round trips it
-// measures and the delays it emulates are real ones. Returns the time run, s.
+// Ticks at the rate on the wall clock until done(t) says so: tick i at t =
+// i / rate (a fixed step: the loop's physics and the arm's servo step per
+// tick), due at that time after the start. A late station catches up; more
+// than 10 periods late it skips the ticks it missed, so its time stays
+// within 10 periods of the wall clock's (the delays it emulates are real
+// ones; the operator measures its round trips on the wall clock,
+// OperatorOptions::wall_clock). Returns the time run, s.
 template <class Tick, class Done>
 double paced(double rate_hz, Tick&& tick, Done&& done) {
   const auto start = Clock::now();
-  const auto seconds = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
-  double t = 0.0;
-  for (std::int64_t i = 0;; ++i) {
-    const double due_s = double(i) / rate_hz;
-    const double now_s = seconds();
-    if (now_s > due_s + 10.0 / rate_hz)
+  std::int64_t i = 0;
+  for (;; ++i) {
+    const double now_s = std::chrono::duration<double>(Clock::now() - start).count();
+    if (now_s > double(i + 10) / rate_hz)
       i = std::int64_t(now_s * rate_hz);
-    else if (now_s < due_s)
+    else
       std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
-                                                std::chrono::duration<double>(due_s)));
-    t = seconds();
+                                                std::chrono::duration<double>(double(i) / rate_hz)));
+    const double t = double(i) / rate_hz;
     tick(t);
     if (done(t)) break;
   }
-  return t + 1.0 / rate_hz;
+  return double(i + 1) / rate_hz;
 }
 
 bool stopping(const ProcessOptions& o) { return o.stop && o.stop->load(std::memory_order_relaxed); }
@@ -327,6 +327,7 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
   // duration is the user's.
   OperatorOptions options;
   options.keep_records = false;
+  options.wall_clock = true;
   OperatorStation station(op, s, *device, *udp.endpoint, id, options);
   std::filesystem::create_directories(o.out);
   StationCsv csv = StationCsv::operator_csv(o.out / "operator.csv");

@@ -601,7 +601,7 @@ void OperatorStation::receive(double t_s) {
         const std::uint32_t age = seq_command_ - m.command_sequence;
         if (age > 0 && age < command_sent_s_.size() &&
             (!rtt_known_ || std::int32_t(m.command_sequence - rtt_sequence_) > 0)) {
-          rtt_s_ = t_s - command_sent_s_[m.command_sequence % command_sent_s_.size()];
+          rtt_s_ = round_trip_clock_s(t_s) - command_sent_s_[m.command_sequence % command_sent_s_.size()];
           rtt_sequence_ = m.command_sequence;
           rtt_known_ = true;
           rtt_max_now_s_ = std::max(rtt_max_now_s_, rtt_s_);
@@ -721,6 +721,11 @@ void OperatorStation::merge(double t_s) {
   active_blends_ = kept;
 }
 
+double OperatorStation::round_trip_clock_s(double t_s) const {
+  if (!options_.wall_clock) return t_s;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 double OperatorStation::round_trip_bound_s() const {
   if (!rtt_known_)
     return settings_.to_remote.delay_s + settings_.to_operator.delay_s +
@@ -799,7 +804,7 @@ void OperatorStation::tick(double t_s) {
     cmd.round_trip_us = std::uint32_t(std::clamp(round_trip_bound_s() * 1e6, 1.0, 4e9));
   std::uint8_t out[net::kHeaderSize + net::kCommandPayloadSize + net::kCrcSize];
   const std::uint32_t sent_sequence = seq_command_;
-  command_sent_s_[seq_command_ % command_sent_s_.size()] = t_s;
+  command_sent_s_[seq_command_ % command_sent_s_.size()] = round_trip_clock_s(t_s);
   net::Header h{net::MessageType::kCommand, settings_.link_id, session_, seq_command_++,
                 to_ns(t_s)};
   const std::size_t n = net::encode_command(h, cmd, out);

@@ -70,7 +70,7 @@ start_remote() {
   remote_pid=$!
   port=""
   for _ in $(seq 1 200); do
-    port=$(sed -n 's/.*remote listening on 127.0.0.1:\([0-9]*\).*/\1/p' "$out.log")
+    port=$(sed -n 's/.*remote listening on 127.0.0.1:\([0-9]*\).*/\1/p' "$out.log" 2>/dev/null || true)
     [ -n "$port" ] && break
     sleep 0.05
   done

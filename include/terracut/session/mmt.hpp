@@ -206,6 +206,10 @@ struct OperatorOptions {
   /// for a session without a set end (the viewer's, the live stations of
   /// `terracut mmt --role`, which stream them to a file).
   bool keep_records = true;
+  /// Measure the round trip on the wall clock (a station in real time: its
+  /// tick times may lag the wall clock's while it catches up); false: on the
+  /// station's time (simulated time, where the wall clock means nothing).
+  bool wall_clock = false;
 };
 
 class OperatorStation {
@@ -274,6 +278,7 @@ class OperatorStation {
   void receive(double t_s);
   void merge(double t_s);
   void measure_link(double t_s);
+  double round_trip_clock_s(double t_s) const;
   double protection_s() const;
 
   MmtSettings settings_;
@@ -308,7 +313,8 @@ class OperatorStation {
   std::vector<OperatorRecord> records_;
   OperatorRecord last_{};
   OperatorOptions options_;
-  // When each command was sent, s, by sequence modulo the ring's size.
+  // When each command was sent (station time, or the wall clock's with
+  // OperatorOptions::wall_clock), s, by sequence modulo the ring's size.
   std::vector<double> command_sent_s_;
   std::uint32_t rtt_sequence_ = 0;  // the command the newest round trip is of
   double rtt_s_ = 0.0;

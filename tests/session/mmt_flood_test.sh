@@ -1,0 +1,112 @@
+#!/bin/sh
+# An authenticated two-process session under attack from the same machine
+# (loopback): a 50 000 datagram/s junk flood from another local port and an
+# ENet intruder (terracut-netprobe) against the remote's port for the whole
+# session, against the same session without them.
+#  - the intruder never takes the session over: one session, the operator's;
+#    every connection it made is refused and counted (but one still in its
+#    handshake when the remote ended);
+#  - every flood datagram is counted by the remote before terracut's
+#    stations see anything (no peer's, oversize, a connection request, or
+#    dropped by the kernel);
+#  - the operator keeps at least 90 % of its commands, and the session's
+#    force error (the report's, MMT) stays within 20 % of the clean run's.
+# Usage: mmt_flood_test.sh TERRACUT NETPROBE SOURCE_DIR WORK_DIR
+set -eu
+terracut=$1
+netprobe=$2
+src=$3
+work=$4
+rm -rf "$work"
+mkdir -p "$work"
+unset TERRACUT_MMT_KEY || true
+scenario="$src/scenarios/mmt_trench_clay.yaml"
+# No jitter: without it no command arrives out of order, so a clean run keeps
+# them all and every command lost is the flood's doing.
+link="--rtt-ms 100 --jitter-ms 0"
+"$terracut" key --out "$work/mmt.key" > /dev/null
+key="--key $work/mmt.key"
+pids=""
+trap 'for p in $pids; do kill -9 $p 2>/dev/null || true; done' EXIT
+
+start_remote() {
+  out=$1
+  "$terracut" mmt "$scenario" --role remote --listen 127.0.0.1:0 --out "$out" $key $link \
+    > "$out.log" 2> "$out.err" &
+  remote_pid=$!
+  pids="$pids $remote_pid"
+  port=""
+  for _ in $(seq 1 200); do
+    port=$(sed -n 's/.*remote listening on 127.0.0.1:\([0-9]*\).*/\1/p' "$out.log" 2>/dev/null || true)
+    [ -n "$port" ] && break
+    sleep 0.05
+  done
+  [ -n "$port" ] || { echo "the remote did not say its port"; cat "$out.log" "$out.err"; exit 1; }
+}
+
+# The clean session.
+start_remote "$work/clean_remote"
+"$terracut" mmt "$scenario" --role operator --connect "127.0.0.1:$port" $key $link \
+  --out "$work/clean_operator" > "$work/clean_operator.log" 2>&1
+wait $remote_pid
+"$terracut" mmt "$scenario" --report "$work/clean_operator" "$work/clean_remote" --out "$work/clean" -q --no-plot
+
+# The attacked session: the flood and the intruder start before the operator
+# and stop before it ends (so that the remote reads every datagram of theirs).
+start_remote "$work/remote"
+"$netprobe" --port "$port" --flood-rate 50000 --intruder --duration 3.5 --out "$work/probe.json" &
+probe_pid=$!
+pids="$pids $probe_pid"
+sleep 0.3
+"$terracut" mmt "$scenario" --role operator --connect "127.0.0.1:$port" $key $link \
+  --out "$work/operator" > "$work/operator.log" 2> "$work/operator.err"
+wait $probe_pid
+wait $remote_pid
+trap - EXIT
+"$terracut" mmt "$scenario" --report "$work/operator" "$work/remote" --out "$work/attacked" -q --no-plot
+
+/usr/bin/python3 - "$work" <<'PY'
+import json, sys
+work = sys.argv[1]
+def load(p):
+    return json.load(open(f"{work}/{p}"))
+probe, op, rm = load("probe.json"), load("operator/summary.json"), load("remote/summary.json")
+clean, attacked = load("clean/summary.json"), load("attacked/summary.json")
+ok = True
+def check(cond, what):
+    global ok
+    if not cond:
+        print("FAILED:", what)
+        ok = False
+flood, intr, udp = probe["flood"], probe["intruder"], rm["udp"]
+print(f"flood {flood['sent']} datagrams ({flood['sent'] / 3.5:.0f}/s), intruder {intr['connected']} connections; "
+      f"remote: unknown {udp['dropped_unknown_source']}, oversize {udp['dropped_oversize']}, requests "
+      f"{udp['connection_requests']}, kernel {udp['dropped_by_kernel']}, refused {udp['peers_refused']}; "
+      f"commands {op['commands']['received_by_remote']} of {op['commands']['followed']}; force error "
+      f"{attacked['force_error']['mmt_rms_n']:.1f} N against {clean['force_error']['mmt_rms_n']:.1f} N clean")
+check(flood["sent"] > 0.2 * 50000 * 3.5, f"the flood sent only {flood['sent']}")
+check(intr["connected"] > 0, "the intruder never connected")
+# The intruder: refused, counted, never the session's.
+refused = sum(udp["peers_refused"].values())
+check(udp["sessions"] == 1 and udp["resumed"] == 0, f"sessions {udp['sessions']}, resumed {udp['resumed']}")
+check(rm["operator"]["id"] != 0 and rm["operator"]["state_at_end"] == "ended_the_session", f"remote's operator {rm['operator']}")
+check(intr["connected"] - 1 <= refused <= intr["connected"], f"{refused} refused of {intr['connected']} intruder connections")
+check(op["ended"]["how"] == "completed" and rm["ended"]["how"] == "operator_ended", f"ended {op['ended']} / {rm['ended']}")
+# Every flood datagram counted before a station saw it. The counts also hold
+# the intruder's and the operator's connection requests (each at most a few
+# datagrams) and any of the operator's datagrams the kernel dropped.
+counted = udp["dropped_unknown_source"] + udp["dropped_oversize"] + udp["connection_requests"] + udp["dropped_by_kernel"]
+lost = op["commands"]["followed"] - op["commands"]["received_by_remote"]
+check(counted >= flood["sent"], f"counted {counted} of {flood['sent']} flood datagrams")
+check(counted <= flood["sent"] + 3 * intr["attempts"] + 10 + 3 * lost, f"counted {counted} for {flood['sent']} sent")
+check(udp["dropped_oversize"] == flood["oversize"], f"oversize {udp['dropped_oversize']} of {flood['oversize']}")
+check(udp["dropped_by_kernel"] >= flood["empty"], f"kernel drops {udp['dropped_by_kernel']}, empty datagrams {flood['empty']}")
+# The session survived: commands kept, and the force the operator felt.
+kept = op["commands"]["received_by_remote"] / max(1, op["commands"]["followed"])
+check(kept >= 0.9, f"the remote received {kept:.3f} of the commands")
+check(rm["accepted"] >= 0.9 * op["commands"]["sent"] - 200, f"remote accepted {rm['accepted']} of {op['commands']['sent']}")
+f_att, f_clean = attacked["force_error"]["mmt_rms_n"], clean["force_error"]["mmt_rms_n"]
+check(abs(f_att - f_clean) <= 0.2 * f_clean, f"force error {f_att:.1f} N against {f_clean:.1f} N clean")
+sys.exit(0 if ok else 1)
+PY
+echo "MMT under a flood and an intruder: ok"
