@@ -118,6 +118,9 @@ double paced(double rate_hz, Tick&& tick, Done&& done) {
   return double(i + 1) / rate_hz;
 }
 
+// A time in the messages: to the millisecond.
+std::string ms_text(double t_s) { return format_number(std::round(t_s * 1000.0) / 1000.0); }
+
 bool stopping(const ProcessOptions& o) { return o.stop && o.stop->load(std::memory_order_relaxed); }
 
 std::pair<std::string, int> address_of(const MmtSettings& s, const std::string& endpoint,
@@ -257,7 +260,7 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
           operator_lost_at_s = t;
           if (o.warn)
             *o.warn << "terracut mmt: remote: the operator has been unheard for "
-                    << format_number(s.link_lost_s) << " s (t = " << format_number(t)
+                    << format_number(s.link_lost_s) << " s (t = " << ms_text(t)
                     << " s); waiting for it to come back\n";
         }
         if (!lost) operator_lost_at_s = -1.0;
@@ -306,7 +309,7 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
            << " patches sent, " << carrier->counters().refused_total() << " peers refused\n";
   if (lost && o.warn)
     *o.warn << "terracut mmt: remote: the session's operator was lost at t = "
-            << format_number(operator_lost_at_s) << " s and did not come back; exit code "
+            << ms_text(operator_lost_at_s) << " s and did not come back; exit code "
             << kExitLinkLost << "\n";
   return lost ? kExitLinkLost : 0;
 }
@@ -406,12 +409,12 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
     if (o.warn) {
       if (ended == Ended::kLinkLost)
         *o.warn << "terracut mmt: operator: the link to the remote died: nothing heard since t = "
-                << format_number(station.last_heard_s()) << " s (" << format_number(s.link_lost_s)
+                << ms_text(station.last_heard_s()) << " s (" << format_number(s.link_lost_s)
                 << " s, mmt.link_lost_s); the force faded out after "
                 << format_number(s.timeout_s) << " s; exit code " << kExitLinkLost << "\n";
       else
         *o.warn << "terracut mmt: operator: the remote ended the session at t = "
-                << format_number(ran) << " s, before the operator's run was done; exit code "
+                << ms_text(ran) << " s, before the operator's run was done; exit code "
                 << kExitLinkLost << "\n";
     }
     return kExitLinkLost;

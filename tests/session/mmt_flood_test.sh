@@ -17,35 +17,16 @@ terracut=$1
 netprobe=$2
 src=$3
 work=$4
-rm -rf "$work"
-mkdir -p "$work"
-unset TERRACUT_MMT_KEY || true
 scenario="$src/scenarios/mmt_trench_clay.yaml"
+. "$src/tests/session/mmt_stations.sh"
 # No jitter: without it no command arrives out of order, so a clean run keeps
 # them all and every command lost is the flood's doing.
 link="--rtt-ms 100 --jitter-ms 0"
 "$terracut" key --out "$work/mmt.key" > /dev/null
 key="--key $work/mmt.key"
-pids=""
-trap 'for p in $pids; do kill -9 $p 2>/dev/null || true; done' EXIT
-
-start_remote() {
-  out=$1
-  "$terracut" mmt "$scenario" --role remote --listen 127.0.0.1:0 --out "$out" $key $link \
-    > "$out.log" 2> "$out.err" &
-  remote_pid=$!
-  pids="$pids $remote_pid"
-  port=""
-  for _ in $(seq 1 200); do
-    port=$(sed -n 's/.*remote listening on 127.0.0.1:\([0-9]*\).*/\1/p' "$out.log" 2>/dev/null || true)
-    [ -n "$port" ] && break
-    sleep 0.05
-  done
-  [ -n "$port" ] || { echo "the remote did not say its port"; cat "$out.log" "$out.err"; exit 1; }
-}
 
 # The clean session.
-start_remote "$work/clean_remote"
+start_remote "$work/clean_remote" $key $link
 "$terracut" mmt "$scenario" --role operator --connect "127.0.0.1:$port" $key $link \
   --out "$work/clean_operator" > "$work/clean_operator.log" 2>&1
 wait $remote_pid
@@ -53,7 +34,7 @@ wait $remote_pid
 
 # The attacked session: the flood and the intruder start before the operator
 # and stop before it ends (so that the remote reads every datagram of theirs).
-start_remote "$work/remote"
+start_remote "$work/remote" $key $link
 "$netprobe" --port "$port" --flood-rate 50000 --intruder --duration 3.5 --out "$work/probe.json" &
 probe_pid=$!
 pids="$pids $probe_pid"

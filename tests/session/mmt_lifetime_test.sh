@@ -14,59 +14,29 @@ set -eu
 terracut=$1
 src=$2
 work=$3
-rm -rf "$work"
-mkdir -p "$work"
-unset TERRACUT_MMT_KEY || true
+scenario="$work/trench.yaml"
+. "$src/tests/session/mmt_stations.sh"
 # The trench with a 20 ms round trip and a link that is dead after 1.5 s unheard.
 sed -e 's/^  timeout_s: 0.2$/  timeout_s: 0.2\n  link_lost_s: 1.5/' \
     -e 's/^    delay_s: 0.05 .*/    delay_s: 0.01/' \
     -e 's/^    jitter_s: 0.002$/    jitter_s: 0.0/' \
     "$src/scenarios/mmt_trench_clay.yaml" > "$work/trench.yaml"
 grep -q "link_lost_s: 1.5" "$work/trench.yaml" || { echo "the scenario copy has no link_lost_s"; exit 1; }
-scenario="$work/trench.yaml"
 "$terracut" key --out "$work/mmt.key" > /dev/null
 key="--key $work/mmt.key"
-pids=""
-trap 'for p in $pids; do kill -9 $p 2>/dev/null || true; done' EXIT
-
-# Starts a remote on any free port: $1 its folder, then its options; sets
-# remote_pid and port.
-start_remote() {
-  out=$1
-  shift
-  "$terracut" mmt "$scenario" --role remote --listen 127.0.0.1:0 --out "$out" $key "$@" \
-    > "$out.log" 2> "$out.err" &
-  remote_pid=$!
-  pids="$pids $remote_pid"
-  port=""
-  for _ in $(seq 1 200); do
-    port=$(sed -n 's/.*remote listening on 127.0.0.1:\([0-9]*\).*/\1/p' "$out.log" 2>/dev/null || true)
-    [ -n "$port" ] && break
-    sleep 0.05
-  done
-  [ -n "$port" ] || { echo "the remote did not say its port"; cat "$out.log" "$out.err"; exit 1; }
-}
-# Waits for pid; its exit code in code (not in a subshell: only the shell
-# that started it may wait for it).
-code_of() {
-  set +e
-  wait "$1"
-  code=$?
-  set -e
-}
 
 # A remote that waits for a late operator: started now, joined in 15 s.
-start_remote "$work/late_remote"
+start_remote "$work/late_remote" $key
 late_pid=$remote_pid
 late_port=$port
 late_start=$(date +%s.%N)
 
 # No operator at all: the remote lives its --duration and says so.
-start_remote "$work/alone" --duration 2
+start_remote "$work/alone" $key --duration 2
 code_of $remote_pid; [ "$code" = 0 ] || { echo "the lone remote failed"; cat "$work/alone.err"; exit 1; }
 
 # The remote is killed mid-session: the operator ends with exit code 4.
-start_remote "$work/killed_remote"
+start_remote "$work/killed_remote" $key
 "$terracut" mmt "$scenario" --role operator --connect "127.0.0.1:$port" $key --out "$work/orphan" \
   > "$work/orphan.log" 2> "$work/orphan.err" &
 orphan_pid=$!
@@ -79,7 +49,7 @@ t1=$(date +%s.%N)
 grep -q "the link to the remote died" "$work/orphan.err" || { cat "$work/orphan.err"; exit 1; }
 
 # The operator is killed mid-session: the remote ends at its --duration with exit code 4.
-start_remote "$work/bereft" --duration 5
+start_remote "$work/bereft" $key --duration 5
 "$terracut" mmt "$scenario" --role operator --connect "127.0.0.1:$port" $key --out "$work/killed_operator" \
   > /dev/null 2>&1 &
 victim=$!
@@ -89,7 +59,7 @@ kill -9 $victim
 code_of $remote_pid; [ "$code" = 4 ] || { echo "the remote of a killed operator did not exit 4"; cat "$work/bereft.err"; exit 1; }
 
 # SIGTERM stops a remote cleanly; its operator hears that the session is over.
-start_remote "$work/stopped"
+start_remote "$work/stopped" $key
 "$terracut" mmt "$scenario" --role operator --connect "127.0.0.1:$port" $key --out "$work/cut_short" \
   > /dev/null 2> "$work/cut_short.err" &
 cut_pid=$!

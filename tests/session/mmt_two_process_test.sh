@@ -12,10 +12,8 @@ set -eu
 terracut=$1
 src=$2
 work=$3
-rm -rf "$work"
-mkdir -p "$work"
-unset TERRACUT_MMT_KEY || true
 scenario="$src/scenarios/mmt_trench_clay.yaml"
+. "$src/tests/session/mmt_stations.sh"
 link="--rtt-ms 100 --jitter-ms 2 --loss 0.05"
 
 # Bad command lines are refused with a message naming the option (exit 1).
@@ -60,27 +58,9 @@ done
 # 2 RTTs x 2 losses, plus the deadband variant per RTT, and the header.
 [ "$(wc -l < "$work/study/study.csv")" -eq 7 ] || { echo "study.csv:"; cat "$work/study/study.csv"; exit 1; }
 
-# Starts a remote station on any free port ($1: folder, then its options);
-# sets remote_pid and port.
-start_remote() {
-  out=$1
-  shift
-  "$terracut" mmt "$scenario" --role remote --listen 127.0.0.1:0 --out "$out" "$@" \
-    > "$out.log" 2> "$out.err" &
-  remote_pid=$!
-  port=""
-  for _ in $(seq 1 200); do
-    port=$(sed -n 's/.*remote listening on 127.0.0.1:\([0-9]*\).*/\1/p' "$out.log" 2>/dev/null || true)
-    [ -n "$port" ] && break
-    sleep 0.05
-  done
-  [ -n "$port" ] || { echo "the remote did not say its port"; cat "$out.log" "$out.err"; exit 1; }
-}
-
 # Another key: the operator is refused by name (exit 1), the remote counts it.
 "$terracut" key --out "$work/other.key" > /dev/null
 start_remote "$work/refusing" --key "$work/mmt.key" --duration 4
-trap 'kill $remote_pid 2>/dev/null || true' EXIT
 refuse "refused this operator (bad_key" mmt "$scenario" --role operator --connect "127.0.0.1:$port" \
   --key "$work/other.key" --out "$work/x"
 wait $remote_pid
@@ -90,7 +70,6 @@ start_remote "$work/remote" $link --key "$work/mmt.key"
 "$terracut" mmt "$scenario" --role operator --connect "127.0.0.1:$port" $link \
   --key "$work/mmt.key" --out "$work/operator" > "$work/operator.log" 2>&1
 wait $remote_pid
-trap - EXIT
 "$terracut" mmt "$scenario" --report "$work/operator" "$work/remote" --out "$work/report" -q
 for f in operator.csv remote.csv terrain_error.csv summary.json mmt.png; do
   [ -s "$work/report/$f" ] || { echo "two-process report: no $f"; exit 1; }
@@ -103,6 +82,7 @@ start_remote "$work/insecure_remote" --insecure-loopback --duration 30
 wait $remote_pid
 grep -q "NOT authenticated" "$work/insecure.log" || { cat "$work/insecure.log"; exit 1; }
 grep -q "NOT authenticated" "$work/insecure_remote.err" || { cat "$work/insecure_remote.err"; exit 1; }
+trap - EXIT
 
 /usr/bin/python3 - "$work" <<'PY'
 import json, sys
