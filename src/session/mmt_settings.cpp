@@ -74,8 +74,8 @@ std::string validate(const MmtSettings& s) {
   if (!(m = check("timeout_s", s.timeout_s)).empty()) return m;
   if (!(m = check("link_lost_s", s.link_lost_s)).empty()) return m;
   if (!(s.link_lost_s > s.timeout_s))
-    return must_be("link_lost_s", "greater than timeout_s (" + format_number(s.timeout_s) + ")",
-                   s.link_lost_s);
+    return "link_lost_s " + format_number(s.link_lost_s) + " s is not longer than timeout_s (" +
+           format_number(s.timeout_s) + " s): the link would be dead before its silence faded the force";
   if (!(m = check("udp.port", s.port)).empty()) return m;
   return {};
 }
