@@ -441,6 +441,7 @@ void RemoteStation::send_estimate(double t_s) {
 }
 
 void RemoteStation::tick(double t_s) {
+  const auto tick_start = std::chrono::steady_clock::now();
   receive(t_s);
   // Silence: the arm holds where it is.
   const bool holding = has_command_ && t_s - last_command_s_ > settings_.timeout_s;
@@ -455,7 +456,6 @@ void RemoteStation::tick(double t_s) {
   loop.step1(t_s);
   const haptics::LoopRecord& r =
       loop.step2(ticked_ ? t_s - previous_t_s_ : 0.0, seconds_since(start), false);
-  const double compute_s = seconds_since(start);
   previous_t_s_ = t_s;
   ticked_ = true;
   if (sim.step_count() > steps_before) {
@@ -495,7 +495,7 @@ void RemoteStation::tick(double t_s) {
   rec.force_scale = theta_;
   rec.holding = holding;
   rec.active = has_command_;
-  rec.compute_s = compute_s;
+  rec.compute_s = seconds_since(tick_start);  // the whole tick: what arrived, the loop, what it sent
   last_ = rec;
   if (options_.keep_records) records_.push_back(rec);
 }

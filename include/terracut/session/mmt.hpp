@@ -62,7 +62,7 @@ struct RemoteRecord {
   double force_scale = 1.0;  ///< the estimate
   bool holding = false;      ///< link silent: holding still
   bool active = false;       ///< a command has arrived
-  double compute_s = 0.0;
+  double compute_s = 0.0;    ///< the whole tick (receiving, the loop, sensing, sending), s
 };
 
 /// One operator tick.
@@ -80,7 +80,7 @@ struct OperatorRecord {
   bool link_silent = false;
   double passivity_j = 0.0;      ///< energy into the hand over the last window, MMT, J
   double passivity_dfr_j = 0.0;  ///< the same for direct force reflection, J
-  double compute_s = 0.0;
+  double compute_s = 0.0;        ///< the whole tick (receiving, merging, the loop, sending), s
   std::uint32_t command_sequence = 0;  ///< the command sent this tick
   double round_trip_s = 0.0;   ///< newest measured round trip, s (0: none yet)
   double command_loss = 0.0;   ///< commands the remote did not receive over about the last second, fraction
@@ -330,7 +330,7 @@ class OperatorStation {
   std::vector<std::int64_t> loss_received_;
   double loss_recent_ = 0.0;
   std::int64_t silences_ = 0;
-  double silence_start_s_ = 0.0, longest_silence_s_ = 0.0;
+  double longest_silence_s_ = 0.0;
   bool was_silent_ = false;
   StationCounters counters_{};
   net::Inbox inbox_;
