@@ -475,6 +475,12 @@ std::unique_ptr<EnetEndpoint::State> make_state(const EnetOptions& o, bool liste
     throw InputError("peer_timeout_s must be in [1, 60]");
   if (!(o.receive_budget_s >= 0.0) || !(o.takeover_silence_s >= 0.0))
     throw InputError("receive_budget_s and takeover_silence_s must be >= 0");
+  // A key left at its default (zeros) is no key: say so rather than run
+  // "authenticated" with the key everyone knows.
+  if (!o.key.insecure &&
+      std::all_of(o.key.bytes.begin(), o.key.bytes.end(), [](std::uint8_t b) { return b == 0; }))
+    throw InputError("the link's key is all zeros (none was given): give the stations a key, or "
+                     "insecure_key() for a demo on loopback");
   enet_acquire();
   auto state = std::make_unique<EnetEndpoint::State>();
   state->o = o;

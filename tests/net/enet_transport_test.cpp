@@ -379,6 +379,19 @@ TEST(EnetLink, AJunkFloodIsCountedDatagramByDatagramAndTheSessionKeepsItsDatagra
   EXPECT_EQ(s.remote->peer_id(), 41u);
 }
 
+TEST(EnetLink, AKeyLeftAtZerosIsRefused) {
+  EnetOptions o;  // no key given
+  try {
+    EnetEndpoint::listen("127.0.0.1", 0, o);
+    FAIL() << "listened with no key";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("all zeros"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(EnetEndpoint::connect("127.0.0.1", 1, o), InputError);
+  o.key = insecure_key();
+  EXPECT_NO_THROW(EnetEndpoint::listen("127.0.0.1", 0, o));
+}
+
 TEST(EnetLink, BadAddressesAreNamed) {
   EXPECT_THROW(EnetEndpoint::listen("not-an-ip", 0, options(key_of(1), 1)), InputError);
   EXPECT_THROW(EnetEndpoint::connect("127.0.0.1", 0, options(key_of(1), 1)), InputError);

@@ -179,6 +179,7 @@ TEST(ViewerMmt, NoRemoteStationAtTheAddressIsRefusedByName) {
   o.paced = false;
   o.mmt = true;
   o.remote = "127.0.0.1:1";  // nothing listens there
+  o.key = net::insecure_key();
   o.connect_timeout_s = 0.3;
   try {
     LoopDriver d(sc, viewer_settings(sc.haptics), o, nullptr);

@@ -62,7 +62,8 @@ inline constexpr std::size_t kRefusalCount = 6;  // index = value; [0] unused
 std::string_view to_string(Refusal reason);
 
 struct EnetOptions {
-  /// The pre-shared key (or insecure_key() for --insecure-loopback).
+  /// The pre-shared key (or insecure_key() for --insecure-loopback); one
+  /// left at zeros is refused.
   LinkKey key;
   /// This station's id: the operator's identifies it across reconnections.
   std::uint32_t station_id = 0;
