@@ -614,7 +614,13 @@ void EnetEndpoint::reserve_in_flight(std::size_t datagrams, std::size_t bytes) {
   if (s_->opened.size() < bytes + kSealOverhead) s_->opened.resize(bytes + kSealOverhead);
 }
 
-int EnetEndpoint::port() const { return s_->host ? int(s_->host->address.port) : -1; }
+int EnetEndpoint::port() const {
+  // The socket's own port: an operator's host binds any free one (its
+  // ENetHost::address says 0).
+  ENetAddress a{};
+  if (!s_->host || enet_socket_get_address(s_->host->socket, &a) != 0) return -1;
+  return int(a.port);
+}
 bool EnetEndpoint::connected() const { return s_->session >= 0; }
 bool EnetEndpoint::peer_ended() const { return s_->peer_ended; }
 std::optional<Refusal> EnetEndpoint::refused_by_peer() const { return s_->refused_by_peer; }

@@ -14,8 +14,9 @@
 // forged but valid messages of a new session (far poses, absurd soil
 // factors, heights of tens of metres: accepted, as a restarted peer is);
 // floods of up to 64 at once; and outages, during which nothing the peer
-// sends arrives. In mmt-enet a raw UDP socket also sends random bytes to
-// both stations' ports (ENet itself must drop them).
+// sends arrives. In mmt-enet the stations' session is authenticated
+// (net/secure.hpp) and a raw UDP socket also sends random bytes to both
+// stations' ports: their carriers must drop and count every one.
 //
 // Asserted over the whole run (exit status 1 and a line per broken promise):
 //   - the operator's device force never exceeds safety.max_force_n nor grows
@@ -646,7 +647,24 @@ int run_mmt_soak(const MmtSoakOptions& o) {
                 static_cast<long long>(side.hostile.real_order), static_cast<long long>(side.hostile.real_framing),
                 side.hostile.first_anomaly.empty() ? "" : "; the first: ", side.hostile.first_anomaly.c_str());
   }
-  if (enet) std::printf("  raw UDP datagrams to the ENet ports: %lld\n", static_cast<long long>(raw.sent));
+  if (enet) {
+    // Every raw datagram counted by the carrier it reached, before a station
+    // saw it (the random bytes of one may read as a connection request).
+    std::printf("  raw UDP datagrams to the ENet ports: %lld;", static_cast<long long>(raw.sent));
+    std::int64_t counted_all = 0;
+    for (const net::EnetEndpoint* e : {enet_remote.get(), enet_operator.get()}) {
+      const net::EnetCounters& c = e->counters();
+      const std::int64_t counted = c.dropped_unknown_source + c.dropped_oversize + c.kernel_dropped +
+                                   c.connection_requests;
+      counted_all += counted;
+      std::printf(" %s counted %lld (no peer's %lld, kernel %lld)", e == enet_remote.get() ? "remote" : "operator",
+                  static_cast<long long>(counted), static_cast<long long>(c.dropped_unknown_source),
+                  static_cast<long long>(c.kernel_dropped));
+    }
+    std::printf("\n");
+    require(counted_all >= raw.sent, "the carriers counted " + std::to_string(counted_all) + " of " +
+                                         std::to_string(raw.sent) + " raw datagrams");
+  }
   std::printf("  %s\n", failures == 0 ? "all promises kept" : "PROMISES BROKEN");
   return failures == 0 ? 0 : 1;
 }

@@ -133,7 +133,7 @@ class EnetEndpoint final : public Endpoint {
   /// link up to wait_s for it to be delivered. Nothing when no session.
   void end_session(double wait_s);
 
-  /// The bound UDP port.
+  /// The bound UDP port (the operator's too: a free one the kernel chose).
   int port() const;
   /// True while an authenticated session's peer is connected.
   bool connected() const;
