@@ -292,8 +292,14 @@ int ENET_CALLBACK intercept(ENetHost* host, ENetEvent*) {
   for (std::size_t i = 0; i < host->peerCount; ++i) {
     const ENetPeer& p = host->peers[i];
     if (p.state != ENET_PEER_STATE_DISCONNECTED && p.address.host == from.host &&
-        p.address.port == from.port)
+        p.address.port == from.port) {
+      const PeerState* slot = static_cast<const PeerState*>(p.data);
+      if (!slot)
+        ++s->counters.to_half_open;
+      else if (slot->stage != PeerState::Stage::kSession)
+        ++s->counters.to_unauthenticated;
       return 0;
+    }
   }
   if (s->listener && connection_request(host->receivedData, n)) {
     ++s->counters.connection_requests;

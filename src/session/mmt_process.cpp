@@ -58,6 +58,8 @@ nlohmann::ordered_json udp_json(const net::EnetEndpoint& carrier, const net::Lin
           {"dropped_unknown_source", c.dropped_unknown_source},
           {"dropped_oversize", c.dropped_oversize},
           {"connection_requests", c.connection_requests},
+          {"to_half_open_connections", c.to_half_open},
+          {"to_unauthenticated_peers", c.to_unauthenticated},
           {"dropped_by_kernel", c.kernel_dropped},
           {"receive_errors", c.receive_errors},
           {"receive_budget_stops", c.budget_stops},

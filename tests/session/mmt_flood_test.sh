@@ -17,8 +17,15 @@ terracut=$1
 netprobe=$2
 src=$3
 work=$4
-scenario="$src/scenarios/mmt_trench_clay.yaml"
+scenario="$work/trench.yaml"
 . "$src/tests/session/mmt_stations.sh"
+# The trench without the soil estimate: its fit follows the timing of the
+# commands' arrival, which a loaded machine changes (a clean run's estimate
+# read 1.19 instead of 1.45 at a load average of 6, the force error 67
+# instead of 45 N; docs/teleoperation.md, "Not done yet"), and this test is
+# about what the flood does to the link, not what load does to the fit.
+sed -e 's/^    estimate: true$/    estimate: false/' "$src/scenarios/mmt_trench_clay.yaml" > "$scenario"
+grep -q "estimate: false" "$scenario" || { echo "the scenario copy still estimates"; exit 1; }
 # No jitter: without it no command arrives out of order, so a clean run keeps
 # them all and every command lost is the flood's doing.
 link="--rtt-ms 100 --jitter-ms 0"
@@ -73,13 +80,18 @@ check(udp["sessions"] == 1 and udp["resumed"] == 0, f"sessions {udp['sessions']}
 check(rm["operator"]["id"] != 0 and rm["operator"]["state_at_end"] == "ended_the_session", f"remote's operator {rm['operator']}")
 check(intr["connected"] - 1 <= refused <= intr["connected"], f"{refused} refused of {intr['connected']} intruder connections")
 check(op["ended"]["how"] == "completed" and rm["ended"]["how"] == "operator_ended", f"ended {op['ended']} / {rm['ended']}")
-# Every flood datagram counted before a station saw it. The counts also hold
-# the intruder's and the operator's connection requests (each at most a few
-# datagrams) and any of the operator's datagrams the kernel dropped.
-counted = udp["dropped_unknown_source"] + udp["dropped_oversize"] + udp["connection_requests"] + udp["dropped_by_kernel"]
+# Every flood datagram counted before a station saw it: no peer's, oversize,
+# a connection request, the kernel's drop, or passed to a connection a
+# random request opened (ENet then discards it; the count is ours). The
+# counts also hold the intruder's and the operator's connection traffic
+# (ENet's handshake, acknowledgements and pings, the intruder's tries: at
+# most about ten datagrams a connection) and the operator's datagrams the
+# kernel dropped.
+counted = (udp["dropped_unknown_source"] + udp["dropped_oversize"] + udp["connection_requests"] + udp["dropped_by_kernel"]
+           + udp["to_half_open_connections"] + udp["to_unauthenticated_peers"])
 lost = op["commands"]["followed"] - op["commands"]["received_by_remote"]
 check(counted >= flood["sent"], f"counted {counted} of {flood['sent']} flood datagrams")
-check(counted <= flood["sent"] + 3 * intr["attempts"] + 10 + 3 * lost, f"counted {counted} for {flood['sent']} sent")
+check(counted <= flood["sent"] + 20 * intr["attempts"] + 20 + 3 * lost, f"counted {counted} for {flood['sent']} sent")
 check(udp["dropped_oversize"] == flood["oversize"], f"oversize {udp['dropped_oversize']} of {flood['oversize']}")
 check(udp["dropped_by_kernel"] >= flood["empty"], f"kernel drops {udp['dropped_by_kernel']}, empty datagrams {flood['empty']}")
 # Nothing of the operator's lost without a count: over loopback only a full

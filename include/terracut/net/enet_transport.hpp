@@ -90,6 +90,13 @@ struct EnetCounters {
   /// Connection requests from new addresses, passed to ENet: those ENet did
   /// not accept (malformed) are connection_requests - connections.
   std::int64_t connection_requests = 0;
+  /// Passed to ENet from the address of a connection ENet has not finished
+  /// (no CONNECT event yet: a request ENet answered and waits on; a flood's
+  /// random request may open one, and its junk then comes from a "peer"),
+  /// and from peers connected but not authenticated (refused soon): what
+  /// ENet does with them is its own, the count is terracut's.
+  std::int64_t to_half_open = 0;
+  std::int64_t to_unauthenticated = 0;
   /// The kernel's drops for the socket since it opened: receive buffer full,
   /// or an empty datagram (the socket filter drops those).
   std::int64_t kernel_dropped = 0;
