@@ -1,13 +1,22 @@
 // The link emulator as a decorator of any transport (emulated_link.hpp).
 #include "terracut/net/emulated_link.hpp"
 
+#include <chrono>
+
 namespace terracut::net {
 
-EmulatedEndpoint::EmulatedEndpoint(Endpoint& inner, const LinkConditions& sending)
-    : inner_(inner), emulator_(sending) {}
+EmulatedEndpoint::EmulatedEndpoint(Endpoint& inner, const LinkConditions& sending,
+                                   EmulatorClock clock)
+    : inner_(inner), emulator_(sending), clock_(clock) {}
+
+double EmulatedEndpoint::now(double now_s) const {
+  if (clock_ == EmulatorClock::kCaller) return now_s;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 void EmulatedEndpoint::send(Channel channel, const std::uint8_t* data, std::size_t size,
                             double now_s) {
+  now_s = now(now_s);
   ++traffic_.sent;
   traffic_.sent_bytes += std::int64_t(size);
   const auto arrive = emulator_.schedule(now_s, channel == Channel::kReliable);
@@ -17,6 +26,7 @@ void EmulatedEndpoint::send(Channel channel, const std::uint8_t* data, std::size
 }
 
 void EmulatedEndpoint::release(double now_s) {
+  now_s = now(now_s);
   while (!held_.empty() && held_.front_s() <= now_s) {
     const std::vector<std::uint8_t>& bytes = held_.front_bytes();
     inner_.send(static_cast<Channel>(held_.front_tag()), bytes.data(), bytes.size(), now_s);
@@ -25,7 +35,7 @@ void EmulatedEndpoint::release(double now_s) {
 }
 
 void EmulatedEndpoint::receive(double now_s, Inbox& out) {
-  release(now_s);
+  release(now_s);  // (release reads the wall clock itself when it is the emulator's)
   const std::size_t before = out.size();
   inner_.receive(now_s, out);
   for (std::size_t i = before; i < out.size(); ++i) {

@@ -216,7 +216,7 @@ UdpLink connect_operator_link(const MmtSettings& s, const std::string& endpoint,
     link.receive(0.0, none);
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
-  udp.endpoint = std::make_unique<net::EmulatedEndpoint>(*udp.carrier, s.to_remote);
+  udp.endpoint = std::make_unique<net::EmulatedEndpoint>(*udp.carrier, s.to_remote, net::EmulatorClock::kWall);
   return udp;
 }
 
@@ -232,7 +232,7 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
   const World local(op);  // the operator's initial terrain: what the deadband compares against
   const std::uint32_t id = new_station_id();
   auto carrier = net::EnetEndpoint::listen(address, port, udp_options(s, o.key, id));
-  net::EmulatedEndpoint link(*carrier, s.to_operator);
+  net::EmulatedEndpoint link(*carrier, s.to_operator, net::EmulatorClock::kWall);
   // The records go to remote.csv as they are made: a live session has no set end.
   RemoteOptions options;
   options.keep_records = false;

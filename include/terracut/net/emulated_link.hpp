@@ -16,11 +16,21 @@
 
 namespace terracut::net {
 
+/// Whose time the emulator holds datagrams by.
+enum class EmulatorClock {
+  kCaller,  ///< the now_s the station passes (simulated time: the in-memory link)
+  /// The wall clock (steady_clock), whatever now_s says: a real transport,
+  /// where a station's tick times may lag the wall clock while it catches
+  /// up, and a delay held in them would be shorter than the one emulated.
+  kWall,
+};
+
 class EmulatedEndpoint final : public Endpoint {
  public:
   /// inner must outlive this endpoint. Throws InputError naming the field
   /// of bad conditions.
-  EmulatedEndpoint(Endpoint& inner, const LinkConditions& sending);
+  EmulatedEndpoint(Endpoint& inner, const LinkConditions& sending,
+                   EmulatorClock clock = EmulatorClock::kCaller);
 
   /// Asks the emulator when the datagram arrives (nothing more when it is
   /// lost), holds it until then, and hands the wrapped endpoint what is due.
@@ -28,7 +38,8 @@ class EmulatedEndpoint final : public Endpoint {
   /// Hands on what is due by now_s, then receives from the wrapped endpoint.
   void receive(double now_s, Inbox& out) override;
   using Endpoint::receive;
-  /// Hands the wrapped endpoint every held datagram due by now_s.
+  /// Hands the wrapped endpoint every held datagram due by now_s (the wall
+  /// clock's now with EmulatorClock::kWall).
   void release(double now_s);
   /// Room in the held queue (and in the wrapped endpoint's).
   void reserve_in_flight(std::size_t datagrams, std::size_t bytes) override;
@@ -41,8 +52,10 @@ class EmulatedEndpoint final : public Endpoint {
   const Endpoint& inner() const { return inner_; }
 
  private:
+  double now(double now_s) const;
   Endpoint& inner_;
   LinkEmulator emulator_;
+  EmulatorClock clock_;
   HeldQueue held_;  // tag: the Channel
 };
 
