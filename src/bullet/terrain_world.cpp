@@ -12,6 +12,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/core/ranges.hpp"
 #include "merged_heightfield.hpp"
 #include "terrain_world_impl.hpp"
 
@@ -155,8 +156,7 @@ TerrainWorld::TerrainWorld(const HeightGrid& grid, Simulation* owner, HeightGrid
     : grid_(grid), owner_(owner), bare_(bare), params_(checked(params)), blade_(blade),
       specs_(std::move(bodies)) {
   // Settings: everything is checked here so the step can trust it.
-  if (!(std::isfinite(rate_hz) && rate_hz > 0.0 && rate_hz <= 1e6))
-    throw InputError(must_be("rate_hz", "in (0, 1e6]", rate_hz));
+  if (std::string e = check(kRateRange, rate_hz); !e.empty()) throw InputError(e);
   if (params_.tool.enabled && !(std::isfinite(blade.length_m) && blade.length_m > 0.0))
     throw InputError("blade.length_m must be finite and > 0 for the tool plate");
   if (grid.cols() < 2 || grid.rows() < 2)

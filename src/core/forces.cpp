@@ -8,6 +8,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/core/ranges.hpp"
 
 namespace terracut {
 
@@ -85,10 +86,7 @@ std::string validate(const ForceModelParams& params) {
   if (auto m = check_positive("workspace_scale", params.workspace_scale); !m.empty()) return m;
   if (auto m = check_positive("max_contact_length_m", params.max_contact_length_m); !m.empty())
     return m;
-  if (!(std::isfinite(params.loop_rate_hz) && params.loop_rate_hz > 0.0 &&
-        params.loop_rate_hz <= 1e6)) {
-    return must_be("loop_rate_hz", "in (0, 1e6]", params.loop_rate_hz);
-  }
+  if (std::string e = check(kRateRange, params.loop_rate_hz, "loop_rate_hz"); !e.empty()) return e;
   return nested("device", validate(params.device));
 }
 

@@ -8,6 +8,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/core/ranges.hpp"
 #include "terracut/core/soil_ahead.hpp"
 
 namespace terracut {
@@ -44,8 +45,7 @@ Segment reach_back(const Segment& from, const Segment& to, double back) {
 
 std::string validate(const SimParams& params) {
   if (std::string e = validate(params.grid); !e.empty()) return e;
-  if (!(std::isfinite(params.rate_hz) && params.rate_hz > 0.0 && params.rate_hz <= 1e6))
-    return must_be("rate_hz", "in (0, 1e6]", params.rate_hz);
+  if (std::string e = check(kRateRange, params.rate_hz); !e.empty()) return e;
   if (!(std::isfinite(params.blade.length_m) && params.blade.length_m > 0.0))
     return must_be("blade.length_m", "finite and > 0", params.blade.length_m);
   if (!(params.max_arc_error_cells > 0.0 && params.max_arc_error_cells <= 1.0))

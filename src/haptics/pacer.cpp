@@ -16,6 +16,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/core/ranges.hpp"
 
 namespace terracut::haptics {
 
@@ -68,8 +69,7 @@ std::shared_ptr<PacerClock> steady_pacer_clock() {
 }
 
 std::string validate(const PacerSettings& settings) {
-  if (!(std::isfinite(settings.rate_hz) && settings.rate_hz > 0.0 && settings.rate_hz <= 1e6))
-    return must_be("pacer.rate_hz", "in (0, 1e6]", settings.rate_hz);
+  if (std::string e = check(kRateRange, settings.rate_hz, "pacer.rate_hz"); !e.empty()) return e;
   if (!(std::isfinite(settings.spin_s) && settings.spin_s >= 0.0 &&
         settings.spin_s <= 1.0 / settings.rate_hz))
     return must_be("pacer.spin_s",

@@ -50,7 +50,7 @@ constexpr double kMax = yaml::kMaxMagnitude;
 
 // Every number of the file with a range of its own (scenario_ranges.hpp).
 constexpr yaml::Range kRanges[] = {
-    {"rate_hz", 0.0, 1e6, Ends::kOpenLow},
+    kRateRange,
     {"blade.length_m", 0.0, kMax, Ends::kOpenLow},
     {"blade.rake_angle_deg", 0.0, 180.0, Ends::kOpen},
     {"blade.edge_thickness_m", 0.0, kMax, Ends::kOpenLow},

@@ -36,6 +36,10 @@ struct Range {
   bool whole = false;  ///< a whole number (lo and hi whole too)
 };
 
+/// Every rate of a step or a tick, Hz: the simulation's, the haptic loop's,
+/// the pacer's, the Bullet world's and the force model's take it from here.
+inline constexpr Range kRateRange{"rate_hz", 0.0, 1e6, RangeEnds::kOpenLow};
+
 /// "(0, 1000]": the range written with its ends.
 std::string range_text(double lo, double hi, RangeEnds ends);
 
