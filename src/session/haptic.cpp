@@ -394,9 +394,7 @@ std::string HapticSession::summary_json() const {
 void HapticSession::write_outputs(const fs::path& out_dir) {
   io::make_output_folder(out_dir);
   rig_->world().finish();
-  std::ostringstream csv;
-  write_haptics_csv(csv, rig_->loop().records());
-  io::write_text_file(out_dir / "haptics.csv", csv.str());
+  write_haptics_csv(out_dir / "haptics.csv", rig_->loop().records());
   io::write_text_file(out_dir / "summary.json", summary_json());
 }
 
