@@ -59,7 +59,7 @@ Json json_percentiles(const TimePercentiles& s) {
 }  // namespace
 
 DevicePath followed_path(const Scenario& scenario, const HapticSettings& settings,
-                         const std::string& source) {
+                         const std::string& source, std::optional<double> rate_hz) {
   const io::Scenario& sc = scenario.base;
   std::vector<Motion> strokes;
   if (!settings.cut.empty()) {
@@ -75,19 +75,20 @@ DevicePath followed_path(const Scenario& scenario, const HapticSettings& setting
                      " device follows a cut, and the scenario has none");
   // A hand cannot jump from one stroke's end to the next one's start.
   if (settings.device == DeviceKind::kSim) strokes.resize(1);
-  return DevicePath(std::move(strokes), settings.rate_hz, Workspace(settings.workspace));
+  return DevicePath(std::move(strokes), rate_hz.value_or(sc.rate_hz), Workspace(settings.workspace));
 }
 
 std::unique_ptr<Device> make_device(const Scenario& scenario, const HapticSettings& settings,
-                                    int udp_port, const std::string& source) {
+                                    int udp_port, const std::string& source,
+                                    std::optional<double> rate_hz) {
   switch (settings.device) {
     case DeviceKind::kScript:
-      return std::make_unique<ScriptDevice>(followed_path(scenario, settings, source));
+      return std::make_unique<ScriptDevice>(followed_path(scenario, settings, source, rate_hz));
     case DeviceKind::kSim:
       return std::make_unique<SimHandDevice>(SimHand(settings.hand,
                                                      settings.forces.device.inherent_damping_n_s_per_m,
-                                                     followed_path(scenario, settings, source),
-                                                     settings.rate_hz));
+                                                     followed_path(scenario, settings, source, rate_hz),
+                                                     rate_hz.value_or(scenario.base.rate_hz)));
     case DeviceKind::kUdp:
       // A real device through the bridge (docs/bridge-protocol.md).
       return std::make_unique<UdpDevice>(settings.udp.address, udp_port);
@@ -144,9 +145,14 @@ HapticSession::HapticSession(const Scenario& input, const SessionOptions& option
   // the port asked for, and the loop never reads it.
   const int port = settings.udp.port;
   if (port == 0) settings.udp.port = 1;
+  // The loop's rate: the scenario's, or the command line's.
+  if (options.rate_hz)
+    if (std::string m = check(kLoopRateRange, *options.rate_hz, "--rate"); !m.empty())
+      throw InputError(m);
+  const double rate_hz = options.rate_hz.value_or(sc.rate_hz);
   std::optional<LoopParams> params;
   try {
-    params.emplace(settings, sc.blade);
+    params.emplace(settings, sc.blade, rate_hz);
   } catch (const InputError& e) {
     throw InputError(source_.string() + ": " + e.what());
   }
@@ -154,9 +160,9 @@ HapticSession::HapticSession(const Scenario& input, const SessionOptions& option
 
   // The device, and the path the script and sim devices follow: its length
   // and its first orientation (the default one).
-  device_ = make_device(input, valid, port, source_.string());
+  device_ = make_device(input, valid, port, source_.string(), rate_hz);
   std::optional<DevicePath> path;
-  if (kind_ != DeviceKind::kUdp) path.emplace(followed_path(input, valid, source_.string()));
+  if (kind_ != DeviceKind::kUdp) path.emplace(followed_path(input, valid, source_.string(), rate_hz));
   cut_name_ = path ? path->strokes().front().name : "";
   const Quat default_orientation = path ? path->strokes().front().keyframes.front().pose.orientation : Quat{};
   const double path_s = path ? path->duration_s() : 0.0;
@@ -169,7 +175,7 @@ HapticSession::HapticSession(const Scenario& input, const SessionOptions& option
 
   // The world and the loop.
   RigOptions ro;
-  ro.loop.ticks = std::max<std::int64_t>(1, std::llround(duration_s_ * valid.rate_hz));
+  ro.loop.ticks = std::max<std::int64_t>(1, std::llround(duration_s_ * rate_hz));
   ro.loop.record_capacity = std::min<std::size_t>(options.max_records, std::size_t(ro.loop.ticks));
   ro.loop.realtime = options.realtime;
   ro.loop.snapshot = options.snapshot;
@@ -392,7 +398,7 @@ std::string HapticSession::summary_line() const {
                 "%.1f us max %.1f us, compute p50 %.1f us p99 %.1f us, %lld missed deadlines, "
                 "max device force %.3g N, removed %.4g m^3",
                 name_.c_str(), std::string(to_string(kind_)).c_str(),
-                static_cast<long long>(l.counters().ticks), l.settings().rate_hz,
+                static_cast<long long>(l.counters().ticks), l.params().rate_hz(),
                 clock_ == ClockMode::kFake ? "fake" : "real", j.p50_s * 1e6, j.p99_s * 1e6,
                 j.max_s * 1e6, c.p50_s * 1e6, c.p99_s * 1e6,
                 static_cast<long long>(ps.missed_deadlines), l.max_device_force_n(),

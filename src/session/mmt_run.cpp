@@ -125,10 +125,10 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
   settings_ = apply_overrides(*op.mmt, overrides);
   op_ = std::make_unique<Scenario>(op);
   remote_scn_ = std::make_unique<Scenario>(load_remote_scenario(op));
-  if (remote_scn_->haptics.rate_hz != op_->haptics.rate_hz)
+  if (remote_scn_->base.rate_hz != op_->base.rate_hz)
     throw InputError(settings_.remote_scenario.string() +
-                     ": haptics.rate_hz: the remote must run at the operator's rate (" +
-                     format_number(op_->haptics.rate_hz) + " Hz)");
+                     ": rate_hz: the remote must run at the operator's rate (" +
+                     format_number(op_->base.rate_hz) + " Hz)");
   if (op_->haptics.device == haptics::DeviceKind::kUdp)
     throw InputError(op.base.source_path.string() +
                      ": haptics.device: a real device over udp runs in real time: run the "
