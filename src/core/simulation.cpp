@@ -59,7 +59,8 @@ std::string validate(const SimParams& params) {
     if (params.soil.model != SoilModel::kFlow)
       return "blade.bucket: a bucket carries soil, so it needs soil model flow (soil: {model: flow})";
   }
-  if (std::string e = check_field("blade.edge_thickness_m", params.blade.edge_thickness_m); !e.empty())
+  if (std::string e = check_field("blade.edge_thickness_m", params.blade.edge_thickness_m);
+      !e.empty())
     return e;
   if (params.representation != Representation::kColumns &&
       params.representation != Representation::kSurface)

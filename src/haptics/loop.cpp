@@ -39,9 +39,7 @@ ForceModel built_model(const ForceModelParams& params) {
 }  // namespace
 
 LoopParams::LoopParams(const HapticSettings& settings, const BladeSpec& blade, double rate_hz)
-    : rate_hz_(rate_hz),
-      settings_(validated(settings, blade, rate_hz)),
-      model_(built_model(settings_.forces)) {}
+    : settings_(validated(settings, blade, rate_hz)), model_(built_model(settings_.forces)) {}
 
 HapticLoop::HapticLoop(const LoopParams& params, Simulation& sim, Quat default_orientation,
                        Device& device, const LoopOptions& options)

@@ -81,7 +81,8 @@ void CsvFile::close() {
   const bool bad = std::ferror(file_) != 0;
   const int rc = std::fclose(file_);
   file_ = nullptr;
-  if (failed_errno_ != 0) fail_file(path_, std::string("write failed: ") + std::strerror(failed_errno_));
+  if (failed_errno_ != 0)
+    fail_file(path_, std::string("write failed: ") + std::strerror(failed_errno_));
   if (bad || rc != 0) fail_file(path_, std::string("write failed: ") + std::strerror(errno));
 }
 

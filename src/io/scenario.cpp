@@ -54,7 +54,7 @@ constexpr double kMax = yaml::kMaxMagnitude;
 constexpr yaml::Range kRanges[] = {
     find_range(kSimParamsRanges, "rate_hz"),
     find_range(kSimParamsRanges, "blade.length_m"),
-    {"blade.rake_angle_deg", 0.0, 180.0, Ends::kOpen},
+    find_range(kSimParamsRanges, "blade.rake_angle_deg"),
     find_range(kSimParamsRanges, "blade.edge_thickness_m"),
     // The file's own: a bucket: section is a bucket (the struct's depth 0 is none).
     {"blade.bucket.depth_m", 0.0, kMax, Ends::kOpenLow},

@@ -75,7 +75,8 @@ DevicePath followed_path(const Scenario& scenario, const HapticSettings& setting
                      " device follows a cut, and the scenario has none");
   // A hand cannot jump from one stroke's end to the next one's start.
   if (settings.device == DeviceKind::kSim) strokes.resize(1);
-  return DevicePath(std::move(strokes), rate_hz.value_or(sc.rate_hz), Workspace(settings.workspace));
+  return DevicePath(std::move(strokes), rate_hz.value_or(sc.rate_hz),
+                    Workspace(settings.workspace));
 }
 
 std::unique_ptr<Device> make_device(const Scenario& scenario, const HapticSettings& settings,
@@ -162,7 +163,8 @@ HapticSession::HapticSession(const Scenario& input, const SessionOptions& option
   // and its first orientation (the default one).
   device_ = make_device(input, valid, port, source_.string(), rate_hz);
   std::optional<DevicePath> path;
-  if (kind_ != DeviceKind::kUdp) path.emplace(followed_path(input, valid, source_.string(), rate_hz));
+  if (kind_ != DeviceKind::kUdp)
+    path.emplace(followed_path(input, valid, source_.string(), rate_hz));
   cut_name_ = path ? path->strokes().front().name : "";
   const Quat default_orientation = path ? path->strokes().front().keyframes.front().pose.orientation : Quat{};
   const double path_s = path ? path->duration_s() : 0.0;

@@ -33,8 +33,8 @@ TEST(WorldAllocation, BulletAllocationsAreCounted) {
 
 TEST(WorldAllocation, StepsAllocateNothingOnceWarm) {
   test::Scene scene;
-  const std::filesystem::path csv_path =
-      std::filesystem::temp_directory_path() / ("terracut_world_alloc_" + std::to_string(getpid()) + ".csv");
+  const std::filesystem::path csv_path = std::filesystem::temp_directory_path() /
+                                         ("terracut_world_alloc_" + std::to_string(getpid()) + ".csv");
   BodiesCsvWriter csv(csv_path);
   // Warm-up: the first contacts grow Bullet's internal arrays (manifolds,
   // solver pools, island lists) to their working size; they are never

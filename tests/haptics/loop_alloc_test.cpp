@@ -54,7 +54,8 @@ TEST(LoopAllocation, ScriptAndSimTicksAllocateNothing) {
   }
   {
     SimHandDevice device(
-        SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, path, test::trench().scenario.rate_hz));
+        SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, path,
+                test::trench().scenario.rate_hz));
     const io::Scenario& sc = test::trench().scenario;
     const Simulation probe(io::sim_params(sc), io::build_initial_heights(sc));
     SnapshotExchange exchange(probe.grid());

@@ -51,13 +51,14 @@ struct SimParams {
 
 /// The ranges of SimParams' own numbers (core/ranges.hpp): validate()
 /// checks the fields through this table and the scenario reader reads the
-/// file's same fields through its entries. The grid, the soil and the blade's
-/// rake with the material have their own checks (validate(GridSpec),
-/// kSoilFlowRanges, the earthmoving model's).
+/// file's same fields through its entries. The grid and the soil have their
+/// own checks (validate(GridSpec), kSoilFlowRanges); the blade's rake is the
+/// earthmoving model's entry, which validate() checks with the material.
 inline constexpr Range kSimParamsRanges[] = {
     kRateRange,
     {"max_arc_error_cells", 0.0, 1.0, RangeEnds::kOpenLow},
     {"blade.length_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    at_path(find_range(kEarthmovingRanges, "rake_angle_deg"), "blade.rake_angle_deg"),
     {"blade.edge_thickness_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
     {"blade.bucket.depth_m", 0.0, kRangeMax, RangeEnds::kClosed},  // 0: no bucket
     {"blade.bucket.height_m", 0.0, kRangeMax, RangeEnds::kOpenLow},

@@ -142,13 +142,13 @@ class LoopParams {
 
   /// The settings with the derived force fields filled in.
   const HapticSettings& settings() const { return settings_; }
-  /// The loop rate, Hz: the simulation the loop steps must run at this rate.
-  double rate_hz() const { return rate_hz_; }
+  /// The loop rate, Hz (kept once, as the force model's loop_rate_hz): the
+  /// simulation the loop steps must run at this rate.
+  double rate_hz() const { return settings_.forces.loop_rate_hz; }
   /// The force model (after the device check).
   const ForceModel& force_model() const { return model_; }
 
  private:
-  double rate_hz_;
   HapticSettings settings_;
   ForceModel model_;
 };
