@@ -72,7 +72,7 @@ int run(const Options& opt) {
   if (!opt.connect.empty()) parse_endpoint(opt.connect, "--connect", address, port);
   if (!port || *port < 1) throw InputError("--connect: the port must be in [1, 65535]");
 
-  const double rate = opt.rate_hz > 0.0 ? opt.rate_hz : s.rate_hz;
+  const double rate = opt.rate_hz > 0.0 ? opt.rate_hz : sc.rate_hz;
   const double duration = opt.duration_s > 0.0 ? opt.duration_s : motion.duration_s() + s.settle_s;
   const std::uint32_t session =
       opt.session >= 0 ? std::uint32_t(opt.session)
@@ -161,7 +161,7 @@ int main(int argc, char** argv) {
   app.add_option("--connect,-c", opt.connect,
                  "The haptic loop's address: ADDR:PORT, PORT or [IPV6]:PORT. Default haptics.udp")
       ->type_name("ADDR:PORT");
-  app.add_option("--rate", opt.rate_hz, "Poses per second. Default haptics.rate_hz")
+  app.add_option("--rate", opt.rate_hz, "Poses per second. Default the scenario's rate_hz")
       ->type_name("HZ")
       ->check(CLI::Range(1.0, 10000.0));
   app.add_option("--duration", opt.duration_s,

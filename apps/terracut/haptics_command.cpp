@@ -38,6 +38,7 @@ Command add_haptics_command(CLI::App& app) {
     std::string out;
     std::string device;
     double duration_s = 0.0;
+    double rate_hz = 0.0;
     std::string clock;
     bool no_realtime = false;
     bool no_plot = false;
@@ -51,7 +52,8 @@ Command add_haptics_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "haptics",
       "Run the haptic loop on a scenario: a device (scripted, a simulated hand, or a real one\n"
-      "over UDP) drives the blade at the loop rate (default 1 kHz) and feels the cutting force.\n"
+      "over UDP) drives the blade at the scenario's rate_hz (default 1 kHz) and feels the\n"
+      "cutting force.\n"
       "Writes the per-tick log, a summary and a force plot into an output folder.");
   sub->add_option("scenario", opt->scenario,
                   "Scenario file (YAML) with a `haptics:` section (docs/haptics.md; without one\n"
@@ -75,6 +77,11 @@ Command add_haptics_command(CLI::App& app) {
                   "duration plus haptics.settle_s (script, sim), 30 s (udp)")
       ->type_name("S")
       ->check(CLI::Range(1e-6, 86400.0));
+  sub->add_option("--rate", opt->rate_hz,
+                  "Loop rate in Hz, overriding the scenario's rate_hz for this session (the\n"
+                  "simulation steps at it too)")
+      ->type_name("HZ")
+      ->check(CLI::Range(haptics::kLoopRateRange.lo, haptics::kLoopRateRange.hi));
   sub->add_flag("--end-with-device", opt->end_with_device,
                 "End the session when the device stops sending: after its first pose, 0.5 s\n"
                 "without one (udp: the device process's own session ended). --duration still\n"
@@ -155,6 +162,7 @@ Command add_haptics_command(CLI::App& app) {
       so.udp_port = d.port;
     }
     if (opt->duration_s > 0.0) so.duration_s = opt->duration_s;
+    if (opt->rate_hz > 0.0) so.rate_hz = opt->rate_hz;
     if (!opt->clock.empty())
       so.clock = opt->clock == "fake" ? session::ClockMode::kFake : session::ClockMode::kReal;
     so.realtime = !opt->no_realtime;

@@ -31,7 +31,7 @@ DriverOptions reset_options(const DriverOptions& previous, const ViewerDevice& d
 LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticSettings& settings,
                        const DriverOptions& options, LoopTiming* timing)
     : scenario_(scenario),
-      params_(settings, scenario.base.blade),
+      params_(settings, scenario.base.blade, scenario.base.rate_hz),
       options_(options),
       spec_(io::grid_spec(scenario.base)),
       representation_(scenario.base.representation),

@@ -263,7 +263,7 @@ void ViewerApp::apply_model_changes() {
     // The simulation's check (the material with the rake) and the loop's own
     // (InputError naming the field, or a refused rendering).
     if (const std::string e = validate(io::sim_params(sc.base)); !e.empty()) throw InputError(e);
-    const haptics::LoopParams check(pending_haptics_, sc.base.blade);
+    const haptics::LoopParams check(pending_haptics_, sc.base.blade, sc.base.rate_hz);
     close_session();
     scenario_ = sc;
     haptics_ = check.settings();

@@ -160,7 +160,8 @@ limits), then compute() is a pure function of one sample. It never changes
 the physical force.)doc")
       .def(py::init([](const PyScenario& s) {
              const haptics::HapticSettings h =
-                 haptics::with_derived_fields(s.s->haptics, s.base().blade.length_m);
+                 haptics::with_derived_fields(s.s->haptics, s.base().blade.length_m,
+                                              s.base().rate_hz);
              return ForceModel(h.forces);
            }), py::arg("scenario"))
       .def("compute", [](const ForceModel& f, const StepResult& step, py::object velocity,

@@ -12,6 +12,7 @@
 
 #include "bindings.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/core/ranges.hpp"
 #include "terracut/session/batch.hpp"
 
 namespace terracut::python {
@@ -217,8 +218,7 @@ reader's message, "FILE:LINE: field: what".)doc")
       .def("cut_poses", [](const PyScenario& s, py::object cut, std::optional<double> rate_hz) {
             const io::Scenario& sc = s.base();
             const double rate = rate_hz.value_or(sc.rate_hz);
-            if (!(std::isfinite(rate) && rate > 0.0 && rate <= 1e6))
-              throw InputError(must_be("rate_hz", "in (0, 1e6]", rate));
+            if (std::string m = check(kRateRange, rate); !m.empty()) throw InputError(m);
             return cut_poses(sc.cuts[std::size_t(cut_index(sc, cut))], rate);
           }, py::arg("cut"), py::arg("rate_hz") = py::none(),
           "The poses a run steps the cut (name or index) through: (N, 7) float64 rows "

@@ -45,22 +45,23 @@ Segment reach_back(const Segment& from, const Segment& to, double back) {
 
 std::string validate(const SimParams& params) {
   if (std::string e = validate(params.grid); !e.empty()) return e;
-  if (std::string e = check(kRateRange, params.rate_hz); !e.empty()) return e;
-  if (!(std::isfinite(params.blade.length_m) && params.blade.length_m > 0.0))
-    return must_be("blade.length_m", "finite and > 0", params.blade.length_m);
-  if (!(params.max_arc_error_cells > 0.0 && params.max_arc_error_cells <= 1.0))
-    return must_be("max_arc_error_cells", "in (0, 1]", params.max_arc_error_cells);
+  const auto check_field = [](std::string_view path, double value) {
+    return check(find_range(kSimParamsRanges, path), value);
+  };
+  if (std::string e = check_field("rate_hz", params.rate_hz); !e.empty()) return e;
+  if (std::string e = check_field("blade.length_m", params.blade.length_m); !e.empty()) return e;
+  if (std::string e = check_field("max_arc_error_cells", params.max_arc_error_cells); !e.empty())
+    return e;
   const BucketSpec& bucket = params.blade.bucket;
-  if (!(std::isfinite(bucket.depth_m) && bucket.depth_m >= 0.0))
-    return must_be("blade.bucket.depth_m", "finite and >= 0", bucket.depth_m);
+  if (std::string e = check_field("blade.bucket.depth_m", bucket.depth_m); !e.empty()) return e;
   if (bucket.enabled()) {
-    if (!(std::isfinite(bucket.height_m) && bucket.height_m > 0.0))
-      return must_be("blade.bucket.height_m", "finite and > 0", bucket.height_m);
+    if (std::string e = check_field("blade.bucket.height_m", bucket.height_m); !e.empty()) return e;
     if (params.soil.model != SoilModel::kFlow)
       return "blade.bucket: a bucket carries soil, so it needs soil model flow (soil: {model: flow})";
   }
-  if (!(std::isfinite(params.blade.edge_thickness_m) && params.blade.edge_thickness_m > 0.0))
-    return must_be("blade.edge_thickness_m", "finite and > 0", params.blade.edge_thickness_m);
+  if (std::string e = check_field("blade.edge_thickness_m", params.blade.edge_thickness_m);
+      !e.empty())
+    return e;
   if (params.representation != Representation::kColumns &&
       params.representation != Representation::kSurface)
     return "representation must be columns or surface";

@@ -49,13 +49,16 @@ using Ends = yaml::Field::Ends;
 constexpr double kMax = yaml::kMaxMagnitude;
 
 // Every number of the file with a range of its own (scenario_ranges.hpp).
+// The simulation's and the soil's are their structs' entries
+// (kSimParamsRanges, kSoilFlowRanges), read here through the same entry.
 constexpr yaml::Range kRanges[] = {
-    kRateRange,
-    {"blade.length_m", 0.0, kMax, Ends::kOpenLow},
-    {"blade.rake_angle_deg", 0.0, 180.0, Ends::kOpen},
-    {"blade.edge_thickness_m", 0.0, kMax, Ends::kOpenLow},
+    find_range(kSimParamsRanges, "rate_hz"),
+    find_range(kSimParamsRanges, "blade.length_m"),
+    find_range(kSimParamsRanges, "blade.rake_angle_deg"),
+    find_range(kSimParamsRanges, "blade.edge_thickness_m"),
+    // The file's own: a bucket: section is a bucket (the struct's depth 0 is none).
     {"blade.bucket.depth_m", 0.0, kMax, Ends::kOpenLow},
-    {"blade.bucket.height_m", 0.0, kMax, Ends::kOpenLow},
+    find_range(kSimParamsRanges, "blade.bucket.height_m"),
     {"terrain.size_m[0]", 0.0, kMax, Ends::kOpenLow},
     {"terrain.size_m[1]", 0.0, kMax, Ends::kOpenLow},
     {"terrain.full_scale_m", 0.0, kMax, Ends::kOpenLow},
@@ -64,7 +67,7 @@ constexpr yaml::Range kRanges[] = {
     {"terrain.mound.radius_m", 0.0, kMax, Ends::kOpenLow},
     {"terrain.plane.height_m", 0.0, kMax, Ends::kClosed},
     {"cuts[].keyframes[].t_s", 0.0, kMax, Ends::kClosed},
-    {"soil.max_pair_checks_per_step", 1000, 1e9, Ends::kClosed, true},
+    at_path(find_range(kSoilFlowRanges, "max_pair_checks_per_step"), "soil.max_pair_checks_per_step"),
     {"reference.mound.radius_m", 0.0, kMax, Ends::kOpenLow},
     {"reference.mound.height_m", 0.0, kMax, Ends::kOpenLow},
 };

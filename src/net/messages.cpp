@@ -58,24 +58,6 @@ std::size_t payload_size(const std::uint8_t* data) { return get_u32(data + 32); 
 
 }  // namespace
 
-std::string_view to_string(Reject reason) {
-  switch (reason) {
-    case Reject::kNone: return "none";
-    case Reject::kTruncated: return "truncated";
-    case Reject::kBadLength: return "bad_length";
-    case Reject::kBadMagic: return "bad_magic";
-    case Reject::kBadVersion: return "bad_version";
-    case Reject::kBadChecksum: return "bad_checksum";
-    case Reject::kBadType: return "bad_type";
-    case Reject::kForeign: return "foreign";
-    case Reject::kBadPayload: return "bad_payload";
-    case Reject::kDuplicate: return "duplicate";
-    case Reject::kReordered: return "reordered";
-    case Reject::kStale: return "stale";
-  }
-  return "unknown";
-}
-
 Reject to_reject(wire::Order order) {
   switch (order) {
     case wire::Order::kAccepted: return Reject::kNone;

@@ -78,15 +78,15 @@ constexpr ForceColumn kForceColumns[] = {
 // force.csv: t, cut and the force columns, one row per step.
 class ForceCsv {
  public:
-  explicit ForceCsv(const std::filesystem::path& path) : file_(path, header()) {}
+  explicit ForceCsv(const std::filesystem::path& path) : file_(path, header()) {
+    cells_.reserve(std::size(kForceColumns) + 2);
+  }
   void row(const StepOutput& out, const std::string& cut_name) {
-    line_.clear();
-    for (const ForceColumn& c : kForceColumns) {
-      char cell[32];
-      std::snprintf(cell, sizeof cell, ",%.9g", c.get(out));
-      line_ += cell;
-    }
-    file_.row({out.t_s, cut_name + line_});
+    cells_.clear();
+    cells_.emplace_back(out.t_s);
+    cells_.emplace_back(cut_name);
+    for (const ForceColumn& c : kForceColumns) cells_.emplace_back(c.get(out));
+    file_.row(cells_);
   }
   void close() { file_.close(); }
 
@@ -97,7 +97,7 @@ class ForceCsv {
     return h;
   }
   io::CsvFile file_;
-  std::string line_;
+  std::vector<io::CsvFile::Cell> cells_;  // a row's, reserved once
 };
 
 // A cut's force statistics, summed step by step.

@@ -247,7 +247,7 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
   Ended ended = Ended::kStopped;
   double operator_lost_at_s = -1.0;
   const double duration = paced(
-      op.haptics.rate_hz,
+      op.base.rate_hz,
       [&](double t) {
         station.tick(t);
         csv.add(station.last_record());
@@ -266,7 +266,7 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
         }
         if (!lost) operator_lost_at_s = -1.0;
         if (carrier->peer_ended()) return ended = Ended::kOperatorEnded, true;
-        if (o.overrides.duration_s && t + 0.5 / op.haptics.rate_hz >= *o.overrides.duration_s)
+        if (o.overrides.duration_s && t + 0.5 / op.base.rate_hz >= *o.overrides.duration_s)
           return ended = Ended::kDuration, true;
         if (stopping(o)) return ended = Ended::kStopped, true;
         return false;

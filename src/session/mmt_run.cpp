@@ -66,29 +66,10 @@ namespace {
 constexpr const char* kOperatorCsvHeader =
     "t,x,y,z,fx,fy,fz,fdx,fdy,fdz,remote_fx,remote_fy,remote_fz,contact_length,"
     "scale_applied,scale_target,updating,link_silent,passivity_j,passivity_dfr_j,"
-    "compute_us,command_sequence,round_trip_s,command_loss\n";
+    "compute_us,command_sequence,round_trip_s,command_loss";
 constexpr const char* kRemoteCsvHeader =
     "t,command_sequence,cmd_x,cmd_y,cmd_z,x,y,z,fx,fy,fz,contact_length,cut_depth,"
-    "force_scale,holding,active,compute_us\n";
-
-void write_row(std::ostream& out, const OperatorRecord& r) {
-  out << r.t_s << ',' << r.tool_m.x << ',' << r.tool_m.y << ',' << r.tool_m.z << ','
-      << r.force_world_n.x << ',' << r.force_world_n.y << ',' << r.force_world_n.z << ','
-      << r.force_device_n.x << ',' << r.force_device_n.y << ',' << r.force_device_n.z << ','
-      << r.remote_force_world_n.x << ',' << r.remote_force_world_n.y << ','
-      << r.remote_force_world_n.z << ',' << r.contact_length_m << ',' << r.scale_applied << ','
-      << r.scale_target << ',' << int(r.updating) << ',' << int(r.link_silent) << ','
-      << r.passivity_j << ',' << r.passivity_dfr_j << ',' << r.compute_s * 1e6 << ','
-      << r.command_sequence << ',' << r.round_trip_s << ',' << r.command_loss << '\n';
-}
-
-void write_row(std::ostream& out, const RemoteRecord& r) {
-  out << r.t_s << ',' << r.command_sequence << ',' << r.commanded_m.x << ',' << r.commanded_m.y
-      << ',' << r.commanded_m.z << ',' << r.tool_m.x << ',' << r.tool_m.y << ',' << r.tool_m.z
-      << ',' << r.force_world_n.x << ',' << r.force_world_n.y << ',' << r.force_world_n.z << ','
-      << r.contact_length_m << ',' << r.cut_depth_m << ',' << r.force_scale << ','
-      << int(r.holding) << ',' << int(r.active) << ',' << r.compute_s * 1e6 << '\n';
-}
+    "force_scale,holding,active,compute_us";
 
 }  // namespace
 
@@ -107,14 +88,7 @@ void write_remote_csv(const std::vector<RemoteRecord>& records, const std::files
 }
 
 StationCsv::StationCsv(const std::filesystem::path& path, const char* header)
-    : path_(path), buffer_(new char[std::size_t(1) << 16]), out_(std::make_unique<std::ofstream>()) {
-  // The buffer is set before the file opens (libstdc++ uses it only then).
-  out_->rdbuf()->pubsetbuf(buffer_.get(), std::streamsize(1) << 16);
-  out_->open(path, std::ios::binary);
-  if (!*out_) throw InputError(path.string() + ": cannot be written");
-  out_->precision(9);
-  *out_ << header;
-}
+    : file_(std::make_unique<io::CsvFile>(path, header)) {}
 
 StationCsv::StationCsv(StationCsv&&) noexcept = default;
 StationCsv& StationCsv::operator=(StationCsv&&) noexcept = default;
@@ -129,29 +103,32 @@ StationCsv StationCsv::remote_csv(const std::filesystem::path& path) {
 }
 
 void StationCsv::add(const OperatorRecord& r) {
-  write_row(*out_, r);
-  if (!*out_) throw InputError(path_.string() + ": cannot be written");
+  file_->row({r.t_s, r.tool_m.x, r.tool_m.y, r.tool_m.z, r.force_world_n.x, r.force_world_n.y,
+              r.force_world_n.z, r.force_device_n.x, r.force_device_n.y, r.force_device_n.z,
+              r.remote_force_world_n.x, r.remote_force_world_n.y, r.remote_force_world_n.z,
+              r.contact_length_m, r.scale_applied, r.scale_target, r.updating, r.link_silent,
+              r.passivity_j, r.passivity_dfr_j, r.compute_s * 1e6, r.command_sequence,
+              r.round_trip_s, r.command_loss});
 }
 
 void StationCsv::add(const RemoteRecord& r) {
-  write_row(*out_, r);
-  if (!*out_) throw InputError(path_.string() + ": cannot be written");
+  file_->row({r.t_s, r.command_sequence, r.commanded_m.x, r.commanded_m.y, r.commanded_m.z,
+              r.tool_m.x, r.tool_m.y, r.tool_m.z, r.force_world_n.x, r.force_world_n.y,
+              r.force_world_n.z, r.contact_length_m, r.cut_depth_m, r.force_scale, r.holding,
+              r.active, r.compute_s * 1e6});
 }
 
-void StationCsv::finish() {
-  out_->close();
-  if (!*out_) throw InputError(path_.string() + ": cannot be written");
-}
+void StationCsv::finish() { file_->close(); }
 
 MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
   if (!op.mmt) throw InputError(no_mmt_section(op));
   settings_ = apply_overrides(*op.mmt, overrides);
   op_ = std::make_unique<Scenario>(op);
   remote_scn_ = std::make_unique<Scenario>(load_remote_scenario(op));
-  if (remote_scn_->haptics.rate_hz != op_->haptics.rate_hz)
+  if (remote_scn_->base.rate_hz != op_->base.rate_hz)
     throw InputError(settings_.remote_scenario.string() +
-                     ": haptics.rate_hz: the remote must run at the operator's rate (" +
-                     format_number(op_->haptics.rate_hz) + " Hz)");
+                     ": rate_hz: the remote must run at the operator's rate (" +
+                     format_number(op_->base.rate_hz) + " Hz)");
   if (op_->haptics.device == haptics::DeviceKind::kUdp)
     throw InputError(op.base.source_path.string() +
                      ": haptics.device: a real device over udp runs in real time: run the "

@@ -23,7 +23,7 @@ std::uint64_t to_ns(double t_s) { return std::uint64_t(std::llround(std::max(0.0
 // The loop's parameters of a scenario, with the scenario named in errors.
 haptics::LoopParams loop_params(const Scenario& sc) {
   try {
-    return haptics::LoopParams(sc.haptics, sc.base.blade);
+    return haptics::LoopParams(sc.haptics, sc.base.blade, sc.base.rate_hz);
   } catch (const InputError& e) {
     throw InputError(sc.base.source_path.string() + ": " + e.what());
   }

@@ -35,13 +35,15 @@ test::LoopRig trench_loop(const HapticSettings& settings, Device& device, std::i
 }
 
 const Motion& trench_cut() { return trench().scenario.cuts[0]; }
+// The trench's one rate, the loop's.
+double trench_rate_hz() { return trench().scenario.rate_hz; }
 
 DevicePath trench_path(const HapticSettings& s) {
   return DevicePath(trench_cut(), Workspace(s.workspace));
 }
 
 std::int64_t ticks_of(const HapticSettings& s) {
-  return std::llround((trench_cut().duration_s() + s.settle_s) * s.rate_hz);
+  return std::llround((trench_cut().duration_s() + s.settle_s) * trench_rate_hz());
 }
 
 // The trench's soil flows: after each step, what the loop's earthmoving
@@ -349,7 +351,7 @@ TEST(HapticLoop, DeterministicRunsAreIdentical) {
         device = std::make_unique<ScriptDevice>(trench_path(s));
       else
         device = std::make_unique<SimHandDevice>(
-            SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, trench_path(s), s.rate_hz));
+            SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, trench_path(s), trench_rate_hz()));
       auto loop = trench_loop(s, *device, 3000);
       loop->run_deterministic();
       out = loop->records();
@@ -385,7 +387,7 @@ TEST(HapticLoop, BadSampleIsCountedAndAnsweredWithZeroForce) {
   // renders beta |v|, within 5 % of it after ln 20 of the filter's time constants.
   const double rebuild_s = rs[1999].force_device_n.x / s.safety.max_force_rate_n_per_s;
   const double settle_s = std::log(20.0) / (2.0 * std::numbers::pi * s.velocity_cutoff_hz);
-  const std::size_t back = 2005 + std::size_t(std::ceil((rebuild_s + settle_s) * s.rate_hz)) + 2;
+  const std::size_t back = 2005 + std::size_t(std::ceil((rebuild_s + settle_s) * trench_rate_hz())) + 2;
   EXPECT_NEAR(length(rs[back].force_device_n), length(rs[1999].force_device_n),
               0.05 * length(rs[1999].force_device_n));
   EXPECT_EQ(device.commands.size(), std::size_t(ticks));
@@ -402,8 +404,8 @@ TEST(HapticLoop, SilentDeviceTripsTheWatchdogAndSoftStartsOnReturn) {
   const std::vector<LoopRecord> rs = loop->records();
   const double f0 = length(rs[1999].force_device_n);
   ASSERT_GT(f0, 0.5);
-  const int timeout = int(std::lround(s.safety.watchdog_timeout_s * s.rate_hz));
-  const int ramp = int(std::lround(s.safety.watchdog_ramp_s * s.rate_hz));
+  const int timeout = int(std::lround(s.safety.watchdog_timeout_s * trench_rate_hz()));
+  const int ramp = int(std::lround(s.safety.watchdog_ramp_s * trench_rate_hz()));
   // Before the timeout the last force is held; after it, ramped to zero.
   EXPECT_FALSE(rs[std::size_t(1999 + timeout)].flags & kFlagWatchdog);
   EXPECT_TRUE(rs[std::size_t(2001 + timeout)].flags & kFlagWatchdog);
@@ -422,7 +424,7 @@ TEST(HapticLoop, SilentDeviceTripsTheWatchdogAndSoftStartsOnReturn) {
 TEST(HapticLoop, BadSampleDuringTheWatchdogFadeGetsZeroForce) {
   const HapticSettings& s = trench().haptics;
   ScriptDevice script(trench_path(s));
-  const int timeout = int(std::lround(s.safety.watchdog_timeout_s * s.rate_hz));
+  const int timeout = int(std::lround(s.safety.watchdog_timeout_s * trench_rate_hz()));
   const std::int64_t bad = 2000 + timeout + 10;  // silent from 2000, tripped by now, fading
   test::FaultyDevice device(
       script, [&](std::int64_t tick) { return tick == bad; },
@@ -434,7 +436,7 @@ TEST(HapticLoop, BadSampleDuringTheWatchdogFadeGetsZeroForce) {
   ASSERT_TRUE(rs[std::size_t(bad - 1)].flags & kFlagWatchdog);
   EXPECT_TRUE(rs[std::size_t(bad)].flags & kFlagBadSample);
   EXPECT_EQ(length(rs[std::size_t(bad)].force_device_n), 0.0);
-  const double step_n = s.safety.max_force_rate_n_per_s / s.rate_hz;
+  const double step_n = s.safety.max_force_rate_n_per_s / trench_rate_hz();
   EXPECT_LE(length(rs[std::size_t(bad + 1)].force_device_n), step_n * (1 + 1e-9));
   EXPECT_EQ(loop->counters().bad_samples, 1);
 }
@@ -445,7 +447,7 @@ TEST(HapticLoop, BadSampleDuringTheWatchdogFadeGetsZeroForce) {
 TEST(HapticLoop, SimHandTrenchStaysBoundedAndDigs) {
   const HapticSettings& s = trench().haptics;
   SimHandDevice device(
-      SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, trench_path(s), s.rate_hz));
+      SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, trench_path(s), trench_rate_hz()));
   auto loop = trench_loop(s, device, ticks_of(s));
   loop->run_deterministic();
   const std::vector<LoopRecord> rs = loop->records();
@@ -533,7 +535,7 @@ HoldResult hold_against_floor(HapticSettings s, double floor_stiffness_world) {
   hold.keyframes = {{0.0, {{0.0, -0.03, 0.0}, Quat{}}}};  // 2 mm below the floor, on the device
   const DevicePath path(hold, Workspace(s.workspace));
   SimHandDevice device(
-      SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, path, s.rate_hz));
+      SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, path, trench_rate_hz()));
   LoopOptions o;
   o.ticks = 2000;
   o.realtime = false;
@@ -541,7 +543,7 @@ HoldResult hold_against_floor(HapticSettings s, double floor_stiffness_world) {
   HapticLoop& loop = *rig;
   HoldResult r;
   for (std::int64_t i = 0; i < o.ticks; ++i) {
-    loop.step1(double(i) / s.rate_hz);
+    loop.step1(double(i) / trench_rate_hz());
     const double e = holding_energy(device.hand(), loop);
     if (i == 0) r.start_j = e;
     r.max_j = std::max(r.max_j, e);
@@ -591,7 +593,7 @@ TEST(HapticLoop, StatisticsFromTheTickTimes) {
   auto loop = trench_loop(s, device, 1000);
   // A fake clock: 989 periods exactly nominal, 10 late by 500 us; compute
   // times 100 us, except one of 700 us; three missed deadlines.
-  const double T = 1.0 / s.rate_hz;
+  const double T = 1.0 / trench_rate_hz();
   for (int i = 0; i < 1000; ++i) {
     loop->step1(i * T);
     const double period = i == 0 ? 0.0 : (i % 100 == 50 ? T + 500e-6 : T);
@@ -737,7 +739,7 @@ TEST(HapticLoop, APausedDeviceHoldsTheLoopAndItsClock) {
   ASSERT_EQ(rs.size(), 100u);
   // Every period is the nominal one, to the fake clock's spin step (1 us),
   // the one after the 1.5 s pause included.
-  const double T = 1.0 / s.rate_hz;
+  const double T = 1.0 / trench_rate_hz();
   for (std::size_t i = 1; i < rs.size(); ++i) {
     EXPECT_NEAR(rs[i].t_s - rs[i - 1].t_s, T, 1.5e-6) << "tick " << i;
     EXPECT_NEAR(rs[i].period_s, T, 1.5e-6) << "tick " << i;

@@ -440,7 +440,7 @@ int run_mmt_soak(const MmtSoakOptions& o) {
   const io::Scenario& b = op.base;
   // The operator's hand: the scenario's cut, over and over.
   const std::unique_ptr<haptics::Device> hand = session::make_operator_device(op, true);
-  const double rate_hz = op.haptics.rate_hz;
+  const double rate_hz = op.base.rate_hz;
   CheckingDevice checker(*hand, op.haptics.safety, rate_hz);
 
   std::unique_ptr<net::EmulatedLink> memory;

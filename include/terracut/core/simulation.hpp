@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "terracut/core/cut.hpp"
+#include "terracut/core/ranges.hpp"
 #include "terracut/core/soil.hpp"
 #include "terracut/core/step_listener.hpp"
 #include "terracut/core/tool_force.hpp"
@@ -33,7 +34,10 @@ namespace terracut {
 struct SimParams {
   GridSpec grid{};
   Representation representation = Representation::kSurface;
-  double rate_hz = 1000.0;  ///< fixed step rate, Hz, in (0, 1e6]
+  /// The fixed step rate, Hz, in (0, 1e6]: the one rate of a run (the
+  /// scenario's rate_hz). A haptic loop steps the simulation at it too,
+  /// unless its program overrides it (session::WorldOptions::rate_hz).
+  double rate_hz = 1000.0;
   BladeSpec blade{};
   /// A step whose rotation would move a blade end off its straight path by
   /// more than this fraction of a cell is split into sub-steps (slerp), so a
@@ -43,6 +47,21 @@ struct SimParams {
   /// force and the flow read, and what happens to what the blade cuts
   /// (soil.hpp); kVanish by default.
   SoilFlowParams soil{};
+};
+
+/// The ranges of SimParams' own numbers (core/ranges.hpp): validate()
+/// checks the fields through this table and the scenario reader reads the
+/// file's same fields through its entries. The grid and the soil have their
+/// own checks (validate(GridSpec), kSoilFlowRanges); the blade's rake is the
+/// earthmoving model's entry, which validate() checks with the material.
+inline constexpr Range kSimParamsRanges[] = {
+    kRateRange,
+    {"max_arc_error_cells", 0.0, 1.0, RangeEnds::kOpenLow},
+    {"blade.length_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    at_path(find_range(kEarthmovingRanges, "rake_angle_deg"), "blade.rake_angle_deg"),
+    {"blade.edge_thickness_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"blade.bucket.depth_m", 0.0, kRangeMax, RangeEnds::kClosed},  // 0: no bucket
+    {"blade.bucket.height_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
 };
 
 /// Returns an empty string when params are valid, else a message naming the field.

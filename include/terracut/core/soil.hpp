@@ -219,6 +219,13 @@ struct SoilFlowParams {
   SoilEdge edge = SoilEdge::kWall;
 };
 
+/// The ranges of SoilFlowParams' own numbers (core/ranges.hpp): validate()
+/// checks them and the scenario reader reads `soil:` through them (the
+/// material's are material_ranges()).
+inline constexpr Range kSoilFlowRanges[] = {
+    {"max_pair_checks_per_step", 1000, 1e9, RangeEnds::kClosed, true},
+};
+
 /// Returns an empty string when params are valid, else a message naming the field.
 std::string validate(const SoilFlowParams& params);
 

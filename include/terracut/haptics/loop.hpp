@@ -122,6 +122,10 @@ struct LoopCounters {
 /// Percentiles of a per-tick time, microseconds (core/stats.hpp).
 using TimePercentiles = TimingStats;
 
+/// The range of a haptic loop's rate, Hz: narrower than a simulation's
+/// (kRateRange), since a device is paced and answered every tick.
+inline constexpr Range kLoopRateRange{"rate_hz", 10.0, 10000.0, RangeEnds::kClosed};
+
 /// The loop's parameters: the haptic settings, validated once, with their
 /// derived values computed once (the force model's workspace scale, loop
 /// rate and largest contact length) and the force model built once (its
@@ -129,16 +133,18 @@ using TimePercentiles = TimingStats;
 class LoopParams {
  public:
   /// settings: as parsed (any derived force fields are replaced); blade: the
-  /// scenario's blade (its length bounds the contact). Throws InputError
-  /// "haptics.FIELD ..." naming the bad field, including a ForceModel refusal
-  /// ("haptics.forces. ...").
-  LoopParams(const HapticSettings& settings, const BladeSpec& blade);
+  /// scenario's blade (its length bounds the contact); rate_hz: the loop's
+  /// rate, the simulation's (the scenario's rate_hz, or a program's
+  /// override), in kLoopRateRange. Throws InputError "haptics.FIELD ..."
+  /// naming the bad field, including a ForceModel refusal ("haptics.forces.
+  /// ..."), or "rate_hz ..." for a rate out of the loop's range.
+  LoopParams(const HapticSettings& settings, const BladeSpec& blade, double rate_hz);
 
   /// The settings with the derived force fields filled in.
   const HapticSettings& settings() const { return settings_; }
-  /// The loop rate, Hz (settings().rate_hz): the simulation the loop steps
-  /// must run at this rate.
-  double rate_hz() const { return settings_.rate_hz; }
+  /// The loop rate, Hz (kept once, as the force model's loop_rate_hz): the
+  /// simulation the loop steps must run at this rate.
+  double rate_hz() const { return settings_.forces.loop_rate_hz; }
   /// The force model (after the device check).
   const ForceModel& force_model() const { return model_; }
 

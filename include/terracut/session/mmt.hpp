@@ -35,6 +35,7 @@
 #include "terracut/core/wire.hpp"
 #include "terracut/core/stats.hpp"
 #include "terracut/haptics/device.hpp"
+#include "terracut/io/recording.hpp"
 #include "terracut/io/scenario.hpp"
 #include "terracut/net/emulated_link.hpp"
 #include "terracut/net/emulator.hpp"
@@ -450,8 +451,9 @@ void write_remote_csv(const std::vector<RemoteRecord>& records, const std::files
 /// The same files written a tick at a time, for a live station whose
 /// records are not kept (an hour at 1 kHz is about 1.1 GB of them): the
 /// header on opening, a row per add(), buffered (a write to the file about
-/// every 400 rows). Throws InputError naming the file when it cannot be
-/// opened, and from add() or finish() when a write failed.
+/// every 400 rows; an io::CsvFile, the one CSV writer). Throws InputError
+/// naming the file when it cannot be created, and from add() or finish()
+/// when a write failed.
 class StationCsv {
  public:
   static StationCsv operator_csv(const std::filesystem::path& path);
@@ -466,9 +468,7 @@ class StationCsv {
 
  private:
   StationCsv(const std::filesystem::path& path, const char* header);
-  std::filesystem::path path_;
-  std::unique_ptr<char[]> buffer_;
-  std::unique_ptr<std::ofstream> out_;
+  std::unique_ptr<io::CsvFile> file_;
 };
 
 /// The operator's device of an mmt run: the scenario's script, sim or udp
