@@ -242,8 +242,14 @@ void LoopDriver::publish_mmt() {
   m.estimates.store(oc.estimates, std::memory_order_relaxed);
   m.rejected.store(oc.rejected.total() + (remote_ ? remote_->counters().rejected.total() : 0),
                   std::memory_order_relaxed);
-  m.scale_applied.store(r.scale_applied, std::memory_order_relaxed);
-  m.scale_target.store(r.scale_target, std::memory_order_relaxed);
+  const net::Estimate& e = operator_->last_estimate();
+  for (int f = 0; f < kSoilFieldCount; ++f) {
+    const std::size_t i = std::size_t(f);
+    m.material_applied[i].store(field_value(r.material, SoilField(f)), std::memory_order_relaxed);
+    m.estimate[i].store(field_value(e.material, SoilField(f)), std::memory_order_relaxed);
+    m.estimate_sd[i].store(e.sd[i], std::memory_order_relaxed);
+  }
+  m.identifiable.store(e.identifiable, std::memory_order_relaxed);
   m.link_silent.store(r.link_silent, std::memory_order_relaxed);
 }
 

@@ -1,6 +1,8 @@
 // Two-process MMT (mmt_process.hpp).
 #include "terracut/session/mmt_process.hpp"
 
+#include "mmt_json.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <chrono>
@@ -131,10 +133,9 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
   nlohmann::ordered_json j = station_json(station.counters(), *link, duration);
   j["role"] = "remote";
   j["connections"] = link->connections();
-  j["force_scale"] = station.force_scale();
-  j["estimate"] = {{"samples", station.estimate_samples()},
-                   {"outliers_left_out", station.estimate_outliers()},
-                   {"capped_left_out", station.estimate_capped()}};
+  j["estimate"] = detail::estimate_json(station.estimate(), &station.true_material());
+  j["remote_arm"] = {{"force_limit_n", s.arm_force_limit_n},
+                     {"stalled_ticks", station.stalled_ticks()}};
   write_json(o.out / "summary.json", j);
   if (o.log)
     *o.log << "terracut mmt: remote done: " << station.counters().accepted << " commands, "
@@ -175,6 +176,8 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
   nlohmann::ordered_json j = station_json(station.counters(), *link, ran);
   j["role"] = "operator";
   j["max_force_step_at_update_n"] = station.max_update_step_n();
+  j["material_applied"] = detail::material_json(station.simulation().force_material());
+  j["estimates_applied"] = station.counters().estimates;
   j["passivity_max_energy_into_hand_j"] = passivity;
   write_json(o.out / "summary.json", j);
   if (o.log)

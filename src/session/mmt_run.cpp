@@ -14,6 +14,8 @@
 #include "terracut/haptics/workspace.hpp"
 #include "terracut/session/mmt.hpp"
 
+#include "mmt_json.hpp"
+
 namespace terracut::session {
 namespace {
 
@@ -47,19 +49,27 @@ namespace {
 
 constexpr const char* kOperatorCsvHeader =
     "t,x,y,z,fx,fy,fz,fdx,fdy,fdz,remote_fx,remote_fy,remote_fz,contact_length,"
-    "scale_applied,scale_target,updating,link_silent,passivity_j,passivity_dfr_j,"
-    "compute_us\n";
+    "unit_weight,cohesion,adhesion,phi,delta,material_blend,updating,link_silent,passivity_j,"
+    "passivity_dfr_j,compute_us\n";
 constexpr const char* kRemoteCsvHeader =
     "t,command_sequence,cmd_x,cmd_y,cmd_z,x,y,z,fx,fy,fz,contact_length,cut_depth,"
-    "force_scale,holding,active,compute_us\n";
+    "est_unit_weight,est_cohesion,est_adhesion,est_phi,est_delta,sd_unit_weight,sd_cohesion,"
+    "sd_adhesion,sd_phi,sd_delta,identifiable,estimate_samples,estimate_error,in_changed_soil,"
+    "stalled,holding,active,compute_us\n";
+
+void write_material(std::ostream& out, const SoilMaterial& m) {
+  out << m.unit_weight_n_per_m3 << ',' << m.cohesion_pa << ',' << m.adhesion_pa << ','
+      << m.internal_friction_deg << ',' << m.soil_tool_friction_deg << ',';
+}
 
 void write_row(std::ostream& out, const OperatorRecord& r) {
   out << r.t_s << ',' << r.tool_m.x << ',' << r.tool_m.y << ',' << r.tool_m.z << ','
       << r.force_world_n.x << ',' << r.force_world_n.y << ',' << r.force_world_n.z << ','
       << r.force_device_n.x << ',' << r.force_device_n.y << ',' << r.force_device_n.z << ','
       << r.remote_force_world_n.x << ',' << r.remote_force_world_n.y << ','
-      << r.remote_force_world_n.z << ',' << r.contact_length_m << ',' << r.scale_applied << ','
-      << r.scale_target << ',' << int(r.updating) << ',' << int(r.link_silent) << ','
+      << r.remote_force_world_n.z << ',' << r.contact_length_m << ',';
+  write_material(out, r.material);
+  out << r.material_blend << ',' << int(r.updating) << ',' << int(r.link_silent) << ','
       << r.passivity_j << ',' << r.passivity_dfr_j << ',' << r.compute_s * 1e6 << '\n';
 }
 
@@ -67,8 +77,12 @@ void write_row(std::ostream& out, const RemoteRecord& r) {
   out << r.t_s << ',' << r.command_sequence << ',' << r.commanded_m.x << ',' << r.commanded_m.y
       << ',' << r.commanded_m.z << ',' << r.tool_m.x << ',' << r.tool_m.y << ',' << r.tool_m.z
       << ',' << r.force_world_n.x << ',' << r.force_world_n.y << ',' << r.force_world_n.z << ','
-      << r.contact_length_m << ',' << r.cut_depth_m << ',' << r.force_scale << ','
-      << int(r.holding) << ',' << int(r.active) << ',' << r.compute_s * 1e6 << '\n';
+      << r.contact_length_m << ',' << r.cut_depth_m << ',';
+  write_material(out, r.estimate.material);
+  for (double sd : r.estimate.sd) out << sd << ',';
+  out << r.estimate.identifiable << ',' << r.estimate.samples << ',' << r.estimate_error << ','
+      << int(r.in_changed_soil) << ',' << int(r.stalled) << ',' << int(r.holding) << ','
+      << int(r.active) << ',' << r.compute_s * 1e6 << '\n';
 }
 
 }  // namespace
@@ -211,9 +225,25 @@ MmtSummary MmtRun::summary() const {
   s.deadband = settings_.deadband;
   const auto& op = operator_->records();
   const auto& rm = remote_->records();
-  // The remote acts on command i one one-way delay later: compare there.
-  const std::int64_t lag = std::llround(settings_.to_remote.delay_s * rate_hz_);
-  std::vector<double> e_mmt, e_dfr, f_rem;
+  // The remote acts on command i one one-way delay later, and its arm, a
+  // first-order servo, follows a steady motion one time constant behind:
+  // compare there (the same commanded motion). Direct reflection is
+  // compared the same way.
+  const std::int64_t lag = std::llround(
+      (settings_.to_remote.delay_s + settings_.follower_time_constant_s) * rate_hz_);
+  // The remote's cutting: from its first tick with a cut on.
+  double first_cut_s = -1.0, change_s = -1.0;
+  for (const RemoteRecord& r : rm) {
+    if (first_cut_s < 0.0 && r.active && r.cut_depth_m > 0.0 && r.estimate_error >= 0.0)
+      first_cut_s = r.t_s;
+    if (change_s < 0.0 && r.in_changed_soil) change_s = r.t_s;
+  }
+  s.cutting_from_s = first_cut_s < 0.0 ? -1.0 : first_cut_s + 1.0;
+  if (change_s >= 0.0) {
+    s.settle_excluded_from_s = change_s;
+    s.settle_excluded_to_s = change_s + s.rtt_s + 0.5;
+  }
+  std::vector<double> e_mmt, e_dfr, f_rem, e_mmt1, e_dfr1, f_rem1;
   for (std::size_t i = 0; i < op.size(); ++i) {
     const std::size_t j = i + std::size_t(lag);
     if (j >= rm.size() || !rm[j].active) continue;
@@ -223,15 +253,41 @@ MmtSummary MmtRun::summary() const {
     if (length(op[i].force_world_n) == 0.0 && length(op[i].remote_force_world_n) == 0.0 &&
         length(rm[j].force_world_n) == 0.0)
       continue;
-    e_mmt.push_back(length(op[i].force_world_n - rm[j].force_world_n));
-    e_dfr.push_back(length(op[i].remote_force_world_n - rm[j].force_world_n));
-    f_rem.push_back(length(rm[j].force_world_n));
+    const double em = length(op[i].force_world_n - rm[j].force_world_n);
+    const double ed = length(op[i].remote_force_world_n - rm[j].force_world_n);
+    const double fr = length(rm[j].force_world_n);
+    e_mmt.push_back(em);
+    e_dfr.push_back(ed);
+    f_rem.push_back(fr);
+    const double t = rm[j].t_s;
+    if (first_cut_s >= 0.0 && t >= s.cutting_from_s &&
+        !(change_s >= 0.0 && t >= s.settle_excluded_from_s && t < s.settle_excluded_to_s)) {
+      e_mmt1.push_back(em);
+      e_dfr1.push_back(ed);
+      f_rem1.push_back(fr);
+    }
   }
   s.force_rms_remote_n = rms(f_rem);
   s.force_error_rms_mmt_n = rms(e_mmt);
   s.force_error_rms_dfr_n = rms(e_dfr);
   for (double e : e_mmt) s.force_error_max_mmt_n = std::max(s.force_error_max_mmt_n, e);
   for (double e : e_dfr) s.force_error_max_dfr_n = std::max(s.force_error_max_dfr_n, e);
+  s.force_rms_remote_after_1s_n = rms(f_rem1);
+  s.force_error_rms_mmt_after_1s_n = rms(e_mmt1);
+  s.force_error_rms_dfr_after_1s_n = rms(e_dfr1);
+  if (s.force_rms_remote_after_1s_n > 0.0) {
+    s.force_error_rel_mmt_after_1s = s.force_error_rms_mmt_after_1s_n / s.force_rms_remote_after_1s_n;
+    s.force_error_rel_dfr_after_1s = s.force_error_rms_dfr_after_1s_n / s.force_rms_remote_after_1s_n;
+  }
+  // Re-identification: from the blade entering the new soil to the last
+  // tick, while it cuts, whose estimate was more than 5 % off the measured
+  // horizontal force.
+  if (change_s >= 0.0) {
+    double last_off_s = change_s;
+    for (const RemoteRecord& r : rm)
+      if (r.t_s >= change_s && r.estimate_error > 0.05) last_off_s = r.t_s;
+    s.reidentified_after_s = last_off_s - change_s;
+  }
   for (const auto& [t, e] : terrain_error_) s.terrain_rms_max_m = std::max(s.terrain_rms_max_m, e);
   s.terrain_rms_final_m = terrain_error_.empty() ? 0.0 : terrain_error_.back().second;
   std::vector<double> track;
@@ -255,11 +311,10 @@ MmtSummary MmtRun::summary() const {
     s.passivity_max_mmt_j = std::max(s.passivity_max_mmt_j, r.passivity_j);
     s.passivity_max_dfr_j = std::max(s.passivity_max_dfr_j, r.passivity_dfr_j);
   }
-  s.force_scale_final = remote_->force_scale();
-  s.force_scale_applied = op.empty() ? 1.0 : op.back().scale_applied;
-  s.estimate_samples = remote_->estimate_samples();
-  s.estimate_outliers = remote_->estimate_outliers();
-  s.estimate_capped = remote_->estimate_capped();
+  s.estimate = remote_->estimate();
+  s.remote_material = remote_->true_material();
+  s.material_applied = operator_->simulation().force_material();
+  s.stalled_ticks = remote_->stalled_ticks();
   std::vector<double> c;
   for (const OperatorRecord& r : op) c.push_back(r.compute_s);
   s.operator_compute = timing_stats(c);
@@ -316,11 +371,19 @@ void MmtRun::write_outputs(const std::filesystem::path& dir) const {
                   {"estimates_applied", operator_->counters().estimates},
                   {"max_force_step_at_update_n", s.max_update_step_n},
                   {"max_force_step_while_updating_n", s.max_step_while_updating_n}};
-  j["estimate"] = {{"force_scale", s.force_scale_final},
-                   {"force_scale_applied", s.force_scale_applied},
-                   {"samples", s.estimate_samples},
-                   {"outliers_left_out", s.estimate_outliers},
-                   {"capped_left_out", s.estimate_capped}};
+  j["force_error_after_1s"] = {{"from_s", s.cutting_from_s},
+                               {"left_out_from_s", s.settle_excluded_from_s},
+                               {"left_out_to_s", s.settle_excluded_to_s},
+                               {"remote_force_rms_n", s.force_rms_remote_after_1s_n},
+                               {"mmt_rms_n", s.force_error_rms_mmt_after_1s_n},
+                               {"direct_rms_n", s.force_error_rms_dfr_after_1s_n},
+                               {"mmt_relative", s.force_error_rel_mmt_after_1s},
+                               {"direct_relative", s.force_error_rel_dfr_after_1s}};
+  j["estimate"] = detail::estimate_json(s.estimate, &s.remote_material);
+  j["estimate"]["material_applied_by_operator"] = detail::material_json(s.material_applied);
+  j["estimate"]["reidentified_after_s"] = s.reidentified_after_s;
+  j["remote_arm"] = {{"force_limit_n", settings_.arm_force_limit_n},
+                     {"stalled_ticks", s.stalled_ticks}};
   j["passivity"] = {{"window_s", 1.0},
                     {"mmt_max_energy_into_hand_j", s.passivity_max_mmt_j},
                     {"direct_max_energy_into_hand_j", s.passivity_max_dfr_j}};

@@ -33,19 +33,20 @@
 
 #include "terracut/core/blade.hpp"
 #include "terracut/core/grid.hpp"
+#include "terracut/core/material.hpp"
 #include "terracut/core/math.hpp"
 #include "terracut/core/wire.hpp"
 
 namespace terracut::net {
 
 inline constexpr std::uint32_t kMagic = 0x4D4D4354u;  // "TCMM" in memory order
-inline constexpr std::uint16_t kVersion = 1;
+inline constexpr std::uint16_t kVersion = 2;  ///< 2: the estimate is a soil material (1: one force factor)
 inline constexpr std::size_t kHeaderSize = 40;
 inline constexpr std::size_t kCrcSize = 4;
 inline constexpr std::size_t kCommandPayloadSize = 72;
 inline constexpr std::size_t kMeasurementPayloadSize = 112;
 inline constexpr std::size_t kPatchFixedSize = 32;  ///< before the compressed heights
-inline constexpr std::size_t kEstimatePayloadSize = 32;
+inline constexpr std::size_t kEstimatePayloadSize = 96;
 /// Largest patch, samples (2048 x 2048); a patch declaring more is refused.
 inline constexpr std::int64_t kMaxPatchSamples = std::int64_t(1) << 22;
 
@@ -103,16 +104,20 @@ struct Patch {
   std::vector<float> heights;  ///< rect rows x cols, row-major, metres
 };
 
-/// The remote's estimate of the soil (32 bytes): t_s f64 at 40, force_scale
-/// f64 at 48, variance f64 at 56, samples u32 at 64, flags u32 at 68.
+/// The remote's estimate of its soil (96 bytes): t_s f64 at 40; the
+/// material's unit_weight_n_per_m3, cohesion_pa, adhesion_pa,
+/// internal_friction_deg, soil_tool_friction_deg f64 at 48, 56, 64, 72, 80;
+/// their standard uncertainties f64 at 88 ... 120 (same order and units);
+/// samples u32 at 128, identifiable u32 at 132 (bit i: field i, in
+/// core/soil_estimator.hpp's SoilField order). The repose angle is not
+/// sent: the force does not depend on it and the operator keeps its own.
 struct Estimate {
   double t_s = 0.0;
-  /// Measured force / the operator's model's force at the same cut: the
-  /// factor the operator's cutting force should be multiplied by, > 0.
-  double force_scale = 1.0;
-  double variance = 0.0;       ///< RLS covariance of force_scale
-  std::uint32_t samples = 0;   ///< samples the estimate has seen
-  std::uint32_t flags = 0;
+  /// The fitted fields; repose_deg is not part of the message.
+  SoilMaterial material{};
+  std::array<double, 5> sd{};    ///< standard uncertainties, >= 0
+  std::uint32_t samples = 0;     ///< samples the estimate has taken in
+  std::uint32_t identifiable = 0;
 };
 
 /// Why a datagram was rejected. Format reasons come from the decoders; the
