@@ -148,6 +148,7 @@ void SoilEstimator::restart_memory() {
   surprises_ = 0;
   memory_size_ = 0;
   memory_next_ = 0;
+  refined_before_ = false;
 }
 
 void SoilEstimator::reset() {
@@ -156,7 +157,6 @@ void SoilEstimator::reset() {
     c.theta = {m.unit_weight_n_per_m3 * kToKilo, m.cohesion_pa * kToKilo, m.adhesion_pa * kToKilo};
     c.cost = 0.0;
     c.beta_rad = 0.0;
-    c.last_error = 0.0;
   }
   restart_memory();
   best_ = -1;
@@ -194,20 +194,21 @@ bool SoilEstimator::advance(int count) {
   return true;
 }
 
-// beta*, the failure-plane angle that minimises P for the candidate's
-// material (earthmoving.hpp): a golden-section search to 1e-7 rad around
-// the candidate's previous beta* (the cut changes little between samples),
-// or the whole range by earthmoving_force's own search on its first sample
-// or when the previous one sits at the bracket's end. P is flat at its
-// minimum, so 1e-7 rad changes the factors' P by far less than rounding.
-double SoilEstimator::failure_angle(Candidate& c, const EarthmovingParams& params,
-                                    const SoilSample& s, double q) const {
+namespace {
+
+// beta*, the failure-plane angle that minimises P for a material
+// (earthmoving.hpp): a golden-section search to 1e-7 rad around a previous
+// beta* (the cut and the material change little between calls), or the
+// whole range by earthmoving_force's own search when there is none
+// (previous <= 0) or the minimum sits at the bracket's end. P is flat at
+// its minimum, so 1e-7 rad changes it by far less than rounding.
+double beta_star(const EarthmovingParams& params, const SoilSample& s, double q, double previous) {
   const BetaRange range = earthmoving_beta_range(params);
   constexpr double kEdge = 1e-4, kBracket = 0.08;
   const double lo_all = range.lo_rad + kEdge;
   const double hi_all = range.hi_rad >= 1.5707963267948966 ? range.hi_rad : range.hi_rad - kEdge;
-  if (c.beta_rad > 0.0) {
-    double a = std::max(lo_all, c.beta_rad - kBracket), b = std::min(hi_all, c.beta_rad + kBracket);
+  if (previous > 0.0) {
+    double a = std::max(lo_all, previous - kBracket), b = std::min(hi_all, previous + kBracket);
     auto total = [&](double beta) {
       return earthmoving_total_n(params, s.width_m, s.depth_m, beta, q);
     };
@@ -231,14 +232,18 @@ double SoilEstimator::failure_angle(Candidate& c, const EarthmovingParams& param
     }
     const double beta = 0.5 * (a + b);
     // Inside the bracket (or at the range's own end): the minimum.
-    const bool at_bracket_end = (beta - (c.beta_rad - kBracket) < 1e-5 && beta - lo_all > 1e-5) ||
-                                ((c.beta_rad + kBracket) - beta < 1e-5 && hi_all - beta > 1e-5);
-    if (!at_bracket_end) {
-      c.beta_rad = beta;
-      return beta;
-    }
+    const bool at_bracket_end = (beta - (previous - kBracket) < 1e-5 && beta - lo_all > 1e-5) ||
+                                ((previous + kBracket) - beta < 1e-5 && hi_all - beta > 1e-5);
+    if (!at_bracket_end) return beta;
   }
-  c.beta_rad = earthmoving_force(params, s.width_m, s.depth_m, q).beta_rad;
+  return earthmoving_force(params, s.width_m, s.depth_m, q).beta_rad;
+}
+
+}  // namespace
+
+double SoilEstimator::failure_angle(Candidate& c, const EarthmovingParams& params,
+                                    const SoilSample& s, double q) const {
+  c.beta_rad = beta_star(params, s, q, c.beta_rad);
   return c.beta_rad;
 }
 
@@ -274,10 +279,6 @@ void SoilEstimator::take(Candidate& c, const SoilSample& s) const {
   const std::array<double, 3> xh{p_gamma * sin_ad, p_c * sin_ad, p_a * sin_ad + d * w * cot_a};
   const std::array<double, 3> xv{p_gamma * cos_ad, p_c * cos_ad, p_a * cos_ad - d * w};
   const double lambda = settings_.forgetting_per_sample;
-  // The a-priori error of the horizontal force: how far this candidate's
-  // fit so far was from the sample (the change-of-soil test's).
-  c.last_error = s.horizontal_n * kToKilo -
-                 (xh[0] * c.theta[0] + xh[1] * c.theta[1] + xh[2] * c.theta[2]);
   // Forgetting once per sample: the first equation carries it.
   c.cost = lambda * c.cost + rls_update(c.theta, c.p, xh, s.horizontal_n * kToKilo, lambda);
   c.cost += rls_update(c.theta, c.p, xv, s.vertical_n * kToKilo, 1.0);
@@ -292,24 +293,29 @@ void SoilEstimator::finish_sample() {
   for (std::size_t k = 0; k < memory_size_; ++k) ++memory_[k].age;
   ++estimate_.samples;
   ++since_reset_;
-  // A change of soil: the estimate's own candidate missed kSurprises more
-  // samples than it met (a count up on a miss, down on a hit) by more than kSurpriseFraction of the force (and by more than
-  // 4 times its residuals' RMS), once the memory had kSettled samples. Then
-  // the memory restarts (the covariance back to the prior's, the costs to
-  // zero, the fits kept as the starting point): covariance resetting, so
-  // that the new soil is learnt at the rate of a fresh start and not after
-  // the old samples have been forgotten.
+  // A change of soil: the estimate missed kSurprises more samples than it
+  // met (a count up on a miss, down on a hit), a miss being a horizontal
+  // force more than kSurpriseFraction of the measured one and more than 4
+  // times the fit's residual RMS (before the misses began) away from the
+  // estimate's, once the memory had kSettled samples. Then the memory
+  // restarts (the covariance back to the prior's, the costs to zero, the
+  // fits kept as the starting point): covariance resetting, so that the new
+  // soil is learnt at the rate of a fresh start and not after the old
+  // samples have been forgotten.
   constexpr double kSurpriseFraction = 0.08;
   constexpr int kSurprises = 3;
   constexpr std::int64_t kSettled = 10;
-  if (best_ >= 0 && since_reset_ > kSettled) {
-    // Against the residuals the fit had before the misses began (each
-    // miss raises them).
-    const Candidate& was = candidates_[std::size_t(best_)];
+  if (estimate_.known && since_reset_ > kSettled) {
     if (surprises_ == 0) calm_rms_n_ = estimate_.residual_rms_n;
-    const double sigma = std::max(calm_rms_n_, settings_.force_noise_n) * kToKilo;
-    const double e = std::fabs(was.last_error);
-    if (e > kSurpriseFraction * std::fabs(sample_.horizontal_n * kToKilo) && e > 4.0 * sigma)
+    EarthmovingParams p;
+    p.soil = estimate_.material;
+    p.rake_angle_deg = sample_.rake_deg;
+    const double predicted =
+        earthmoving_force(p, sample_.width_m, sample_.depth_m,
+                          p.soil.unit_weight_n_per_m3 * sample_.pile_m).horizontal_n;
+    const double e = std::fabs(predicted - sample_.horizontal_n);
+    const double floor_n = 4.0 * std::max(calm_rms_n_, settings_.force_noise_n);
+    if (e > kSurpriseFraction * std::fabs(sample_.horizontal_n) && e > floor_n)
       ++surprises_;
     else
       surprises_ = std::max(surprises_ - 1, 0);
@@ -399,6 +405,10 @@ void SoilEstimator::finish_sample() {
         neighbour_change[std::size_t(i)] = std::max(
             neighbour_change[std::size_t(i)], std::fabs(c.theta[std::size_t(i)] - b.theta[std::size_t(i)]));
   }
+  // The grid's answer: the pair's own fit, with the profile's spread and
+  // the grid's resolution (the pair of least cost lies within a step of
+  // the truth) as its uncertainty.
+  std::array<double, kSoilFieldCount> x{b.theta[0], b.theta[1], b.theta[2], b.phi_deg, b.delta_deg};
   std::array<double, kSoilFieldCount> var{};
   for (int i = 0; i < 3; ++i)
     var[std::size_t(i)] = sigma2 * b.p[std::size_t(4 * i)] +
@@ -407,23 +417,34 @@ void SoilEstimator::finish_sample() {
   var[3] = spread[3] * spread[3] + step * step / 3.0;
   var[4] = spread[4] * spread[4] + step * step / 3.0;
 
-  // The information matrix of all five parameters over the samples in
-  // memory (forgetting-weighted), at the estimate: a parameter the cuts do
-  // not tell apart from the others (one depth: the weight's d^2 against the
-  // cohesion's d; one rake and no adhesion: delta against c_a) has an
-  // unbounded variance there, whatever the profile says.
-  const std::array<double, kSoilFieldCount> fisher_var = information_variance(b, sigma2);
-  for (int f = 0; f < kSoilFieldCount; ++f)
-    var[std::size_t(f)] = std::max(var[std::size_t(f)], fisher_var[std::size_t(f)]);
+  // Refined between the grid's points: Gauss-Newton (Levenberg-Marquardt)
+  // on all five parameters over the cuts in memory, from the pair's fit,
+  // and the uncertainty of the information matrix there (a parameter the
+  // cuts do not tell apart from the others, as the weight's d^2 from the
+  // cohesion's d at one depth, has an unbounded variance).
+  // Started from the grid's answer, and from the previous estimate (the
+  // grid's best pair can jump where the cuts leave the angles loose, as a
+  // blade leaving the soil does); the better fit is kept.
+  Refined fit = refine(x);
+  if (refined_before_) {
+    const Refined again = refine(previous_x_);
+    if (again.ok && (!fit.ok || again.cost < fit.cost)) fit = again;
+  }
+  if (fit.ok) {
+    previous_x_ = fit.x;
+    refined_before_ = true;
+    x = fit.x;
+    var = fit.var;
+    estimate_.residual_rms_n = std::sqrt(fit.cost / std::max(fit.weight, 1.0)) / kToKilo;
+  }
 
   SoilMaterial& m = estimate_.material;
   m = settings_.prior;
-  m.unit_weight_n_per_m3 =
-      std::max(b.theta[0] / kToKilo, 0.01 * settings_.prior.unit_weight_n_per_m3);
-  m.cohesion_pa = std::max(b.theta[1] / kToKilo, 0.0);
-  m.adhesion_pa = std::max(b.theta[2] / kToKilo, 0.0);
-  m.internal_friction_deg = b.phi_deg;
-  m.soil_tool_friction_deg = b.delta_deg;
+  m.unit_weight_n_per_m3 = std::max(x[0] / kToKilo, 0.01 * settings_.prior.unit_weight_n_per_m3);
+  m.cohesion_pa = std::max(x[1] / kToKilo, 0.0);
+  m.adhesion_pa = std::max(x[2] / kToKilo, 0.0);
+  m.internal_friction_deg = x[3];
+  m.soil_tool_friction_deg = x[4];
   for (int i = 0; i < 3; ++i) estimate_.sd[std::size_t(i)] = std::sqrt(var[std::size_t(i)]) / kToKilo;
   estimate_.sd[3] = std::sqrt(var[3]);
   estimate_.sd[4] = std::sqrt(var[4]);
@@ -433,12 +454,13 @@ void SoilEstimator::finish_sample() {
       estimate_.identifiable |= 1u << f;
 }
 
+namespace {
 
 // The model's H and V (kN) for a remembered cut at the given parameters
 // (theta in kN/m^3 and kPa, angles in degrees) at the cut's failure angle:
 // at beta* the force is stationary in beta, so its derivatives in the
 // parameters at a fixed beta are the derivatives of the force itself.
-static void model_hv(const SoilSample& s, double beta, const std::array<double, 5>& x, double& h,
+void model_hv(const SoilSample& s, double beta, const std::array<double, 5>& x, double& h,
                      double& v) {
   EarthmovingParams params;
   params.rake_angle_deg = s.rake_deg;
@@ -454,58 +476,41 @@ static void model_hv(const SoilSample& s, double beta, const std::array<double, 
   v = p * std::cos(alpha + delta) - x[2] * d * w;
 }
 
-std::array<double, kSoilFieldCount> SoilEstimator::information_variance(const Candidate& b,
-                                                                        double sigma2) const {
-  std::array<double, kSoilFieldCount> out{};
-  constexpr double kUnbounded = 1e12;  // (parameter units)^2: nothing known
-  out.fill(kUnbounded);
-  if (memory_size_ == 0) return out;
-  const std::array<double, 5> x0{b.theta[0], b.theta[1], b.theta[2], b.phi_deg, b.delta_deg};
-  constexpr double kAngleStep = 0.01;  // degrees, for the angles' derivatives
-  double f[5][5] = {};
-  const double lambda = settings_.forgetting_per_sample;
-  for (std::size_t k = 0; k < memory_size_; ++k) {
-    const Remembered& r = memory_[k];
-    const double weight = std::pow(lambda, double(r.age));
-    double jh[5], jv[5], h0, v0;
-    model_hv(r.sample, r.beta_rad, x0, h0, v0);
-    for (int i = 0; i < 5; ++i) {
-      std::array<double, 5> x = x0;
-      const double dx = i < 3 ? 1.0 : kAngleStep;  // linear: any step is exact
-      x[std::size_t(i)] += dx;
-      double h, v;
-      model_hv(r.sample, r.beta_rad, x, h, v);
-      jh[i] = (h - h0) / dx;
-      jv[i] = (v - v0) / dx;
-    }
-    for (int i = 0; i < 5; ++i)
-      for (int j = 0; j < 5; ++j) f[i][j] += weight * (jh[i] * jh[j] + jv[i] * jv[j]);
-  }
-  // Invert by Gauss-Jordan with partial pivoting; a pivot below 1e-10 of
-  // the largest diagonal is a direction the cuts do not see.
-  double inv[5][5] = {};
-  double a[5][5];
+}  // namespace
+
+namespace {
+
+// Solves A x = b (5 x 5) by Gauss-Jordan with partial pivoting, giving the
+// inverse too; false when a pivot is below 1e-10 of the largest diagonal
+// (a direction the data do not see).
+bool solve5(const double (&a_in)[5][5], const double (&b_in)[5], double (&x)[5], double (&inv)[5][5]) {
+  double a[5][5], b[5];
   double scale = 0.0;
   for (int i = 0; i < 5; ++i) {
-    for (int j = 0; j < 5; ++j) a[i][j] = f[i][j];
-    inv[i][i] = 1.0;
-    scale = std::max(scale, f[i][i]);
+    for (int j = 0; j < 5; ++j) {
+      a[i][j] = a_in[i][j];
+      inv[i][j] = i == j ? 1.0 : 0.0;
+    }
+    b[i] = b_in[i];
+    scale = std::max(scale, std::fabs(a_in[i][i]));
   }
-  if (!(scale > 0.0)) return out;
+  if (!(scale > 0.0)) return false;
   for (int col = 0; col < 5; ++col) {
     int piv = col;
     for (int r = col + 1; r < 5; ++r)
       if (std::fabs(a[r][col]) > std::fabs(a[piv][col])) piv = r;
-    if (!(std::fabs(a[piv][col]) > 1e-10 * scale)) return out;
+    if (!(std::fabs(a[piv][col]) > 1e-10 * scale)) return false;
     for (int k = 0; k < 5; ++k) {
       std::swap(a[col][k], a[piv][k]);
       std::swap(inv[col][k], inv[piv][k]);
     }
+    std::swap(b[col], b[piv]);
     const double d = a[col][col];
     for (int k = 0; k < 5; ++k) {
       a[col][k] /= d;
       inv[col][k] /= d;
     }
+    b[col] /= d;
     for (int r = 0; r < 5; ++r)
       if (r != col) {
         const double m = a[r][col];
@@ -513,15 +518,122 @@ std::array<double, kSoilFieldCount> SoilEstimator::information_variance(const Ca
           a[r][k] -= m * a[col][k];
           inv[r][k] -= m * inv[col][k];
         }
+        b[r] -= m * b[col];
       }
   }
-  for (int i = 0; i < 5; ++i) {
-    const double var = sigma2 * inv[i][i];
-    if (!(var >= 0.0) || !std::isfinite(var)) continue;
-    // Back to N/m^3 and Pa for the linear ones (the estimate's sd units
-    // are applied by the caller: kN-based here).
-    out[std::size_t(i)] = std::min(var, kUnbounded);
+  for (int i = 0; i < 5; ++i) x[i] = b[i];
+  return true;
+}
+
+}  // namespace
+
+SoilEstimator::Refined SoilEstimator::refine(const std::array<double, kSoilFieldCount>& start) const {
+  Refined out;
+  out.x = start;
+  if (memory_size_ == 0) return out;
+  const double lambda = settings_.forgetting_per_sample;
+  double max_rake = 0.0;
+  for (std::size_t k = 0; k < memory_size_; ++k) max_rake = std::max(max_rake, memory_[k].sample.rake_deg);
+  // Physical values: weight > 0, cohesion and adhesion >= 0, 0 <= delta <=
+  // phi, and a failure wedge at every rake remembered.
+  auto clip = [&](std::array<double, 5>& x) {
+    x[0] = std::max(x[0], 0.01 * settings_.prior.unit_weight_n_per_m3 * kToKilo);
+    x[1] = std::max(x[1], 0.0);
+    x[2] = std::max(x[2], 0.0);
+    x[3] = std::clamp(x[3], 0.0, std::min(88.0, 178.0 - max_rake));
+    x[4] = std::clamp(x[4], 0.0, std::min(x[3], 178.0 - max_rake - x[3]));
+  };
+  // The weighted cost, and with want_normal the normal equations, at x.
+  auto evaluate = [&](const std::array<double, 5>& x, bool want_normal, double (&f)[5][5],
+                      double (&g)[5], double& weight) {
+    double cost = 0.0;
+    weight = 0.0;
+    if (want_normal)
+      for (int i = 0; i < 5; ++i) {
+        g[i] = 0.0;
+        for (int j = 0; j < 5; ++j) f[i][j] = 0.0;
+      }
+    constexpr double kAngleStep = 0.01;  // degrees, for the angles' derivatives
+    for (std::size_t k = 0; k < memory_size_; ++k) {
+      const Remembered& r = memory_[k];
+      const double w = std::pow(lambda, double(r.age));
+      double h0, v0;
+      model_hv(r.sample, r.beta_rad, x, h0, v0);
+      const double rh = r.sample.horizontal_n * kToKilo - h0, rv = r.sample.vertical_n * kToKilo - v0;
+      cost += w * (rh * rh + rv * rv);
+      weight += 2.0 * w;
+      if (!want_normal) continue;
+      double jh[5], jv[5];
+      for (int i = 0; i < 5; ++i) {
+        std::array<double, 5> xi = x;
+        const double dx = i < 3 ? 1.0 : kAngleStep;  // linear: any step is exact
+        xi[std::size_t(i)] += dx;
+        double h, v;
+        model_hv(r.sample, r.beta_rad, xi, h, v);
+        jh[i] = (h - h0) / dx;
+        jv[i] = (v - v0) / dx;
+      }
+      for (int i = 0; i < 5; ++i) {
+        g[i] += w * (jh[i] * rh + jv[i] * rv);
+        for (int j = 0; j < 5; ++j) f[i][j] += w * (jh[i] * jh[j] + jv[i] * jv[j]);
+      }
+    }
+    return cost;
+  };
+  double f[5][5], g[5], weight = 0.0;
+  std::array<double, 5> x = start;
+  clip(x);
+  // Each remembered cut's failure angle at the starting point (the force is
+  // stationary in it, so the steps below may keep it fixed).
+  for (std::size_t k = 0; k < memory_size_; ++k) {
+    Remembered& r = memory_[k];
+    EarthmovingParams p;
+    p.rake_angle_deg = r.sample.rake_deg;
+    p.soil.unit_weight_n_per_m3 = x[0] / kToKilo;
+    p.soil.cohesion_pa = x[1] / kToKilo;
+    p.soil.adhesion_pa = x[2] / kToKilo;
+    p.soil.internal_friction_deg = x[3];
+    p.soil.soil_tool_friction_deg = x[4];
+    r.beta_rad = beta_star(p, r.sample, p.soil.unit_weight_n_per_m3 * r.sample.pile_m, r.beta_rad);
   }
+  double cost = evaluate(x, true, f, g, weight);
+  double mu = 1e-3;
+  constexpr int kIterations = 4;
+  for (int it = 0; it < kIterations; ++it) {
+    double a[5][5], step[5], inv[5][5];
+    for (int i = 0; i < 5; ++i)
+      for (int j = 0; j < 5; ++j) a[i][j] = f[i][j] + (i == j ? mu * f[i][i] + 1e-12 : 0.0);
+    if (!solve5(a, g, step, inv)) break;
+    std::array<double, 5> trial = x;
+    for (int i = 0; i < 5; ++i) trial[std::size_t(i)] += step[i];
+    clip(trial);
+    double f2[5][5], g2[5], w2;
+    const double trial_cost = evaluate(trial, true, f2, g2, w2);
+    if (trial_cost < cost) {
+      x = trial;
+      cost = trial_cost;
+      std::copy(&f2[0][0], &f2[0][0] + 25, &f[0][0]);
+      std::copy(g2, g2 + 5, g);
+      mu = std::max(mu / 3.0, 1e-7);
+    } else {
+      mu *= 10.0;
+    }
+  }
+  out.x = x;
+  out.cost = cost;
+  out.weight = weight;
+  out.ok = true;
+  // The residual variance with the sensor's floor, and Cov = sigma^2 F^-1.
+  const double noise_kn = settings_.force_noise_n * kToKilo;
+  const double sigma2 = std::max(cost / std::max(weight - 5.0, 1.0), noise_kn * noise_kn);
+  constexpr double kUnbounded = 1e12;  // (parameter units)^2: nothing known
+  out.var.fill(kUnbounded);
+  double zero[5] = {}, unused[5], inv[5][5];
+  if (solve5(f, zero, unused, inv))
+    for (int i = 0; i < 5; ++i) {
+      const double v = sigma2 * inv[i][i];
+      if (v >= 0.0 && std::isfinite(v)) out.var[std::size_t(i)] = std::min(v, kUnbounded);
+    }
   return out;
 }
 

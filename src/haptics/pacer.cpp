@@ -171,7 +171,8 @@ Tick Pacer::wait_next() {
   if (!started_) return start();
   // End the current tick.
   double end = clock_->now_s();
-  compute_.record(recorded_compute_s_ >= 0.0 ? recorded_compute_s_ : end - tick_.start_s);
+  const double compute_s = recorded_compute_s_ >= 0.0 ? recorded_compute_s_ : end - tick_.start_s;
+  compute_.record(compute_s);
   recorded_compute_s_ = -1.0;
   ++ticks_;
 
@@ -183,6 +184,10 @@ Tick Pacer::wait_next() {
     // The work ran past this deadline: start at once, on the latest slot
     // that has begun, and drop the slots that passed entirely.
     ++missed_;
+    // Why: the work alone took longer than a period, or the tick had
+    // started late (woken late, or after an overrun) and its work, shorter
+    // than a period, still ended past the deadline.
+    if (compute_s > period_s_) ++missed_by_compute_;
     std::int64_t latest = std::int64_t(std::floor((end - origin_s_) / period_s_));
     latest = std::max(latest, slot);
     while (origin_s_ + double(latest) * period_s_ > end && latest > slot) --latest;  // rounding
@@ -214,6 +219,8 @@ LoopStats Pacer::stats() const {
   s.rate_hz = settings_.rate_hz;
   s.ticks = ticks_;
   s.missed_deadlines = missed_;
+  s.missed_by_compute = missed_by_compute_;
+  s.missed_by_late_start = missed_ - missed_by_compute_;
   s.skipped_slots = skipped_;
   s.compute = time_stats(compute_);
   s.period_jitter = time_stats(jitter_);
@@ -224,6 +231,7 @@ LoopStats Pacer::stats() const {
 void Pacer::reset_stats() {
   ticks_ = 0;
   missed_ = 0;
+  missed_by_compute_ = 0;
   skipped_ = 0;
   compute_.clear();
   jitter_.clear();

@@ -244,9 +244,23 @@ std::vector<std::string> HapticSession::warnings() const {
                 " device samples were not finite (ignored, answered with zero force)");
   if (s.nonfinite > 0)
     w.push_back(std::to_string(s.nonfinite) + " non-finite forces were replaced by zero");
-  if (c.missed_deadlines > 0)
-    w.push_back(std::to_string(c.missed_deadlines) +
-                " ticks started late: the tick before ran past their deadline (see timing_us)");
+  if (c.missed_deadlines > 0) {
+    // Say which it was: a tick whose work took longer than a period, or a
+    // tick that had itself started late (the OS woke the loop late) and
+    // ran past the next deadline with less work than a period.
+    const LoopStats& ps = l.pacer_stats();
+    std::string why;
+    if (ps.missed_by_compute > 0)
+      why += std::to_string(ps.missed_by_compute) + " after a tick that computed longer than a period (" +
+             format_number(std::round(ps.compute.max_s * 1e7) / 10.0) + " us at most; timing_us.compute)";
+    if (ps.missed_by_late_start > 0)
+      why += std::string(why.empty() ? "" : ", ") + std::to_string(ps.missed_by_late_start) +
+             " after a tick that had started late and computed less than a period (the OS woke the "
+             "loop up to " + format_number(std::round(ps.wake_latency.max_s * 1e7) / 10.0) +
+             " us after its deadline; timing_us.wake_latency)";
+    w.push_back(std::to_string(c.missed_deadlines) + " ticks started late: " +
+                (why.empty() ? std::string("the tick before ran past their deadline") : why));
+  }
   // The waits before the device's first sample and after its last are
   // expected (the safety limiter holds zero force then); a silence in between
   // is not.
@@ -311,6 +325,8 @@ std::string HapticSession::summary_json() const {
   j << "    \"wake_latency\": " << json_percentiles(ps.wake_latency) << ",\n";
   j << "    \"period\": " << json_percentiles(l.period()) << ",\n";
   j << "    \"missed_deadlines\": " << ps.missed_deadlines << ",\n";
+  j << "    \"missed_by_compute\": " << ps.missed_by_compute << ",\n";
+  j << "    \"missed_by_late_start\": " << ps.missed_by_late_start << ",\n";
   j << "    \"skipped_slots\": " << ps.skipped_slots << "\n  },\n";
   j << "  \"loop\": {\"samples\": " << c.samples << ", \"silent_ticks\": " << c.silent_ticks
     << ", \"bad_samples\": " << c.bad_samples << ", \"reconnects\": " << c.reconnects

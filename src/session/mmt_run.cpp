@@ -355,7 +355,7 @@ void MmtRun::write_outputs(const std::filesystem::path& dir) const {
                       {"mmt_max_n", s.force_error_max_mmt_n},
                       {"direct_rms_n", s.force_error_rms_dfr_n},
                       {"direct_max_n", s.force_error_max_dfr_n},
-                      {"aligned_by_s", settings_.to_remote.delay_s}};
+                      {"aligned_by_s", settings_.to_remote.delay_s + settings_.follower_time_constant_s}};
   j["terrain_error"] = {{"final_rms_m", s.terrain_rms_final_m}, {"max_rms_m", s.terrain_rms_max_m}};
   j["tracking"] = {{"rms_m", s.tracking_rms_m}, {"max_m", s.tracking_max_m}};
   j["traffic"] = {{"to_remote_packets_per_s", s.packets_per_s_to_remote},
@@ -379,6 +379,15 @@ void MmtRun::write_outputs(const std::filesystem::path& dir) const {
                                {"direct_rms_n", s.force_error_rms_dfr_after_1s_n},
                                {"mmt_relative", s.force_error_rel_mmt_after_1s},
                                {"direct_relative", s.force_error_rel_dfr_after_1s}};
+  j["remote_soil"] = {{"material", detail::material_json(remote_->base_material())},
+                      {"changed_to", settings_.change_soil
+                                         ? detail::material_json(remote_->changed_material())
+                                         : nlohmann::ordered_json()},
+                      {"change_z_below_m", settings_.change_soil ? nlohmann::ordered_json(settings_.change_z_m)
+                                                                 : nlohmann::ordered_json()},
+                      {"changed_at_s", s.settle_excluded_from_s > 0.0
+                                           ? nlohmann::ordered_json(s.settle_excluded_from_s)
+                                           : nlohmann::ordered_json()}};
   j["estimate"] = detail::estimate_json(s.estimate, &s.remote_material);
   j["estimate"]["material_applied_by_operator"] = detail::material_json(s.material_applied);
   j["estimate"]["reidentified_after_s"] = s.reidentified_after_s;

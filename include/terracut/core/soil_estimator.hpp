@@ -175,7 +175,6 @@ class SoilEstimator {
     double cost = 0.0;                  // forgetting-weighted sum of squared residuals, kN^2
     double weight = 0.0;                // forgetting-weighted number of equations
     double beta_rad = 0.0;              // beta* of the previous sample (0: none yet)
-    double last_error = 0.0;            // a-priori error of the newest sample's H, kN
   };
   struct Remembered {
     SoilSample sample{};
@@ -183,7 +182,13 @@ class SoilEstimator {
     std::int64_t age = 0;   // samples since
   };
   void restart_memory();
-  std::array<double, kSoilFieldCount> information_variance(const Candidate& b, double sigma2) const;
+  struct Refined {
+    std::array<double, kSoilFieldCount> x{};    // gamma kN/m^3, c kPa, c_a kPa, phi deg, delta deg
+    std::array<double, kSoilFieldCount> var{};  // their variances
+    double cost = 0.0, weight = 0.0;            // over the cuts in memory, kN^2
+    bool ok = false;
+  };
+  Refined refine(const std::array<double, kSoilFieldCount>& start) const;
   void take(Candidate& c, const SoilSample& s) const;
   double failure_angle(Candidate& c, const EarthmovingParams& params, const SoilSample& s,
                        double q) const;
@@ -197,11 +202,14 @@ class SoilEstimator {
   SoilSample sample_{};
   bool pending_ = false;
   std::size_t next_ = 0;
-  std::vector<Remembered> memory_;  // a ring of the newest cuts
+  // A ring of the newest cuts; their failure angles are refreshed by refine().
+  mutable std::vector<Remembered> memory_;
   std::size_t memory_next_ = 0, memory_size_ = 0;
   std::int64_t since_reset_ = 0;  // samples since the memory last restarted
   int surprises_ = 0;             // consecutive samples far off the estimate
   int best_ = -1;                 // the estimate's candidate
+  std::array<double, kSoilFieldCount> previous_x_{};  // the previous refined fit
+  bool refined_before_ = false;
   double calm_rms_n_ = 0.0;       // the residuals' RMS before the misses began, N
   SoilEstimate estimate_{};
 };

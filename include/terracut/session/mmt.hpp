@@ -147,6 +147,10 @@ class RemoteStation {
   const SoilEstimate& estimate() const { return estimator_->estimate(); }
   /// The material the remote's force uses now (its soil, or soil_change's).
   const SoilMaterial& true_material() const;
+  /// The remote's soil before mmt.remote.soil_change, and beyond it (the
+  /// same without a change).
+  const SoilMaterial& base_material() const { return base_material_; }
+  const SoilMaterial& changed_material() const { return changed_material_; }
   /// Ticks the arm's force limit held the tool.
   std::int64_t stalled_ticks() const { return stalled_ticks_; }
   /// Packets sent that carried model updates (patches + estimates).
