@@ -22,6 +22,7 @@
 #include "commands.hpp"
 #include "report_files.hpp"
 #include "validate_dem.hpp"
+#include "validate_soilbin.hpp"
 #include "terracut/core/simulation.hpp"
 #include "terracut/core/soil.hpp"
 #include "terracut/core/stats.hpp"
@@ -755,6 +756,7 @@ struct Report {
   BucketResult bucket;
   std::vector<Check> checks;
   std::string dem_markdown;  // the DEM section (validate_dem.hpp), empty when not run
+  std::string soilbin_markdown;  // the soil-bin section (validate_soilbin.hpp), empty when not run
   std::optional<std::string> figures_problem;
   bool figures_skipped = false;  // --no-plot: no figures, so no links to them
   bool with_figures() const { return !figures_skipped && !figures_problem; }
@@ -1115,6 +1117,7 @@ std::string report_markdown(const Report& r) {
      << "Exit code of `terracut validate`: 0 when every check passes, 1 when one fails, 3 when "
         "they all pass but the figures could not be made.\n";
   if (!r.dem_markdown.empty()) md << "\n" << r.dem_markdown;
+  if (!r.soilbin_markdown.empty()) md << "\n" << r.soilbin_markdown;
   return md.str();
 }
 
@@ -1241,11 +1244,15 @@ Command add_validate_command(CLI::App& app) {
                      "Do not make figures (report.md then has tables only)");
   auto dem_dir = std::make_shared<std::string>(TERRACUT_VALIDATION_DIR "/dem/results");
   auto only = std::make_shared<std::string>("all");
+  auto soilbin_dir = std::make_shared<std::string>(TERRACUT_DATA_DIR "/soilbin");
   sub->add_option("--dem", *dem_dir,
                   "The DEM reference's results (material.json, bulldoze/): terracut is run on every "
                   "bulldozing case there and compared (default: the source tree's)");
-  sub->add_option("--only", *only, "Run one section: soil (the physical checks), dem, or all")
-      ->check(CLI::IsMember({"all", "soil", "dem"}));
+  sub->add_option("--soilbin", *soilbin_dir,
+                  "Published soil-bin data sets (<name>.csv with <name>.json): each point predicted from its "
+                  "soil's published properties (default: the source tree's data/soilbin)");
+  sub->add_option("--only", *only, "Run one part: soil (the physical checks), dem, soilbin, or all")
+      ->check(CLI::IsMember({"all", "soil", "dem", "soilbin"}));
   sub->footer(
       "Checks (1 cm cells unless said; tolerances from the cell size, the relaxation's stated\n"
       "tolerance of 2 % of tan(repose), or float rounding; docs/validation.md explains each):\n"
@@ -1265,6 +1272,9 @@ Command add_validate_command(CLI::App& app) {
       "  the force of each 0.1 m of push and the soil ahead of the blade within 15 % of the\n"
       "  DEM's mean (or its seed scatter), the centre line within a grain diameter RMS, the\n"
       "  force's growth within 25 %, at least 1000 times faster\n"
+      "Against soil-bin measurements (--soilbin; data/soilbin/README.md), informative: each\n"
+      "  point's draft from its soil's published properties; mean |error| <= 15 %, every\n"
+      "  point within a factor 1.5\n"
       "\n"
       "Outputs in DIR:\n"
       "  report.md            every check with PASS/FAIL, the tables, the figures embedded\n"
@@ -1288,17 +1298,19 @@ Command add_validate_command(CLI::App& app) {
       "  dem/                 material.json (terracut's soil from the DEM's tests), windows.csv\n"
       "                       (per run and 0.1 m window), cases.csv (over the seeds, with the\n"
       "                       targets), force.csv (force against the distance pushed),\n"
-      "                       profiles.csv (the centre lines)\n"
+      "                       profiles.csv (the centre lines), maps/ (the surfaces)\n"
+      "  soilbin/points.csv   per point: measured and terracut's force, error\n"
       "  soil_cone.png, soil_slope.png, soil_bulldozing.png, soil_conservation.png, soil_bucket.png,\n"
-      "  soil_dem_force.png, soil_dem_profiles.png, soil_dem_piles.png  figures\n"
+      "  soil_dem_force.png, soil_dem_profiles.png, soil_dem_piles.png, soil_dem_maps.png  figures\n"
       "Figures are drawn by `PYTHON TOOLS/plot_validate.py DIR` (matplotlib).\n"
       "\n"
       "Exit code: 0 every check passes; 1 a check fails (report.md and checks.csv say\n"
-      "which) or an output cannot be written; 3 every check passes but the figures could not\n"
-      "be made (report.md is written without them). The DEM's targets are findings, reported\n"
-      "met or missed, and do not change the exit code.");
+      "which), an output cannot be written or the DEM reference or the soil-bin data cannot\n"
+      "be read; 3 every check passes but the figures could not be made (report.md is written\n"
+      "without them). The DEM's and the soil bins' targets are findings, reported met or\n"
+      "missed, and do not change the exit code.");
 
-  return [opt, dem_dir, only]() {
+  return [opt, dem_dir, soilbin_dir, only]() {
     const fs::path out(opt->out);
     create_output_folder(out);
     for (const char* d : {"cone", "slope", "bulldozing", "conservation", "bucket"})
@@ -1314,8 +1326,8 @@ Command add_validate_command(CLI::App& app) {
     Report report;
     // A DEM reference that cannot be read is an error (exit 1), named on
     // stderr and in the report; with the soil's checks it does not stop them.
-    bool dem_unreadable = false;
-    if (*only != "soil") {
+    bool reference_unreadable = false;  // the DEM reference or the soil-bin data
+    if (*only == "all" || *only == "dem") {
       const Clock::time_point t0 = Clock::now();
       try {
         const DemSection dem = run_dem_section(fs::path(*dem_dir), out, say);
@@ -1325,11 +1337,28 @@ Command add_validate_command(CLI::App& app) {
               std::to_string(dem.targets) + " targets met, " + seconds_since(t0));
       } catch (const InputError& e) {
         if (*only == "dem") throw;
-        dem_unreadable = true;
+        reference_unreadable = true;
         report.dem_markdown = std::string("## Against a DEM (LIGGGHTS)\n\nThe DEM reference could not be read: ") +
                               e.what() + "\n";
         std::cerr << "terracut validate: error: the DEM reference: " << e.what() << "\n";
       }
+    }
+    if (*only == "all" || *only == "soilbin") {
+      try {
+        report.soilbin_markdown = run_soilbin_section(fs::path(*soilbin_dir), out, say).markdown;
+      } catch (const InputError& e) {
+        if (*only == "soilbin") throw;
+        reference_unreadable = true;
+        report.soilbin_markdown =
+            std::string("## Against soil-bin measurements\n\nThe data sets could not be read: ") + e.what() + "\n";
+        std::cerr << "terracut validate: error: the soil-bin data: " << e.what() << "\n";
+      }
+    }
+    if (*only == "soilbin") {
+      write_file(out / "report.md", "# terracut against soil-bin measurements\n\nWritten by `terracut validate "
+                                    "--only soilbin` (terracut " TERRACUT_VERSION "); docs/validation.md explains "
+                                    "it.\n\n" + report.soilbin_markdown);
+      return kExitOk;
     }
     if (*only == "dem") {
       // The DEM section alone: its findings decide no exit code.
@@ -1392,7 +1421,7 @@ Command add_validate_command(CLI::App& app) {
     write_outputs(out, report);
     report.figures_skipped = opt->no_plots;
     write_file(out / "report.md", report_markdown(report));
-    const int checks_code = all_pass && !dem_unreadable ? kExitOk : kExitError;
+    const int checks_code = all_pass && !reference_unreadable ? kExitOk : kExitError;
     if (opt->no_plots) {
       say("figures skipped (--no-plot); report: " + (out / "report.md").string());
       return checks_code;
@@ -1404,7 +1433,7 @@ Command add_validate_command(CLI::App& app) {
       std::cerr << "terracut validate: error: figures not made: " << *report.figures_problem
                 << "\nThe report without figures is in " << (out / "report.md").string()
                 << "\n";
-      return all_pass && !dem_unreadable ? kExitNoFigures : kExitError;
+      return all_pass && !reference_unreadable ? kExitNoFigures : kExitError;
     }
     say("report: " + (out / "report.md").string());
     return checks_code;

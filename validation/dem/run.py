@@ -8,6 +8,7 @@
   run.py summary                         results/bulldoze/summary.csv from the runs present
   run.py all                             everything, seeds 1 2 3
   run.py smoke                           every script, a few hundred steps on tiny beds (CI)
+  run.py digest                          markdown tables of the bulldozing summary and costs
 
 LIGGGHTS runs one process at a time under `nice -n 19`; scratch goes to
 validation/dem/work/ (git-ignored).  Use /usr/bin/python3 (numpy, scipy)."""
@@ -58,6 +59,33 @@ def cmd_summary(a):
     print(bulldoze.write_summary())
 
 
+def cmd_digest(a):
+    """Markdown tables of summary.csv and costs.csv (for the README)."""
+    import csv
+    rows = list(csv.DictReader(l for l in open(os.path.join(dem.RESULTS, "bulldoze", "summary.csv"))
+                               if not l.startswith("#")))
+    print("| case | window (m) | fx mean (N) | fx std (N) | fz mean (N) | fz std (N) | pile volume (m^3) "
+          "| pile peak (m) | seeds |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    by = {}
+    for r in rows:
+        by.setdefault((r["case"], r["window_start_m"], r["window_end_m"]), {})[r["seed"]] = r
+    for (c, w0, w1), d in by.items():
+        m, sd = d.get("mean"), d.get("std")
+        if not m:
+            continue
+        print("| `%s` | %s-%s | %.1f | %.1f | %.1f | %.1f | %.2e +- %.1e | %.3f +- %.3f | %s |" % (
+            c, w0, w1, float(m["fx_mean_n"]), float(sd["fx_mean_n"]), float(m["fz_mean_n"]),
+            float(sd["fz_mean_n"]), float(m["pile_volume_m3"]), float(sd["pile_volume_m3"]),
+            float(m["pile_peak_height_m"]), float(sd["pile_peak_height_m"]), m["n_seeds"]))
+    print()
+    print("| kind | run | wall-clock (s) | note |")
+    print("| --- | --- | --- | --- |")
+    for r in csv.DictReader(open(os.path.join(dem.RESULTS, "costs.csv"))):
+        if r["kind"].startswith("bulldoze"):
+            print("| %s | %s | %s | %s |" % (r["kind"], r["tag"], r["wall_s"], r["note"]))
+
+
 def cmd_all(a):
     material.run_all([1, 2, 3])
     for s in (1, 2, 3):
@@ -105,6 +133,8 @@ def main():
     s = sub.add_parser("all")
     s.add_argument("--force", action="store_true")
     s.set_defaults(fn=cmd_all)
+    s = sub.add_parser("digest")
+    s.set_defaults(fn=cmd_digest)
     s = sub.add_parser("smoke")
     s.set_defaults(fn=cmd_smoke)
     a = p.parse_args()

@@ -142,11 +142,11 @@ def make_bed(seed, smoke=False, force=False):
         "bulk_density_kg_per_m3": phi * dem.PARTICLE["density_kg_per_m3"],
         "density_box_m": box,
         "settling_ke_per_grain_j": settle,
-        "wall_s": wall,
+        "wall_s": wall, "cpu_s": dem.LAST_CPU_S,
     }
     dem.write_json(meta, info)
     if not smoke:
-        dem.log_cost("bulldoze_bed", "seed%d" % seed, wall, "%d grains" % len(x))
+        dem.log_cost("bulldoze_bed", "seed%d" % seed, wall, "%d grains; cpu %.0f s" % (len(x), dem.LAST_CPU_S))
     return info
 
 
@@ -216,6 +216,7 @@ def run_case(case, seed, smoke=False, force=False):
         "lowfile": os.path.join(wd, "lowering.txt"), "forcefile": os.path.join(wd, "force.txt"),
     })
     wall = dem.run_liggghts(os.path.join(HERE, "push.in"), v, wd, "push")
+    cpu = dem.LAST_CPU_S
     os.makedirs(outdir, exist_ok=True)
     # forces
     sr = binfo["restart_step"]
@@ -299,12 +300,15 @@ def run_case(case, seed, smoke=False, force=False):
         "timestep_s": dt, "rayleigh_check": dem.rayleigh_check(),
         "parameters": dem.parameters_json(),
         "wall_clock_s": wall,
+        "cpu_s": cpu,
+        "cost_note": "one LIGGGHTS process under nice -n 19 on a 2-core machine shared with C++ builds; "
+                     "wall-clock includes waiting for the CPU, cpu_s is the process's own CPU time",
     }
     info["metrics"] = window_metrics(info, outdir, grains)
     dem.write_json(os.path.join(outdir, "run.json"), info)
     if not smoke:
         dem.log_cost("bulldoze_run", "%s/seed%d" % (case, seed), wall,
-                     "%d grains, %d steps" % (binfo["particles"], s0 + 3 * nseg))
+                     "%d grains; %d steps; cpu %.0f s" % (binfo["particles"], s0 + 3 * nseg, cpu))
     return info
 
 
