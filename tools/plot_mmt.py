@@ -139,10 +139,14 @@ def plot_study(folder, out):
         rtts = sorted(set(rows["rtt_ms"]))
         for key, color, marker, name in (("after_1s_direct_rel", "tab:red", "o", "direct reflection"),
                                          ("after_1s_mmt_rel", "tab:blue", "s", "MMT")):
-            mean = np.array([np.mean(rows[key][rows["rtt_ms"] == r]) for r in rtts]) * 100
-            lo = np.array([np.min(rows[key][rows["rtt_ms"] == r]) for r in rtts]) * 100
-            hi = np.array([np.max(rows[key][rows["rtt_ms"] == r]) for r in rtts]) * 100
-            ax[0].errorbar(rtts, mean, yerr=[mean - lo, hi - mean], ls=styles[i % 3], color=color,
+            # -1: no cut left in the window (a change of soil's left-out time reached past it)
+            v = [rows[key][(rows["rtt_ms"] == r) & (rows[key] >= 0)] * 100 for r in rtts]
+            x = [r for r, a in zip(rtts, v) if len(a)]
+            v = [a for a in v if len(a)]
+            mean = np.array([a.mean() for a in v])
+            lo = np.array([a.min() for a in v])
+            hi = np.array([a.max() for a in v])
+            ax[0].errorbar(x, mean, yerr=[np.maximum(mean - lo, 0), np.maximum(hi - mean, 0)], ls=styles[i % 3], color=color,
                            marker=marker, capsize=3, label=f"{name}, loss {loss * 100:.0f} %")
     ax[0].axhline(5.0, color="black", lw=0.8, ls="--", label="target: 5 %")
     ax[0].set_xscale("symlog", linthresh=50)

@@ -33,7 +33,7 @@ struct Options {
   std::optional<double> rtt_ms, loss, jitter_ms, deadband, blend_s, duration_s;
   std::optional<long long> seed;
   bool sweep = false;
-  std::string rtts = "0,50,100,200,500,1000";
+  std::string rtts = "0,20,50,100,200,500,1000";
   std::string losses = "0,0.01,0.1";
   std::string seeds = "1,2,3";
   std::string device;
@@ -219,19 +219,23 @@ int run_sweep(const Options& o, const session::Scenario& sc) {
                       << fixed(100 * s.force_error_rel_dfr_after_1s, 1) << " % of "
                       << fixed(s.force_rms_remote_after_1s_n, 1) << " N RMS\n";
         }
-      // Over the seeds: the mean and the worst.
+      // Over the seeds: the mean and the worst (of the runs whose window
+      // held a cut: see MmtSummary).
       double mmt_mean = 0.0, mmt_worst = 0.0, dfr_mean = 0.0, dfr_worst = 0.0, reid_worst = -1.0,
              packets = 0.0;
-      int within = 0, identifiable = 0;
+      int within = 0, identifiable = 0, measured = 0;
       bool mmt_better = true;
       for (const session::MmtSummary& s : runs) {
-        mmt_mean += s.force_error_rel_mmt_after_1s / double(runs.size());
-        dfr_mean += s.force_error_rel_dfr_after_1s / double(runs.size());
-        mmt_worst = std::max(mmt_worst, s.force_error_rel_mmt_after_1s);
-        dfr_worst = std::max(dfr_worst, s.force_error_rel_dfr_after_1s);
-        reid_worst = std::max(reid_worst, s.reidentified_after_s);
         packets += s.update_packets_per_s / double(runs.size());
-        mmt_better = mmt_better && s.force_error_rms_mmt_after_1s_n < s.force_error_rms_dfr_after_1s_n;
+        reid_worst = std::max(reid_worst, s.reidentified_after_s);
+        if (s.force_error_rel_mmt_after_1s >= 0.0) {
+          ++measured;
+          mmt_mean += s.force_error_rel_mmt_after_1s;
+          dfr_mean += s.force_error_rel_dfr_after_1s;
+          mmt_worst = std::max(mmt_worst, s.force_error_rel_mmt_after_1s);
+          dfr_worst = std::max(dfr_worst, s.force_error_rel_dfr_after_1s);
+          mmt_better = mmt_better && s.force_error_rms_mmt_after_1s_n < s.force_error_rms_dfr_after_1s_n;
+        }
         for (int f = 0; f < kSoilFieldCount; ++f) {
           const SoilField field = SoilField(f);
           if (!s.estimate.is_identifiable(field)) continue;
@@ -241,10 +245,16 @@ int run_sweep(const Options& o, const session::Scenario& sc) {
                     2.0 * s.estimate.sd[std::size_t(f)];
         }
       }
+      const std::string none = "n/a (no cut left after the change)";
+      if (measured > 0) {
+        mmt_mean /= measured;
+        dfr_mean /= measured;
+      }
       md << "| " << fixed(rtt, 0) << " | " << fixed(loss * 100, 0) << " % | "
-         << fixed(100 * mmt_mean, 1) << " / " << fixed(100 * mmt_worst, 1) << " | "
-         << fixed(100 * dfr_mean, 1) << " / " << fixed(100 * dfr_worst, 1) << " | "
-         << (mmt_better ? "yes" : "no") << " | "
+         << (measured > 0 ? fixed(100 * mmt_mean, 1) + " / " + fixed(100 * mmt_worst, 1) : none)
+         << " | "
+         << (measured > 0 ? fixed(100 * dfr_mean, 1) + " / " + fixed(100 * dfr_worst, 1) : none)
+         << " | " << (measured == 0 ? "-" : mmt_better ? "yes" : "no") << " | "
          << (reid_worst >= 0.0 ? fixed(reid_worst, 3) : std::string("-")) << " | " << within
          << " of " << identifiable << " | " << fixed(packets, 1) << " | "
          << (banded ? fixed(banded->update_packets_per_s, 1) + " (" +

@@ -13,6 +13,10 @@ namespace terracut {
 
 namespace {
 
+// The model's H and V for a remembered cut at parameters x (defined below).
+void model_hv(const SoilSample& s, double beta, const std::array<double, 5>& x, double& h,
+              double& v);
+
 // The linear parameters are fitted in kN/m^3 and kPa against forces in kN,
 // so that the covariance and the residuals stay near unity.
 constexpr double kToKilo = 1e-3;
@@ -293,18 +297,23 @@ void SoilEstimator::finish_sample() {
   for (std::size_t k = 0; k < memory_size_; ++k) ++memory_[k].age;
   ++estimate_.samples;
   ++since_reset_;
-  // A change of soil: the estimate missed kSurprises more samples than it
-  // met (a count up on a miss, down on a hit), a miss being a horizontal
-  // force more than kSurpriseFraction of the measured one and more than 4
-  // times the fit's residual RMS (before the misses began) away from the
-  // estimate's, once the memory had kSettled samples. Then the memory
-  // restarts (the covariance back to the prior's, the costs to zero, the
-  // fits kept as the starting point): covariance resetting, so that the new
-  // soil is learnt at the rate of a fresh start and not after the old
-  // samples have been forgotten.
+  // A change of soil is a run of samples the estimate mispredicts that no
+  // one material fits together with the remembered ones. A miss is a
+  // horizontal force more than kSurpriseFraction of the measured one and
+  // more than 4 times the fit's residual RMS (before the misses began) away
+  // from the estimate's (counted up on a miss, down on a hit, once the
+  // memory had kSettled samples). At kSurprises the refit below decides: if
+  // the newest samples are fitted as well as the old ones were, they only
+  // showed what the old cuts had left loose (a depth never cut before), and
+  // the memory stays; if not, the soil changed and the memory restarts (the
+  // covariance back to the prior's, the costs to zero, the fits kept as the
+  // starting point): covariance resetting, so that the new soil is learnt
+  // at the rate of a fresh start and not after the old samples have been
+  // forgotten.
   constexpr double kSurpriseFraction = 0.08;
   constexpr int kSurprises = 3;
   constexpr std::int64_t kSettled = 10;
+  bool judge_change = false;
   if (estimate_.known && since_reset_ > kSettled) {
     if (surprises_ == 0) calm_rms_n_ = estimate_.residual_rms_n;
     EarthmovingParams p;
@@ -319,10 +328,7 @@ void SoilEstimator::finish_sample() {
       ++surprises_;
     else
       surprises_ = std::max(surprises_ - 1, 0);
-    if (surprises_ >= kSurprises) {
-      restart_memory();
-      ++estimate_.restarts;
-    }
+    judge_change = surprises_ >= kSurprises;
   }
   // Until the memory holds kFirst samples (six equations for three linear
   // parameters and the pair of angles) every candidate fits them: the
@@ -452,6 +458,33 @@ void SoilEstimator::finish_sample() {
   for (int f = 0; f < kSoilFieldCount; ++f)
     if (estimate_.sd[std::size_t(f)] <= settings_.resolution[std::size_t(f)])
       estimate_.identifiable |= 1u << f;
+
+  // The run of misses judged: the newest kSurprises + 2 samples' residuals
+  // under the refit against the fit's residuals before the misses.
+  if (judge_change) {
+    surprises_ = 0;
+    const double newest_rms_n = fit.ok ? newest_residual_rms_n(fit.x, kSurprises + 2) : HUGE_VAL;
+    if (newest_rms_n > 4.0 * std::max(calm_rms_n_, settings_.force_noise_n)) {
+      restart_memory();
+      ++estimate_.restarts;
+    }
+  }
+}
+
+double SoilEstimator::newest_residual_rms_n(const std::array<double, kSoilFieldCount>& x,
+                                            std::int64_t newest) const {
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t k = 0; k < memory_size_; ++k) {
+    const Remembered& r = memory_[k];
+    if (r.age >= newest) continue;
+    double h, v;
+    model_hv(r.sample, r.beta_rad, x, h, v);
+    const double eh = r.sample.horizontal_n * kToKilo - h, ev = r.sample.vertical_n * kToKilo - v;
+    sum += eh * eh + ev * ev;
+    n += 2;
+  }
+  return n > 0 ? std::sqrt(sum / n) / kToKilo : 0.0;
 }
 
 namespace {

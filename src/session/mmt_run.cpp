@@ -275,7 +275,13 @@ MmtSummary MmtRun::summary() const {
   s.force_rms_remote_after_1s_n = rms(f_rem1);
   s.force_error_rms_mmt_after_1s_n = rms(e_mmt1);
   s.force_error_rms_dfr_after_1s_n = rms(e_dfr1);
-  if (s.force_rms_remote_after_1s_n > 0.0) {
+  // A window with less than 0.1 s of the remote cutting (a change of soil
+  // whose left-out round trip reaches past the end of the cut) has no
+  // figure: -1.
+  std::size_t cutting_ticks = 0;
+  for (double f : f_rem1) cutting_ticks += f > 1.0;
+  s.force_error_rel_mmt_after_1s = s.force_error_rel_dfr_after_1s = -1.0;
+  if (s.force_rms_remote_after_1s_n > 0.0 && double(cutting_ticks) >= 0.1 * rate_hz_) {
     s.force_error_rel_mmt_after_1s = s.force_error_rms_mmt_after_1s_n / s.force_rms_remote_after_1s_n;
     s.force_error_rel_dfr_after_1s = s.force_error_rms_dfr_after_1s_n / s.force_rms_remote_after_1s_n;
   }

@@ -644,6 +644,14 @@ void OperatorStation::receive(double t_s) {
           break;
         case net::MessageType::kEstimate:
           r = net::decode_estimate(d.data(), d.size(), e);
+          // A material this blade cannot cut (rake + delta + phi leaves no
+          // failure wedge) is no estimate for this model.
+          if (r == net::Reject::kNone) {
+            EarthmovingParams check;
+            check.soil = e.material;
+            check.rake_angle_deg = simulation().params().blade.rake_angle_deg;
+            if (!validate(check).empty()) r = net::Reject::kBadPayload;
+          }
           filter = &estimates_;
           break;
         default:

@@ -367,6 +367,13 @@ TEST(Mmt, BadPacketsOnBothStationsAreCountedNeverFatal) {
   bad.material.cohesion_pa = std::nan("");
   net::encode_estimate({net::MessageType::kEstimate, link, 5, 1, 0}, bad, e.data());
   inject(p.link.b(), e);
+  // A valid material that leaves the vertical blade no failure wedge
+  // (90 + 89 + 89 degrees): refused, not applied.
+  net::Estimate steep;
+  steep.material.internal_friction_deg = 89.0;
+  steep.material.soil_tool_friction_deg = 89.0;
+  net::encode_estimate({net::MessageType::kEstimate, link, 5, 2, 0}, steep, e.data());
+  inject(p.link.b(), e);
   net::encode_measurement({net::MessageType::kMeasurement, link, 5, 2, 5000}, net::Measurement{}, m.data());
   inject(p.link.b(), m);
   net::encode_measurement({net::MessageType::kMeasurement, link, 5, 3, 4000}, net::Measurement{}, m.data());
@@ -374,7 +381,7 @@ TEST(Mmt, BadPacketsOnBothStationsAreCountedNeverFatal) {
   p.op.tick(0.0);
   const net::RejectCounts& ro = p.op.counters().rejected;
   EXPECT_EQ(ro[net::Reject::kBadType], 1);
-  EXPECT_EQ(ro[net::Reject::kBadPayload], 3);
+  EXPECT_EQ(ro[net::Reject::kBadPayload], 4);
   EXPECT_EQ(ro[net::Reject::kStale], 1);
   EXPECT_EQ(p.op.counters().patches, p.remote.counters().patches);  // only the real ones
   // The stations go on working.

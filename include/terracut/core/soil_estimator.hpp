@@ -189,6 +189,7 @@ class SoilEstimator {
     bool ok = false;
   };
   Refined refine(const std::array<double, kSoilFieldCount>& start) const;
+  double newest_residual_rms_n(const std::array<double, kSoilFieldCount>& x, std::int64_t newest) const;
   void take(Candidate& c, const SoilSample& s) const;
   double failure_angle(Candidate& c, const EarthmovingParams& params, const SoilSample& s,
                        double q) const;

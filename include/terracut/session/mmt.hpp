@@ -347,7 +347,8 @@ struct MmtSummary {
   /// The force error after the first second of the remote's cutting (the
   /// study's targets): RMS of |F_op - F_remote| and of the remote's force
   /// over the ticks from the remote's first cut + 1 s on, N, and their
-  /// ratio; the same for direct reflection. settle_excluded_s: a window
+  /// ratio (-1 when the window holds less than 0.1 s of the remote
+  /// cutting); the same for direct reflection. settle_excluded_s: a window
   /// after a change of soil left out (a round trip plus 0.5 s: the soil no
   /// model could know yet), 0 without one.
   double cutting_from_s = 0.0;

@@ -1,0 +1,104 @@
+#!/usr/bin/python3
+"""Draw several `terracut mmt --sweep` studies side by side.
+
+Usage: /usr/bin/python3 tools/plot_mmt_studies.py --out FILE.png DIR [DIR ...] [--quiet]
+
+Each DIR is a `terracut mmt SCENARIO --sweep --out DIR` folder (study.csv,
+and summary.json files are not needed). One panel per study: the force error
+after the first second of cutting, in % of the remote's force RMS, against
+round-trip delay, for MMT (the local model learning the remote's soil) and
+for direct force reflection, at each loss (mean over the seeds, bars from
+the best to the worst seed), with the 5 % target; the panel is titled with
+the folder's name. A last panel: model-update packets per second with and
+without the perceptual deadband, every study at its first loss.
+
+Exit codes: 0 done; 2 bad arguments or input folder; 3 numpy or matplotlib missing.
+"""
+import os
+import sys
+
+from plot_common import import_plotting, make_fail
+
+fail = make_fail("plot_mmt_studies.py")
+np, plt = import_plotting(fail)
+
+
+def main(argv):
+    out, quiet, folders = None, False, []
+    i = 1
+    while i < len(argv):
+        a = argv[i]
+        if a in ("-h", "--help"):
+            print(__doc__)
+            sys.exit(0)
+        if a == "--quiet":
+            quiet = True
+        elif a == "--out":
+            if i + 1 >= len(argv):
+                fail("--out needs a file name")
+            out = argv[i + 1]
+            i += 1
+        else:
+            folders.append(a)
+        i += 1
+    if out is None or not folders:
+        fail("usage: plot_mmt_studies.py --out FILE.png DIR [DIR ...]")
+    studies = []
+    for f in folders:
+        path = os.path.join(f, "study.csv")
+        if not os.path.isfile(path):
+            fail(f"{path} not found (a `terracut mmt --sweep --out` folder?)")
+        studies.append((os.path.basename(os.path.normpath(f)), np.genfromtxt(path, delimiter=",", names=True)))
+    n = len(studies) + 1
+    fig, axes = plt.subplots(1, n, figsize=(4.3 * n, 4.4))
+    styles = ["-", "--", ":"]
+    for ax, (name, s) in zip(axes, studies):
+        full = s[s["deadband"] == 0]
+        for k, loss in enumerate(sorted(set(full["loss"]))):
+            rows = full[full["loss"] == loss]
+            rtts = sorted(set(rows["rtt_ms"]))
+            for key, color, marker, label in (("after_1s_direct_rel", "tab:red", "o", "direct"),
+                                              ("after_1s_mmt_rel", "tab:blue", "s", "MMT")):
+                # -1: no cut left in the window (a change of soil's left-out time reached past it)
+                v = [rows[key][(rows["rtt_ms"] == r) & (rows[key] >= 0)] * 100 for r in rtts]
+                x = [r for r, a in zip(rtts, v) if len(a)]
+                v = [a for a in v if len(a)]
+                mean = np.array([x.mean() for x in v])
+                lo = np.array([x.min() for x in v])
+                hi = np.array([x.max() for x in v])
+                ax.errorbar(x, mean, yerr=[np.maximum(mean - lo, 0), np.maximum(hi - mean, 0)], ls=styles[k % 3], color=color,
+                            marker=marker, ms=4, capsize=2, label=f"{label}, loss {loss * 100:.0f} %")
+        ax.axhline(5.0, color="black", lw=0.8, ls="--", label="target 5 %")
+        ax.set_xscale("symlog", linthresh=20)
+        ax.set_yscale("log")
+        ax.set_xlabel("round-trip delay (ms)")
+        ax.set_title(name, fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+    axes[0].set_ylabel("force error after 1 s of cutting\n(% of the remote's force RMS)")
+    axes[0].legend(fontsize=6, loc="lower right")
+    ax = axes[-1]
+    for name, s in studies:
+        full = s[s["deadband"] == 0]
+        base = full[(full["loss"] == min(full["loss"])) & (full["seed"] == full["seed"][0])]
+        o = np.argsort(base["rtt_ms"])
+        line, = ax.plot(base["rtt_ms"][o], base["update_packets_per_s"][o], "-o", ms=3, label=f"{name}")
+        db = s[s["deadband"] > 0]
+        if len(db):
+            od = np.argsort(db["rtt_ms"])
+            ax.plot(db["rtt_ms"][od], db["update_packets_per_s"][od], "--s", ms=3, color=line.get_color(),
+                    label=f"{name}, deadband {db['deadband'][0] * 100:.0f} %")
+    ax.set_xscale("symlog", linthresh=20)
+    ax.set_ylim(bottom=0)
+    ax.set_xlabel("round-trip delay (ms)")
+    ax.set_ylabel("model-update packets per second")
+    ax.set_title("model updates", fontsize=10)
+    ax.legend(fontsize=6)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    if not quiet:
+        print(f"plot_mmt_studies.py: wrote {out}")
+
+
+if __name__ == "__main__":
+    main(sys.argv)
