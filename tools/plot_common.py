@@ -57,6 +57,47 @@ def parse_dir_args(argv, doc, default_png, fail, script):
     return folder, out or os.path.join(folder, default_png), quiet
 
 
+def parse_dirs_args(argv, doc, fail, script):
+    """(folders, output png, quiet) from `SCRIPT --out FILE.png DIR [DIR ...] [--quiet]`."""
+    folders, out, quiet = [], None, False
+    i = 1
+    while i < len(argv):
+        a = argv[i]
+        if a in ("-h", "--help"):
+            print(doc)
+            sys.exit(0)
+        elif a == "--quiet":
+            quiet = True
+        elif a == "--out":
+            if i + 1 >= len(argv):
+                fail("--out needs a file name")
+            out = argv[i + 1]
+            i += 1
+        else:
+            folders.append(a)
+        i += 1
+    if out is None or not folders:
+        fail(f"usage: {script} --out FILE.png DIR [DIR ...]")
+    return folders, out, quiet
+
+
+def over_seeds(np, rows, key, scale=1.0):
+    """Per round trip of a `terracut mmt --sweep` study.csv's rows: (rtts,
+    mean, distance down to the best seed, up to the worst) of column key
+    times scale, leaving out the runs that have no figure (negative: no cut
+    in the window)."""
+    rtts, mean, down, up = [], [], [], []
+    for r in sorted(set(rows["rtt_ms"])):
+        v = rows[key][(rows["rtt_ms"] == r) & (rows[key] >= 0)] * scale
+        if len(v) == 0:
+            continue
+        rtts.append(r)
+        mean.append(v.mean())
+        down.append(max(v.mean() - v.min(), 0.0))
+        up.append(max(v.max() - v.mean(), 0.0))
+    return rtts, np.array(mean), np.array(down), np.array(up)
+
+
 def parse_folder_args(argv, doc):
     """(folder, quiet) from `SCRIPT DIR [--quiet]`, for the scripts that draw a
     report folder's figures into it; --help prints doc and exits 0, any other

@@ -29,7 +29,7 @@ import json
 import os
 import sys
 
-from plot_common import import_plotting, make_fail, parse_dir_args
+from plot_common import import_plotting, make_fail, over_seeds, parse_dir_args
 
 fail = make_fail("plot_mmt.py")
 np, plt = import_plotting(fail)
@@ -136,17 +136,10 @@ def plot_study(folder, out):
     styles = ["-", "--", ":"]
     for i, loss in enumerate(losses):
         rows = full[full["loss"] == loss]
-        rtts = sorted(set(rows["rtt_ms"]))
         for key, color, marker, name in (("after_1s_direct_rel", "tab:red", "o", "direct reflection"),
                                          ("after_1s_mmt_rel", "tab:blue", "s", "MMT")):
-            # -1: no cut left in the window (a change of soil's left-out time reached past it)
-            v = [rows[key][(rows["rtt_ms"] == r) & (rows[key] >= 0)] * 100 for r in rtts]
-            x = [r for r, a in zip(rtts, v) if len(a)]
-            v = [a for a in v if len(a)]
-            mean = np.array([a.mean() for a in v])
-            lo = np.array([a.min() for a in v])
-            hi = np.array([a.max() for a in v])
-            ax[0].errorbar(x, mean, yerr=[np.maximum(mean - lo, 0), np.maximum(hi - mean, 0)], ls=styles[i % 3], color=color,
+            x, mean, down, up = over_seeds(np, rows, key, 100.0)
+            ax[0].errorbar(x, mean, yerr=[down, up], ls=styles[i % 3], color=color,
                            marker=marker, capsize=3, label=f"{name}, loss {loss * 100:.0f} %")
     ax[0].axhline(5.0, color="black", lw=0.8, ls="--", label="target: 5 %")
     ax[0].set_xscale("symlog", linthresh=50)

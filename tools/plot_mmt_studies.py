@@ -17,32 +17,14 @@ Exit codes: 0 done; 2 bad arguments or input folder; 3 numpy or matplotlib missi
 import os
 import sys
 
-from plot_common import import_plotting, make_fail
+from plot_common import import_plotting, make_fail, over_seeds, parse_dirs_args
 
 fail = make_fail("plot_mmt_studies.py")
 np, plt = import_plotting(fail)
 
 
 def main(argv):
-    out, quiet, folders = None, False, []
-    i = 1
-    while i < len(argv):
-        a = argv[i]
-        if a in ("-h", "--help"):
-            print(__doc__)
-            sys.exit(0)
-        if a == "--quiet":
-            quiet = True
-        elif a == "--out":
-            if i + 1 >= len(argv):
-                fail("--out needs a file name")
-            out = argv[i + 1]
-            i += 1
-        else:
-            folders.append(a)
-        i += 1
-    if out is None or not folders:
-        fail("usage: plot_mmt_studies.py --out FILE.png DIR [DIR ...]")
+    folders, out, quiet = parse_dirs_args(argv, __doc__, fail, "plot_mmt_studies.py")
     studies = []
     for f in folders:
         path = os.path.join(f, "study.csv")
@@ -56,17 +38,10 @@ def main(argv):
         full = s[s["deadband"] == 0]
         for k, loss in enumerate(sorted(set(full["loss"]))):
             rows = full[full["loss"] == loss]
-            rtts = sorted(set(rows["rtt_ms"]))
             for key, color, marker, label in (("after_1s_direct_rel", "tab:red", "o", "direct"),
                                               ("after_1s_mmt_rel", "tab:blue", "s", "MMT")):
-                # -1: no cut left in the window (a change of soil's left-out time reached past it)
-                v = [rows[key][(rows["rtt_ms"] == r) & (rows[key] >= 0)] * 100 for r in rtts]
-                x = [r for r, a in zip(rtts, v) if len(a)]
-                v = [a for a in v if len(a)]
-                mean = np.array([x.mean() for x in v])
-                lo = np.array([x.min() for x in v])
-                hi = np.array([x.max() for x in v])
-                ax.errorbar(x, mean, yerr=[np.maximum(mean - lo, 0), np.maximum(hi - mean, 0)], ls=styles[k % 3], color=color,
+                x, mean, down, up = over_seeds(np, rows, key, 100.0)
+                ax.errorbar(x, mean, yerr=[down, up], ls=styles[k % 3], color=color,
                             marker=marker, ms=4, capsize=2, label=f"{label}, loss {loss * 100:.0f} %")
         ax.axhline(5.0, color="black", lw=0.8, ls="--", label="target 5 %")
         ax.set_xscale("symlog", linthresh=20)

@@ -257,8 +257,10 @@ int run_sweep(const Options& o, const session::Scenario& sc) {
          << " | " << (measured == 0 ? "-" : mmt_better ? "yes" : "no") << " | "
          << (reid_worst >= 0.0 ? fixed(reid_worst, 3) : std::string("-")) << " | " << within
          << " of " << identifiable << " | " << fixed(packets, 1) << " | "
-         << (banded ? fixed(banded->update_packets_per_s, 1) + " (" +
-                          fixed(100 * banded->force_error_rel_mmt_after_1s, 1) + " %)"
+         << (banded ? fixed(banded->update_packets_per_s, 1) +
+                          (banded->force_error_rel_mmt_after_1s >= 0.0
+                               ? " (" + fixed(100 * banded->force_error_rel_mmt_after_1s, 1) + " %)"
+                               : std::string(""))
                     : std::string("")) << " |\n";
     }
   }

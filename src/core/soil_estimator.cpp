@@ -8,6 +8,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/core/penetration.hpp"
 
 namespace terracut {
 
@@ -15,7 +16,7 @@ namespace {
 
 // The model's H and V for a remembered cut at parameters x (defined below).
 void model_hv(const SoilSample& s, double beta, const std::array<double, 5>& x, double& h,
-              double& v);
+              double& v, double& p);
 
 // The linear parameters are fitted in kN/m^3 and kPa against forces in kN,
 // so that the covariance and the residuals stay near unity.
@@ -23,7 +24,26 @@ constexpr double kToKilo = 1e-3;
 
 bool finite_all(const SoilSample& s) {
   return std::isfinite(s.width_m) && std::isfinite(s.depth_m) && std::isfinite(s.pile_m) &&
-         std::isfinite(s.rake_deg) && std::isfinite(s.horizontal_n) && std::isfinite(s.vertical_n);
+         std::isfinite(s.rake_deg) && std::isfinite(s.horizontal_n) && std::isfinite(s.vertical_n) &&
+         std::isfinite(s.penetration_n) && std::isfinite(s.embedment_depth_m) &&
+         std::isfinite(s.embedded_length_m) && std::isfinite(s.edge_thickness_m);
+}
+
+// The penetration force (kN) of a sample's edge at a material of (gamma
+// kN/m^3, c kPa, c_a kPa) and angles (degrees): the model itself
+// (penetration.hpp), down (tip and faces) or up (faces).
+double penetration_kn(const SoilSample& s, double gamma, double c, double c_a, double phi,
+                      double delta) {
+  SoilMaterial m;
+  m.unit_weight_n_per_m3 = gamma / kToKilo;
+  m.cohesion_pa = c / kToKilo;
+  m.adhesion_pa = c_a / kToKilo;
+  m.internal_friction_deg = phi;
+  m.soil_tool_friction_deg = delta;
+  const PenetrationResult r =
+      penetration_resistance(m, s.edge_thickness_m, s.embedded_length_m, s.embedment_depth_m,
+                             m.unit_weight_n_per_m3 * s.pile_m);
+  return (s.penetration_direction < 0 ? r.down_n() : r.up_n()) * kToKilo;
 }
 
 // One scalar equation y = x . theta into an RLS state, with forgetting
@@ -71,7 +91,8 @@ double field_value(const SoilMaterial& m, SoilField field) {
   return 0.0;
 }
 
-StepSample soil_sample(const ToolForce& force, const ToolMotion& motion, double rake_deg) noexcept {
+StepSample soil_sample(const ToolForce& force, const ToolMotion& motion, double rake_deg,
+                       double edge_thickness_m) noexcept {
   StepSample out;
   const Vec3 v = motion.velocity_m_per_s;
   const double speed = std::hypot(v.x, v.z);
@@ -86,6 +107,15 @@ StepSample soil_sample(const ToolForce& force, const ToolMotion& motion, double 
   out.sample.rake_deg = rake_deg;
   out.sample.horizontal_n = -(f.x * v.x + f.z * v.z) / speed;
   out.sample.vertical_n = -f.y;
+  // The edge moving down or up in the soil: the penetration force too.
+  if (std::fabs(v.y) >= kRestSpeed_m_per_s && force.embedment_depth_m > 0.0 &&
+      force.embedded_length_m > 0.0 && edge_thickness_m > 0.0) {
+    out.sample.penetration_direction = v.y < 0.0 ? -1 : 1;
+    out.sample.penetration_n = std::fabs(force.penetration_n.y);
+    out.sample.embedment_depth_m = force.embedment_depth_m;
+    out.sample.embedded_length_m = force.embedded_length_m;
+    out.sample.edge_thickness_m = edge_thickness_m;
+  }
   out.valid = finite_all(out.sample);
   return out;
 }
@@ -181,6 +211,10 @@ bool SoilEstimator::begin(const SoilSample& sample) {
   if (pending_) return false;
   if (!finite_all(sample) || !(sample.width_m > 0.0) || !(sample.depth_m > 0.0) ||
       !(sample.pile_m >= 0.0) || !(sample.rake_deg > 0.0 && sample.rake_deg < 180.0))
+    return false;
+  if (sample.penetration_direction != 0 &&
+      (!(sample.penetration_n >= 0.0) || !(sample.embedment_depth_m > 0.0) ||
+       !(sample.embedded_length_m > 0.0) || !(sample.edge_thickness_m > 0.0)))
     return false;
   sample_ = sample;
   pending_ = true;
@@ -287,6 +321,15 @@ void SoilEstimator::take(Candidate& c, const SoilSample& s) const {
   c.cost = lambda * c.cost + rls_update(c.theta, c.p, xh, s.horizontal_n * kToKilo, lambda);
   c.cost += rls_update(c.theta, c.p, xv, s.vertical_n * kToKilo, 1.0);
   c.weight = lambda * c.weight + 2.0;
+  // The penetration force, linear in (gamma, c, c_a) at the pair's angles:
+  // its regressors are the model's force at each unit parameter.
+  if (s.penetration_direction != 0) {
+    const std::array<double, 3> xp{penetration_kn(s, 1.0, 0.0, 0.0, c.phi_deg, c.delta_deg),
+                                   penetration_kn(s, 0.0, 1.0, 0.0, c.phi_deg, c.delta_deg),
+                                   penetration_kn(s, 0.0, 0.0, 1.0, c.phi_deg, c.delta_deg)};
+    c.cost += rls_update(c.theta, c.p, xp, s.penetration_n * kToKilo, 1.0);
+    c.weight += 1.0;
+  }
 }
 
 // The estimate from the candidates: the best admissible pair and its fit,
@@ -478,11 +521,16 @@ double SoilEstimator::newest_residual_rms_n(const std::array<double, kSoilFieldC
   for (std::size_t k = 0; k < memory_size_; ++k) {
     const Remembered& r = memory_[k];
     if (r.age >= newest) continue;
-    double h, v;
-    model_hv(r.sample, r.beta_rad, x, h, v);
+    double h, v, p;
+    model_hv(r.sample, r.beta_rad, x, h, v, p);
     const double eh = r.sample.horizontal_n * kToKilo - h, ev = r.sample.vertical_n * kToKilo - v;
     sum += eh * eh + ev * ev;
     n += 2;
+    if (r.sample.penetration_direction != 0) {
+      const double ep = r.sample.penetration_n * kToKilo - p;
+      sum += ep * ep;
+      ++n;
+    }
   }
   return n > 0 ? std::sqrt(sum / n) / kToKilo : 0.0;
 }
@@ -494,7 +542,7 @@ namespace {
 // at beta* the force is stationary in beta, so its derivatives in the
 // parameters at a fixed beta are the derivatives of the force itself.
 void model_hv(const SoilSample& s, double beta, const std::array<double, 5>& x, double& h,
-                     double& v) {
+              double& v, double& p) {
   EarthmovingParams params;
   params.rake_angle_deg = s.rake_deg;
   params.side_failure = true;
@@ -503,10 +551,11 @@ void model_hv(const SoilSample& s, double beta, const std::array<double, 5>& x, 
   const EarthmovingFactors n = earthmoving_factors(params, beta, s.width_m, s.depth_m);
   const double alpha = radians(s.rake_deg), delta = radians(x[4]);
   const double w = s.width_m, d = s.depth_m;
-  const double p = w * (x[0] * (d * d * n.n_gamma + s.pile_m * d * n.n_q) + x[1] * d * n.n_c +
-                        x[2] * d * n.n_a);
-  h = p * std::sin(alpha + delta) + x[2] * d * w * std::cos(alpha) / std::sin(alpha);
-  v = p * std::cos(alpha + delta) - x[2] * d * w;
+  const double p_face = w * (x[0] * (d * d * n.n_gamma + s.pile_m * d * n.n_q) + x[1] * d * n.n_c +
+                             x[2] * d * n.n_a);
+  h = p_face * std::sin(alpha + delta) + x[2] * d * w * std::cos(alpha) / std::sin(alpha);
+  v = p_face * std::cos(alpha + delta) - x[2] * d * w;
+  p = s.penetration_direction != 0 ? penetration_kn(s, x[0], x[1], x[2], x[3], x[4]) : 0.0;
 }
 
 }  // namespace
@@ -590,25 +639,28 @@ SoilEstimator::Refined SoilEstimator::refine(const std::array<double, kSoilField
     for (std::size_t k = 0; k < memory_size_; ++k) {
       const Remembered& r = memory_[k];
       const double w = std::pow(lambda, double(r.age));
-      double h0, v0;
-      model_hv(r.sample, r.beta_rad, x, h0, v0);
+      double h0, v0, p0;
+      model_hv(r.sample, r.beta_rad, x, h0, v0, p0);
+      const bool pen = r.sample.penetration_direction != 0;
       const double rh = r.sample.horizontal_n * kToKilo - h0, rv = r.sample.vertical_n * kToKilo - v0;
-      cost += w * (rh * rh + rv * rv);
-      weight += 2.0 * w;
+      const double rp = pen ? r.sample.penetration_n * kToKilo - p0 : 0.0;
+      cost += w * (rh * rh + rv * rv + rp * rp);
+      weight += (pen ? 3.0 : 2.0) * w;
       if (!want_normal) continue;
-      double jh[5], jv[5];
+      double jh[5], jv[5], jp[5];
       for (int i = 0; i < 5; ++i) {
         std::array<double, 5> xi = x;
         const double dx = i < 3 ? 1.0 : kAngleStep;  // linear: any step is exact
         xi[std::size_t(i)] += dx;
-        double h, v;
-        model_hv(r.sample, r.beta_rad, xi, h, v);
+        double h, v, p;
+        model_hv(r.sample, r.beta_rad, xi, h, v, p);
         jh[i] = (h - h0) / dx;
         jv[i] = (v - v0) / dx;
+        jp[i] = pen ? (p - p0) / dx : 0.0;
       }
       for (int i = 0; i < 5; ++i) {
-        g[i] += w * (jh[i] * rh + jv[i] * rv);
-        for (int j = 0; j < 5; ++j) f[i][j] += w * (jh[i] * jh[j] + jv[i] * jv[j]);
+        g[i] += w * (jh[i] * rh + jv[i] * rv + jp[i] * rp);
+        for (int j = 0; j < 5; ++j) f[i][j] += w * (jh[i] * jh[j] + jv[i] * jv[j] + jp[i] * jp[j]);
       }
     }
     return cost;

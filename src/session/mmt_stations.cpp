@@ -392,8 +392,8 @@ void RemoteStation::choose_material() {
 void RemoteStation::update_estimate() {
   estimate_error_ = -1.0;
   const StepOutput& out = simulation().last();
-  const double rake = simulation().params().blade.rake_angle_deg;
-  const StepSample s = soil_sample(out.force, out.motion, rake);
+  const BladeSpec& blade = simulation().params().blade;
+  const StepSample s = soil_sample(out.force, out.motion, blade.rake_angle_deg, blade.edge_thickness_m);
   if (settings_.estimate) {
     if (s.valid && !estimator_->busy() && ticks_ % estimate_every_ == 0)
       estimator_->begin(s.sample);

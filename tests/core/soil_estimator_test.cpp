@@ -10,6 +10,7 @@
 #include <random>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/penetration.hpp"
 
 namespace terracut {
 namespace {
@@ -124,6 +125,28 @@ TEST(SoilEstimator, OneCutDoesNotIdentifyWeightAndCohesionApart) {
               0.02 * s.horizontal_n);
 }
 
+// The same single cut, with the edge also moving down and up in the soil:
+// the bearing under the tip grows with phi as e^(pi tan phi) while the
+// cutting force does not tell phi from the weight and the cohesion, so
+// the penetration force pins the internal friction (and with it the rest).
+TEST(SoilEstimator, PenetrationTellsTheFrictionAngle) {
+  SoilEstimator est(sand_prior());
+  const SoilMaterial truth = soil_preset(SoilPreset::kClay);
+  for (int i = 0; i < 300; ++i) {
+    SoilSample s = sample_of(truth, 0.4, 0.08, 0.0, 90.0);
+    s.penetration_direction = i % 2 == 0 ? -1 : 1;
+    s.edge_thickness_m = 0.02;
+    s.embedded_length_m = 0.4;
+    s.embedment_depth_m = 0.02 + 0.0003 * (i % 200);
+    const PenetrationResult r = penetration_resistance(truth, 0.02, 0.4, s.embedment_depth_m);
+    s.penetration_n = s.penetration_direction < 0 ? r.down_n() : r.up_n();
+    ASSERT_TRUE(est.add(s));
+  }
+  const SoilEstimate& e = est.estimate();
+  EXPECT_TRUE(e.is_identifiable(SoilField::kInternalFriction)) << "sd phi " << e.sd[3];
+  expect_identified(e, truth, "clay, one cut with penetration");
+}
+
 // A change of soil is followed within the forgetting's memory: after 3
 // memories of gravel the estimate predicts the gravel's force.
 TEST(SoilEstimator, FollowsAChangeOfSoil) {
@@ -180,16 +203,25 @@ TEST(SoilEstimator, StepSampleIsThePhysicalCuttingForceOnly) {
   f.bodies_n = {0.0, 0.0, 5000.0};      // a rock: not the soil
   ToolMotion m;
   m.velocity_m_per_s = {0.0, -0.2, -1.0};
-  const StepSample s = soil_sample(f, m, 90.0);
+  const StepSample s = soil_sample(f, m, 90.0, 0.02);
   ASSERT_TRUE(s.valid);
   EXPECT_DOUBLE_EQ(s.sample.horizontal_n, 350.0);
   EXPECT_DOUBLE_EQ(s.sample.vertical_n, -90.0);
   EXPECT_DOUBLE_EQ(s.sample.depth_m, 0.05);
+  EXPECT_EQ(s.sample.penetration_direction, 0);  // not embedded: no penetration part
+  // Embedded and moving down: the penetration part (the physical one) too.
+  f.embedment_depth_m = 0.05;
+  f.embedded_length_m = 0.4;
+  const StepSample pen = soil_sample(f, m, 90.0, 0.02);
+  ASSERT_TRUE(pen.valid);
+  EXPECT_EQ(pen.sample.penetration_direction, -1);
+  EXPECT_DOUBLE_EQ(pen.sample.penetration_n, 999.0);
+  EXPECT_DOUBLE_EQ(pen.sample.horizontal_n, 350.0);  // still without the rock
   m.velocity_m_per_s = {0.0, -0.2, 0.0};  // no horizontal motion: nothing mobilised
-  EXPECT_FALSE(soil_sample(f, m, 90.0).valid);
+  EXPECT_FALSE(soil_sample(f, m, 90.0, 0.02).valid);
   m.velocity_m_per_s = {0.0, 0.0, -1.0};
   f.cut_depth_m = 0.0;  // no cut
-  EXPECT_FALSE(soil_sample(f, m, 90.0).valid);
+  EXPECT_FALSE(soil_sample(f, m, 90.0, 0.02).valid);
 }
 
 TEST(SoilEstimator, RefusesBadSettingsAndSamples) {

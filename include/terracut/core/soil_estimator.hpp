@@ -78,19 +78,30 @@ struct SoilSample {
   double rake_deg = 90.0;   ///< the blade's rake angle, degrees, (0, 180)
   double horizontal_n = 0.0;  ///< the force resisting the horizontal motion, N
   double vertical_n = 0.0;    ///< the vertical force, N, positive pushing the blade down (McKyes' sign)
+  /// The penetration force's part (penetration.hpp), when the edge moves
+  /// vertically while embedded: -1 down (the bearing under the tip and the
+  /// faces' friction), +1 up (the faces only), 0 none (the rest unused).
+  int penetration_direction = 0;
+  double penetration_n = 0.0;      ///< its magnitude, N, >= 0
+  double embedment_depth_m = 0.0;  ///< the edge's depth below the soil beside it, m, > 0
+  double embedded_length_m = 0.0;  ///< the length of edge that deep, m, > 0
+  double edge_thickness_m = 0.0;   ///< the cutting edge's thickness, m, > 0
 };
 
 /// The sample of a step: the physical force's cutting and surcharge parts
 /// (ToolForce::cutting_n + surcharge_n) resolved along the motion and the
-/// vertical, with the cut they came from. valid is false (nothing to learn)
-/// while the tool does not move horizontally faster than kRestSpeed_m_per_s
-/// or cuts nothing (no engaged width or depth). Nothing a device renders
-/// enters: ToolForce is the physical force (tool_force.hpp).
+/// vertical, with the cut they came from, and its penetration part while
+/// the edge also moves vertically in the soil (edge_thickness_m: the
+/// blade's). valid is false (nothing to learn) while the tool does not move
+/// horizontally faster than kRestSpeed_m_per_s or cuts nothing (no engaged
+/// width or depth). Nothing a device renders enters: ToolForce is the
+/// physical force (tool_force.hpp).
 struct StepSample {
   bool valid = false;
   SoilSample sample{};
 };
-StepSample soil_sample(const ToolForce& force, const ToolMotion& motion, double rake_deg) noexcept;
+StepSample soil_sample(const ToolForce& force, const ToolMotion& motion, double rake_deg,
+                       double edge_thickness_m) noexcept;
 
 /// Settings of the estimator; validated at construction.
 struct SoilEstimatorSettings {
