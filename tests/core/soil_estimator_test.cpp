@@ -89,10 +89,10 @@ TEST(SoilEstimator, IdentifiesKnownMaterialsWithinTheirUncertainty) {
   for (SoilPreset preset : {SoilPreset::kClay, SoilPreset::kGravel, SoilPreset::kLooseSand}) {
     SoilEstimator est(sand_prior());
     const SoilMaterial truth = soil_preset(preset);
-    feed_varied(est, truth, 400, 7);
+    feed_varied(est, truth, 250, 7);
     const SoilEstimate& e = est.estimate();
     EXPECT_TRUE(e.known);
-    EXPECT_EQ(e.samples, 400);
+    EXPECT_EQ(e.samples, 250);
     expect_identified(e, truth, std::string(to_string(preset)).c_str());
   }
 }
@@ -104,7 +104,7 @@ TEST(SoilEstimator, NoisyForcesStayWithinTheReportedUncertainty) {
   s.force_noise_n = 5.0;
   SoilEstimator est(s);
   const SoilMaterial truth = soil_preset(SoilPreset::kClay);
-  feed_varied(est, truth, 600, 11, 5.0);
+  feed_varied(est, truth, 300, 11, 5.0);
   expect_identified(est.estimate(), truth, "clay with noise");
 }
 

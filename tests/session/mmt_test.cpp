@@ -134,7 +134,7 @@ TEST(Mmt, ForceStepAtUpdatesStaysUnderTheBound) {
   run.run();
   const MmtSummary s = run.summary();
   EXPECT_GT(s.patches, 50);
-  EXPECT_GT(s.estimates, 100);
+  EXPECT_GT(s.estimates, 10);  // the estimate is sent while it moves, then stays
   EXPECT_LE(s.max_update_step_n, 0.005 + 1e-12);
   // The bound held and still the material got where it was going.
   for (int f = 0; f < kSoilFieldCount; ++f)
