@@ -9,7 +9,7 @@ after the first second of cutting, in % of the remote's force RMS, against
 round-trip delay, for MMT (the local model learning the remote's soil) and
 for direct force reflection, at each loss (mean over the seeds, bars from
 the best to the worst seed), with the 5 % target; the panel is titled with
-the folder's name. A last panel: model-update packets per second with and
+the folder's name (less a leading "study_"). A last panel: model-update packets per second with and
 without the perceptual deadband, every study at its first loss.
 
 Exit codes: 0 done; 2 bad arguments or input folder; 3 numpy or matplotlib missing.
@@ -30,7 +30,9 @@ def main(argv):
         path = os.path.join(f, "study.csv")
         if not os.path.isfile(path):
             fail(f"{path} not found (a `terracut mmt --sweep --out` folder?)")
-        studies.append((os.path.basename(os.path.normpath(f)), np.genfromtxt(path, delimiter=",", names=True)))
+        name = os.path.basename(os.path.normpath(f))
+        studies.append((name[6:] if name.startswith("study_") else name,
+                        np.genfromtxt(path, delimiter=",", names=True)))
     n = len(studies) + 1
     fig, axes = plt.subplots(1, n, figsize=(4.3 * n, 4.4))
     styles = ["-", "--", ":"]
@@ -45,12 +47,13 @@ def main(argv):
                             marker=marker, ms=4, capsize=2, label=f"{label}, loss {loss * 100:.0f} %")
         ax.axhline(5.0, color="black", lw=0.8, ls="--", label="target 5 %")
         ax.set_xscale("symlog", linthresh=20)
+        ax.set_xlim(left=0)
         ax.set_yscale("log")
         ax.set_xlabel("round-trip delay (ms)")
         ax.set_title(name, fontsize=10)
         ax.grid(alpha=0.3, which="both")
     axes[0].set_ylabel("force error after 1 s of cutting\n(% of the remote's force RMS)")
-    axes[0].legend(fontsize=6, loc="lower right")
+    axes[0].legend(fontsize=6, loc="upper left")
     ax = axes[-1]
     for name, s in studies:
         full = s[s["deadband"] == 0]
@@ -63,6 +66,7 @@ def main(argv):
             ax.plot(db["rtt_ms"][od], db["update_packets_per_s"][od], "--s", ms=3, color=line.get_color(),
                     label=f"{name}, deadband {db['deadband'][0] * 100:.0f} %")
     ax.set_xscale("symlog", linthresh=20)
+    ax.set_xlim(left=0)
     ax.set_ylim(bottom=0)
     ax.set_xlabel("round-trip delay (ms)")
     ax.set_ylabel("model-update packets per second")

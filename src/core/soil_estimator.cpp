@@ -155,10 +155,11 @@ SoilEstimator::SoilEstimator(const SoilEstimatorSettings& settings) : settings_(
     }
   }
   row_start_.push_back(int(candidates_.size()));
-  // The cuts remembered for the information matrix: three memories of the
-  // forgetting (their weight beyond is under 5 %), at most 512.
+  // The cuts remembered for the refinement and the information matrix:
+  // three memories of the forgetting (their weight beyond is under 5 %), at
+  // most 256 (the refinement's cost on the tick that finishes a sample).
   const double memory = 1.0 / std::max(1.0 - settings_.forgetting_per_sample, 1e-6);
-  memory_.resize(std::size_t(std::clamp(3.0 * memory, 16.0, 512.0)));
+  memory_.resize(std::size_t(std::clamp(3.0 * memory, 16.0, 256.0)));
   reset();
 }
 
@@ -423,6 +424,17 @@ void SoilEstimator::finish_sample() {
   Remembered& r = memory_[memory_next_];
   r.sample = sample_;
   r.beta_rad = b.beta_rad;
+  if (refined_before_) {
+    // Its failure angle at the estimate the refinement starts from.
+    EarthmovingParams p;
+    p.rake_angle_deg = sample_.rake_deg;
+    p.soil.unit_weight_n_per_m3 = previous_x_[0] / kToKilo;
+    p.soil.cohesion_pa = previous_x_[1] / kToKilo;
+    p.soil.adhesion_pa = previous_x_[2] / kToKilo;
+    p.soil.internal_friction_deg = previous_x_[3];
+    p.soil.soil_tool_friction_deg = previous_x_[4];
+    r.beta_rad = beta_star(p, sample_, p.soil.unit_weight_n_per_m3 * sample_.pile_m, r.beta_rad);
+  }
   r.age = 0;
   memory_next_ = (memory_next_ + 1) % memory_.size();
   memory_size_ = std::min(memory_size_ + 1, memory_.size());
@@ -454,6 +466,15 @@ void SoilEstimator::finish_sample() {
         neighbour_change[std::size_t(i)] = std::max(
             neighbour_change[std::size_t(i)], std::fabs(c.theta[std::size_t(i)] - b.theta[std::size_t(i)]));
   }
+  // The estimate is made anew every kRefineEvery samples (the refinement
+  // below costs about a millisecond over 256 remembered cuts: once in five
+  // samples it fits the ticks of a 1 kHz loop on average, and a station
+  // sends its estimate every sensing period anyway), and whenever a run of
+  // misses is to be judged; in between the samples go on into the pairs and
+  // the memory.
+  constexpr std::int64_t kRefineEvery = 5;
+  if (refined_before_ && !judge_change && estimate_.samples % kRefineEvery != 0) return;
+
   // The grid's answer: the pair's own fit, with the profile's spread and
   // the grid's resolution (the pair of least cost lies within a step of
   // the truth) as its uncertainty.
@@ -471,13 +492,17 @@ void SoilEstimator::finish_sample() {
   // and the uncertainty of the information matrix there (a parameter the
   // cuts do not tell apart from the others, as the weight's d^2 from the
   // cohesion's d at one depth, has an unbounded variance).
-  // Started from the grid's answer, and from the previous estimate (the
-  // grid's best pair can jump where the cuts leave the angles loose, as a
-  // blade leaving the soil does); the better fit is kept.
-  Refined fit = refine(x);
-  if (refined_before_) {
-    const Refined again = refine(previous_x_);
-    if (again.ok && (!fit.ok || again.cost < fit.cost)) fit = again;
+  // Started from the previous estimate (the grid's best pair can jump
+  // where the cuts leave the angles loose, as a blade leaving the soil
+  // does), and every other time (or without a previous one) from the
+  // grid's answer too, which finds another valley when there is one; the
+  // better fit is kept.
+  constexpr std::int64_t kGridEvery = 2 * kRefineEvery;
+  Refined fit;
+  if (refined_before_) fit = refine(previous_x_, false);
+  if (!refined_before_ || estimate_.samples % kGridEvery == 0) {
+    const Refined grid = refine(x, true);
+    if (grid.ok && (!fit.ok || grid.cost < fit.cost)) fit = grid;
   }
   if (fit.ok) {
     previous_x_ = fit.x;
@@ -609,7 +634,8 @@ bool solve5(const double (&a_in)[5][5], const double (&b_in)[5], double (&x)[5],
 
 }  // namespace
 
-SoilEstimator::Refined SoilEstimator::refine(const std::array<double, kSoilFieldCount>& start) const {
+SoilEstimator::Refined SoilEstimator::refine(const std::array<double, kSoilFieldCount>& start,
+                                             bool refresh_angles) const {
   Refined out;
   out.x = start;
   if (memory_size_ == 0) return out;
@@ -669,8 +695,9 @@ SoilEstimator::Refined SoilEstimator::refine(const std::array<double, kSoilField
   std::array<double, 5> x = start;
   clip(x);
   // Each remembered cut's failure angle at the starting point (the force is
-  // stationary in it, so the steps below may keep it fixed).
-  for (std::size_t k = 0; k < memory_size_; ++k) {
+  // stationary in it, so the steps below may keep it fixed); from the
+  // previous estimate they are still those it found.
+  for (std::size_t k = 0; refresh_angles && k < memory_size_; ++k) {
     Remembered& r = memory_[k];
     EarthmovingParams p;
     p.rake_angle_deg = r.sample.rake_deg;
@@ -683,7 +710,7 @@ SoilEstimator::Refined SoilEstimator::refine(const std::array<double, kSoilField
   }
   double cost = evaluate(x, true, f, g, weight);
   double mu = 1e-3;
-  constexpr int kIterations = 4;
+  constexpr int kIterations = 2;  // from a warm start; the next sample goes on
   for (int it = 0; it < kIterations; ++it) {
     double a[5][5], step[5], inv[5][5];
     for (int i = 0; i < 5; ++i)

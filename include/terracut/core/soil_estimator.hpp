@@ -199,7 +199,7 @@ class SoilEstimator {
     double cost = 0.0, weight = 0.0;            // over the cuts in memory, kN^2
     bool ok = false;
   };
-  Refined refine(const std::array<double, kSoilFieldCount>& start) const;
+  Refined refine(const std::array<double, kSoilFieldCount>& start, bool refresh_angles) const;
   double newest_residual_rms_n(const std::array<double, kSoilFieldCount>& x, std::int64_t newest) const;
   void take(Candidate& c, const SoilSample& s) const;
   double failure_angle(Candidate& c, const EarthmovingParams& params, const SoilSample& s,
