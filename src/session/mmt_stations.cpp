@@ -466,7 +466,11 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
 // horizontal force at the newest cut by more than the JND fraction).
 void RemoteStation::send_estimate(double t_s) {
   const SoilEstimate& est = estimate();
-  if (!est.known) return;
+  // The first samples of the first cut fit many materials that
+  // agree at those few depths and nowhere else: the estimate goes out once
+  // kFirstSent samples (0.1 s of cutting at the default period) are in.
+  constexpr std::int64_t kFirstSent = 10;
+  if (!est.known || est.samples < kFirstSent) return;
   const SoilMaterial& m = est.material;
   bool send = !estimate_sent_;
   if (!send && settings_.deadband > 0.0) {
