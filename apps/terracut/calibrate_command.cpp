@@ -2,6 +2,7 @@
 // calibrate.hpp), printed as a table of fitted fields with their
 // uncertainties and as the scenario's `soil:` section, and written as JSON
 // and YAML when --out is given.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include "terracut/io/scenario.hpp"
 #include "terracut/session/scenario.hpp"
 #include "terracut/validation/calibrate.hpp"
+#include "terracut/validation/dem.hpp"
 
 namespace terracut::cli {
 namespace {
@@ -23,7 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct CalibrateOptions {
-  std::string tests, record, scenario, out;
+  std::string tests, record, scenario, dem_run, out;
   std::string fit = "internal_friction_deg,cohesion_pa";
   double window_s = 0.05;
   double from_s = 0.0;
@@ -50,7 +52,13 @@ void write(const validation::Calibration& c, const std::string& source, const fs
   nlohmann::ordered_json j;
   j["source"] = source;
   for (const validation::FittedField& f : c.fields)
-    j["fields"].push_back({{"name", f.name}, {"value", f.value}, {"uncertainty", f.uncertainty}, {"how", f.how}});
+    // An undetermined uncertainty (+inf) is null, and says so.
+    j["fields"].push_back({{"name", f.name},
+                           {"value", f.value},
+                           {"uncertainty", std::isfinite(f.uncertainty) ? nlohmann::ordered_json(f.uncertainty)
+                                                                        : nlohmann::ordered_json(nullptr)},
+                           {"uncertainty_determined", std::isfinite(f.uncertainty)},
+                           {"how", f.how}});
   j["material"] = {{"unit_weight_n_per_m3", c.material.unit_weight_n_per_m3},
                    {"internal_friction_deg", c.material.internal_friction_deg},
                    {"cohesion_pa", c.material.cohesion_pa},
@@ -88,6 +96,11 @@ Command add_calibrate_command(CLI::App& app) {
                                         "A force record, CSV: t_s,x_m,y_m,z_m,qw,qx,qy,qz,fx_n,fy_n,fz_n "
                                         "(the blade's world pose and the force on it, fixed rate)");
   tests->excludes(record);
+  CLI::Option* dem_run = sub->add_option(
+      "--dem-run", opt->dem_run,
+      "A DEM bulldozing run's folder (validation/dem/results/bulldoze/CASE/seedK): its force during the push "
+      "as the record, its bed, blade and motion as the path; with --tests, the start is the tests' material");
+  dem_run->excludes(record);
   sub->add_option("--scenario", opt->scenario,
                   "With --record: the scenario of the terrain, the blade and the material to start from");
   sub->add_option("--fit", opt->fit,
@@ -109,7 +122,21 @@ Command add_calibrate_command(CLI::App& app) {
   return [opt]() {
     validation::Calibration c;
     std::string source;
-    if (!opt->tests.empty()) {
+    if (!opt->dem_run.empty()) {
+      const validation::DemRun run = validation::read_dem_run(opt->dem_run);
+      const SoilMaterial start = opt->tests.empty()
+                                     ? SoilMaterial{}
+                                     : validation::calibrate_from_tests(validation::read_material_tests(opt->tests)).material;
+      const validation::DemReplay replay = validation::dem_replay(run, start);
+      validation::RecordFit fit;
+      fit.fields = io::parse_name_list(opt->fit, "--fit");
+      fit.window_s = opt->window_s;
+      // The record holds the DEM's force during the push only.
+      fit.from_t_s = std::max(opt->from_s, double(replay.push_first) / replay.params.rate_hz);
+      c = validation::calibrate_from_force_record(replay.params, replay.heights,
+                                                  validation::dem_force_record(run, replay), fit);
+      source = opt->dem_run + (opt->tests.empty() ? std::string() : " from " + opt->tests + "'s material");
+    } else if (!opt->tests.empty()) {
       c = validation::calibrate_from_tests(validation::read_material_tests(opt->tests));
       source = opt->tests;
     } else if (!opt->record.empty()) {
@@ -126,7 +153,7 @@ Command add_calibrate_command(CLI::App& app) {
                                                   io::build_initial_heights(sc.base), rec, fit);
       source = opt->record + " on " + opt->scenario;
     } else {
-      throw InputError("calibrate: give --tests FILE or --record FILE --scenario FILE");
+      throw InputError("calibrate: give --tests FILE, --record FILE --scenario FILE, or --dem-run DIR");
     }
     print(c, source);
     if (!opt->out.empty()) write(c, source, opt->out);

@@ -7,13 +7,17 @@
 
 #include <functional>
 
+#include "../exit_codes.hpp"
+
 namespace terracut::cli {
 
-/// Exit codes shared by every subcommand.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitError = 1;     ///< bad input, a failed run or an unwritable output;
-                                         ///< validate: a check failed
-inline constexpr int kExitNoFigures = 3; ///< reproduce, validate: results written, figures could not be made
+/// Exit codes of the subcommands: those of every terracut program (exit_codes.hpp).
+inline constexpr int kExitOk = apps::kExitOk;
+inline constexpr int kExitError = apps::kExitError;  ///< bad input, a failed run or an unwritable
+                                                     ///< output; validate: a check failed
+inline constexpr int kExitUsage = apps::kExitUsage;  ///< a command line that cannot be parsed
+/// reproduce, validate: results written, figures could not be made.
+inline constexpr int kExitNoFigures = apps::kExitPartial;
 
 using Command = std::function<int()>;
 

@@ -200,8 +200,9 @@ Command add_haptics_command(CLI::App& app) {
     sigaction(SIGTERM, &old_term, nullptr);
 
     session.write_outputs(opt->out);
-    // (The real-time line was printed when the loop started.)
-    for (const std::string& w : session.warnings())
+    // (The real-time line was printed when the loop started, the device
+    // check's changes when the session was built: each is said once.)
+    for (const std::string& w : session.run_warnings())
       if (w.rfind("real-time:", 0) != 0) std::cerr << "terracut haptics: warning: " << w << "\n";
     if (!opt->quiet) std::cout << session.summary_line() << " -> " << opt->out << "\n";
     if (session.world().bodies()) {

@@ -1238,8 +1238,9 @@ Command add_validate_command(CLI::App& app) {
       "validate",
       "Check the soil that flows (soil: {model: flow}) against physics: a column collapsing\n"
       "into a cone at the angle of repose, slopes that stand or relax, a blade bulldozing a\n"
-      "pile (mass balance and wedge), and conservation over a long mixed run. Writes CSV\n"
-      "files, a report (report.md) with PASS/FAIL per check, and figures into a folder.");
+      "pile (mass balance and wedge), conservation over a long mixed run, and a bucket's\n"
+      "scoop, carry and dump. Writes CSV files, a report (report.md) with PASS/FAIL per\n"
+      "check, and figures into a folder.");
   add_report_options(*sub, *opt, "plot_validate.py",
                      "Do not make figures (report.md then has tables only)");
   auto dem_dir = std::make_shared<std::string>(TERRACUT_VALIDATION_DIR "/dem/results");
@@ -1266,7 +1267,10 @@ Command add_validate_command(CLI::App& app) {
       "    floor (m), the volume\n"
       "  4 conservation: a mixed run of cuts (along Z, turned, yawed, tilted) on flow soil;\n"
       "    the total volume against the initial one at every step (relative)\n"
-      "  5 speed, informative: the soil phase's time per step, p50/p99 (microseconds)\n"
+      "  5 bucket: a bucket scoops (the load is what the grid lost, w d x, under its\n"
+      "    capacity; no pile ahead), carries (the load holds) and dumps past the repose\n"
+      "    angle (empty, the load under the lip); grid + load = initial at every step\n"
+      "  6 speed, informative: the soil phase's time per step, p50/p99 (microseconds)\n"
       "Against a DEM (--dem; validation/dem/README.md), informative, each target met or missed:\n"
       "  terracut with the material of the DEM's own tests, on each bulldozing case and seed:\n"
       "  the force of each 0.1 m of push and the soil ahead of the blade within 15 % of the\n"

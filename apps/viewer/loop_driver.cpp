@@ -138,6 +138,13 @@ const haptics::HapticLoop& LoopDriver::loop() const {
   return operator_ ? operator_->rig().loop() : rig_->loop();
 }
 
+std::string LoopDriver::realtime_line() const {
+  if (operator_)
+    return "real-time: not asked (teleoperation: the stations tick on the viewer's own thread, "
+           "normal scheduling)";
+  return loop().realtime_status().message;
+}
+
 void LoopDriver::start() {
   if (started_) return;
   started_ = true;
@@ -211,6 +218,14 @@ void LoopDriver::paced_mmt_main() {
   Clock::time_point deadline = Clock::now();
   std::int64_t i = 0;
   while (lockstep_running_.load(std::memory_order_relaxed)) {
+    // Paused with the remote in this process: both stations hold (their
+    // time leaves the pause out), as the plain loop does. A remote in
+    // another process runs on, so the operator keeps answering it.
+    if (!udp_ && i > 0 && device_->paused()) {
+      std::this_thread::sleep_for(std::chrono::duration<double>(haptics::HapticLoop::kPausePoll_s));
+      deadline = Clock::now();
+      continue;
+    }
     tick(i);
     ++i;
     ticks_done_.store(i);

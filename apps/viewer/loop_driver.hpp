@@ -149,6 +149,10 @@ class LoopDriver {
   ViewerDevice& device() { return *device_; }
   /// The loop (the operator station's in MMT); its results only after stop().
   const haptics::HapticLoop& loop() const;
+  /// How the loop's thread is scheduled, in the words `terracut haptics`
+  /// uses ("real-time: SCHED_FIFO priority 80, ..."); in MMT the stations
+  /// tick on this driver's own thread, which asks for no real-time.
+  std::string realtime_line() const;
   /// Teleoperation: the stations run (DriverOptions::mmt).
   bool mmt() const { return operator_ != nullptr; }
   /// The link's figures (zeros when not mmt()).

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <string>
 
+#include "../exit_codes.hpp"
 #include "gl_context.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/session/mmt_process.hpp"
@@ -103,13 +104,14 @@ int main(int argc, char** argv) {
   bool no_realtime = false;
   app.add_flag("--no-realtime", no_realtime,
                "do not ask for SCHED_FIFO for the haptic loop's thread");
+  app.footer(terracut::apps::kExitCodesHelp);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // --help and --version exit 0; every command-line error exits 2, as
-    // docs/viewer.md says (CLI11's own codes differ by error).
+    // --help and --version exit 0; every command-line error exits with the
+    // one usage code (CLI11's own codes differ by error).
     const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    return code == 0 ? terracut::apps::kExitOk : terracut::apps::kExitUsage;
   }
   opt.realtime = !no_realtime;
 
@@ -151,6 +153,14 @@ int main(int argc, char** argv) {
       opt.representation = terracut::parse_representation(representation);
     if (!resolution.empty()) opt.resolution = terracut::io::parse_resolution(resolution);
     if (!opt.screenshot.empty() || opt.benchmark_frames > 0) opt.headless = true;
+    // A screenshot that cannot be written is said before the whole sequence is drawn.
+    if (!opt.screenshot.empty()) {
+      const std::filesystem::path folder = opt.screenshot.parent_path();
+      std::error_code ec;
+      if (!folder.empty() && !std::filesystem::is_directory(folder, ec))
+        throw terracut::InputError("--screenshot: the folder " + folder.string() +
+                                   " does not exist (the PNG is written into an existing folder)");
+    }
     if (std::filesystem::path(input).extension() == ".png" && app.count("--extent") == 0)
       std::cerr << "terracut-viewer: " << input << " opens as " << opt.heightmap_size_m << " x "
                 << opt.heightmap_size_m << " m with white = " << opt.heightmap_full_scale_m
@@ -159,10 +169,10 @@ int main(int argc, char** argv) {
     terracut::viewer::ViewerApp viewer(opt, terracut::viewer::load_input(opt));
     return opt.headless ? viewer.run_headless() : viewer.run_window();
   } catch (const terracut::InputError& e) {
-    std::cerr << "terracut-viewer: " << e.what() << "\n";
-    return 2;
+    std::cerr << "terracut-viewer: error: " << e.what() << "\n";
+    return terracut::apps::kExitError;
   } catch (const std::exception& e) {
     std::cerr << "terracut-viewer: error: " << e.what() << "\n";
-    return 1;
+    return terracut::apps::kExitError;
   }
 }

@@ -151,13 +151,20 @@ void ViewerApp::frame_on_tool_path() {
 
 void ViewerApp::print_realtime_line() {
   // The loop thread's scheduling, in the words `terracut haptics` uses.
-  std::cerr << "terracut-viewer: " << driver_->loop().realtime_status().message << "\n";
+  std::cerr << "terracut-viewer: " << driver_->realtime_line() << "\n";
 }
 
 void ViewerApp::close_session() {
   if (driver_) driver_->stop();
   driver_.reset();
   terrain_.reset();
+}
+
+void ViewerApp::release_gl(bool with_glfw) {
+  close_session();
+  window_fb_.reset();
+  shutdown_imgui(with_glfw);
+  shapes_.reset();
 }
 
 bool ViewerApp::take_frame() {
@@ -336,6 +343,16 @@ GLFWwindow* ViewerApp::open_window() {
 int ViewerApp::run_window() {
   GLFWwindow* window = open_window();
   if (!window) return kExitNoContext;
+  // The window and its context outlive everything drawn with it, on every
+  // way out (an error that opening a session throws included).
+  struct WindowScope {
+    GLFWwindow* window;
+    ~WindowScope() {
+      glfwDestroyWindow(window);
+      glfwTerminate();
+    }
+  } window_scope{window};
+  const GLScope gl_scope{*this, true};
   init_gl_objects();
   init_imgui(true, window);
 
@@ -384,13 +401,7 @@ int ViewerApp::run_window() {
                "%.1f frames/s while drawing\n",
                static_cast<long long>(drawn), open_s, static_cast<long long>(iterations),
                drawing_s > 0.0 ? double(drawn) / drawing_s : 0.0);
-  close_session();
-  window_fb_.reset();
-  shutdown_imgui(true);
-  shapes_.reset();
-  glfwDestroyWindow(window);
-  glfwTerminate();
-  return 0;
+  return apps::kExitOk;
 }
 
 bool ViewerApp::window_frame(GLFWwindow* window, double dt_s) {

@@ -94,6 +94,18 @@ class ViewerApp {
   void init_gl_objects();
   void init_imgui(bool with_glfw, GLFWwindow* window);
   void shutdown_imgui(bool with_glfw);
+  /// Deletes everything made with the OpenGL context (the session's terrain
+  /// renderer, the shapes, the window's framebuffer, ImGui's backend) while
+  /// it is still current; idempotent. Every way out of run_headless and
+  /// run_window calls it, an error included (GLScope): a GL call without a
+  /// current context aborts inside epoxy.
+  void release_gl(bool with_glfw);
+  /// Calls release_gl when it goes out of scope (declare it after the context).
+  struct GLScope {
+    ViewerApp& app;
+    bool with_glfw;
+    ~GLScope() { app.release_gl(with_glfw); }
+  };
   void open_session(const DriverOptions& driver_options);
   /// Widens the orbit camera's framing to the tool's scripted path.
   void frame_on_tool_path();

@@ -16,7 +16,8 @@ Scenarios come from files (Scenario.load), dicts with the same schema
 also from a numpy array (Simulation.from_heights). terracut.run() is
 `terracut run` (the same files on disk); terracut.sweep() runs many cases,
 locally or on a Dask cluster. Errors are terracut.InputError (a ValueError)
-with the C++ library's messages.
+with the C++ library's messages. terracut.__version__ is the library's
+version, as `terracut --version` prints it.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from pathlib import Path
 from typing import Any, Union
 
 from ._terracut import (  # noqa: F401
+    __version__,
     ForceModel,
     InputError,
     SafetyLimiter,

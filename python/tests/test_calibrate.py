@@ -51,6 +51,10 @@ def test_calibrate_tests_refuses_bad_input():
         terracut.calibrate_tests({"plate": [1000.0, 700.0]})
     with pytest.raises(terracut.InputError, match="cannot be read"):
         terracut.calibrate_tests("/nonexistent/tests.json")
+    with pytest.raises(terracut.InputError, match="expected a JSON file's path or a dict"):
+        terracut.calibrate_tests(([1000.0, 700.0],))
+    with pytest.raises(terracut.InputError, match="repose_deg: expected a list of numbers"):
+        terracut.calibrate_tests({"repose_deg": [[30.0, 31.0]]})
 
 
 def _record(scenario, steps=600):
@@ -98,3 +102,7 @@ def test_calibrate_record_refuses_bad_input():
         terracut.calibrate_record(sc, t[::-1].copy(), poses, force)
     with pytest.raises(terracut.InputError, match="cannot be read"):
         terracut.calibrate_record(sc, "/nonexistent/record.csv")
+    with pytest.raises(terracut.InputError, match="max_iterations"):
+        terracut.calibrate_record(sc, t, poses, force, max_iterations=0)
+    with pytest.raises(terracut.InputError, match="given twice"):
+        terracut.calibrate_record(sc, t, poses, force, fit=["cohesion_pa", "cohesion_pa"])

@@ -215,7 +215,9 @@ const StepOutput& Simulation::finish_step() {
   // The listeners see the finished step (its cut and changed rectangle) and
   // may push on the tool.
   Vec3 listener_force{};
+  in_listener_ = true;
   for (StepListener* listener : listeners_) listener_force = listener_force + listener->on_step(out_);
+  in_listener_ = false;
   out_.listener_force_world_n = listener_force;
   out_.force.bodies_n = listener_force;
   out_.force.total_n = out_.force.total_n + listener_force;
@@ -224,6 +226,20 @@ const StepOutput& Simulation::finish_step() {
   out_.timers.listeners_s = end - force_end;
   out_.timers.total_s = end - begin_clock_s_;
   return out_;
+}
+
+float Simulation::lower_sample(std::int64_t i, float height_m) {
+  if (!in_listener_)
+    throw std::logic_error("Simulation::lower_sample: only from a listener's on_step or on_edit");
+  return grid_.lower(i, height_m);
+}
+
+void Simulation::move_height(std::int64_t from, std::int64_t to, float amount_m) {
+  if (!in_listener_)
+    throw std::logic_error("Simulation::move_height: only from a listener's on_step or on_edit");
+  float* h = grid_.edit_layers().height_m;
+  h[from] -= amount_m;
+  h[to] += amount_m;
 }
 
 void Simulation::include_changed(const Rect& rect) {
@@ -279,6 +295,14 @@ void Simulation::reset() {
   step_count_ = 0;
   removed_volume_m3_ = 0.0;
   out_ = {};
+  // Whoever caches heights (the Bullet world) hears of the whole grid.
+  tell_edited({0, 0, grid_.cols(), grid_.rows()});
+}
+
+void Simulation::tell_edited(const Rect& changed) {
+  in_listener_ = true;
+  for (StepListener* listener : listeners_) listener->on_edit(changed);
+  in_listener_ = false;
 }
 
 Rect Simulation::edit_heights(const Rect& rect, std::span<const float> values_m) {
@@ -306,7 +330,7 @@ Rect Simulation::edit_heights(const Rect& rect, std::span<const float> values_m)
   }
   const Rect changed = grid_.set_heights(rect, values_m.data());
   if (soil_) soil_->wake(changed);
-  for (StepListener* listener : listeners_) listener->on_edit(changed);
+  tell_edited(changed);
   return changed;
 }
 

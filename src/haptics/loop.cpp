@@ -430,10 +430,23 @@ void HapticLoop::thread_main(std::promise<void>& ready) {
         options_.clock ? options_.clock : steady_pacer_clock();
     Pacer pacer(ps, clock);
     Tick tick = pacer.start();
-    const double origin = tick.start_s;
+    double origin = tick.start_s;
     for (std::int64_t i = 0; i < options_.ticks; ++i) {
       if (stop_requested_.load(std::memory_order_relaxed)) break;
-      if (i > 0) tick = pacer.wait_next();
+      if (i > 0 && device_.paused()) {
+        // Held while the device is paused (the viewer's Pause): no ticks,
+        // a short sleep at a time to see Play or a stop. The loop's time
+        // leaves the pause out: the next tick is one period after the last.
+        const double last_start = tick.start_s;
+        pacer.hold();
+        while (device_.paused() && !stop_requested_.load(std::memory_order_relaxed))
+          clock->sleep_until(clock->now_s() + kPausePoll_s);
+        if (stop_requested_.load(std::memory_order_relaxed)) break;
+        tick = pacer.resume();
+        origin += tick.start_s - last_start - tick.period_s;
+      } else if (i > 0) {
+        tick = pacer.wait_next();
+      }
       paced_tick(pacer, *clock, tick, origin, false);
     }
     pacer_stats_ = pacer.stats();

@@ -167,14 +167,38 @@ Tick Pacer::start() {
 
 void Pacer::record_compute(double compute_s) { recorded_compute_s_ = compute_s >= 0.0 ? compute_s : 0.0; }
 
+double Pacer::end_tick() {
+  const double end = clock_->now_s();
+  last_compute_s_ = recorded_compute_s_ >= 0.0 ? recorded_compute_s_ : end - tick_.start_s;
+  compute_.record(last_compute_s_);
+  recorded_compute_s_ = -1.0;
+  ++ticks_;
+  return end;
+}
+
+void Pacer::hold() {
+  if (!started_ || held_) return;
+  end_tick();
+  held_ = true;
+}
+
+Tick Pacer::resume() {
+  if (!started_) return start();
+  if (!held_) end_tick();
+  held_ = false;
+  // The next slot starts now: the grid moves so that its deadline is the
+  // present time (and the slots of the pause are neither run nor skipped).
+  const double now = clock_->now_s();
+  const std::int64_t slot = tick_.slot + 1;
+  origin_s_ = now - double(slot) * period_s_;
+  tick_ = Tick{tick_.index + 1, slot, now, now, period_s_, false};
+  return tick_;
+}
+
 Tick Pacer::wait_next() {
   if (!started_) return start();
   // End the current tick.
-  double end = clock_->now_s();
-  const double compute_s = recorded_compute_s_ >= 0.0 ? recorded_compute_s_ : end - tick_.start_s;
-  compute_.record(compute_s);
-  recorded_compute_s_ = -1.0;
-  ++ticks_;
+  double end = end_tick();
 
   std::int64_t slot = tick_.slot + 1;
   double deadline = origin_s_ + double(slot) * period_s_;
@@ -187,7 +211,7 @@ Tick Pacer::wait_next() {
     // Why: the work alone took longer than a period, or the tick had
     // started late (woken late, or after an overrun) and its work, shorter
     // than a period, still ended past the deadline.
-    if (compute_s > period_s_) ++missed_by_compute_;
+    if (last_compute_s_ > period_s_) ++missed_by_compute_;
     std::int64_t latest = std::int64_t(std::floor((end - origin_s_) / period_s_));
     latest = std::max(latest, slot);
     while (origin_s_ + double(latest) * period_s_ > end && latest > slot) --latest;  // rounding

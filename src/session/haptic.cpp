@@ -234,6 +234,13 @@ void HapticSession::run() {
 
 std::vector<std::string> HapticSession::warnings() const {
   std::vector<std::string> w = build_warnings_;
+  const std::vector<std::string> run = run_warnings();
+  w.insert(w.end(), run.begin(), run.end());
+  return w;
+}
+
+std::vector<std::string> HapticSession::run_warnings() const {
+  std::vector<std::string> w;
   const HapticLoop& l = rig_->loop();
   const LoopCounters& c = l.counters();
   const SafetyCounters& s = l.safety().counters();

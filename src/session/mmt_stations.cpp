@@ -726,7 +726,7 @@ void OperatorStation::receive(double t_s) {
 // changed recently wait the same way (the remote has not seen that change
 // yet); every sample ends at the remote's height.
 void OperatorStation::merge(double t_s) {
-  HeightGrid& grid = rig_->world().simulation().grid();
+  const HeightGrid& grid = rig_->world().simulation().grid();
   const haptics::LoopRecord& last = rig_->loop().last();
   const bool in_contact = last.contact_length_m > 0.0;
   // The edge where the tool is now (the loop steps the simulation only

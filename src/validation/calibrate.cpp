@@ -7,6 +7,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "terracut/core/error.hpp"
@@ -27,10 +28,12 @@ double mean(const std::vector<double>& v) {
   return v.empty() ? 0.0 : s / double(v.size());
 }
 
+constexpr double kUndetermined = std::numeric_limits<double>::infinity();
+
 // The standard uncertainty of the mean: the sample standard deviation over
-// sqrt(n) (0 for one value).
+// sqrt(n); undetermined (+inf) for one value.
 double mean_uncertainty(const std::vector<double>& v) {
-  if (v.size() < 2) return 0.0;
+  if (v.size() < 2) return kUndetermined;
   const double m = mean(v);
   double q = 0.0;
   for (double x : v) q += (x - m) * (x - m);
@@ -170,6 +173,10 @@ Calibration calibrate_from_tests(const MaterialTests& t, const SoilMaterial& sta
                         "the bulk density's mean over " + std::to_string(t.bulk_density_kg_per_m3.size()) +
                             " tests x 9.81"});
   }
+  for (const auto& [name, values] : {std::pair{"bulk_density_kg_per_m3", &t.bulk_density_kg_per_m3},
+                                      std::pair{"repose_deg", &t.repose_deg}})
+    if (values->size() == 1) c.notes.push_back(std::string(name) + ": one test; its uncertainty needs a second");
+  if (t.plate.size() == 1) c.notes.push_back("plate: one test; its uncertainty needs a second");
   if (!t.repose_deg.empty()) {
     c.material.repose_deg = mean(t.repose_deg);
     c.fields.push_back({"repose_deg", c.material.repose_deg, mean_uncertainty(t.repose_deg),
@@ -195,8 +202,11 @@ Calibration calibrate_from_tests(const MaterialTests& t, const SoilMaterial& sta
     const double slope = sxy / sxx, intercept = my - slope * mx;
     double rss = 0;
     for (const auto& s : t.shear) rss += std::pow(s.tau_pa - intercept - slope * s.sigma_pa, 2);
-    const double var = n > 2 ? rss / double(n - 2) : 0.0;
+    // Two points fix the line exactly: no degree of freedom is left to
+    // estimate its scatter, so its uncertainty is undetermined.
+    const double var = n > 2 ? rss / double(n - 2) : kUndetermined;
     const double se_slope = std::sqrt(var / sxx), se_int = std::sqrt(var * (1.0 / double(n) + mx * mx / sxx));
+    if (n == 2) c.notes.push_back("shear: two tests fix the line exactly; its uncertainty needs a third");
     c.material.internal_friction_deg = std::atan(slope) / kDeg;
     c.material.cohesion_pa = std::max(0.0, intercept);
     c.fields.push_back({"internal_friction_deg", c.material.internal_friction_deg,
@@ -219,12 +229,18 @@ Calibration calibrate_from_tests(const MaterialTests& t, const SoilMaterial& sta
     const double k = sxy / sxx;
     double rss = 0;
     for (const auto& s : t.plate) rss += std::pow(s.tau_pa - k * s.sigma_pa, 2);
-    const double var = t.plate.size() > 1 ? rss / double(t.plate.size() - 1) : 0.0;
+    const double var = t.plate.size() > 1 ? rss / double(t.plate.size() - 1) : kUndetermined;
     c.material.soil_tool_friction_deg = std::atan(k) / kDeg;
     c.fields.push_back({"soil_tool_friction_deg", c.material.soil_tool_friction_deg,
                         std::sqrt(var / sxx) / (1.0 + k * k) / kDeg,
                         "the friction of " + std::to_string(t.plate.size()) + " plate tests (a line through zero)"});
   }
+  std::string kept;
+  for (const char* field : {"unit_weight_n_per_m3", "internal_friction_deg", "cohesion_pa", "soil_tool_friction_deg",
+                            "adhesion_pa", "repose_deg"})
+    if (std::none_of(c.fields.begin(), c.fields.end(), [&](const FittedField& f) { return f.name == field; }))
+      kept += std::string(kept.empty() ? "" : ", ") + field;
+  if (!kept.empty()) c.notes.push_back("no test gives " + kept + ": kept at the start material's values");
   if (std::string e = validate(c.material); !e.empty()) throw InputError("the tests give " + e);
   return c;
 }
@@ -257,6 +273,13 @@ ForceRecord read_force_record(const fs::path& csv) {
     }
     if (!r.t_s.empty() && !(v[0] > r.t_s.back()))
       throw InputError(csv.string() + ":" + std::to_string(row) + ": times must increase");
+    if (r.t_s.size() >= 2) {
+      const double dt0 = r.t_s[1] - r.t_s[0], dt = v[0] - r.t_s.back();
+      if (std::abs(dt - dt0) > 1e-3 * dt0)
+        throw InputError(csv.string() + ":" + std::to_string(row) + ": the samples are not at a fixed rate (" +
+                         format_number(dt) + " s after the previous one, the first two are " +
+                         format_number(dt0) + " s apart)");
+    }
     r.t_s.push_back(v[0]);
     const Quat q{v[4], v[5], v[6], v[7]};
     if (!(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z > 1e-12))
@@ -296,6 +319,19 @@ Calibration calibrate_from_force_record(const SimParams& params, const std::vect
                                         const ForceRecord& record, const RecordFit& fit) {
   const int n = int(fit.fields.size());
   if (n < 1) throw InputError("calibrate: no field to fit");
+  if (fit.max_iterations < 1) throw InputError("calibrate: max_iterations must be at least 1");
+  if (!(fit.window_s > 0.0) || !std::isfinite(fit.window_s)) throw InputError("calibrate: window_s must be > 0");
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < i; ++k)
+      if (fit.fields[std::size_t(i)] == fit.fields[std::size_t(k)])
+        throw InputError("calibrate: " + fit.fields[std::size_t(i)] + " is given twice");
+  if (record.t_s.size() < 2 || record.pose.size() != record.t_s.size() || record.force_n.size() != record.t_s.size())
+    throw InputError("calibrate: the record needs two samples or more, each with a pose and a force");
+  for (std::size_t k = 1; k < record.t_s.size(); ++k) {
+    const double dt0 = record.t_s[1] - record.t_s[0], dt = record.t_s[k] - record.t_s[k - 1];
+    if (!(dt0 > 0.0) || std::abs(dt - dt0) > 1e-3 * dt0)
+      throw InputError("calibrate: the record's samples are not at a fixed rate (sample " + std::to_string(k) + ")");
+  }
   for (const std::string& f : fit.fields) {
     SoilMaterial probe;
     if (!field_of(probe, f))
@@ -348,10 +384,42 @@ Calibration calibrate_from_force_record(const SimParams& params, const std::vect
     for (int i = 0; i < n; ++i) *field_of(t, fit.fields[std::size_t(i)]) = v[std::size_t(i)];
     return t;
   };
-  const auto residuals = [&](const std::vector<double>& v) {
-    std::vector<double> model = run(material_at(v));
+  // The residuals at v; nullopt where the material is not a valid one (a
+  // trial step past a joint limit such as rake + delta + phi < 179).
+  const auto try_residuals = [&](const std::vector<double>& v) -> std::optional<std::vector<double>> {
+    const SoilMaterial t = material_at(v);
+    if (!validate(t).empty()) return std::nullopt;
+    SimParams trial = params;
+    trial.soil.material = t;
+    if (!validate(trial).empty()) return std::nullopt;
+    std::vector<double> model = run(t);
     for (std::size_t k = 0; k < model.size(); ++k) model[k] -= measured[k];
     return model;
+  };
+  const auto residuals = [&](const std::vector<double>& v) {
+    auto r = try_residuals(v);
+    if (!r) throw InputError("calibrate: the start material is not valid for this scenario");
+    return *r;
+  };
+  // The Jacobian at x by forward differences, backward at an upper bound
+  // or where the forward step leaves the valid materials; a column neither
+  // can take stays zero (the field is then pinned).
+  const auto jacobian_at = [&](const std::vector<double>& x0, const std::vector<double>& r0) {
+    std::vector<double> jac(r0.size() * std::size_t(n), 0.0);
+    for (int i = 0; i < n; ++i) {
+      for (double sign : {1.0, -1.0}) {
+        std::vector<double> xp = x0;
+        double step = sign * h[std::size_t(i)];
+        if (sign > 0.0 && xp[std::size_t(i)] + step > hi[std::size_t(i)]) continue;
+        if (sign < 0.0 && xp[std::size_t(i)] + step < lo[std::size_t(i)]) continue;
+        xp[std::size_t(i)] += step;
+        const auto rp = try_residuals(xp);
+        if (!rp) continue;
+        for (std::size_t k = 0; k < r0.size(); ++k) jac[k * std::size_t(n) + std::size_t(i)] = ((*rp)[k] - r0[k]) / step;
+        break;
+      }
+    }
+    return jac;
   };
   const auto rss_of = [](const std::vector<double>& r) {
     double s = 0.0;
@@ -365,16 +433,7 @@ Calibration calibrate_from_force_record(const SimParams& params, const std::vect
   double rss = rss_of(r), lambda = 1e-3;
   std::vector<double> jac;  // m x n, row-major
   for (int iter = 0; iter < fit.max_iterations; ++iter) {
-    // The Jacobian by forward differences (backward at an upper bound).
-    jac.assign(r.size() * std::size_t(n), 0.0);
-    for (int i = 0; i < n; ++i) {
-      std::vector<double> xp = x;
-      double step = h[std::size_t(i)];
-      if (xp[std::size_t(i)] + step > hi[std::size_t(i)]) step = -step;
-      xp[std::size_t(i)] += step;
-      const std::vector<double> rp = residuals(xp);
-      for (std::size_t k = 0; k < r.size(); ++k) jac[k * std::size_t(n) + std::size_t(i)] = (rp[k] - r[k]) / step;
-    }
+    jac = jacobian_at(x, r);
     // Levenberg-Marquardt: (J'J + lambda diag(J'J)) dx = -J'r.
     bool improved = false;
     for (int tries = 0; tries < 8 && !improved; ++tries) {
@@ -394,7 +453,12 @@ Calibration calibrate_from_force_record(const SimParams& params, const std::vect
       std::vector<double> xn = x;
       for (int i = 0; i < n; ++i)
         xn[std::size_t(i)] = std::clamp(x[std::size_t(i)] + dx[std::size_t(i)], lo[std::size_t(i)], hi[std::size_t(i)]);
-      const std::vector<double> rn = residuals(xn);
+      const auto trial = try_residuals(xn);
+      if (!trial) {  // outside the valid materials: a shorter step
+        lambda *= 10.0;
+        continue;
+      }
+      const std::vector<double>& rn = *trial;
       const double rssn = rss_of(rn);
       if (rssn < rss) {
         const double gain = (rss - rssn) / std::max(rss, 1e-300);
@@ -411,9 +475,14 @@ Calibration calibrate_from_force_record(const SimParams& params, const std::vect
     if (!improved) break;
   }
 
-  // The uncertainty: the covariance s^2 (J'J)^-1 at the solution.
+  // The uncertainty: the covariance s^2 (J'J)^-1 at the solution (the
+  // Jacobian taken again there); undetermined without a degree of freedom.
+  jac = jacobian_at(x, r);
   const std::size_t mrows = r.size();
-  const double s2 = mrows > std::size_t(n) ? rss / double(mrows - std::size_t(n)) : 0.0;
+  const double s2 = mrows > std::size_t(n) ? rss / double(mrows - std::size_t(n)) : kUndetermined;
+  if (mrows <= std::size_t(n))
+    out.notes.push_back("the record has as many window values as fields: the fit is exact and its uncertainty "
+                        "undetermined (a longer record, or longer --window-s fewer fields)");
   std::vector<double> a(std::size_t(n * n), 0.0);
   for (std::size_t k = 0; k < mrows; ++k)
     for (int i = 0; i < n; ++i)

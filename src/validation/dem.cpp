@@ -4,13 +4,16 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 #include "terracut/core/simulation.hpp"
 #include "terracut/io/image.hpp"
 
@@ -82,6 +85,8 @@ void read_force(const fs::path& path, DemRun& run) {
         throw InputError(path.string() + ":" + std::to_string(row) + ": '" + cell + "' is not a finite number");
       }
     }
+    if (!run.push_m.empty() && !(v[1] > run.push_m.back()))
+      throw InputError(path.string() + ":" + std::to_string(row) + ": push_m must increase");
     run.push_m.push_back(v[1]);
     run.fx_n.push_back(v[2]);
     run.fy_n.push_back(v[3]);
@@ -90,49 +95,95 @@ void read_force(const fs::path& path, DemRun& run) {
   if (run.push_m.empty()) throw InputError(path.string() + ": no rows");
 }
 
-DemRun read_run(const fs::path& dir) {
+// A number at a dotted path that must lie in [lo, hi].
+double number_in(const Json& j, const std::string& path, const fs::path& file, double lo, double hi) {
+  const double v = number(j, path, file);
+  if (!(v >= lo && v <= hi))
+    throw InputError(file.string() + ": " + path + ": " + format_number(v) + " is outside [" + format_number(lo) +
+                     ", " + format_number(hi) + "]");
+  return v;
+}
+
+DemRun read_run_json(const fs::path& dir) {
   const fs::path file = dir / "run.json";
   const Json j = read_json(file);
   DemRun r;
-  r.case_name = j.value("case", dir.parent_path().filename().string());
-  r.seed = int(number(j, "seed", file));
-  r.blade_width_m = number(j, "blade.width_m", file);
-  r.rake_deg = number(j, "blade.rake_deg", file);
-  r.depth_m = number(j, "blade.depth_m", file);
-  r.initial_surface_mean_m = number(j, "bed.initial_surface_mean_m", file);
-  r.tip_x_start_m = number(j, "blade.tip_line_at_push_start.x_m", file);
-  r.tip_z_start_m = number(j, "blade.tip_line_at_push_start.z_m", file);
-  r.blade_y_from_m = number(j, "blade.tip_line_at_push_start.y_from_m", file);
-  r.blade_y_to_m = number(j, "blade.tip_line_at_push_start.y_to_m", file);
-  r.lowering_start_x_m = number(j, "blade.tip_line_at_lowering_start.x_m", file);
-  r.lowering_start_z_m = number(j, "blade.tip_line_at_lowering_start.z_m", file);
-  r.lowering_speed_m_per_s = number(j, "motion.lowering_speed_m_per_s", file);
-  r.hold_s = number(j, "motion.hold_s", file);
-  r.push_speed_m_per_s = number(j, "motion.push_speed_m_per_s", file);
-  r.push_total_m = number(j, "motion.push_total_m", file);
-  r.wall_s = number(j, "wall_clock_s", file);
-  r.particles = int(number(j, "bed.particles", file));
-  r.cell_m = number(j, "surfaces.cell_m", file);
-  if (!j.contains("surfaces") || !j["surfaces"].contains("shape_rows_cols") ||
-      j["surfaces"]["shape_rows_cols"].size() != 2)
-    throw InputError(file.string() + ": surfaces.shape_rows_cols: expected [rows, cols]");
-  r.rows = j["surfaces"]["shape_rows_cols"][0].get<int>();
-  r.cols = j["surfaces"]["shape_rows_cols"][1].get<int>();
-  if (r.rows < 2 || r.cols < 2 || !(r.cell_m > 0.0) || !(r.blade_width_m > 0.0) ||
-      !(r.push_speed_m_per_s > 0.0) || !(r.lowering_speed_m_per_s > 0.0))
-    throw InputError(file.string() + ": the grid, the blade or the motion is degenerate");
-  r.surface_initial = read_grid(dir / "surface_initial.npy", r.rows, r.cols);
-  for (int mm : {0, 100, 200, 300}) {
-    const fs::path f = dir / ("surface_" + std::to_string(mm) + ".npy");
-    if (fs::exists(f)) r.surface_at_push_mm[mm] = read_grid(f, r.rows, r.cols);
+  r.case_name = dir.parent_path().filename().string();
+  if (j.contains("case")) {
+    if (!j["case"].is_string()) throw InputError(file.string() + ": case: expected a name");
+    r.case_name = j["case"].get<std::string>();
   }
-  read_force(dir / "force.csv", r);
+  r.seed = int(number_in(j, "seed", file, 0, 1e9));
+  r.cell_m = number_in(j, "surfaces.cell_m", file, 1e-4, 1.0);
+  const Json* shape = j.contains("surfaces") && j["surfaces"].is_object() && j["surfaces"].contains("shape_rows_cols")
+                          ? &j["surfaces"]["shape_rows_cols"]
+                          : nullptr;
+  if (!shape || !shape->is_array() || shape->size() != 2 || !(*shape)[0].is_number_integer() ||
+      !(*shape)[1].is_number_integer())
+    throw InputError(file.string() + ": surfaces.shape_rows_cols: expected [rows, cols], two whole numbers");
+  r.rows = (*shape)[0].get<int>();
+  r.cols = (*shape)[1].get<int>();
+  if (r.rows < 2 || r.cols < 2 || std::int64_t(r.rows) * r.cols > 100000000)
+    throw InputError(file.string() + ": surfaces.shape_rows_cols: " + std::to_string(r.rows) + " x " +
+                     std::to_string(r.cols) + " is not a grid (2 x 2 to 1e8 cells)");
+  const double length_x = r.cols * r.cell_m, width_y = r.rows * r.cell_m;
+  r.blade_width_m = number_in(j, "blade.width_m", file, r.cell_m, width_y);
+  r.rake_deg = number_in(j, "blade.rake_deg", file, 1.0, 179.0);
+  r.depth_m = number_in(j, "blade.depth_m", file, 1e-4, 10.0);
+  r.initial_surface_mean_m = number_in(j, "bed.initial_surface_mean_m", file, 1e-4, 100.0);
+  r.tip_x_start_m = number_in(j, "blade.tip_line_at_push_start.x_m", file, 0.0, length_x);
+  r.tip_z_start_m = number_in(j, "blade.tip_line_at_push_start.z_m", file, 0.0, 100.0);
+  r.blade_y_from_m = number_in(j, "blade.tip_line_at_push_start.y_from_m", file, 0.0, width_y);
+  r.blade_y_to_m = number_in(j, "blade.tip_line_at_push_start.y_to_m", file, 0.0, width_y);
+  if (!(r.blade_y_to_m > r.blade_y_from_m) ||
+      std::abs((r.blade_y_to_m - r.blade_y_from_m) - r.blade_width_m) > r.cell_m)
+    throw InputError(file.string() + ": blade.tip_line_at_push_start: the span y_from_m..y_to_m is not the blade's "
+                     "width (" + format_number(r.blade_width_m) + " m)");
+  r.lowering_start_x_m = number_in(j, "blade.tip_line_at_lowering_start.x_m", file, 0.0, length_x);
+  r.lowering_start_z_m = number_in(j, "blade.tip_line_at_lowering_start.z_m", file, 0.0, 100.0);
+  r.lowering_speed_m_per_s = number_in(j, "motion.lowering_speed_m_per_s", file, 1e-4, 10.0);
+  r.hold_s = number_in(j, "motion.hold_s", file, 0.0, 10.0);
+  r.push_speed_m_per_s = number_in(j, "motion.push_speed_m_per_s", file, 1e-4, 10.0);
+  r.push_total_m = number_in(j, "motion.push_total_m", file, kDemWindow_m, length_x - r.tip_x_start_m);
+  r.wall_s = number_in(j, "wall_clock_s", file, 0.0, 1e9);
+  if (j.contains("cpu_s")) r.cpu_s = number_in(j, "cpu_s", file, 0.0, 1e9);
+  if (j.contains("blade") && j["blade"].is_object() && j["blade"].contains("rear_top_edge_x_offset_m"))
+    r.rear_offset_m = number_in(j, "blade.rear_top_edge_x_offset_m", file, -length_x, 0.0);
+  r.particles = int(number_in(j, "bed.particles", file, 0, 1e9));
+  // The lowering must take a sensible time (a million steps at 1 kHz at most).
+  const double lower_m = std::hypot(r.tip_x_start_m - r.lowering_start_x_m, r.tip_z_start_m - r.lowering_start_z_m);
+  if (lower_m / r.lowering_speed_m_per_s > 1000.0 || r.push_total_m / r.push_speed_m_per_s > 1000.0)
+    throw InputError(file.string() + ": motion: the lowering or the push lasts more than 1000 s");
   return r;
 }
 
-}  // namespace
+DemRun read_run(const fs::path& dir) {
+  DemRun r;
+  try {
+    r = read_run_json(dir);
+  } catch (const Json::exception& e) {
+    throw InputError((dir / "run.json").string() + ": " + e.what());
+  }
+  r.surface_initial = read_grid(dir / "surface_initial.npy", r.rows, r.cols);
+  // A surface after every window of push (and at its start, when written).
+  const int windows = int(std::lround(r.push_total_m / kDemWindow_m));
+  for (int k = 0; k <= windows; ++k) {
+    const int mm = int(std::lround(k * kDemWindow_m * 1000.0));
+    const fs::path f = dir / ("surface_" + std::to_string(mm) + ".npy");
+    if (fs::exists(f)) r.surface_at_push_mm[mm] = read_grid(f, r.rows, r.cols);
+    else if (k > 0) throw InputError(f.string() + ": missing (the surface after " + std::to_string(mm) + " mm of push)");
+  }
+  read_force(dir / "force.csv", r);
+  // The force record covers the push: a row within 2 % of it at each end.
+  const double slack = 0.02 * r.push_total_m;
+  if (r.push_m.front() > slack || r.push_m.back() < r.push_total_m - slack)
+    throw InputError((dir / "force.csv").string() + ": covers " + format_number(r.push_m.front()) + " to " +
+                     format_number(r.push_m.back()) + " m of push, not the run's 0 to " +
+                     format_number(r.push_total_m) + " m");
+  return r;
+}
 
-DemMaterialTests read_dem_material(const fs::path& json) {
+DemMaterialTests read_dem_material_json(const fs::path& json) {
   const Json j = read_json(json);
   DemMaterialTests t;
   t.repose_deg = number(j, "repose_deg", json);
@@ -153,6 +204,23 @@ DemMaterialTests read_dem_material(const fs::path& json) {
   return t;
 }
 
+}  // namespace
+
+DemMaterialTests read_dem_material(const fs::path& json) {
+  try {
+    return read_dem_material_json(json);
+  } catch (const Json::exception& e) {
+    throw InputError(json.string() + ": " + e.what());
+  }
+}
+
+
+DemRun read_dem_run(const fs::path& run_dir) {
+  if (!fs::exists(run_dir / "run.json"))
+    throw InputError(run_dir.string() + ": not a DEM run (no run.json; validation/dem/README.md)");
+  return read_run(run_dir);
+}
+
 std::vector<DemRun> read_dem_runs(const fs::path& results_dir) {
   std::vector<DemRun> runs;
   const fs::path root = results_dir / "bulldoze";
@@ -168,9 +236,10 @@ std::vector<DemRun> read_dem_runs(const fs::path& results_dir) {
   return runs;
 }
 
-TerracutRun run_terracut(const DemRun& dem, const SoilMaterial& material, double rate_hz) {
+DemReplay dem_replay(const DemRun& dem, const SoilMaterial& material, double rate_hz) {
+  DemReplay r;
   // The DEM's grid as the terrain: DEM x -> X (columns), y -> Z (rows).
-  SimParams p;
+  SimParams& p = r.params;
   p.grid.cols = dem.cols;
   p.grid.rows = dem.rows;
   p.grid.size_x_m = dem.cols * dem.cell_m;
@@ -183,46 +252,90 @@ TerracutRun run_terracut(const DemRun& dem, const SoilMaterial& material, double
   p.soil.model = SoilModel::kFlow;
   p.soil.material = material;
   p.soil.max_pair_checks_per_step = 1000000000;  // an offline comparison: the converged model
-  Simulation sim(p, dem.surface_initial);
+  r.heights = dem.surface_initial;
 
   // The edge along Z (the DEM's y), centred on the blade's span.
   const double z_centre = 0.5 * (dem.blade_y_from_m + dem.blade_y_to_m);
   const Quat along_z = quat_from_euler_deg({0.0, -90.0, 0.0});
   const auto pose = [&](double x, double y) { return BladePose{{x, y, z_centre}, along_z}; };
-  TerracutRun out;
-  const auto t0 = std::chrono::steady_clock::now();
   // Lowering: from the DEM's start to the push's start, at its speed.
   const double lx = dem.tip_x_start_m - dem.lowering_start_x_m, ly = dem.tip_z_start_m - dem.lowering_start_z_m;
   const double lower_m = std::hypot(lx, ly);
-  const std::int64_t n_lower = std::max<std::int64_t>(1, std::llround(lower_m / dem.lowering_speed_m_per_s * rate_hz));
+  const std::int64_t n_lower =
+      std::max<std::int64_t>(1, std::llround(lower_m / dem.lowering_speed_m_per_s * rate_hz));
   for (std::int64_t i = 0; i <= n_lower; ++i) {
     const double f = double(i) / double(n_lower);
-    sim.step(pose(dem.lowering_start_x_m + f * lx, dem.lowering_start_z_m + f * ly));
+    r.poses.push_back(pose(dem.lowering_start_x_m + f * lx, dem.lowering_start_z_m + f * ly));
   }
   const std::int64_t n_hold = std::llround(dem.hold_s * rate_hz);
-  for (std::int64_t i = 0; i < n_hold; ++i) sim.step(pose(dem.tip_x_start_m, dem.tip_z_start_m));
+  for (std::int64_t i = 0; i < n_hold; ++i) r.poses.push_back(pose(dem.tip_x_start_m, dem.tip_z_start_m));
+  // The push, along +X at the DEM's speed.
+  r.push_first = r.poses.size();
+  const std::int64_t n_push = std::llround(dem.push_total_m / dem.push_speed_m_per_s * rate_hz);
+  for (std::int64_t i = 1; i <= n_push; ++i)
+    r.poses.push_back(pose(dem.tip_x_start_m + dem.push_speed_m_per_s * double(i) / rate_hz, dem.tip_z_start_m));
+  return r;
+}
+
+ForceRecord dem_force_record(const DemRun& dem, const DemReplay& replay) {
+  ForceRecord rec;
+  const double rate = replay.params.rate_hz;
+  std::size_t k = 0;  // the DEM row at or after the step's push
+  for (std::size_t i = 0; i < replay.poses.size(); ++i) {
+    rec.t_s.push_back(double(i) / rate);
+    rec.pose.push_back(replay.poses[i]);
+    Vec3 f{};
+    if (i >= replay.push_first) {
+      // The DEM's 2.5 ms means, linear between their centres (held past
+      // the first and the last), in terracut's frame (DEM y -> Z, z -> Y).
+      const double pushed = dem.push_speed_m_per_s * double(i - replay.push_first + 1) / rate;
+      while (k < dem.push_m.size() && dem.push_m[k] < pushed) ++k;
+      double fx, fy, fz;
+      if (k == 0 || k == dem.push_m.size()) {
+        const std::size_t at = k == 0 ? 0 : dem.push_m.size() - 1;
+        fx = dem.fx_n[at], fy = dem.fy_n[at], fz = dem.fz_n[at];
+      } else {
+        const double w = (pushed - dem.push_m[k - 1]) / (dem.push_m[k] - dem.push_m[k - 1]);
+        fx = (1 - w) * dem.fx_n[k - 1] + w * dem.fx_n[k];
+        fy = (1 - w) * dem.fy_n[k - 1] + w * dem.fy_n[k];
+        fz = (1 - w) * dem.fz_n[k - 1] + w * dem.fz_n[k];
+      }
+      f = {fx, fz, fy};
+    }
+    rec.force_n.push_back(f);
+  }
+  return rec;
+}
+
+TerracutRun run_terracut(const DemRun& dem, const SoilMaterial& material, double rate_hz) {
+  const DemReplay replay = dem_replay(dem, material, rate_hz);
+  Simulation sim(replay.params, replay.heights);
+  TerracutRun out;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t c0 = std::clock();
+  for (std::size_t i = 0; i < replay.push_first; ++i) sim.step(replay.poses[i]);
   const auto grid_copy = [&] {
     return std::vector<float>(sim.grid().heights(), sim.grid().heights() + sim.grid().spec().sample_count());
   };
   out.surface_at_push_mm[0] = grid_copy();
-  // The push, along +X at the DEM's speed; snapshots at every 0.1 m.
+  // The push; snapshots at every window's end.
   const auto p0 = std::chrono::steady_clock::now();
-  const std::int64_t n_push = std::llround(dem.push_total_m / dem.push_speed_m_per_s * rate_hz);
-  int next_mm = 100;
-  for (std::int64_t i = 1; i <= n_push; ++i) {
-    const double pushed = dem.push_speed_m_per_s * double(i) / rate_hz;
-    const StepOutput& o = sim.step(pose(dem.tip_x_start_m + pushed, dem.tip_z_start_m));
+  int next_mm = int(std::lround(kDemWindow_m * 1000.0));
+  for (std::size_t i = replay.push_first; i < replay.poses.size(); ++i) {
+    const double pushed = dem.push_speed_m_per_s * double(i - replay.push_first + 1) / rate_hz;
+    const StepOutput& o = sim.step(replay.poses[i]);
     out.push_m.push_back(pushed);
     out.fx_n.push_back(o.force.total_n.x);
     out.fy_n.push_back(o.force.total_n.z);  // the DEM's y is terracut's Z
     out.fz_n.push_back(o.force.total_n.y);
     if (pushed >= next_mm * 1e-3 - 0.25 * dem.push_speed_m_per_s / rate_hz) {
       out.surface_at_push_mm[next_mm] = grid_copy();
-      next_mm += 100;
+      next_mm += int(std::lround(kDemWindow_m * 1000.0));
     }
   }
   const auto t1 = std::chrono::steady_clock::now();
   out.wall_s = std::chrono::duration<double>(t1 - t0).count();
+  out.cpu_s = double(std::clock() - c0) / CLOCKS_PER_SEC;
   out.push_wall_s = std::chrono::duration<double>(t1 - p0).count();
   out.steps = sim.step_count();
   return out;
@@ -242,19 +355,30 @@ std::vector<double> centre_line(const std::vector<float>& grid, int rows, int co
 
 namespace {
 
-// Net rise over the initial surface in the cells at or ahead of the tip
-// line (all across), m^3; and the highest point there above the mean
-// initial surface, m.
-void pile_ahead(const std::vector<float>& now, const std::vector<float>& initial, int rows, int cols,
-                double cell_m, double tip_x_m, double mean_initial_m, double& volume_m3, double& peak_m) {
+// Net rise over the initial surface in the DEM's pile region at a tip line
+// x = tip_x_m: the cells at or ahead of it (all across) and, for a raked
+// blade, the cells over its plate (from the rear top edge, rear_offset_m
+// behind the tip, within the blade's span) whose surface lies above the
+// plate, the soil carried on its face (validation/dem/bulldoze/bulldoze.py,
+// window_metrics), m^3; and the highest point there above the mean initial
+// surface, m.
+void pile_ahead(const std::vector<float>& now, const DemRun& dem, double tip_x_m, double& volume_m3,
+                double& peak_m) {
   volume_m3 = 0.0;
   peak_m = 0.0;
-  for (int j = 0; j < rows; ++j)
-    for (int i = 0; i < cols; ++i) {
-      if ((i + 0.5) * cell_m < tip_x_m) continue;
-      const std::size_t k = std::size_t(j) * cols + i;
-      volume_m3 += (double(now[k]) - double(initial[k])) * cell_m * cell_m;
-      peak_m = std::max(peak_m, double(now[k]) - mean_initial_m);
+  const double yc = 0.5 * (dem.blade_y_from_m + dem.blade_y_to_m);
+  const double tan_rake = dem.rake_deg < 89.999 ? std::tan(dem.rake_deg * std::numbers::pi / 180.0) : 0.0;
+  for (int j = 0; j < dem.rows; ++j)
+    for (int i = 0; i < dem.cols; ++i) {
+      const double x = (i + 0.5) * dem.cell_m, y = (j + 0.5) * dem.cell_m;
+      const std::size_t k = std::size_t(j) * dem.cols + i;
+      const bool ahead = x >= tip_x_m;
+      const bool over_plate = x >= tip_x_m + dem.rear_offset_m && x < tip_x_m &&
+                              std::abs(y - yc) <= 0.5 * dem.blade_width_m &&
+                              double(now[k]) > dem.tip_z_start_m + (tip_x_m - x) * tan_rake;
+      if (!ahead && !over_plate) continue;
+      volume_m3 += (double(now[k]) - double(dem.surface_initial[k])) * dem.cell_m * dem.cell_m;
+      peak_m = std::max(peak_m, double(now[k]) - dem.initial_surface_mean_m);
     }
 }
 
@@ -266,7 +390,7 @@ double mean_of(const std::vector<double>& x, const std::vector<double>& v, doubl
       s += v[i];
       ++n;
     }
-  return n > 0 ? s / n : 0.0;
+  return n > 0 ? s / n : std::numeric_limits<double>::quiet_NaN();
 }
 
 // The slope of a least-squares line through (x, -v) for x > from, N/m.
@@ -293,8 +417,11 @@ RunComparison compare(const DemRun& dem, const TerracutRun& tc, double window_m)
   c.seed = dem.seed;
   c.dem_wall_s = dem.wall_s;
   c.terracut_wall_s = tc.wall_s;
+  c.dem_cpu_s = dem.cpu_s;
+  c.terracut_cpu_s = tc.cpu_s;
   const double y_centre = 0.5 * (dem.blade_y_from_m + dem.blade_y_to_m);
-  const int windows = int(std::lround(dem.push_total_m / window_m));
+  const std::vector<double> initial = centre_line(dem.surface_initial, dem.rows, dem.cols, dem.cell_m, y_centre);
+  const int windows = std::max(1, int(std::lround(dem.push_total_m / window_m)));
   for (int k = 0; k < windows; ++k) {
     WindowComparison w;
     w.start_m = k * window_m;
@@ -307,19 +434,27 @@ RunComparison compare(const DemRun& dem, const TerracutRun& tc, double window_m)
     const int mm = int(std::lround(w.end_m * 1000.0));
     const auto d = dem.surface_at_push_mm.find(mm);
     const auto t = tc.surface_at_push_mm.find(mm);
-    if (d != dem.surface_at_push_mm.end() && t != tc.surface_at_push_mm.end()) {
+    w.has_surface = d != dem.surface_at_push_mm.end() && t != tc.surface_at_push_mm.end();
+    if (w.has_surface) {
       const double tip = dem.tip_x_start_m + w.end_m;
-      pile_ahead(d->second, dem.surface_initial, dem.rows, dem.cols, dem.cell_m, tip,
-                 dem.initial_surface_mean_m, w.dem_pile_m3, w.dem_peak_m);
-      pile_ahead(t->second, dem.surface_initial, dem.rows, dem.cols, dem.cell_m, tip,
-                 dem.initial_surface_mean_m, w.terracut_pile_m3, w.terracut_peak_m);
-      // The centre line, away from the blade's own cells (the DEM's grid
-      // does not hold the plate; terracut's has the cut under it).
+      pile_ahead(d->second, dem, tip, w.dem_pile_m3, w.dem_peak_m);
+      pile_ahead(t->second, dem, tip, w.terracut_pile_m3, w.terracut_peak_m);
+      // The centre line over the span either surface disturbed, away from
+      // the blade's own cells (the DEM's grid does not hold the plate;
+      // terracut's has the cut under it).
       const std::vector<double> a = centre_line(d->second, dem.rows, dem.cols, dem.cell_m, y_centre);
       const std::vector<double> b = centre_line(t->second, dem.rows, dem.cols, dem.cell_m, y_centre);
+      const double moved = 0.25 * dem.depth_m;
+      int first = dem.cols, last = -1;
+      for (int i = 0; i < dem.cols; ++i)
+        if (std::abs(a[std::size_t(i)] - initial[std::size_t(i)]) > moved ||
+            std::abs(b[std::size_t(i)] - initial[std::size_t(i)]) > moved) {
+          first = std::min(first, i);
+          last = i;
+        }
       double s = 0.0;
       int n = 0;
-      for (int i = 0; i < dem.cols; ++i) {
+      for (int i = first; i <= last; ++i) {
         if (std::abs((i + 0.5) * dem.cell_m - tip) < 1.5 * dem.cell_m) continue;
         s += (a[std::size_t(i)] - b[std::size_t(i)]) * (a[std::size_t(i)] - b[std::size_t(i)]);
         ++n;
@@ -396,24 +531,29 @@ std::vector<CaseSummary> summarize(const std::vector<RunComparison>& runs, doubl
       w.dem_fx_std_n = f.std;
       w.terracut_fx_n = stats_of(tfx).mean;
       w.force_met = within(w.terracut_fx_n, f, kForceTarget, w.force_error);
-      w.dem_pile_m3 = p.mean;
-      w.dem_pile_std_m3 = p.std;
-      w.terracut_pile_m3 = stats_of(tpile).mean;
-      w.pile_met = within(w.terracut_pile_m3, p, kPileTarget, w.pile_error);
+      w.has_surface = std::all_of(rs.begin(), rs.end(), [&](const RunComparison* r) { return r->windows[k].has_surface; });
       w.dem_fz_n = stats_of(dfz).mean;
       w.terracut_fz_n = stats_of(tfz).mean;
-      w.dem_peak_m = stats_of(dpeak).mean;
-      w.terracut_peak_m = stats_of(tpeak).mean;
-      w.profile_rms_m = stats_of(prof).mean;
-      w.profile_met = w.profile_rms_m <= grain_diameter_m;
+      if (w.has_surface) {
+        w.dem_pile_m3 = p.mean;
+        w.dem_pile_std_m3 = p.std;
+        w.terracut_pile_m3 = stats_of(tpile).mean;
+        w.pile_met = within(w.terracut_pile_m3, p, kPileTarget, w.pile_error);
+        w.dem_peak_m = stats_of(dpeak).mean;
+        w.terracut_peak_m = stats_of(tpeak).mean;
+        w.profile_rms_m = stats_of(prof).mean;
+        w.profile_met = w.profile_rms_m <= grain_diameter_m;
+      }
       c.windows.push_back(w);
     }
-    std::vector<double> ds, ts, dw, tw;
+    std::vector<double> ds, ts, dw, tw, dc, tc;
     for (const RunComparison* r : rs) {
       ds.push_back(r->dem_slope_n_per_m);
       ts.push_back(r->terracut_slope_n_per_m);
       dw.push_back(r->dem_wall_s);
       tw.push_back(r->terracut_wall_s);
+      dc.push_back(r->dem_cpu_s);
+      tc.push_back(r->terracut_cpu_s);
     }
     const Stats slope = stats_of(ds);
     c.dem_slope_n_per_m = slope.mean;
@@ -422,7 +562,13 @@ std::vector<CaseSummary> summarize(const std::vector<RunComparison>& runs, doubl
     c.slope_met = within(c.terracut_slope_n_per_m, slope, kSlopeTarget, c.slope_error);
     c.dem_wall_s = stats_of(dw).mean;
     c.terracut_wall_s = stats_of(tw).mean;
-    c.speedup = c.terracut_wall_s > 0.0 ? c.dem_wall_s / c.terracut_wall_s : 0.0;
+    c.dem_cpu_s = stats_of(dc).mean;
+    c.terracut_cpu_s = stats_of(tc).mean;
+    c.speedup_in_cpu_time =
+        std::all_of(dc.begin(), dc.end(), [](double x) { return x > 0.0; }) && c.terracut_cpu_s > 0.0;
+    c.speedup = c.speedup_in_cpu_time ? c.dem_cpu_s / c.terracut_cpu_s
+                : c.terracut_wall_s > 0.0 ? c.dem_wall_s / c.terracut_wall_s
+                                          : 0.0;
     c.speed_met = c.speedup >= kSpeedTarget;
     out.push_back(c);
   }

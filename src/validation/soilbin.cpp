@@ -6,7 +6,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "terracut/core/earthmoving.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/core/format.hpp"
 #include "terracut/core/simulation.hpp"
 #include "terracut/io/soil_yaml.hpp"
 #include "terracut/io/yaml_reader.hpp"
@@ -21,10 +23,12 @@ constexpr const char* kHeader =
     "point_id,blade_width_m,rake_angle_deg,depth_m,speed_m_per_s,horizontal_force_n,vertical_force_n,"
     "source_location,reading";
 
-// One CSV line's cells: commas split, double quotes group ("" is a quote).
-std::vector<std::string> cells_of(const std::string& line) {
+// One CSV line's cells: commas split; a cell that starts with a double
+// quote runs to the closing one ("" inside is a quote). Throws InputError
+// at where for a quote inside an unquoted cell or an unterminated one.
+std::vector<std::string> cells_of(const std::string& line, const std::string& where) {
   std::vector<std::string> out(1);
-  bool quoted = false;
+  bool quoted = false, closed = false;
   for (std::size_t i = 0; i < line.size(); ++i) {
     const char c = line[i];
     if (quoted) {
@@ -33,20 +37,30 @@ std::vector<std::string> cells_of(const std::string& line) {
         ++i;
       } else if (c == '"') {
         quoted = false;
+        closed = true;
       } else {
         out.back() += c;
       }
-    } else if (c == '"') {
-      quoted = true;
     } else if (c == ',') {
       out.emplace_back();
-    } else if (c != '\r') {
+      closed = false;
+    } else if (c == '\r') {
+      continue;
+    } else if (closed) {
+      throw InputError(where + ": text after a quoted cell's closing quote (cell " + std::to_string(out.size()) + ")");
+    } else if (c == '"') {
+      if (!out.back().empty())
+        throw InputError(where + ": a quote inside an unquoted cell (cell " + std::to_string(out.size()) + ")");
+      quoted = true;
+    } else {
       out.back() += c;
     }
   }
+  if (quoted) throw InputError(where + ": unterminated quote (cell " + std::to_string(out.size()) + ")");
   return out;
 }
 
+// A number in [lo, hi].
 double number_in(const std::string& cell, const std::string& where, const char* column, double lo, double hi) {
   double v = 0.0;
   try {
@@ -56,9 +70,9 @@ double number_in(const std::string& cell, const std::string& where, const char* 
   } catch (const std::exception&) {
     throw InputError(where + ": " + column + ": '" + cell + "' is not a number");
   }
-  if (!(std::isfinite(v) && v > lo && v <= hi))
-    throw InputError(where + ": " + column + ": " + cell + " is outside (" + std::to_string(lo) + ", " +
-                     std::to_string(hi) + "]");
+  if (!(std::isfinite(v) && v >= lo && v <= hi))
+    throw InputError(where + ": " + column + ": " + cell + " is outside [" + format_number(lo) + ", " +
+                     format_number(hi) + "]");
   return v;
 }
 
@@ -74,17 +88,19 @@ std::vector<SoilBinPoint> read_points(const fs::path& csv) {
   while (std::getline(in, line)) {
     ++row;
     if (line.empty() || line == "\r") continue;
-    const std::vector<std::string> c = cells_of(line);
     const std::string where = csv.string() + ":" + std::to_string(row);
+    const std::vector<std::string> c = cells_of(line, where);
     if (c.size() != 9) throw InputError(where + ": 9 columns expected, got " + std::to_string(c.size()));
     SoilBinPoint p;
     p.id = c[0];
     if (p.id.empty()) throw InputError(where + ": point_id: empty");
-    p.blade_width_m = number_in(c[1], where, "blade_width_m", 0.0, 100.0);
-    p.rake_deg = number_in(c[2], where, "rake_angle_deg", 0.0, 180.0);
-    p.depth_m = number_in(c[3], where, "depth_m", 0.0, 10.0);
-    p.speed_m_per_s = number_in(c[4], where, "speed_m_per_s", 0.0, 100.0);
-    p.horizontal_n = number_in(c[5], where, "horizontal_force_n", 0.0, 1e9);
+    // Soil-bin blades: millimetres to metres wide and deep, at 1 mm/s to
+    // 20 m/s (a prediction steps 0.3 m at 1 kHz: at most 3e5 steps).
+    p.blade_width_m = number_in(c[1], where, "blade_width_m", 1e-3, 20.0);
+    p.rake_deg = number_in(c[2], where, "rake_angle_deg", 1.0, 179.0);
+    p.depth_m = number_in(c[3], where, "depth_m", 1e-3, 5.0);
+    p.speed_m_per_s = number_in(c[4], where, "speed_m_per_s", 1e-3, 20.0);
+    p.horizontal_n = number_in(c[5], where, "horizontal_force_n", 1e-6, 1e9);
     if (!c[6].empty()) p.vertical_n = number_in(c[6], where, "vertical_force_n", -1e9, 1e9);
     p.source_location = c[7];
     p.reading = c[8];
@@ -116,14 +132,38 @@ std::vector<SoilBinSet> read_soilbin_sets(const fs::path& dir) {
     if (!root.IsMap() || !root["terracut_soil"]) continue;  // a candidate without a material: not a data set
     SoilBinSet set;
     set.name = json.stem().string();
-    if (root["citation"] && root["citation"].IsScalar()) set.citation = root["citation"].as<std::string>();
-    if (root["how_read"] && root["how_read"].IsScalar()) set.how_read = root["how_read"].as<std::string>();
+    // The citation as written: a text, or an object shown in flow style.
+    const auto text_of = [](const YAML::Node& n) {
+      if (n.IsScalar()) return n.as<std::string>();
+      YAML::Emitter e;
+      e << YAML::Flow << n;
+      return std::string(e.c_str());
+    };
+    if (root["citation"]) set.citation = text_of(root["citation"]);
+    if (root["how_read"]) set.how_read = text_of(root["how_read"]);
     const io::yaml::Field soil(ctx, root["terracut_soil"], "terracut_soil", YAML::Mark());
-    io::read_soil_material(io::yaml::Map(soil, io::soil_material_keys()), set.material);
+    const io::yaml::Map fields(soil, io::soil_material_keys());
+    io::read_soil_material(fields, set.material);
+    // The published properties, all of them: a default must not stand in
+    // for one (a preset names where the values come from).
+    if (!fields.has("preset")) {
+      if (!fields.has("density_kg_per_m3") && !fields.has("unit_weight_n_per_m3"))
+        soil.fail("give the soil's density_kg_per_m3 or unit_weight_n_per_m3 (or a preset)");
+      for (const char* key : {"internal_friction_deg", "cohesion_pa", "soil_tool_friction_deg", "adhesion_pa"})
+        if (!fields.has(key)) soil.fail(std::string("give the soil's ") + key + " (0 where it has none), or a preset");
+    }
     if (std::string e = validate(set.material); !e.empty())
       throw InputError(json.string() + ": terracut_soil." + e);
     const fs::path csv = fs::path(json).replace_extension(".csv");
     if (fs::exists(csv)) set.points = read_points(csv);
+    // Every point's blade must make a failure wedge in this soil.
+    for (const SoilBinPoint& p : set.points) {
+      EarthmovingParams ep;
+      ep.soil = set.material;
+      ep.rake_angle_deg = p.rake_deg;
+      if (std::string e = validate(ep); !e.empty())
+        throw InputError(csv.string() + ": point " + p.id + ": " + e);
+    }
     sets.push_back(std::move(set));
   }
   return sets;
@@ -165,7 +205,12 @@ SoilBinComparison compare_soilbin(const SoilBinSet& set) {
   c.name = set.name;
   double sum = 0.0;
   for (const SoilBinPoint& pt : set.points) {
-    const SoilBinPrediction pr = predict_soilbin(pt, set.material);
+    SoilBinPrediction pr;
+    try {
+      pr = predict_soilbin(pt, set.material);
+    } catch (const InputError& e) {
+      throw InputError(set.name + ": point " + pt.id + ": " + e.what());
+    }
     c.predicted.push_back(pr);
     const double e = (pr.horizontal_n - pt.horizontal_n) / pt.horizontal_n;
     c.error.push_back(e);

@@ -7,9 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <thread>
 #include <utility>
 
 #include "haptics_fixture.hpp"
@@ -680,6 +682,100 @@ TEST(HapticLoop, PacedLoopStatisticsWithAFakeClock) {
   EXPECT_NEAR(ps.compute.max_s, 2.5e-3, 1e-8);
   EXPECT_NEAR(ps.period_jitter.max_s, 1.5e-3, 1e-8);
   EXPECT_LT(ps.period_jitter.p50_s, 2e-6);
+}
+
+// A device its user pauses for a while (the viewer's virtual one): paused
+// from read 40 for 300 looks, then playing again.
+class PausingDevice final : public Device {
+ public:
+  explicit PausingDevice(Device& inner) : inner_(inner) {}
+  std::string_view kind() const override { return inner_.kind(); }
+  void start(double t_s) override { inner_.start(t_s); }
+  bool read(double t_s, DeviceSample& out) noexcept override {
+    ++reads;
+    return inner_.read(t_s, out);
+  }
+  void write(const DeviceCommand& command) noexcept override { inner_.write(command); }
+  bool paused() noexcept override {
+    if (reads < 40 || looks_paused >= 300) return false;
+    ++looks_paused;
+    reads_while_paused = reads;
+    return true;
+  }
+  std::int64_t reads = 0, looks_paused = 0, reads_while_paused = -1;
+
+ private:
+  Device& inner_;
+};
+
+// The threaded loop holds while its device is paused: no tick runs (the
+// device is not read), the hold sleeps in steps of kPausePoll_s, and the
+// loop's clock leaves the pause out: the tick after it is one period after
+// the tick before, with no late tick, jitter or missed deadline counted.
+TEST(HapticLoop, APausedDeviceHoldsTheLoopAndItsClock) {
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice script(trench_path(s));
+  PausingDevice device(script);
+  auto clock = std::make_shared<TestClock>();
+  const io::Scenario& sc = trench().scenario;
+  LoopOptions o;
+  o.ticks = 100;
+  o.record_capacity = 100;
+  o.realtime = false;
+  o.clock = clock;
+  const test::LoopRig rig = test::make_loop_rig(s, sc, Quat{}, device, o);
+  HapticLoop& loop = *rig;
+  const double start = clock->now_s();
+  loop.start();
+  loop.join();
+  EXPECT_EQ(device.looks_paused, 300);
+  EXPECT_EQ(device.reads_while_paused, 40);  // nothing was read while paused
+  EXPECT_EQ(loop.counters().ticks, 100);
+  // The fake clock moved through the hold: 300 looks, one poll apart.
+  EXPECT_GE(clock->now_s() - start, 299 * HapticLoop::kPausePoll_s);
+  const std::vector<LoopRecord> rs = loop.records();
+  ASSERT_EQ(rs.size(), 100u);
+  // Every period is the nominal one, to the fake clock's spin step (1 us),
+  // the one after the 1.5 s pause included.
+  const double T = 1.0 / s.rate_hz;
+  for (std::size_t i = 1; i < rs.size(); ++i) {
+    EXPECT_NEAR(rs[i].t_s - rs[i - 1].t_s, T, 1.5e-6) << "tick " << i;
+    EXPECT_NEAR(rs[i].period_s, T, 1.5e-6) << "tick " << i;
+  }
+  EXPECT_EQ(loop.counters().missed_deadlines, 0);
+  EXPECT_EQ(loop.pacer_stats().missed_deadlines, 0);
+  EXPECT_LT(loop.pacer_stats().period_jitter.max_s, 1e-4);
+}
+
+// A stop asked for while the device is paused ends the held loop.
+TEST(HapticLoop, AStopEndsAPausedLoop) {
+  class AlwaysPaused final : public Device {
+   public:
+    explicit AlwaysPaused(Device& inner) : inner_(inner) {}
+    std::string_view kind() const override { return inner_.kind(); }
+    bool read(double t_s, DeviceSample& out) noexcept override { return inner_.read(t_s, out); }
+    void write(const DeviceCommand& command) noexcept override { inner_.write(command); }
+    bool paused() noexcept override { return true; }
+
+   private:
+    Device& inner_;
+  };
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice script(trench_path(s));
+  AlwaysPaused device(script);
+  const io::Scenario& sc = trench().scenario;
+  LoopOptions o;
+  o.ticks = 1000000;
+  o.realtime = false;
+  const test::LoopRig rig = test::make_loop_rig(s, sc, Quat{}, device, o);
+  HapticLoop& loop = *rig;
+  loop.start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_TRUE(loop.running());
+  EXPECT_EQ(loop.counters().ticks, 1);  // the first tick, then held
+  loop.request_stop();
+  loop.join();
+  EXPECT_FALSE(loop.running());
 }
 
 TEST(HapticLoop, RecordsKeepTheNewestWhenFull) {

@@ -88,5 +88,18 @@ TEST(ShippedScenarios, EveryScenarioFileLoads) {
   EXPECT_GE(count, 3);
 }
 
+// docs/scenario-format.md lists every shipped scenario, one row each (a new
+// user reads there what each is for).
+TEST(ShippedScenarios, EveryScenarioFileIsListedInTheFormatDoc) {
+  const std::string doc =
+      test::read_text(fs::path(TERRACUT_SOURCE_DIR) / "docs" / "scenario-format.md");
+  ASSERT_FALSE(doc.empty());
+  for (const auto& entry : fs::directory_iterator(fs::path(TERRACUT_SOURCE_DIR) / "scenarios")) {
+    if (entry.path().extension() != ".yaml") continue;
+    const std::string row = "| `" + entry.path().filename().string() + "` | ";
+    EXPECT_NE(doc.find(row), std::string::npos) << "docs/scenario-format.md has no row " << row;
+  }
+}
+
 }  // namespace
 }  // namespace terracut::session

@@ -141,6 +141,27 @@ TEST_F(SoilBinFiles, BadFilesAreRefusedNamingTheFileTheLineAndTheField) {
             std::string::npos);
   EXPECT_NE(error(kJson, std::string(kHeader) + "a,0.33,90,0.05,0.1,12,,t,\n").find("reading"), std::string::npos);
   EXPECT_NE(error(kJson, std::string(kHeader)).find("no points"), std::string::npos);
+  // Quotes only around a whole cell, and closed.
+  EXPECT_NE(error(kJson, std::string(kHeader) + "a,0.33,90,0.05,0.1,12,,Tab\"le 2\",table\n")
+                .find("s.csv:2: a quote inside an unquoted cell"),
+            std::string::npos);
+  EXPECT_NE(error(kJson, std::string(kHeader) + "a,0.33,90,0.05,0.1,12,,\"Fig. 3,table\n")
+                .find("s.csv:2: unterminated quote"),
+            std::string::npos);
+  // A speed or a depth no soil bin runs at (a prediction would never end).
+  EXPECT_NE(error(kJson, std::string(kHeader) + "a,0.33,90,0.05,1e-7,12,,t,table\n").find("speed_m_per_s: 1e-7 is outside"),
+            std::string::npos);
+  EXPECT_NE(error(kJson, std::string(kHeader) + "a,0.33,90,1e-7,0.1,12,,t,table\n").find("depth_m"),
+            std::string::npos);
+  // A rake that makes no failure wedge in this soil (170 + 26.6 + 38 > 179).
+  EXPECT_NE(error(kJson, std::string(kHeader) + "a,0.33,170,0.05,0.1,12,,t,table\n").find("s.csv: point a:"),
+            std::string::npos);
+  // The published properties, all of them.
+  EXPECT_NE(error(R"({"terracut_soil": {}})", "").find("density_kg_per_m3 or unit_weight_n_per_m3"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"terracut_soil": {"density_kg_per_m3": 1460, "internal_friction_deg": 38}})", "")
+                .find("give the soil's cohesion_pa"),
+            std::string::npos);
 }
 
 TEST(SoilBinData, TheShippedFolderReads) {

@@ -98,6 +98,18 @@ TEST(ViewerMmt, RemotePatchesReachTheDrawnLocalModel) {
 }
 
 
+// The window prints how the loop is scheduled: in MMT the stations tick on
+// the driver's own thread, and that is said (it printed an empty line).
+TEST(ViewerMmt, TheRealTimeLineSaysHowTheStationsAreScheduled) {
+  const session::Scenario sc = session::load_scenario(kTrench);
+  DriverOptions o;
+  o.paced = false;
+  o.mmt = true;
+  LoopDriver d(sc, viewer_settings(sc.haptics), o, nullptr);
+  EXPECT_EQ(d.realtime_line().rfind("real-time: ", 0), 0u) << d.realtime_line();
+  EXPECT_NE(d.realtime_line().find("stations"), std::string::npos) << d.realtime_line();
+}
+
 TEST(ViewerMmt, AScenarioWithoutAnMmtSectionIsRefusedByName) {
   const session::Scenario sc =
       session::load_scenario(fs::path(TERRACUT_SOURCE_DIR) / "scenarios" / "trench_dry_sand.yaml");
@@ -183,8 +195,10 @@ TEST(ViewerMmt, NoRemoteStationAtTheAddressIsRefusedByName) {
   }
 }
 
-// The command line: --remote needs --mmt, and an address it can read.
-TEST(ViewerMmt, BadRemoteOptionsExitTwoNamingTheOption) {
+// The command line: --remote needs --mmt, and an address it can read. Both
+// are bad option values, checked after parsing: exit 1 (bad input) as in
+// every terracut program (apps/exit_codes.hpp), naming the option.
+TEST(ViewerMmt, BadRemoteOptionsExitOneNamingTheOption) {
   const fs::path dir =
       fs::temp_directory_path() / ("terracut_viewer_mmt_cli_" + std::to_string(getpid()));
   fs::create_directories(dir);
@@ -192,7 +206,7 @@ TEST(ViewerMmt, BadRemoteOptionsExitTwoNamingTheOption) {
     args.insert(args.begin(), {TERRACUT_VIEWER_BIN, kTrench.string()});
     const pid_t pid = test::spawn(args, dir / "out.txt", dir / "err.txt");
     ASSERT_GT(pid, 0);
-    EXPECT_EQ(test::wait_exit(pid, 30.0), 2) << args[2];
+    EXPECT_EQ(test::wait_exit(pid, 30.0), 1) << args[2];
     const std::string err = slurp(dir / "err.txt");
     EXPECT_NE(err.find(expect), std::string::npos) << err;
   };

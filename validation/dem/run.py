@@ -5,7 +5,7 @@
   run.py bed --seed 1                    pour the bulldozing bed of a seed (cached in work/)
   run.py bulldoze --case NAME --seed 1   one bulldozing run -> results/bulldoze/NAME/seed1/
   run.py bulldoze --case all --seed 1    every case of a seed
-  run.py summary                         results/bulldoze/summary.csv from the runs present
+  run.py summary [--recompute]           results/bulldoze/summary.csv from the runs present
   run.py all                             everything, seeds 1 2 3
   run.py smoke                           every script, a few hundred steps on tiny beds (CI)
   run.py digest                          markdown tables of the bulldozing summary and costs
@@ -56,6 +56,11 @@ def cmd_bulldoze(a):
 
 
 def cmd_summary(a):
+    if a.recompute:
+        for c in bulldoze.CASES:
+            for s in range(1, 100):
+                if os.path.exists(os.path.join(bulldoze.RES, c, "seed%d" % s, "run.json")):
+                    bulldoze.recompute_metrics(c, s)
     print(bulldoze.write_summary())
 
 
@@ -129,6 +134,8 @@ def main():
     b.add_argument("--force", action="store_true", help="rerun even if results exist")
     b.set_defaults(fn=cmd_bulldoze)
     s = sub.add_parser("summary")
+    s.add_argument("--recompute", action="store_true",
+                   help="recompute every run's window metrics from its files and work/ dumps first")
     s.set_defaults(fn=cmd_summary)
     s = sub.add_parser("all")
     s.add_argument("--force", action="store_true")

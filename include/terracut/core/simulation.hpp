@@ -93,8 +93,9 @@ class Simulation {
   Simulation(const SimParams& params, std::vector<float> initial_heights_m);
 
   const SimParams& params() const { return params_; }
+  /// The terrain, read-only: the simulation owns the heights and changes
+  /// them itself (steps, edit_heights, reset) or for a listener (below).
   const HeightGrid& grid() const { return grid_; }
-  HeightGrid& grid() { return grid_; }
 
   /// Lifts the blade out of the soil: the next step starts a new stroke and
   /// sweeps nothing from the previous pose (used between separate cuts).
@@ -126,11 +127,26 @@ class Simulation {
     return finish_step();
   }
 
-  /// For a step listener that edits heights during its on_step (the Bullet
-  /// world lowering the soil a released buried body stood in, with
-  /// HeightGrid::lower): adds the rectangle to this step's
-  /// StepOutput::changed, which the listeners after it and whoever reads
-  /// last() see. std::logic_error outside a step.
+  // --- A step listener that changes the terrain -------------------------
+  // (Jolt's HeightFieldShape::SetHeights: the owner makes the edit, so that
+  // whoever caches the heights hears of it.) The Bullet world lowers the
+  // soil a released buried body stood in, pushes soil out of the ring round
+  // a body and keeps heights inside its bounds. It does so only through
+  // these, from inside its own callbacks (on_step, on_edit; std::logic_error
+  // anywhere else: an internal error), reads the heights with grid(), and
+  // reports what it changed during a step with include_changed.
+
+  /// Lowers sample i (index = r * cols + c) to height_m when that is lower,
+  /// never below 0 (the rigid floor); returns the height removed, metres (0
+  /// when nothing changed).
+  float lower_sample(std::int64_t i, float height_m);
+  /// Moves amount_m metres of height from sample `from` to sample `to` (soil
+  /// pushed aside): the volume is kept. amount_m in (0, height at from].
+  void move_height(std::int64_t from, std::int64_t to, float amount_m);
+  /// For a step listener that changed heights during its on_step: adds the
+  /// rectangle to this step's StepOutput::changed, which the listeners after
+  /// it and whoever reads last() see, and the soil phase re-examines it (and
+  /// its neighbours) from the next step on. std::logic_error outside a step.
   void include_changed(const Rect& rect);
 
   const StepOutput& last() const { return out_; }
@@ -140,7 +156,8 @@ class Simulation {
   double removed_volume_m3() const { return removed_volume_m3_; }
 
   /// Restores the initial terrain, time and counters (and the force's
-  /// material to the parameters' soil).
+  /// material to the parameters' soil), and tells every listener that the
+  /// whole grid changed (StepListener::on_edit).
   void reset();
 
   /// The material the physical force is computed with (StepOutput::force:
@@ -170,11 +187,15 @@ class Simulation {
   Rect edit_heights(const Rect& rect, std::span<const float> values_m);
 
  private:
+  /// StepListener::on_edit for every listener (they may change heights there).
+  void tell_edited(const Rect& changed);
+
   SimParams params_;
   HeightGrid grid_;
   BladePose previous_pose_{};
   bool has_previous_ = false;
   bool in_step_ = false;
+  bool in_listener_ = false;  // a listener's on_step or on_edit is running
   std::int64_t step_count_ = 0;
   double removed_volume_m3_ = 0.0;
   StepOutput out_{};

@@ -24,7 +24,9 @@
 //     (except the measured compute times). Tests and the `script` device use it.
 //   - start() / request_stop() / join(): on its own thread, paced by the
 //     Pacer (absolute deadlines, sleep then a short spin), with SCHED_FIFO
-//     and locked memory where permitted.
+//     and locked memory where permitted. A device its user paused (the
+//     viewer's virtual one: Device::paused) holds the thread between ticks,
+//     costing nothing, and the loop's time leaves the pause out.
 #pragma once
 
 #include <atomic>
@@ -209,6 +211,9 @@ class HapticLoop {
   void request_stop() { stop_requested_.store(true, std::memory_order_relaxed); }
   /// Waits for the thread to end (it ends after options.ticks or a stop request).
   void join();
+  /// While the device is paused (Device::paused) the thread looks at it
+  /// again every this many seconds, and at a stop request.
+  static constexpr double kPausePoll_s = 0.005;
   /// True while the loop thread runs.
   bool running() const { return running_.load(std::memory_order_acquire); }
 

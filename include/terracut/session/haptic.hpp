@@ -147,8 +147,14 @@ class HapticSession {
   ClockMode clock() const { return clock_; }
   double duration_s() const { return duration_s_; }
   /// Warnings collected at build and after the run (rendering limited,
-  /// real-time refused, bad samples, missed deadlines, ...).
+  /// real-time refused, bad samples, missed deadlines, ...): summary.json's.
   std::vector<std::string> warnings() const;
+  /// What the device check changed at build (said once on SessionOptions::log
+  /// when the session is built).
+  const std::vector<std::string>& build_warnings() const { return build_warnings_; }
+  /// The warnings the run found (warnings() less build_warnings()): what a
+  /// program says at the end.
+  std::vector<std::string> run_warnings() const;
   /// summary.json's text.
   std::string summary_json() const;
 

@@ -1,12 +1,13 @@
 // Calibration of a soil material from records (`terracut calibrate`, and
-// terracut.calibrate in Python):
+// terracut.calibrate_tests / calibrate_record in Python):
 //   - from material tests: a bulk density, an angle of repose, a shear test
 //     (normal and shear stress at failure, at several normal stresses) and a
 //     plate test (the shear and normal stress of the soil sliding on the
 //     tool's material), each a list of measurements; the fit is the
 //     Mohr-Coulomb line of the shear test (friction angle and cohesion),
-//     the mean friction of the plate test, the means of the rest, each with
-//     its standard uncertainty;
+//     the plate tests' line through zero (soil-tool friction), the means of
+//     the rest, each with its standard uncertainty (+inf where the tests
+//     leave no degree of freedom to estimate it: two shear tests, one value);
 //   - from a force record along a known path: the tool's poses and the force
 //     measured on it (a DEM's, a soil bin's, a robot's log) on a known
 //     terrain; terracut replays the path with trial materials and fits the

@@ -18,6 +18,8 @@
 #include <vector>
 
 #include "terracut/core/material.hpp"
+#include "terracut/core/simulation.hpp"
+#include "terracut/validation/calibrate.hpp"
 
 namespace terracut::validation {
 
@@ -41,9 +43,12 @@ DemMaterialTests read_dem_material(const std::filesystem::path& json);
 // terracut's soil material comes from the DEM's tests alone (never from the
 // bulldozing runs it is compared with), as `terracut calibrate --tests
 // results/material.json` gives it (calibrate.hpp: the Mohr-Coulomb line of
-// every seed's shear tests at the peak -- the wedge of a passive failure
-// mobilises the peak --, the plate tests' soil-tool friction, the mean
-// density and repose; no adhesion, the grains are dry).
+// every seed's shear tests at the peak, the plate tests' soil-tool
+// friction, the mean density and repose; no adhesion, the grains are dry).
+
+/// The comparison's window of push, m: the DEM writes its surface after
+/// every 0.1 m, and each window's force is a mean over it.
+inline constexpr double kDemWindow_m = 0.1;
 
 /// One DEM bulldozing run (a case and a seed).
 struct DemRun {
@@ -62,21 +67,46 @@ struct DemRun {
   double push_speed_m_per_s = 0.0;
   double push_total_m = 0.0;
   double wall_s = 0.0;             ///< the DEM's own wall-clock time for the run (one core)
+  double cpu_s = 0.0;              ///< its process's CPU time; 0 when the run did not record it
+  double rear_offset_m = 0.0;      ///< x of the plate's rear top edge from the tip (< 0 for a raked blade)
   int particles = 0;
   // The surfaces: float32 (rows along y) x (cols along x), cell_m, origin at
   // the box corner; metres above the bed floor.
   int rows = 0, cols = 0;
   double cell_m = 0.005;
   std::vector<float> surface_initial;
-  std::map<int, std::vector<float>> surface_at_push_mm;  ///< after 0, 100, 200, 300 mm
+  std::map<int, std::vector<float>> surface_at_push_mm;  ///< after 0 mm and every window's end
   // The force on the blade during the push (2.5 ms means), DEM frame.
   std::vector<double> push_m, fx_n, fy_n, fz_n;
 };
 
 /// Every run under results/bulldoze (case folders holding seed<k>/run.json),
 /// sorted by case then seed. Throws InputError naming a file that cannot be
-/// read or a field that is missing.
+/// read, a field that is missing or of the wrong type, a run whose blade or
+/// push does not fit its bed, a missing surface (one per kDemWindow_m of
+/// push) or a force record that does not cover the push.
 std::vector<DemRun> read_dem_runs(const std::filesystem::path& results_dir);
+
+/// One run's folder (results/bulldoze/<case>/seed<k>). Throws as read_dem_runs.
+DemRun read_dem_run(const std::filesystem::path& run_dir);
+
+/// A DEM run replayed in terracut: the simulation's parameters (the bed's
+/// grid, the blade, soil that flows with the material given, the
+/// relaxation uncapped), the bed, and the blade's pose at every step at
+/// rate_hz: the lowering, the hold, the push (from push_first on).
+struct DemReplay {
+  SimParams params;
+  std::vector<float> heights;
+  std::vector<BladePose> poses;
+  std::size_t push_first = 0;
+};
+DemReplay dem_replay(const DemRun& run, const SoilMaterial& material, double rate_hz = 1000.0);
+
+/// The DEM run as a force record along the replay's poses (calibrate.hpp):
+/// the DEM's force during the push, linear between its 2.5 ms means, in
+/// terracut's frame; zero before the push (fit with from_t_s at the push's
+/// start: push_first / rate).
+ForceRecord dem_force_record(const DemRun& run, const DemReplay& replay);
 
 /// terracut on a DEM run: the same bed surface (the DEM's initial upper
 /// envelope as the heights, its 5 mm cells), the blade (width, rake, a thin
@@ -86,6 +116,7 @@ struct TerracutRun {
   std::vector<double> push_m, fx_n, fy_n, fz_n;  ///< per step of the push, DEM frame
   std::map<int, std::vector<float>> surface_at_push_mm;  ///< heights as the DEM's grids
   double wall_s = 0.0;       ///< the whole run (lowering, hold, push), wall clock
+  double cpu_s = 0.0;        ///< the same in the process's CPU time
   double push_wall_s = 0.0;  ///< the push alone
   std::int64_t steps = 0;
 };
@@ -96,9 +127,17 @@ struct WindowComparison {
   double start_m = 0.0, end_m = 0.0;
   double dem_fx_n = 0.0, terracut_fx_n = 0.0;  ///< mean horizontal force resisting the push (> 0)
   double dem_fz_n = 0.0, terracut_fz_n = 0.0;  ///< mean vertical force on the blade (+ up)
-  double dem_pile_m3 = 0.0, terracut_pile_m3 = 0.0;  ///< net rise ahead of the tip at the window's end
-  double dem_peak_m = 0.0, terracut_peak_m = 0.0;    ///< the highest point ahead above the mean initial surface
-  double profile_rms_m = 0.0;  ///< the centre line's RMS difference at the window's end
+  /// The surfaces at the window's end, on both sides; false: the three
+  /// below are not measured and the window's surface targets are not judged.
+  bool has_surface = false;
+  /// Net rise over the initial surface ahead of the tip line at the window's
+  /// end (and, for a raked blade, over the plate: the DEM's own region).
+  double dem_pile_m3 = 0.0, terracut_pile_m3 = 0.0;
+  double dem_peak_m = 0.0, terracut_peak_m = 0.0;    ///< the highest point there above the mean initial surface
+  /// The centre line's RMS difference at the window's end, over the span
+  /// either surface disturbed (departing from the initial by more than a
+  /// quarter of the cut depth, and every column between).
+  double profile_rms_m = 0.0;
 };
 
 /// A run's comparison: per 0.1 m window, and the force's growth with the
@@ -110,8 +149,9 @@ struct RunComparison {
   std::vector<WindowComparison> windows;
   double dem_slope_n_per_m = 0.0, terracut_slope_n_per_m = 0.0;
   double dem_wall_s = 0.0, terracut_wall_s = 0.0;
+  double dem_cpu_s = 0.0, terracut_cpu_s = 0.0;  ///< 0 for the DEM when its run did not record it
 };
-RunComparison compare(const DemRun& dem, const TerracutRun& terracut, double window_m = 0.1);
+RunComparison compare(const DemRun& dem, const TerracutRun& terracut, double window_m = kDemWindow_m);
 
 /// The targets terracut is held to against the DEM (docs/validation.md):
 /// each 0.1 m window's mean horizontal force and the soil ahead of the blade
@@ -136,6 +176,7 @@ struct CaseSummary {
     double dem_pile_m3 = 0.0, dem_pile_std_m3 = 0.0, terracut_pile_m3 = 0.0, pile_error = 0.0;
     bool pile_met = false;
     double dem_fz_n = 0.0, terracut_fz_n = 0.0;  ///< mean vertical force (+ up), informative
+    bool has_surface = false;  ///< false: pile, peak and profile not measured, not judged
     double dem_peak_m = 0.0, terracut_peak_m = 0.0;
     double profile_rms_m = 0.0;
     bool profile_met = false;
@@ -144,7 +185,10 @@ struct CaseSummary {
   double dem_slope_n_per_m = 0.0, dem_slope_std_n_per_m = 0.0, terracut_slope_n_per_m = 0.0;
   double slope_error = 0.0;
   bool slope_met = false;
-  double dem_wall_s = 0.0, terracut_wall_s = 0.0, speedup = 0.0;
+  /// The speed-up in CPU time when every DEM run recorded it (a shared
+  /// machine's wall clock counts the time a process waits), else in wall time.
+  double dem_wall_s = 0.0, terracut_wall_s = 0.0, dem_cpu_s = 0.0, terracut_cpu_s = 0.0, speedup = 0.0;
+  bool speedup_in_cpu_time = false;
   bool speed_met = false;
 };
 

@@ -326,11 +326,13 @@ def window_metrics(info, outdir, grains):
     """Per 0.1 m push window: mean force, and at the window's end the pile
     ahead of the blade.  Pile region = cells with x >= tip line, plus, for a
     raked blade, the cells over the plate (between its rear top edge and the
-    tip, within the blade width).  pile_volume = sum over the region of
+    tip, within the blade width) whose surface lies above the plate, i.e.
+    the grains carried on the face (not the cut floor seen under the plate).  pile_volume = sum over the region of
     (h - h_initial) * cell^2 (net rise of the surface, bulk volume incl. pores);
     peak height = max over the region of h - H0 (H0 mean initial surface);
     pile_grain_volume = solid volume of grains in the region whose centre is
-    above H0."""
+    above H0, minus the same in the initial bed ahead of the tip line (the
+    undisturbed surface grains that already stick out above H0)."""
     cell = info["surfaces"]["cell_m"]
     ny, nx = info["surfaces"]["shape_rows_cols"]
     H0 = info["bed"]["initial_surface_mean_m"]
@@ -351,14 +353,21 @@ def window_metrics(info, outdir, grains):
         snap = info["surfaces"]["snapshots"]["p%d" % (k + 1)]
         h = np.load(os.path.join(outdir, snap["file"])).astype(float)
         xt = b["tip_line_at_push_start"]["x_m"] + hi
-        region = (X >= xt) | ((X >= xt + back) & (X < xt) & (np.abs(Y - yc) <= w / 2))
+        zt = b["tip_line_at_push_start"]["z_m"]
+        tana = math.tan(math.radians(b["rake_deg"])) if b["rake_deg"] < 89.999 else 0.0
+        over = (X >= xt + back) & (X < xt) & (np.abs(Y - yc) <= w / 2)
+        region = (X >= xt) | (over & (h > zt + (xt - X) * tana))
         vol = float(((h - h_init) * region).sum() * cell * cell)
         peak = float((h[region] - H0).max())
         g = grains["p%d" % (k + 1)]
         gx, gy, gz, gr = g["x"], g["y"], g["z"], g["radius"]
-        greg = (gx >= xt) | ((gx >= xt + back) & (gx < xt) & (np.abs(gy - yc) <= w / 2))
+        greg = (gx >= xt) | ((gx >= xt + back) & (gx < xt) & (np.abs(gy - yc) <= w / 2)
+                             & (gz > zt + (xt - gx) * tana))
         gsel = greg & (gz > H0)
-        gvol = float((4.0 / 3.0 * math.pi * gr[gsel] ** 3).sum())
+        gi = grains["init"]
+        gsel0 = (gi["x"] >= xt) & (gi["z"] > H0)   # the same count in the initial bed ahead of the tip
+        gvol = float((4.0 / 3.0 * math.pi * gr[gsel] ** 3).sum()
+                     - (4.0 / 3.0 * math.pi * gi["radius"][gsel0] ** 3).sum())
         out.append({"window_start_m": lo, "window_end_m": hi,
                     "fx_mean_n": float(force["fx_n"][sel].mean()),
                     "fy_mean_n": float(force["fy_n"][sel].mean()),
@@ -370,6 +379,18 @@ def window_metrics(info, outdir, grains):
                     "pile_peak_height_m": peak,
                     "swept_volume_m3": w * b["depth_m"] * hi})
     return out
+
+
+def recompute_metrics(case, seed):
+    """Recompute the window metrics of a finished run from its committed
+    files and the dumps still in work/ (after a change of definition)."""
+    outdir = os.path.join(RES, case, "seed%d" % seed)
+    info = json.load(open(os.path.join(outdir, "run.json")))
+    wd = _workdir("runs", case, "seed%d" % seed)
+    grains = {k: dem.read_dump(os.path.join(wd, k + ".dump")) for k in ("init", "p1", "p2", "p3")}
+    info["metrics"] = window_metrics(info, outdir, grains)
+    dem.write_json(os.path.join(outdir, "run.json"), info)
+    return info
 
 
 # ------------------------------------------------------------------- summary
