@@ -31,34 +31,8 @@ def import_plotting(fail):
     return numpy, matplotlib.pyplot
 
 
-def parse_dir_args(argv, doc, default_png, fail, script):
-    """(folder, output png, quiet) from `SCRIPT DIR [--out FILE.png] [--quiet]`."""
-    folder, out, quiet = None, None, False
-    i = 1
-    while i < len(argv):
-        a = argv[i]
-        if a in ("-h", "--help"):
-            print(doc)
-            sys.exit(0)
-        elif a == "--quiet":
-            quiet = True
-        elif a == "--out":
-            if i + 1 >= len(argv):
-                fail("--out needs a file name")
-            out = argv[i + 1]
-            i += 1
-        elif folder is None:
-            folder = a
-        else:
-            fail(f"unexpected argument '{a}' (see --help)")
-        i += 1
-    if folder is None:
-        fail(f"no output folder given (usage: {script} DIR [--out FILE.png])")
-    return folder, out or os.path.join(folder, default_png), quiet
-
-
-def parse_dirs_args(argv, doc, fail, script):
-    """(folders, output png, quiet) from `SCRIPT --out FILE.png DIR [DIR ...] [--quiet]`."""
+def _parse_args(argv, doc, fail):
+    """(folders, --out value or None, quiet) from argv; --help prints doc and exits 0."""
     folders, out, quiet = [], None, False
     i = 1
     while i < len(argv):
@@ -76,6 +50,22 @@ def parse_dirs_args(argv, doc, fail, script):
         else:
             folders.append(a)
         i += 1
+    return folders, out, quiet
+
+
+def parse_dir_args(argv, doc, default_png, fail, script):
+    """(folder, output png, quiet) from `SCRIPT DIR [--out FILE.png] [--quiet]`."""
+    folders, out, quiet = _parse_args(argv, doc, fail)
+    if not folders:
+        fail(f"no output folder given (usage: {script} DIR [--out FILE.png])")
+    if len(folders) > 1:
+        fail(f"unexpected argument '{folders[1]}' (see --help)")
+    return folders[0], out or os.path.join(folders[0], default_png), quiet
+
+
+def parse_dirs_args(argv, doc, fail, script):
+    """(folders, output png, quiet) from `SCRIPT --out FILE.png DIR [DIR ...] [--quiet]`."""
+    folders, out, quiet = _parse_args(argv, doc, fail)
     if out is None or not folders:
         fail(f"usage: {script} --out FILE.png DIR [DIR ...]")
     return folders, out, quiet
