@@ -34,11 +34,11 @@ refuse "--rtts: 'abc'" "$scenario" --out "$work/x" --sweep --rtts 0,abc --no-plo
 for f in operator.csv remote.csv terrain_error.csv summary.json mmt.png; do
   [ -s "$work/single/$f" ] || { echo "single-process run: no $f"; exit 1; }
 done
-"$terracut" mmt "$scenario" --sweep --rtts 0,200 --losses 0,0.1 --out "$work/study" -q
+"$terracut" mmt "$scenario" --sweep --rtts 0,200 --losses 0,0.1 --seeds 1 --out "$work/study" -q
 for f in study.csv study.md study.png; do
   [ -s "$work/study/$f" ] || { echo "study: no $f"; exit 1; }
 done
-# 2 RTTs x 2 losses, plus the deadband variant per RTT, and the header.
+# 2 RTTs x 2 losses x 1 seed, plus the deadband variant per RTT, and the header.
 [ "$(wc -l < "$work/study/study.csv")" -eq 7 ] || { echo "study.csv:"; cat "$work/study/study.csv"; exit 1; }
 
 # The remote binds any free port and says which.
