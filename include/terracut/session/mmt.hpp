@@ -121,7 +121,7 @@ struct RemoteOptions {
 class RemoteStation {
  public:
   /// remote: the remote world (load_remote_scenario); nominal: the
-  /// operator's soil material (the soil estimate is against it); mirror: the
+  /// operator's soil material (where the soil estimate starts); mirror: the
   /// operator's initial heights (what the deadband compares against).
   /// Throws InputError naming the field.
   RemoteStation(const Scenario& remote, const MmtSettings& settings,
