@@ -194,7 +194,7 @@ void SoilEstimator::reset() {
     c.beta_rad = 0.0;
   }
   restart_memory();
-  best_ = -1;
+  calm_rms_n_ = 0.0;
   pending_ = false;
   next_ = 0;
   estimate_ = {};
@@ -417,7 +417,6 @@ void SoilEstimator::finish_sample() {
         (chosen < 0 || candidates_[k].cost < candidates_[std::size_t(chosen)].cost))
       chosen = int(k);
   if (chosen < 0) chosen = int(best);
-  best_ = chosen;
   const Candidate& b = candidates_[std::size_t(chosen)];
   // The sample into the memory of cuts, with the failure angle the chosen
   // pair found for it.

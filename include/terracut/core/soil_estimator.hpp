@@ -9,26 +9,31 @@
 //   H = P sin(alpha + delta) + c_a d w cot(alpha)
 //   V = P cos(alpha + delta) - c_a d w,
 // whose factors N depend on the friction angles phi, delta, the rake alpha,
-// d / w and the failure-plane angle beta (the one that minimises P). At
-// fixed angles (phi, delta, beta) both H and V are linear in the unit
-// weight gamma, the cohesion c and the adhesion c_a (Luengo, Singh & Cannon
-// 1998, "Modeling and identification of soil-tool interaction in automated
-// excavation", IROS; Tan, Zweiri, Althoefer & Seneviratne 2005, "Online
-// soil parameter estimation scheme based on Newton-Raphson method for
-// autonomous excavation", IEEE/ASME Trans. Mechatronics 10). So:
+// d / w and the failure-plane angle beta (the one that minimises P), and,
+// while the edge moves down or up in the soil, the penetration force
+// (penetration.hpp: Terzaghi's bearing under the tip, the faces' friction),
+// whose factors depend on phi and delta. At fixed angles (phi, delta, beta)
+// all of them are linear in the unit weight gamma, the cohesion c and the
+// adhesion c_a (Luengo, Singh & Cannon 1998, "Modeling and identification
+// of soil-tool interaction in automated excavation", IROS; Tan, Zweiri,
+// Althoefer & Seneviratne 2005, "Online soil parameter estimation scheme
+// based on Newton-Raphson method for autonomous excavation", IEEE/ASME
+// Trans. Mechatronics 10). So:
 //   - a grid of candidate friction-angle pairs (phi, delta), delta <= phi;
 //   - for each, recursive least squares with exponential forgetting of
-//     (gamma, c, c_a) over the samples' two equations (H and V), the factors
-//     taken at the beta* that the candidate's current estimate gives (as the
-//     force model does), and the forgetting-weighted sum of squared
-//     residuals J(phi, delta);
-//   - the estimate: the friction angles at the minimum of J (a quadratic
-//     through the best grid point and its neighbours), the linear
-//     parameters of the nearest candidate, their standard uncertainties
-//     from the information matrix (the RLS covariance times the residual
-//     variance; for the angles, 2 sigma^2 / the curvature of J, which is the
-//     profile likelihood's), and a parameter identifiable when its
-//     uncertainty is below its resolution (SoilEstimatorSettings).
+//     (gamma, c, c_a) over the samples' equations (H, V and the penetration
+//     force when there is one), the factors taken at the beta* that the
+//     candidate's current fit gives (as the force model finds it), and the
+//     forgetting-weighted sum of its squared residuals;
+//   - the estimate: the admissible pair of least cost refined by
+//     Levenberg-Marquardt on all five parameters over the cuts remembered
+//     (a ring of the newest samples), its standard uncertainties from the
+//     information matrix there (the residual variance times F^-1, F the
+//     forgetting-weighted J^T J), and a parameter identifiable when its
+//     uncertainty is at most its resolution (SoilEstimatorSettings);
+//   - a change of soil: a run of samples the estimate mispredicts that no
+//     one material fits with the remembered ones restarts the memory
+//     (covariance resetting).
 // The residual variance has a floor: a force sensor's noise, so that a
 // simulated remote whose force is the model itself does not report zero
 // uncertainty.
@@ -38,9 +43,11 @@
 // read it): never a rendered force, nor one under a haptic device's
 // low-speed cap, which holds two different soils at the same force.
 //
-// Cost: one earthmoving solution (earthmoving_force) per candidate and
-// sample. advance() spreads a sample's candidates over ticks so that a 1 kHz
-// loop pays a bounded slice per tick. Allocates only at construction.
+// Cost: one failure-angle search per candidate and sample, which advance()
+// spreads over ticks so that a 1 kHz loop pays a bounded slice per tick;
+// the refinement (about a millisecond over 256 remembered cuts) runs every
+// fifth sample, on the tick that finishes it. Allocates only at
+// construction.
 #pragma once
 
 #include <array>
@@ -219,7 +226,6 @@ class SoilEstimator {
   std::size_t memory_next_ = 0, memory_size_ = 0;
   std::int64_t since_reset_ = 0;  // samples since the memory last restarted
   int surprises_ = 0;             // consecutive samples far off the estimate
-  int best_ = -1;                 // the estimate's candidate
   std::array<double, kSoilFieldCount> previous_x_{};  // the previous refined fit
   bool refined_before_ = false;
   double calm_rms_n_ = 0.0;       // the residuals' RMS before the misses began, N
