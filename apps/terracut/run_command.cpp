@@ -114,7 +114,7 @@ Command add_run_command(CLI::App& app) {
     if (!opt->resolution.empty()) resolution = io::parse_resolution(opt->resolution);
     std::optional<Representation> representation;
     if (!opt->representation.empty())
-      representation = parse_representation(opt->representation);
+      representation = parse_enum<Representation>(opt->representation);
     std::optional<std::vector<std::string>> sequence;
     if (!opt->sequence.empty()) sequence = io::parse_name_list(opt->sequence);
     io::apply_overrides(scenario.base, resolution, representation, sequence);

@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
       opt.look_at = terracut::Vec3{x, y, z};
     }
     if (!representation.empty())
-      opt.representation = terracut::parse_representation(representation);
+      opt.representation = terracut::parse_enum<terracut::Representation>(representation);
     if (!resolution.empty()) opt.resolution = terracut::io::parse_resolution(resolution);
     if (!opt.screenshot.empty() || opt.benchmark_frames > 0) opt.headless = true;
     // A screenshot that cannot be written is said before the whole sequence is drawn.

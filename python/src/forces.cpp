@@ -17,7 +17,7 @@ namespace terracut::python {
 // by the fields given); unknown keys are refused by name.
 SoilMaterial material_arg(py::handle obj) {
   const auto preset_of = [](const std::string& name) {
-    auto preset = parse_soil_preset(name);
+    auto preset = parse_enum<SoilPreset>(name);
     if (!preset)
       throw InputError("soil: unknown preset '" + name + "' (dry_sand, loose_sand, clay or gravel)");
     return soil_preset(*preset);

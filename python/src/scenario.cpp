@@ -117,7 +117,7 @@ std::optional<Representation> representation_arg(py::handle obj) {
   if (obj.is_none()) return std::nullopt;
   if (!py::isinstance<py::str>(obj)) throw InputError("representation: expected 'surface' or 'columns'");
   const std::string name = obj.cast<std::string>();
-  auto r = parse_representation(name);
+  auto r = parse_enum<Representation>(name);
   if (!r) throw InputError("representation: must be 'surface' or 'columns', got '" + name + "'");
   return r;
 }

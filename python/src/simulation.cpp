@@ -310,7 +310,7 @@ one thread at a time.)doc")
             p.representation = *representation_arg(py::str(representation));
             p.rate_hz = rate_hz;
             p.blade.length_m = blade_length_m;
-            auto model = parse_soil_model(soil_model);
+            auto model = parse_enum<SoilModel>(soil_model);
             if (!model) throw InputError("soil_model: must be 'vanish' or 'flow', got '" + soil_model + "'");
             p.soil.model = *model;
             p.soil.material = material_arg(soil);

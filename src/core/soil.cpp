@@ -76,18 +76,6 @@ inline unsigned above_mask(__m128 e0, __m128 e1, float tol) {
 
 }  // namespace
 
-std::string_view to_string(SoilModel model) {
-  return model == SoilModel::kFlow ? "flow" : "vanish";
-}
-
-std::string_view to_string(SoilEdge edge) { return edge == SoilEdge::kOpen ? "open" : "wall"; }
-
-std::optional<SoilModel> parse_soil_model(std::string_view name) {
-  if (name == "vanish") return SoilModel::kVanish;
-  if (name == "flow") return SoilModel::kFlow;
-  return std::nullopt;
-}
-
 std::string validate(const SoilFlowParams& p) {
   if (p.model != SoilModel::kVanish && p.model != SoilModel::kFlow)
     return "soil.model must be vanish or flow";

@@ -7,35 +7,6 @@
 
 namespace terracut::haptics {
 
-std::string_view to_string(DeviceKind kind) {
-  switch (kind) {
-    case DeviceKind::kScript:
-      return "script";
-    case DeviceKind::kSim:
-      return "sim";
-    case DeviceKind::kUdp:
-      return "udp";
-  }
-  return "unknown";
-}
-
-std::optional<DeviceKind> parse_device_kind(std::string_view name) {
-  if (name == "script") return DeviceKind::kScript;
-  if (name == "sim") return DeviceKind::kSim;
-  if (name == "udp") return DeviceKind::kUdp;
-  return std::nullopt;
-}
-
-std::string_view to_string(SurfaceReference reference) {
-  return reference == SurfaceReference::kGround ? "ground" : "terrain";
-}
-
-std::optional<SurfaceReference> parse_surface_reference(std::string_view name) {
-  if (name == "ground") return SurfaceReference::kGround;
-  if (name == "terrain") return SurfaceReference::kTerrain;
-  return std::nullopt;
-}
-
 namespace {
 
 // The ranges of HapticSettings' own numbers (forces and safety have theirs,

@@ -98,6 +98,7 @@
 #include <utility>
 #include <vector>
 
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/blade.hpp"
 #include "terracut/core/grid.hpp"
 #include "terracut/core/material.hpp"
@@ -177,18 +178,24 @@ enum class SoilModel {
   kVanish,  ///< it is gone (the paper's model; the default)
   kFlow,    ///< it is pushed ahead of the blade and slides to its angle of repose
 };
-/// "vanish" or "flow".
-std::string_view to_string(SoilModel model);
-/// Inverse of to_string; nullopt for anything else.
-std::optional<SoilModel> parse_soil_model(std::string_view name);
+/// Its names (enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<SoilModel> kSoilModelNames[] = {
+    {SoilModel::kVanish, "vanish"},
+    {SoilModel::kFlow, "flow"},
+};
+constexpr std::span<const EnumName<SoilModel>> enum_names(SoilModel) { return kSoilModelNames; }
 
 /// What the grid's edge does to soil that reaches it.
 enum class SoilEdge {
   kWall,  ///< no soil leaves the terrain (the default)
   kOpen,  ///< soil sliding or pushed past the edge leaves it, and is counted
 };
-/// "wall" or "open".
-std::string_view to_string(SoilEdge edge);
+/// Its names (enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<SoilEdge> kSoilEdgeNames[] = {
+    {SoilEdge::kWall, "wall"},
+    {SoilEdge::kOpen, "open"},
+};
+constexpr std::span<const EnumName<SoilEdge>> enum_names(SoilEdge) { return kSoilEdgeNames; }
 
 /// The soil: its material and what happens to what the blade cuts (the
 /// scenario's `soil:` section); read-only during a run.

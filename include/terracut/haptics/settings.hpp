@@ -29,6 +29,7 @@
 #include <string>
 #include <string_view>
 
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/forces.hpp"
 #include "terracut/core/math.hpp"
 #include "terracut/core/ranges.hpp"
@@ -36,16 +37,21 @@
 
 namespace terracut::haptics {
 
+using terracut::to_string;  // the enumerations' names (core/enum_names.hpp)
+
 /// Which device drives the tool.
 enum class DeviceKind {
   kScript,  ///< the tool follows the scenario's cut keyframes exactly
   kSim,     ///< a simulated operator hand pulled along the cut's path; feels the force
   kUdp,     ///< an external device process over the UDP bridge protocol
 };
-/// "script", "sim" or "udp".
-std::string_view to_string(DeviceKind kind);
-/// Inverse of to_string; nullopt for anything else.
-std::optional<DeviceKind> parse_device_kind(std::string_view name);
+/// Its names (core/enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<DeviceKind> kDeviceKindNames[] = {
+    {DeviceKind::kScript, "script"},
+    {DeviceKind::kSim, "sim"},
+    {DeviceKind::kUdp, "udp"},
+};
+constexpr std::span<const EnumName<DeviceKind>> enum_names(DeviceKind) { return kDeviceKindNames; }
 
 /// Mapping between the device's workspace and the world (see the file comment).
 struct WorkspaceMapping {
@@ -71,9 +77,12 @@ enum class SurfaceReference {
   /// cell), so use it to feel shapes, not while cutting deep.
   kTerrain,
 };
-/// "ground" or "terrain".
-std::string_view to_string(SurfaceReference reference);
-std::optional<SurfaceReference> parse_surface_reference(std::string_view name);
+/// Its names (core/enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<SurfaceReference> kSurfaceReferenceNames[] = {
+    {SurfaceReference::kGround, "ground"},
+    {SurfaceReference::kTerrain, "terrain"},
+};
+constexpr std::span<const EnumName<SurfaceReference>> enum_names(SurfaceReference) { return kSurfaceReferenceNames; }
 
 /// The simulated operator hand of the `sim` device: a point mass held by the
 /// device, pulled by a spring-damper toward a target that moves along the
