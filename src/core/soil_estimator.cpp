@@ -69,17 +69,6 @@ double rls_update(std::array<double, 3>& theta, std::array<double, 9>& p,
 
 }  // namespace
 
-std::string_view to_string(SoilField field) {
-  switch (field) {
-    case SoilField::kUnitWeight: return "unit_weight_n_per_m3";
-    case SoilField::kCohesion: return "cohesion_pa";
-    case SoilField::kAdhesion: return "adhesion_pa";
-    case SoilField::kInternalFriction: return "internal_friction_deg";
-    case SoilField::kSoilToolFriction: return "soil_tool_friction_deg";
-  }
-  return "?";
-}
-
 double field_value(const SoilMaterial& m, SoilField field) {
   switch (field) {
     case SoilField::kUnitWeight: return m.unit_weight_n_per_m3;

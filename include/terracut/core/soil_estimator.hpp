@@ -52,11 +52,13 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "terracut/core/earthmoving.hpp"
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/material.hpp"
 #include "terracut/core/tool_force.hpp"
 
@@ -71,8 +73,15 @@ enum class SoilField : int {
   kSoilToolFriction = 4,  ///< soil_tool_friction_deg
 };
 inline constexpr int kSoilFieldCount = 5;
-/// The field's name in SoilMaterial (and a scenario's soil: section).
-std::string_view to_string(SoilField field);
+/// The fields' names in SoilMaterial (and a scenario's soil: section):
+/// to_string(SoilField) (core/enum_names.hpp).
+inline constexpr EnumName<SoilField> kSoilFieldNames[] = {
+    {SoilField::kUnitWeight, "unit_weight_n_per_m3"},
+    {SoilField::kCohesion, "cohesion_pa"},
+    {SoilField::kAdhesion, "adhesion_pa"},
+    {SoilField::kInternalFriction, "internal_friction_deg"},
+    {SoilField::kSoilToolFriction, "soil_tool_friction_deg"}};
+constexpr std::span<const EnumName<SoilField>> enum_names(SoilField) { return kSoilFieldNames; }
 /// The field's value in a material.
 double field_value(const SoilMaterial& m, SoilField field);
 
