@@ -18,6 +18,9 @@ inline constexpr int kExitUsage = 2;
 /// wrote their results but could not make the figures; `terracut-device`
 /// played, but no force came back.
 inline constexpr int kExitPartial = 3;
+/// `terracut mmt --role`: the link to the other station died (its outputs
+/// are written, and the summary says how the session ended).
+inline constexpr int kExitLinkLost = 4;
 /// `terracut-viewer`: no OpenGL 3.3 context could be made (no EGL/Mesa for
 /// headless rendering, no display for a window); the tests skip on it.
 inline constexpr int kExitNoContext = 77;
@@ -27,7 +30,8 @@ inline constexpr const char* kExitCodesHelp =
     "Exit codes (every terracut program): 0 success; 1 bad input (the message names the\n"
     "file, field or option), a failed run or an unwritable output (validate: a check\n"
     "failed); 2 a command line that cannot be parsed; 3 done but not all (reproduce,\n"
-    "validate, haptics: no figures; terracut-device: no force came back); 77\n"
-    "terracut-viewer: no OpenGL context.";
+    "validate, haptics: no figures; terracut-device: no force came back); 4 mmt --role:\n"
+    "the link to the other station died (outputs written); 77 terracut-viewer: no OpenGL\n"
+    "context.";
 
 }  // namespace terracut::apps

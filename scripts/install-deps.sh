@@ -7,7 +7,7 @@ packages=(
   build-essential cmake pkg-config
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   libpng-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
-  libeigen3-dev libbullet-dev libasio-dev libenet-dev libzstd-dev
+  libeigen3-dev libbullet-dev libasio-dev libenet-dev libzstd-dev libsodium-dev
   libglfw3-dev libepoxy-dev libimgui-dev
   libgl1-mesa-dri libegl-mesa0 libegl-dev xvfb xauth
   python3 python3-numpy python3-matplotlib gnuplot-nox

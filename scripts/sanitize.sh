@@ -72,9 +72,9 @@ fi
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ctest --test-dir "$build" --output-on-failure -j"$jobs" --timeout 600
-# Every fuzz target for a bounded time (30 s of wall time, all six at once;
+# Every fuzz target for a bounded time (30 s of wall time, all seven at once;
 # docs/reliability.md).
 if [[ $fuzz == ON && $seconds != 0 ]]; then
   echo "== $(date -u +%H:%M:%S) sanitize.sh: the fuzz runs"
-  TERRACUT_FUZZ_JOBS=${TERRACUT_FUZZ_JOBS:-6} "$root/scripts/fuzz.sh" "$seconds"
+  TERRACUT_FUZZ_JOBS=${TERRACUT_FUZZ_JOBS:-7} "$root/scripts/fuzz.sh" "$seconds"
 fi

@@ -30,7 +30,7 @@ release_tests() {
 # soil estimate drifts back toward 1 when the machine is loaded (a known
 # limit, docs/teleoperation.md, "Not done yet"): beside the sanitizer
 # builds it runs after them, on an otherwise idle machine.
-wall_clock_test='^session_mmt_two_process$'
+wall_clock_test='^session_mmt_(two_process|lifetime|flood)$'
 
 if [[ ${TERRACUT_SANITIZE:-1} == 0 ]]; then
   "$root/scripts/build.sh" -DTERRACUT_TEST_SUITES="$suites"

@@ -4,15 +4,17 @@
 Usage: /usr/bin/python3 tools/plot_mmt.py DIR [--out FILE.png] [--quiet]
 
 A single run (DIR/operator.csv, DIR/remote.csv, DIR/terrain_error.csv,
-DIR/summary.json) gives DIR/mmt.png, against time:
+DIR/summary.json), or the report of a two-process session (`terracut mmt
+--report`), gives DIR/mmt.png, against the operator's time:
   - the horizontal physical force of the operator's local model (MMT), the
-    remote's measured force shifted back by the one-way delay and its arm's
-    lag (what the operator should feel for the same motion), and the
-    remote's force as it arrives (direct force reflection); the window of
-    the "after 1 s of cutting" figures shaded;
+    remote's measured force for the same command (its first tick following
+    it, and its arm's lag later: what the operator should feel for the same
+    motion), and the remote's force as it arrives (direct force
+    reflection); the window of the "after 1 s of cutting" figures shaded;
   - the remote's estimate of its soil's cohesion and adhesion (kPa) with
     their standard uncertainties, what the operator's model uses, and the
-    remote's true values (dashed);
+    remote's true values (dashed); the remote's ticks drawn at the
+    operator's time of the command they followed plus half the round trip;
   - the same for the friction angles (degrees) and the unit weight;
   - the RMS of local minus remote heights over the worked region.
 A study (DIR/study.csv, from `terracut mmt --sweep`) gives DIR/study.png:
@@ -51,7 +53,8 @@ def band(ax, t, value, sd, color, label):
 
 def truth_line(ax, summary, key, scale, color):
     """The remote's true value of a field (dashed), and after a change of soil the new one."""
-    soil = summary["remote_soil"]
+    # A two-process report has the remote's truth at its end only.
+    soil = summary.get("remote_soil") or {"material": summary["estimate"]["truth"]}
     t_change = soil.get("changed_at_s")
     ax.axhline(soil["material"][key] * scale, color=color, ls="--", lw=1.0)
     if soil.get("changed_to") and t_change is not None:
@@ -64,41 +67,60 @@ def plot_run(folder, out):
     te = read_csv(os.path.join(folder, "terrain_error.csv"))
     with open(os.path.join(folder, "summary.json")) as f:
         summary = json.load(f)
-    aligned = summary["force_error"]["aligned_by_s"]
-    dt = op["t"][1] - op["t"][0] if len(op) > 1 else 1e-3
-    lag = int(round(aligned / dt))
     hz = lambda x, z: np.hypot(x, z)
     t = op["t"]
     f_op = hz(op["fx"], op["fz"])
     f_dfr = hz(op["remote_fx"], op["remote_fz"])
+    # The remote's force for the same commanded motion: its first tick that
+    # followed the operator's command (or a newer one), by command sequence,
+    # as summary.json's force error. The remote's own ticks are drawn at the
+    # operator's time of the command they followed and half the measured
+    # round trip (its clock, in a two-process session, is its own).
     f_rm = np.full_like(t, np.nan)
-    n = min(len(t), len(rm) - lag)
-    f_rm[:n] = hz(rm["fx"][lag:lag + n], rm["fz"][lag:lag + n])
+    # The remote's force for the same commanded motion: its first tick that
+    # followed the operator's command (or a newer one), by command sequence,
+    # and the arm's lag later, as summary.json's force error. The remote's
+    # own ticks are drawn at the operator's time of the command they
+    # followed and half the measured round trip (its clock, in a
+    # two-process session, is its own).
+    f_rm = np.full_like(t, np.nan)
+    dt = t[1] - t[0] if len(t) > 1 else 1e-3
+    aligned = summary["force_error"].get("aligned_after_s", 0.0)
+    lag = int(round(aligned / dt))
+    seq_rm = np.where(rm["active"] > 0, rm["command_sequence"], -1.0)
+    first = np.searchsorted(np.maximum.accumulate(seq_rm), op["command_sequence"], side="left") + lag
+    ok = first < len(rm)
+    f_rm[ok] = hz(rm["fx"][first[ok]], rm["fz"][first[ok]])
+    rtt = summary["link"].get("rtt_measured_s") or summary["link"]["rtt_s"]
+    t_rm = np.interp(rm["command_sequence"], op["command_sequence"], t) + 0.5 * rtt
+    # A remote time in the operator's: its command's time and the arm's lag before.
+    shift = 0.5 * rtt + aligned
 
     fig, ax = plt.subplots(4, 1, figsize=(9, 11.5), sharex=True,
                            gridspec_kw={"height_ratios": [3, 2, 2, 1.2]})
     after = summary["force_error_after_1s"]
-    # The window of the study's figures, in the operator's time (the remote's minus the lag).
     if after["from_s"] >= 0:
-        ax[0].axvspan(after["from_s"] - aligned, t[-1], color="tab:green", alpha=0.07,
+        ax[0].axvspan(after["from_s"] - shift, t[-1], color="tab:green", alpha=0.07,
                       label="after 1 s of cutting (the study's window)")
     if after["left_out_to_s"] > after["left_out_from_s"]:
-        ax[0].axvspan(after["left_out_from_s"] - aligned, after["left_out_to_s"] - aligned,
+        ax[0].axvspan(after["left_out_from_s"] - shift, after["left_out_to_s"] - shift,
                       color="gray", alpha=0.25, label="left out: a round trip + 0.5 s after the change")
-    ax[0].plot(t, f_rm, color="black", lw=2.0, label="remote, measured (aligned)")
+    ax[0].plot(t, f_rm, color="black", lw=2.0, label="remote, measured (for the same command)")
     ax[0].plot(t, f_op, color="tab:blue", label="operator, local model (MMT)")
     ax[0].plot(t, f_dfr, color="tab:red", lw=0.8, label="direct force reflection (as received)")
     ax[0].set_ylabel("horizontal force (N)")
-    ax[0].set_title(f"RTT {summary['link']['rtt_s'] * 1e3:.0f} ms, loss "
+    ax[0].set_title(f"RTT {rtt * 1e3:.0f} ms (measured), loss "
                     f"{summary['link']['loss'] * 100:.0f} %: after 1 s of cutting MMT "
                     f"{after['mmt_relative'] * 100:.1f} %, direct {after['direct_relative'] * 100:.1f} % "
                     f"of the remote's {after['remote_force_rms_n']:.0f} N RMS", fontsize=10)
     ax[0].legend(loc="upper right", fontsize=7)
 
-    rt = rm["t"]
-    band(ax[1], rt, rm["est_cohesion"] * 1e-3, rm["sd_cohesion"] * 1e-3, "tab:purple",
+    act = rm["active"] > 0
+    rt = t_rm[act]
+    est = {k: rm[k][act] for k in rm.dtype.names}
+    band(ax[1], rt, est["est_cohesion"] * 1e-3, est["sd_cohesion"] * 1e-3, "tab:purple",
          "cohesion, remote's estimate")
-    band(ax[1], rt, rm["est_adhesion"] * 1e-3, rm["sd_adhesion"] * 1e-3, "tab:orange",
+    band(ax[1], rt, est["est_adhesion"] * 1e-3, est["sd_adhesion"] * 1e-3, "tab:orange",
          "adhesion, remote's estimate")
     ax[1].plot(t, op["cohesion"] * 1e-3, color="tab:purple", lw=0.8, alpha=0.6, ls="-.",
                label="cohesion, operator's model")
@@ -108,9 +130,9 @@ def plot_run(folder, out):
     ax[1].set_ylim(-0.5, 1.6 * max(np.nanmax(op["cohesion"]) * 1e-3, 1.0))
     ax[1].legend(loc="upper right", fontsize=7, ncol=2)
 
-    band(ax[2], rt, rm["est_phi"], rm["sd_phi"], "tab:brown", "internal friction, estimate")
-    band(ax[2], rt, rm["est_delta"], rm["sd_delta"], "tab:gray", "soil-tool friction, estimate")
-    band(ax[2], rt, rm["est_unit_weight"] * 1e-3, rm["sd_unit_weight"] * 1e-3, "tab:cyan",
+    band(ax[2], rt, est["est_phi"], est["sd_phi"], "tab:brown", "internal friction, estimate")
+    band(ax[2], rt, est["est_delta"], est["sd_delta"], "tab:gray", "soil-tool friction, estimate")
+    band(ax[2], rt, est["est_unit_weight"] * 1e-3, est["sd_unit_weight"] * 1e-3, "tab:cyan",
          "unit weight (kN/m3), estimate")
     truth_line(ax[2], summary, "internal_friction_deg", 1.0, "tab:brown")
     truth_line(ax[2], summary, "soil_tool_friction_deg", 1.0, "tab:gray")
@@ -119,7 +141,9 @@ def plot_run(folder, out):
     ax[2].set_ylim(0, 50)
     ax[2].legend(loc="upper right", fontsize=7, ncol=2)
 
-    ax[3].plot(te["t"], te["rms_m"] * 1e3, color="tab:green")
+    te_t, te_v = np.atleast_1d(te["t"]), np.atleast_1d(te["rms_m"]) * 1e3
+    ax[3].plot(te_t, te_v, color="tab:green", marker="o" if len(te_t) == 1 else None)
+    ax[3].set_ylim(bottom=0.0)
     ax[3].set_ylabel("terrain RMS error (mm)")
     ax[3].set_xlabel("time (s); dashed: the remote's true values (dotted: beyond the change of soil)")
     for a in ax:

@@ -18,6 +18,8 @@ inline constexpr int kExitError = apps::kExitError;  ///< bad input, a failed ru
 inline constexpr int kExitUsage = apps::kExitUsage;  ///< a command line that cannot be parsed
 /// reproduce, validate: results written, figures could not be made.
 inline constexpr int kExitNoFigures = apps::kExitPartial;
+/// mmt --role: the link to the other station died (outputs written).
+inline constexpr int kExitLinkLost = apps::kExitLinkLost;
 
 using Command = std::function<int()>;
 

@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   const terracut::cli::Command calibrate = terracut::cli::add_calibrate_command(app);
   const terracut::cli::Command haptics = terracut::cli::add_haptics_command(app);
   const terracut::cli::Command mmt = terracut::cli::add_mmt_command(app);
+  const terracut::cli::Command key = terracut::cli::add_key_command(app);
 
   try {
     app.parse(argc, argv);
@@ -81,6 +82,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("calibrate")) return calibrate();
     if (app.got_subcommand("haptics")) return haptics();
     if (app.got_subcommand("mmt")) return mmt();
+    if (app.got_subcommand("key")) return key();
   } catch (const terracut::InputError& e) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
@@ -91,6 +93,6 @@ int main(int argc, char** argv) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
   }
-  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, validate, calibrate, haptics, mmt)\n";
+  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, validate, calibrate, haptics, mmt, key)\n";
   return terracut::cli::kExitUsage;
 }

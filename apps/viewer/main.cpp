@@ -101,6 +101,13 @@ int main(int argc, char** argv) {
   app.add_option("--remote", opt.remote,
                  "with --mmt: the remote station is another process (`terracut mmt --role "
                  "remote`) at ADDR:PORT or PORT (UDP, IPv4), not in-process");
+  std::string key_file;
+  app.add_option("--key", key_file,
+                 "with --remote: the key file the remote was started with (`terracut key`); "
+                 "default: the environment variable TERRACUT_MMT_KEY");
+  bool insecure_loopback = false;
+  app.add_flag("--insecure-loopback", insecure_loopback,
+               "with --remote: no key, no authentication (a demo on 127.0.0.1 only)");
   bool no_realtime = false;
   app.add_flag("--no-realtime", no_realtime,
                "do not ask for SCHED_FIFO for the haptic loop's thread");
@@ -120,6 +127,12 @@ int main(int argc, char** argv) {
       if (!opt.mmt)
         throw terracut::InputError("--remote: needs --mmt (the viewer is then the operator station)");
       terracut::session::parse_endpoint(opt.remote, "--remote", "127.0.0.1");  // refused here if bad
+      opt.key = terracut::session::link_key(key_file, insecure_loopback);
+      if (opt.key.insecure)
+        std::cerr << "terracut-viewer: warning: --insecure-loopback: the link is NOT authenticated\n";
+    } else if (!key_file.empty() || insecure_loopback) {
+      throw terracut::InputError(std::string(key_file.empty() ? "--insecure-loopback" : "--key") +
+                                 ": only with --remote");
     }
     opt.input = input;
     opt.screenshot = screenshot;

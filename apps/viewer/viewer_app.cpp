@@ -70,12 +70,13 @@ ViewerApp::ViewerApp(ViewerOptions options, session::Scenario scenario)
   camera_.mode = options_.camera;
 }
 
-ViewerApp::~ViewerApp() { close_session(); }
+ViewerApp::~ViewerApp() { close_session(true); }
 
 void ViewerApp::open_session(const DriverOptions& driver_options) {
   driver_options_ = driver_options;
   driver_options_.mmt = options_.mmt;
   driver_options_.remote = options_.remote;
+  driver_options_.key = options_.key;
   driver_ = std::make_unique<LoopDriver>(scenario_, haptics_, driver_options_, &timing_);
   const GridSpec& spec = driver_->spec();
   const std::vector<float>& initial = driver_->initial_heights();
@@ -154,8 +155,9 @@ void ViewerApp::print_realtime_line() {
   std::cerr << "terracut-viewer: " << driver_->realtime_line() << "\n";
 }
 
-void ViewerApp::close_session() {
+void ViewerApp::close_session(bool end_remote) {
   if (driver_) driver_->stop();
+  if (driver_ && end_remote) driver_->end_session();
   driver_.reset();
   terrain_.reset();
 }
@@ -401,6 +403,9 @@ int ViewerApp::run_window() {
                "%.1f frames/s while drawing\n",
                static_cast<long long>(drawn), open_s, static_cast<long long>(iterations),
                drawing_s > 0.0 ? double(drawn) / drawing_s : 0.0);
+  // The end of the session, told to a remote in another process; the GL
+  // objects and the window go with gl_scope.
+  close_session(true);
   return apps::kExitOk;
 }
 

@@ -53,6 +53,7 @@ int ViewerApp::run_headless() {
                   static_cast<long long>(driver_->ticks_done()));
     }
   }
+  close_session(true);  // the end of the session, told to a remote; the GL objects go with gl_scope
   return status;
 }
 

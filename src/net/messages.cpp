@@ -97,7 +97,7 @@ std::size_t encode_command(Header header, const Command& c, std::uint8_t* out) n
   put_f64(p + 0, c.t_s);
   put_pose(p + 8, c.pose);
   put_u32(p + 64, c.flags);
-  put_u32(p + 68, 0);
+  put_u32(p + 68, c.round_trip_us);
   return finish(header, MessageType::kCommand, kCommandPayloadSize, out);
 }
 
@@ -110,6 +110,8 @@ std::size_t encode_measurement(Header header, const Measurement& m, std::uint8_t
   wire::put_vec3(p + 72, m.force_world_n);
   put_f64(p + 96, m.contact_length_m);
   put_f64(p + 104, m.cut_depth_m);
+  put_u32(p + 112, m.commands_received);
+  put_u32(p + 116, 0);
   return finish(header, MessageType::kMeasurement, kMeasurementPayloadSize, out);
 }
 
@@ -215,6 +217,7 @@ Reject decode_command(const std::uint8_t* data, std::size_t, Command& out) noexc
   out.t_s = get_f64(p + 0);
   out.pose = get_pose(p + 8);
   out.flags = get_u32(p + 64);
+  out.round_trip_us = get_u32(p + 68);
   if (!std::isfinite(out.t_s) || !finite_pose(out.pose)) return Reject::kBadPayload;
   return Reject::kNone;
 }
@@ -229,6 +232,7 @@ Reject decode_measurement(const std::uint8_t* data, std::size_t, Measurement& ou
   out.force_world_n = wire::get_vec3(p + 72);
   out.contact_length_m = get_f64(p + 96);
   out.cut_depth_m = get_f64(p + 104);
+  out.commands_received = get_u32(p + 112);
   if (!std::isfinite(out.t_s) || !finite_pose(out.pose) || !is_finite(out.force_world_n) ||
       !std::isfinite(out.contact_length_m) || !std::isfinite(out.cut_depth_m))
     return Reject::kBadPayload;

@@ -1,16 +1,45 @@
-// The soil estimate's entries of summary.json (mmt_json.hpp).
+// The soil estimate's entries of summary.json and their reading back
+// (mmt_json.hpp).
 #include "mmt_json.hpp"
 
 #include <cmath>
 #include <string>
 
+#include "terracut/core/error.hpp"
+
 namespace terracut::session::detail {
+namespace {
+
+const nlohmann::ordered_json& entry(const nlohmann::ordered_json& j, const char* key,
+                                    const std::filesystem::path& where) {
+  if (!j.is_object() || !j.contains(key) || j[key].is_null())
+    throw InputError(where.string() + ": no estimate entry '" + key + "'");
+  return j[key];
+}
+
+}  // namespace
 
 nlohmann::ordered_json material_json(const SoilMaterial& m) {
   nlohmann::ordered_json j;
   for (int f = 0; f < kSoilFieldCount; ++f)
     j[std::string(to_string(SoilField(f)))] = field_value(m, SoilField(f));
   return j;
+}
+
+SoilMaterial material_from_json(const nlohmann::ordered_json& j, const std::filesystem::path& where) {
+  SoilMaterial m;
+  for (int f = 0; f < kSoilFieldCount; ++f) {
+    const std::string name(to_string(SoilField(f)));
+    const double v = entry(j, name.c_str(), where).get<double>();
+    switch (SoilField(f)) {
+      case SoilField::kUnitWeight: m.unit_weight_n_per_m3 = v; break;
+      case SoilField::kCohesion: m.cohesion_pa = v; break;
+      case SoilField::kAdhesion: m.adhesion_pa = v; break;
+      case SoilField::kInternalFriction: m.internal_friction_deg = v; break;
+      case SoilField::kSoilToolFriction: m.soil_tool_friction_deg = v; break;
+    }
+  }
+  return m;
 }
 
 nlohmann::ordered_json estimate_json(const SoilEstimate& e, const SoilMaterial* truth) {
@@ -42,6 +71,26 @@ nlohmann::ordered_json estimate_json(const SoilEstimate& e, const SoilMaterial* 
     j["identifiable_within_2sd"] = within;
   }
   return j;
+}
+
+SoilEstimate estimate_from_json(const nlohmann::ordered_json& j, const std::filesystem::path& where,
+                                SoilMaterial* truth) {
+  SoilEstimate e;
+  e.material = material_from_json(entry(j, "material", where), where);
+  const nlohmann::ordered_json& sd = entry(j, "sd", where);
+  for (int f = 0; f < kSoilFieldCount; ++f)
+    e.sd[std::size_t(f)] = entry(sd, std::string(to_string(SoilField(f))).c_str(), where).get<double>();
+  for (const auto& name : entry(j, "identifiable", where)) {
+    const auto field = parse_enum<SoilField>(name.get<std::string>());
+    if (!field) throw InputError(where.string() + ": estimate: '" + name.get<std::string>() + "' is no soil field");
+    e.identifiable |= 1u << int(*field);
+  }
+  e.samples = entry(j, "samples", where).get<std::int64_t>();
+  e.restarts = entry(j, "restarts", where).get<std::int64_t>();
+  e.residual_rms_n = entry(j, "residual_rms_n", where).get<double>();
+  e.known = e.samples > 0;
+  if (truth) *truth = material_from_json(entry(j, "truth", where), where);
+  return e;
 }
 
 }  // namespace terracut::session::detail

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "mmt_json.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
 #include "terracut/haptics/script_device.hpp"
@@ -14,17 +15,8 @@
 #include "terracut/haptics/workspace.hpp"
 #include "terracut/session/mmt.hpp"
 
-#include "mmt_json.hpp"
-
 namespace terracut::session {
 namespace {
-
-double rms(const std::vector<double>& v) {
-  if (v.empty()) return 0.0;
-  double s = 0.0;
-  for (double x : v) s += x * x;
-  return std::sqrt(s / double(v.size()));
-}
 
 std::ofstream open_out(const std::filesystem::path& p) {
   std::ofstream out(p, std::ios::binary);
@@ -41,8 +33,32 @@ double operator_duration_s(const Scenario& op) {
   return followed_path(op, op.haptics, op.base.source_path.string()).duration_s() + op.haptics.settle_s;
 }
 
-std::unique_ptr<haptics::Device> make_operator_device(const Scenario& op) {
-  return make_device(op, op.haptics, op.haptics.udp.port, op.base.source_path.string());
+namespace {
+// The script device at the time modulo its round: the path over and over
+// (the soak's --repeat).
+class RepeatingScript final : public haptics::Device {
+ public:
+  explicit RepeatingScript(haptics::DevicePath path)
+      : round_s_(path.duration_s() + 0.5), script_(std::move(path)) {}
+  std::string_view kind() const override { return "script"; }
+  bool read(double t_s, haptics::DeviceSample& out) noexcept override {
+    return script_.read(std::fmod(std::max(t_s, 0.0), round_s_), out);
+  }
+  void write(const haptics::DeviceCommand& c) noexcept override { script_.write(c); }
+  std::vector<haptics::DeviceStat> stats() const override { return script_.stats(); }
+
+ private:
+  double round_s_;
+  haptics::ScriptDevice script_;
+};
+}  // namespace
+
+std::unique_ptr<haptics::Device> make_operator_device(const Scenario& op, bool repeat) {
+  if (!repeat) return make_device(op, op.haptics, op.haptics.udp.port, op.base.source_path.string());
+  if (op.haptics.device != haptics::DeviceKind::kScript)
+    throw InputError(op.base.source_path.string() +
+                     ": --repeat: only the script device replays its cut (haptics.device: script)");
+  return std::make_unique<RepeatingScript>(followed_path(op, op.haptics, op.base.source_path.string()));
 }
 
 namespace {
@@ -50,7 +66,7 @@ namespace {
 constexpr const char* kOperatorCsvHeader =
     "t,x,y,z,fx,fy,fz,fdx,fdy,fdz,remote_fx,remote_fy,remote_fz,contact_length,"
     "unit_weight,cohesion,adhesion,phi,delta,material_blend,updating,link_silent,passivity_j,"
-    "passivity_dfr_j,compute_us\n";
+    "passivity_dfr_j,compute_us,command_sequence,round_trip_s,command_loss\n";
 constexpr const char* kRemoteCsvHeader =
     "t,command_sequence,cmd_x,cmd_y,cmd_z,x,y,z,fx,fy,fz,contact_length,cut_depth,"
     "est_unit_weight,est_cohesion,est_adhesion,est_phi,est_delta,sd_unit_weight,sd_cohesion,"
@@ -70,7 +86,8 @@ void write_row(std::ostream& out, const OperatorRecord& r) {
       << r.remote_force_world_n.z << ',' << r.contact_length_m << ',';
   write_material(out, r.material);
   out << r.material_blend << ',' << int(r.updating) << ',' << int(r.link_silent) << ','
-      << r.passivity_j << ',' << r.passivity_dfr_j << ',' << r.compute_s * 1e6 << '\n';
+      << r.passivity_j << ',' << r.passivity_dfr_j << ',' << r.compute_s * 1e6 << ','
+      << r.command_sequence << ',' << r.round_trip_s << ',' << r.command_loss << '\n';
 }
 
 void write_row(std::ostream& out, const RemoteRecord& r) {
@@ -139,9 +156,7 @@ void StationCsv::finish() {
 }
 
 MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
-  if (!op.mmt)
-    throw InputError(op.base.source_path.string() +
-                     ": mmt: the scenario has no mmt: section (the remote world and the link)");
+  if (!op.mmt) throw InputError(no_mmt_section(op));
   settings_ = apply_overrides(*op.mmt, overrides);
   op_ = std::make_unique<Scenario>(op);
   remote_scn_ = std::make_unique<Scenario>(load_remote_scenario(op));
@@ -154,7 +169,7 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
                      ": haptics.device: a real device over udp runs in real time: run the "
                      "stations as two processes (--role remote / --role operator)");
   device_ = make_operator_device(*op_);
-  link_ = std::make_unique<net::MemoryLink>(settings_.to_remote, settings_.to_operator);
+  link_ = std::make_unique<net::EmulatedLink>(settings_.to_remote, settings_.to_operator);
   operator_ = std::make_unique<OperatorStation>(*op_, settings_, *device_, link_->a(), 1u);
   remote_ = std::make_unique<RemoteStation>(*remote_scn_, settings_, op_->base.soil.material,
                                             operator_->simulation().grid(), link_->b(), 2u);
@@ -163,7 +178,7 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
   // updates to land, and on a lossy link three retransmissions more.
   const net::LinkConditions& back = settings_.to_operator;
   const bool lossy = back.loss > 0.0 || back.burst.p_good_to_bad > 0.0;
-  const double retransmit_s = back.retransmit_s.value_or(2.0 * back.delay_s + 0.02);
+  const double retransmit_s = net::retransmit_timeout_s(back, net::emulated_round_trip_s(back));
   const double duration = overrides.duration_s.value_or(
       operator_duration_s(*op_) + settings_.to_remote.delay_s + back.delay_s +
       settings_.sense_period_s + settings_.blend_s + 0.2 + (lossy ? 3.0 * retransmit_s : 0.0));
@@ -181,6 +196,7 @@ MmtRun::~MmtRun() = default;
 
 void MmtRun::tick() {
   const double t = double(tick_) / rate_hz_;
+  link_->release(t);
   operator_->tick(t);
   remote_->tick(t);
   ++tick_;
@@ -221,86 +237,13 @@ MmtSummary MmtRun::summary() const {
   MmtSummary s;
   s.duration_s = double(tick_) / rate_hz_;
   s.rtt_s = settings_.to_remote.delay_s + settings_.to_operator.delay_s;
+  s.rtt_measured_s = operator_->rtt_s();
   s.loss = settings_.to_remote.loss;
   s.deadband = settings_.deadband;
-  const auto& op = operator_->records();
-  const auto& rm = remote_->records();
-  // The remote acts on command i one one-way delay later, and its arm, a
-  // first-order servo, follows a steady motion one time constant behind:
-  // compare there (the same commanded motion). Direct reflection is
-  // compared the same way.
-  const std::int64_t lag = std::llround(
-      (settings_.to_remote.delay_s + settings_.follower_time_constant_s) * rate_hz_);
-  // The remote's cutting: from its first tick with a cut on.
-  double first_cut_s = -1.0, change_s = -1.0;
-  for (const RemoteRecord& r : rm) {
-    if (first_cut_s < 0.0 && r.active && r.cut_depth_m > 0.0 && r.estimate_error >= 0.0)
-      first_cut_s = r.t_s;
-    if (change_s < 0.0 && r.in_changed_soil) change_s = r.t_s;
-  }
-  s.cutting_from_s = first_cut_s < 0.0 ? -1.0 : first_cut_s + 1.0;
-  if (change_s >= 0.0) {
-    s.settle_excluded_from_s = change_s;
-    s.settle_excluded_to_s = change_s + s.rtt_s + 0.5;
-  }
-  std::vector<double> e_mmt, e_dfr, f_rem, e_mmt1, e_dfr1, f_rem1;
-  for (std::size_t i = 0; i < op.size(); ++i) {
-    const std::size_t j = i + std::size_t(lag);
-    if (j >= rm.size() || !rm[j].active) continue;
-    // Over the ticks where some force is felt or measured: the time in
-    // soil, not the idle time before and after, so that runs of different
-    // lengths compare.
-    if (length(op[i].force_world_n) == 0.0 && length(op[i].remote_force_world_n) == 0.0 &&
-        length(rm[j].force_world_n) == 0.0)
-      continue;
-    const double em = length(op[i].force_world_n - rm[j].force_world_n);
-    const double ed = length(op[i].remote_force_world_n - rm[j].force_world_n);
-    const double fr = length(rm[j].force_world_n);
-    e_mmt.push_back(em);
-    e_dfr.push_back(ed);
-    f_rem.push_back(fr);
-    const double t = rm[j].t_s;
-    if (first_cut_s >= 0.0 && t >= s.cutting_from_s &&
-        !(change_s >= 0.0 && t >= s.settle_excluded_from_s && t < s.settle_excluded_to_s)) {
-      e_mmt1.push_back(em);
-      e_dfr1.push_back(ed);
-      f_rem1.push_back(fr);
-    }
-  }
-  s.force_rms_remote_n = rms(f_rem);
-  s.force_error_rms_mmt_n = rms(e_mmt);
-  s.force_error_rms_dfr_n = rms(e_dfr);
-  for (double e : e_mmt) s.force_error_max_mmt_n = std::max(s.force_error_max_mmt_n, e);
-  for (double e : e_dfr) s.force_error_max_dfr_n = std::max(s.force_error_max_dfr_n, e);
-  s.force_rms_remote_after_1s_n = rms(f_rem1);
-  s.force_error_rms_mmt_after_1s_n = rms(e_mmt1);
-  s.force_error_rms_dfr_after_1s_n = rms(e_dfr1);
-  // A window with less than 0.1 s of the remote cutting (a change of soil
-  // whose left-out round trip reaches past the end of the cut) has no
-  // figure: -1.
-  std::size_t cutting_ticks = 0;
-  for (double f : f_rem1) cutting_ticks += f > 1.0;
-  s.force_error_rel_mmt_after_1s = s.force_error_rel_dfr_after_1s = -1.0;
-  if (s.force_rms_remote_after_1s_n > 0.0 && double(cutting_ticks) >= 0.1 * rate_hz_) {
-    s.force_error_rel_mmt_after_1s = s.force_error_rms_mmt_after_1s_n / s.force_rms_remote_after_1s_n;
-    s.force_error_rel_dfr_after_1s = s.force_error_rms_dfr_after_1s_n / s.force_rms_remote_after_1s_n;
-  }
-  // Re-identification: from the blade entering the new soil to the last
-  // tick, while it cuts, whose estimate was more than 5 % off the measured
-  // horizontal force.
-  if (change_s >= 0.0) {
-    double last_off_s = change_s;
-    for (const RemoteRecord& r : rm)
-      if (r.t_s >= change_s && r.estimate_error > 0.05) last_off_s = r.t_s;
-    s.reidentified_after_s = last_off_s - change_s;
-  }
+  compare_records(operator_->records(), remote_->records(), rate_hz_,
+                  settings_.follower_time_constant_s, s);
   for (const auto& [t, e] : terrain_error_) s.terrain_rms_max_m = std::max(s.terrain_rms_max_m, e);
   s.terrain_rms_final_m = terrain_error_.empty() ? 0.0 : terrain_error_.back().second;
-  std::vector<double> track;
-  for (const RemoteRecord& r : rm)
-    if (r.active) track.push_back(length(r.tool_m - r.commanded_m));
-  s.tracking_rms_m = rms(track);
-  for (double e : track) s.tracking_max_m = std::max(s.tracking_max_m, e);
   const double d = std::max(s.duration_s, 1e-9);
   const net::TrafficCounters& up = link_->a().traffic();
   const net::TrafficCounters& down = link_->b().traffic();
@@ -308,25 +251,22 @@ MmtSummary MmtRun::summary() const {
   s.bytes_per_s_to_remote = double(up.sent_bytes) / d;
   s.packets_per_s_to_operator = double(down.sent) / d;
   s.bytes_per_s_to_operator = double(down.sent_bytes) / d;
+  s.lost_to_remote = link_->a().emulator().counters().lost;
+  s.lost_to_operator = link_->b().emulator().counters().lost;
   s.patches = remote_->counters().patches;
   s.estimates = remote_->counters().estimates;
+  s.patches_merged = operator_->counters().patches;
+  s.estimates_applied = operator_->counters().estimates;
   s.update_packets_per_s = double(remote_->update_packets()) / d;
   s.max_update_step_n = operator_->max_update_step_n();
   s.max_step_while_updating_n = operator_->max_step_while_updating_n();
-  for (const OperatorRecord& r : op) {
-    s.passivity_max_mmt_j = std::max(s.passivity_max_mmt_j, r.passivity_j);
-    s.passivity_max_dfr_j = std::max(s.passivity_max_dfr_j, r.passivity_dfr_j);
-  }
   s.estimate = remote_->estimate();
   s.remote_material = remote_->true_material();
   s.material_applied = operator_->simulation().force_material();
+  s.arm_force_limit_n = settings_.arm_force_limit_n;
   s.stalled_ticks = remote_->stalled_ticks();
-  std::vector<double> c;
-  for (const OperatorRecord& r : op) c.push_back(r.compute_s);
-  s.operator_compute = timing_stats(c);
-  c.clear();
-  for (const RemoteRecord& r : rm) c.push_back(r.compute_s);
-  s.remote_compute = timing_stats(c);
+  s.rejected_operator = operator_->counters().rejected;
+  s.rejected_remote = remote_->counters().rejected;
   return s;
 }
 
@@ -345,46 +285,12 @@ void MmtRun::write_outputs(const std::filesystem::path& dir) const {
   nlohmann::ordered_json j;
   j["scenario"] = op_->base.source_path.string();
   j["remote_scenario"] = remote_scn_->base.source_path.string();
-  j["link"] = {{"rtt_s", s.rtt_s},
-               {"delay_s_each_way", settings_.to_remote.delay_s},
-               {"jitter_s", settings_.to_remote.jitter_s},
-               {"loss", settings_.to_remote.loss},
-               {"burst_p_good_to_bad", settings_.to_remote.burst.p_good_to_bad},
-               {"reorder", settings_.to_remote.reorder},
-               {"seed", settings_.to_remote.seed}};
+  j["link"] = link_json(settings_.to_remote);
+  j["link"]["rtt_s"] = s.rtt_s;
+  j["link"]["rtt_measured_s"] = s.rtt_measured_s;
   j["operator"] = {{"blend_s", settings_.blend_s},
                    {"max_update_step_n", settings_.max_update_step_n},
                    {"deadband", settings_.deadband}};
-  j["duration_s"] = s.duration_s;
-  j["force_error"] = {{"remote_force_rms_n", s.force_rms_remote_n},
-                      {"mmt_rms_n", s.force_error_rms_mmt_n},
-                      {"mmt_max_n", s.force_error_max_mmt_n},
-                      {"direct_rms_n", s.force_error_rms_dfr_n},
-                      {"direct_max_n", s.force_error_max_dfr_n},
-                      {"aligned_by_s", settings_.to_remote.delay_s + settings_.follower_time_constant_s}};
-  j["terrain_error"] = {{"final_rms_m", s.terrain_rms_final_m}, {"max_rms_m", s.terrain_rms_max_m}};
-  j["tracking"] = {{"rms_m", s.tracking_rms_m}, {"max_m", s.tracking_max_m}};
-  j["traffic"] = {{"to_remote_packets_per_s", s.packets_per_s_to_remote},
-                  {"to_remote_bytes_per_s", s.bytes_per_s_to_remote},
-                  {"to_operator_packets_per_s", s.packets_per_s_to_operator},
-                  {"to_operator_bytes_per_s", s.bytes_per_s_to_operator},
-                  {"update_packets_per_s", s.update_packets_per_s},
-                  {"lost_to_remote", link_->a().emulator().counters().lost},
-                  {"lost_to_operator", link_->b().emulator().counters().lost}};
-  j["updates"] = {{"patches", s.patches},
-                  {"estimates", s.estimates},
-                  {"patches_merged", operator_->counters().patches},
-                  {"estimates_applied", operator_->counters().estimates},
-                  {"max_force_step_at_update_n", s.max_update_step_n},
-                  {"max_force_step_while_updating_n", s.max_step_while_updating_n}};
-  j["force_error_after_1s"] = {{"from_s", s.cutting_from_s},
-                               {"left_out_from_s", s.settle_excluded_from_s},
-                               {"left_out_to_s", s.settle_excluded_to_s},
-                               {"remote_force_rms_n", s.force_rms_remote_after_1s_n},
-                               {"mmt_rms_n", s.force_error_rms_mmt_after_1s_n},
-                               {"direct_rms_n", s.force_error_rms_dfr_after_1s_n},
-                               {"mmt_relative", s.force_error_rel_mmt_after_1s},
-                               {"direct_relative", s.force_error_rel_dfr_after_1s}};
   j["remote_soil"] = {{"material", detail::material_json(remote_->base_material())},
                       {"changed_to", settings_.change_soil
                                          ? detail::material_json(remote_->changed_material())
@@ -394,27 +300,7 @@ void MmtRun::write_outputs(const std::filesystem::path& dir) const {
                       {"changed_at_s", s.settle_excluded_from_s > 0.0
                                            ? nlohmann::ordered_json(s.settle_excluded_from_s)
                                            : nlohmann::ordered_json()}};
-  j["estimate"] = detail::estimate_json(s.estimate, &s.remote_material);
-  j["estimate"]["material_applied_by_operator"] = detail::material_json(s.material_applied);
-  j["estimate"]["reidentified_after_s"] = s.reidentified_after_s;
-  j["remote_arm"] = {{"force_limit_n", settings_.arm_force_limit_n},
-                     {"stalled_ticks", s.stalled_ticks}};
-  j["passivity"] = {{"window_s", 1.0},
-                    {"mmt_max_energy_into_hand_j", s.passivity_max_mmt_j},
-                    {"direct_max_energy_into_hand_j", s.passivity_max_dfr_j}};
-  auto rejected = [](const StationCounters& c) {
-    nlohmann::ordered_json r;
-    for (std::size_t i = 1; i < net::kRejectReasonCount; ++i)
-      r[std::string(net::to_string(net::Reject(i)))] = c.rejected.by_reason[i];
-    return r;
-  };
-  j["rejected"] = {{"operator", rejected(operator_->counters())},
-                   {"remote", rejected(remote_->counters())}};
-  auto timing = [](const TimingStats& t) {
-    return nlohmann::ordered_json{{"p50_us", t.p50_us}, {"p99_us", t.p99_us}, {"max_us", t.max_us}};
-  };
-  j["timing"] = {{"operator_tick", timing(s.operator_compute)},
-                 {"remote_tick", timing(s.remote_compute)}};
+  j.update(summary_json(s));
   std::ofstream out = open_out(dir / "summary.json");
   out << j.dump(2) << "\n";
   if (!out) throw InputError((dir / "summary.json").string() + ": cannot be written");

@@ -300,7 +300,7 @@ struct Pair {
   MmtSettings settings;
   Scenario remote_sc;
   std::unique_ptr<haptics::Device> device;
-  net::MemoryLink link;
+  net::EmulatedLink link;
   OperatorStation op;
   RemoteStation remote;
 };
@@ -571,6 +571,10 @@ TEST(Mmt, BadSettingsNameTheField) {
   fails("blend_s: 0.1", "blend_s: -1", "mmt.operator.blend_s");
   fails("sense_period_s: 0.05", "sense_periods: 0.05", "sense_periods");
   fails("soil: clay", "soil: mud", "unknown");
+  // The link is dead only after a silence longer than the one that fades the force.
+  fails("timeout_s: 0.2", "timeout_s: 0.2\n  link_lost_s: 0.1",
+        "mmt.link_lost_s: 0.1 s is not longer than timeout_s (0.2 s)");
+  fails("timeout_s: 0.2", "timeout_s: 0.2\n  link_lost_s: 4000", "mmt.link_lost_s: must be in (0, 3600]");
   // A remote whose grid is not the operator's.
   const fs::path dir = fs::temp_directory_path() / "terracut_mmt_grid";
   fs::create_directories(dir);

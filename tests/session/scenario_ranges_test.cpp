@@ -80,6 +80,7 @@ mmt:
          burst: {p_good_to_bad: 0.01, p_bad_to_good: 0.5, loss_good: 0, loss_bad: 0.5}}
   operator: {blend_s: 0.1, max_update_step_n: 0.01, exclusion_m: 0.15, deadband: 0.05}
   timeout_s: 0.2
+  link_lost_s: 5
   udp: {port: 47100}
   link_id: 1234
 )";
