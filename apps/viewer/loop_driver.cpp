@@ -108,11 +108,11 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
       operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, *udp_.endpoint, id, oo);
     } else {
       remote_scenario_ = std::make_unique<session::Scenario>(session::load_remote_scenario(op));
-      link_ = std::make_unique<net::EmulatedLink>(mmt.to_remote, mmt.to_operator);
-      operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, link_->a(), 1u, oo);
-      remote_ = std::make_unique<session::RemoteStation>(
-          *remote_scenario_, mmt, op.base.soil.material,
-          operator_->simulation().grid(), link_->b(), 2u, session::RemoteOptions{false});
+      session::StationPair pair =
+          session::make_station_pair(op, *remote_scenario_, mmt, *device_, oo, session::RemoteOptions{false});
+      link_ = std::move(pair.link);
+      operator_ = std::move(pair.operator_station);
+      remote_ = std::move(pair.remote_station);
     }
     mmt_live_.emulated_rtt_s.store(mmt.to_remote.delay_s + mmt.to_operator.delay_s);
   } else {

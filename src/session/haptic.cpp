@@ -67,18 +67,20 @@ std::string json_percentiles(const TimePercentiles& s) {
 
 }  // namespace
 
+std::vector<int> followed_cuts(const Scenario& scenario, const HapticSettings& settings) {
+  const io::Scenario& sc = scenario.base;
+  if (settings.cut.empty()) return sc.sequence;
+  const int index = sc.find_cut(settings.cut);
+  return index < 0 ? std::vector<int>{} : std::vector<int>{index};
+}
+
 DevicePath followed_path(const Scenario& scenario, const HapticSettings& settings,
                          const std::string& source) {
   const io::Scenario& sc = scenario.base;
   std::vector<Motion> strokes;
-  if (!settings.cut.empty()) {
-    const int index = sc.find_cut(settings.cut);
-    if (index < 0)
-      throw InputError(source + ": haptics.cut: no cut named '" + settings.cut + "' in the scenario");
-    strokes.push_back(sc.cuts[std::size_t(index)]);
-  } else {
-    for (int index : sc.sequence) strokes.push_back(sc.cuts[std::size_t(index)]);
-  }
+  for (int index : followed_cuts(scenario, settings)) strokes.push_back(sc.cuts[std::size_t(index)]);
+  if (strokes.empty() && !settings.cut.empty())
+    throw InputError(source + ": haptics.cut: no cut named '" + settings.cut + "' in the scenario");
   if (strokes.empty())
     throw InputError(source + ": haptics.cut: the " + std::string(to_string(settings.device)) +
                      " device follows a cut, and the scenario has none");

@@ -155,6 +155,19 @@ void StationCsv::finish() {
   if (!*out_) throw InputError(path_.string() + ": cannot be written");
 }
 
+StationPair make_station_pair(const Scenario& op, const Scenario& remote, const MmtSettings& settings,
+                              haptics::Device& device, const OperatorOptions& operator_options,
+                              const RemoteOptions& remote_options) {
+  StationPair p;
+  p.link = std::make_unique<net::EmulatedLink>(settings.to_remote, settings.to_operator);
+  p.operator_station =
+      std::make_unique<OperatorStation>(op, settings, device, p.link->a(), 1u, operator_options);
+  p.remote_station = std::make_unique<RemoteStation>(remote, settings, op.base.soil.material,
+                                                     p.operator_station->simulation().grid(),
+                                                     p.link->b(), 2u, remote_options);
+  return p;
+}
+
 MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
   if (!op.mmt) throw InputError(no_mmt_section(op));
   settings_ = apply_overrides(*op.mmt, overrides);
@@ -169,10 +182,10 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
                      ": haptics.device: a real device over udp runs in real time: run the "
                      "stations as two processes (--role remote / --role operator)");
   device_ = make_operator_device(*op_);
-  link_ = std::make_unique<net::EmulatedLink>(settings_.to_remote, settings_.to_operator);
-  operator_ = std::make_unique<OperatorStation>(*op_, settings_, *device_, link_->a(), 1u);
-  remote_ = std::make_unique<RemoteStation>(*remote_scn_, settings_, op_->base.soil.material,
-                                            operator_->simulation().grid(), link_->b(), 2u);
+  StationPair pair = make_station_pair(*op_, *remote_scn_, settings_, *device_);
+  link_ = std::move(pair.link);
+  operator_ = std::move(pair.operator_station);
+  remote_ = std::move(pair.remote_station);
   rate_hz_ = operator_->rate_hz();
   // After the path: a round trip, a sensing period and a blend for the last
   // updates to land, and on a lossy link three retransmissions more.

@@ -27,19 +27,11 @@ haptics::LoopParams loop_params(const Scenario& sc) {
   }
 }
 
-// The orientation of the first keyframe of the followed cut, or identity.
+// The orientation of the first keyframe of the followed cut, or identity
+// (a remote world with no cut of its own).
 Quat first_orientation(const Scenario& sc) {
-  const io::Scenario& b = sc.base;
-  const Motion* cut = nullptr;
-  if (!sc.haptics.cut.empty()) {
-    const int i = b.find_cut(sc.haptics.cut);
-    if (i >= 0) cut = &b.cuts[std::size_t(i)];
-  } else if (!b.sequence.empty()) {
-    cut = &b.cuts[std::size_t(b.sequence.front())];
-  } else if (!b.cuts.empty()) {
-    cut = &b.cuts.front();
-  }
-  return cut ? cut->keyframes.front().pose.orientation : Quat{};
+  const std::vector<int> cuts = followed_cuts(sc, sc.haptics);
+  return cuts.empty() ? Quat{} : sc.base.cuts[std::size_t(cuts.front())].keyframes.front().pose.orientation;
 }
 
 // Adds a rectangle to the rectangle of everything worked so far.

@@ -454,6 +454,24 @@ void compare_records(const std::vector<OperatorRecord>& op, const std::vector<Re
 /// of every MMT entry point.
 std::string no_mmt_section(const Scenario& sc);
 
+/// The teleoperation pair of one process: the emulated link and both
+/// stations on it.
+struct StationPair {
+  std::unique_ptr<net::EmulatedLink> link;
+  std::unique_ptr<OperatorStation> operator_station;
+  std::unique_ptr<RemoteStation> remote_station;
+};
+/// The pair as the single-process run and the viewer's operator mode build
+/// it: the link of settings.to_remote and to_operator, the operator station
+/// (session 1) over op's world with device, and the remote station (session
+/// 2) in the remote world (load_remote_scenario), its estimate starting from
+/// the operator's soil material and its deadband from the operator's
+/// initial heights. device and remote must outlive the pair. Throws
+/// InputError naming the field.
+StationPair make_station_pair(const Scenario& op, const Scenario& remote, const MmtSettings& settings,
+                              haptics::Device& device, const OperatorOptions& operator_options = {},
+                              const RemoteOptions& remote_options = {});
+
 /// Both stations in one process.
 class MmtRun {
  public:
