@@ -77,9 +77,14 @@ SoilEstimate estimate_from_json(const nlohmann::ordered_json& j, const std::file
                                 SoilMaterial* truth) {
   SoilEstimate e;
   e.material = material_from_json(entry(j, "material", where), where);
+  // An unbounded uncertainty is written as null (JSON has no infinity).
   const nlohmann::ordered_json& sd = entry(j, "sd", where);
-  for (int f = 0; f < kSoilFieldCount; ++f)
-    e.sd[std::size_t(f)] = entry(sd, std::string(to_string(SoilField(f))).c_str(), where).get<double>();
+  for (int f = 0; f < kSoilFieldCount; ++f) {
+    const std::string name(to_string(SoilField(f)));
+    if (!sd.is_object() || !sd.contains(name))
+      throw InputError(where.string() + ": no estimate entry 'sd." + name + "'");
+    e.sd[std::size_t(f)] = sd[name].is_null() ? HUGE_VAL : sd[name].get<double>();
+  }
   for (const auto& name : entry(j, "identifiable", where)) {
     const auto field = parse_enum<SoilField>(name.get<std::string>());
     if (!field) throw InputError(where.string() + ": estimate: '" + name.get<std::string>() + "' is no soil field");
