@@ -31,9 +31,9 @@ def import_plotting(fail):
     return numpy, matplotlib.pyplot
 
 
-def parse_dir_args(argv, doc, default_png, fail, script):
-    """(folder, output png, quiet) from `SCRIPT DIR [--out FILE.png] [--quiet]`."""
-    folder, out, quiet = None, None, False
+def _parse_args(argv, doc, fail):
+    """(folders, --out value or None, quiet) from argv; --help prints doc and exits 0."""
+    folders, out, quiet = [], None, False
     i = 1
     while i < len(argv):
         a = argv[i]
@@ -47,14 +47,45 @@ def parse_dir_args(argv, doc, default_png, fail, script):
                 fail("--out needs a file name")
             out = argv[i + 1]
             i += 1
-        elif folder is None:
-            folder = a
         else:
-            fail(f"unexpected argument '{a}' (see --help)")
+            folders.append(a)
         i += 1
-    if folder is None:
+    return folders, out, quiet
+
+
+def parse_dir_args(argv, doc, default_png, fail, script):
+    """(folder, output png, quiet) from `SCRIPT DIR [--out FILE.png] [--quiet]`."""
+    folders, out, quiet = _parse_args(argv, doc, fail)
+    if not folders:
         fail(f"no output folder given (usage: {script} DIR [--out FILE.png])")
-    return folder, out or os.path.join(folder, default_png), quiet
+    if len(folders) > 1:
+        fail(f"unexpected argument '{folders[1]}' (see --help)")
+    return folders[0], out or os.path.join(folders[0], default_png), quiet
+
+
+def parse_dirs_args(argv, doc, fail, script):
+    """(folders, output png, quiet) from `SCRIPT --out FILE.png DIR [DIR ...] [--quiet]`."""
+    folders, out, quiet = _parse_args(argv, doc, fail)
+    if out is None or not folders:
+        fail(f"usage: {script} --out FILE.png DIR [DIR ...]")
+    return folders, out, quiet
+
+
+def over_seeds(np, rows, key, scale=1.0):
+    """Per round trip of a `terracut mmt --sweep` study.csv's rows: (rtts,
+    mean, distance down to the best seed, up to the worst) of column key
+    times scale, leaving out the runs that have no figure (negative: no cut
+    in the window)."""
+    rtts, mean, down, up = [], [], [], []
+    for r in sorted(set(rows["rtt_ms"])):
+        v = rows[key][(rows["rtt_ms"] == r) & (rows[key] >= 0)] * scale
+        if len(v) == 0:
+            continue
+        rtts.append(r)
+        mean.append(v.mean())
+        down.append(max(v.mean() - v.min(), 0.0))
+        up.append(max(v.max() - v.mean(), 0.0))
+    return rtts, np.array(mean), np.array(down), np.array(up)
 
 
 def parse_folder_args(argv, doc):

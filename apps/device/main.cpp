@@ -21,6 +21,7 @@
 #include "terracut/haptics/device_player.hpp"
 #include "terracut/haptics/pacer.hpp"
 #include "terracut/haptics/device_option.hpp"
+#include "terracut/session/haptic.hpp"
 #include "terracut/session/scenario.hpp"
 
 namespace {
@@ -52,18 +53,11 @@ int run(const Options& opt) {
   const io::Scenario& sc = input.base;
 
   // The cut to follow (as the loop's script and sim devices do).
-  int cut = -1;
-  if (!s.cut.empty()) {
-    cut = sc.find_cut(s.cut);
-    if (cut < 0)
-      throw InputError(opt.scenario + ": haptics.cut: no cut named '" + s.cut +
-                       "' in the scenario");
-  } else if (!sc.sequence.empty()) {
-    cut = sc.sequence.front();
-  } else if (!sc.cuts.empty()) {
-    cut = 0;
-  }
-  if (cut < 0) throw InputError(opt.scenario + ": the scenario has no cut to follow");
+  const std::vector<int> cuts = session::followed_cuts(input, s);
+  if (cuts.empty() && !s.cut.empty())
+    throw InputError(opt.scenario + ": haptics.cut: no cut named '" + s.cut + "' in the scenario");
+  if (cuts.empty()) throw InputError(opt.scenario + ": the scenario has no cut to follow");
+  const int cut = cuts.front();
   const Motion& motion = sc.cuts[std::size_t(cut)];
 
   // Where to send.

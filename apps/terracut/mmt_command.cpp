@@ -19,6 +19,7 @@
 #include "subprocess.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/core/soil_estimator.hpp"
 #include "terracut/haptics/device_option.hpp"
 #include "terracut/session/mmt.hpp"
 #include "terracut/session/mmt_process.hpp"
@@ -34,8 +35,9 @@ struct Options {
   std::optional<double> rtt_ms, loss, jitter_ms, deadband, blend_s, duration_s;
   std::optional<long long> seed;
   bool sweep = false;
-  std::string rtts = "0,50,100,200,500,1000";
+  std::string rtts = "0,20,50,100,200,500,1000";
   std::string losses = "0,0.01,0.1";
+  std::string seeds = "1,2,3";
   std::string device;
   std::string role;
   std::string listen, connect;
@@ -108,82 +110,178 @@ void plot(const Options& o, const fs::path& dir) {
               << " failed (exit code " << code << "); the results are written\n";
 }
 
+// A number for people: fixed to `digits` decimals (a force to 0.1 N, a
+// time to 1 ms), not the shortest exact form of the double.
+std::string fixed(double v, int digits) {
+  std::ostringstream t;
+  t << std::fixed << std::setprecision(digits) << v;
+  return t.str();
+}
+
+// The estimate in one line: each fitted field with its uncertainty, "?"
+// after the fields the cuts did not identify.
+std::string estimate_line(const SoilEstimate& e) {
+  const SoilMaterial& m = e.material;
+  auto field = [&](SoilField f, double scale, int digits, const char* unit) {
+    const int i = int(f);
+    return fixed(field_value(m, f) * scale, digits) + " +- " +
+           (e.sd[std::size_t(i)] * scale < 1e6 ? fixed(e.sd[std::size_t(i)] * scale, digits) : "inf") +
+           unit + (e.is_identifiable(f) ? "" : " (?)");
+  };
+  return "unit weight " + field(SoilField::kUnitWeight, 1e-3, 2, " kN/m3") + ", cohesion " +
+         field(SoilField::kCohesion, 1e-3, 2, " kPa") + ", adhesion " +
+         field(SoilField::kAdhesion, 1e-3, 2, " kPa") + ", phi " +
+         field(SoilField::kInternalFriction, 1.0, 1, " deg") + ", delta " +
+         field(SoilField::kSoilToolFriction, 1.0, 1, " deg");
+}
+
 int run_one(const Options& o, const session::Scenario& sc) {
   session::MmtRun run(sc, overrides_of(o));
   run.run();
   run.write_outputs(o.out);
   const session::MmtSummary s = run.summary();
-  if (!o.quiet)
-    std::cout << "terracut mmt: " << format_number(s.duration_s) << " s, RTT "
-              << format_number(s.rtt_s * 1e3) << " ms, loss " << format_number(s.loss * 100)
-              << " %: force error RMS " << format_number(s.force_error_rms_mmt_n)
-              << " N (MMT) vs " << format_number(s.force_error_rms_dfr_n)
-              << " N (direct reflection), remote force RMS " << format_number(s.force_rms_remote_n)
-              << " N; terrain RMS " << format_number(s.terrain_rms_final_m * 1e3)
-              << " mm at the end; " << s.patches << " patches, " << s.estimates
-              << " estimates; soil factor " << format_number(s.force_scale_final) << "\n";
+  if (!o.quiet) {
+    std::cout << "terracut mmt: " << fixed(s.duration_s, 2) << " s, RTT " << fixed(s.rtt_s * 1e3, 0)
+              << " ms, loss " << fixed(s.loss * 100, 1) << " %: force error RMS "
+              << fixed(s.force_error_rms_mmt_n, 1) << " N (MMT) vs "
+              << fixed(s.force_error_rms_dfr_n, 1) << " N (direct reflection), remote force RMS "
+              << fixed(s.force_rms_remote_n, 1) << " N; terrain RMS "
+              << fixed(s.terrain_rms_final_m * 1e3, 2) << " mm at the end; " << s.patches
+              << " patches, " << s.estimates << " estimates\n";
+    if (s.cutting_from_s >= 0.0)
+      std::cout << "terracut mmt: after 1 s of cutting (from t = " << fixed(s.cutting_from_s, 3)
+                << " s): MMT " << fixed(100 * s.force_error_rel_mmt_after_1s, 1)
+                << " % of the remote's force RMS, direct reflection "
+                << fixed(100 * s.force_error_rel_dfr_after_1s, 1) << " %\n";
+    std::cout << "terracut mmt: estimate: " << estimate_line(s.estimate) << "\n";
+    if (s.reidentified_after_s >= 0.0)
+      std::cout << "terracut mmt: the change of soil re-identified after "
+                << fixed(s.reidentified_after_s, 3) << " s\n";
+  }
   plot(o, o.out);
   return kExitOk;
 }
 
-// The study: every RTT x loss, one run each (MMT and direct reflection are
-// measured on the same run), plus the deadband variant at each RTT without
-// loss. study.csv, study.md (the README's table), study.png.
+// The study: every RTT x loss x seed, one run each (MMT and direct
+// reflection are measured on the same run), plus the deadband variant at
+// each RTT without loss (first seed). study.csv (a row per run), study.md
+// (the docs' table: over the seeds, the mean and the worst), study.png.
 int run_sweep(const Options& o, const session::Scenario& sc) {
   const std::vector<double> rtts = numbers(o.rtts, "--rtts");
   const std::vector<double> losses = numbers(o.losses, "--losses");
+  const std::vector<double> seeds = numbers(o.seeds, "--seeds");
+  for (double seed : seeds)
+    if (!(seed >= 0.0 && seed == std::floor(seed) && seed <= 1e9))
+      throw InputError(must_be("--seeds", "whole numbers in [0, 1e9]", seed));
   const double jnd = o.deadband.value_or(0.1);
   fs::create_directories(o.out);
   std::ofstream csv(fs::path(o.out) / "study.csv");
   if (!csv) throw InputError((fs::path(o.out) / "study.csv").string() + ": cannot be written");
-  csv << "rtt_ms,loss,deadband,force_rms_remote_n,mmt_rms_n,mmt_max_n,direct_rms_n,direct_max_n,"
-         "terrain_final_mm,tracking_rms_mm,update_packets_per_s,patches,estimates,"
-         "to_operator_bytes_per_s,max_update_step_n,passivity_mmt_j,passivity_direct_j,"
-         "force_scale\n";
+  csv.precision(9);
+  csv << "rtt_ms,loss,seed,deadband,force_rms_remote_n,mmt_rms_n,mmt_max_n,direct_rms_n,"
+         "direct_max_n,after_1s_remote_rms_n,after_1s_mmt_rms_n,after_1s_direct_rms_n,"
+         "after_1s_mmt_rel,after_1s_direct_rel,reidentified_after_s,terrain_final_mm,"
+         "tracking_rms_mm,update_packets_per_s,patches,estimates,to_operator_bytes_per_s,"
+         "max_update_step_n,passivity_mmt_j,passivity_direct_j,stalled_ticks";
+  for (int f = 0; f < kSoilFieldCount; ++f) {
+    const std::string n(to_string(SoilField(f)));
+    csv << ",est_" << n << ",sd_" << n << ",true_" << n << ",identifiable_" << n;
+  }
+  csv << "\n";
   std::ostringstream md;
-  md << "| RTT (ms) | loss | force error MMT, RMS (N) | direct reflection, RMS (N) | "
-        "MMT max (N) | direct max (N) | terrain RMS at end (mm) | update packets/s | "
-        "with deadband " << format_number(jnd * 100) << " % |\n|---|---|---|---|---|---|---|---|---|\n";
+  md << "| RTT (ms) | loss | MMT error after 1 s, % of the remote's RMS (mean / worst of "
+     << seeds.size() << " seeds) | direct reflection, % (mean / worst) | MMT < direct | "
+        "re-identified after (s, worst) | identifiable fields within 2 sd | update packets/s | "
+        "with deadband " << fixed(jnd * 100, 0) << " % (packets/s, MMT %) |\n"
+        "|---|---|---|---|---|---|---|---|---|\n";
   for (double rtt : rtts) {
     for (double loss : losses) {
-      std::vector<session::MmtSummary> pair;
-      for (double db : {0.0, jnd}) {
-        if (db > 0.0 && loss != losses.front()) continue;  // the variant once per RTT
-        Options one = o;
-        one.rtt_ms = rtt;
-        one.loss = loss;
-        one.deadband = db;
-        session::MmtRun run(sc, overrides_of(one));
-        run.run();
-        const session::MmtSummary s = run.summary();
-        pair.push_back(s);
-        csv << format_number(rtt) << ',' << format_number(loss) << ',' << format_number(db) << ','
-            << s.force_rms_remote_n << ',' << s.force_error_rms_mmt_n << ','
-            << s.force_error_max_mmt_n << ',' << s.force_error_rms_dfr_n << ','
-            << s.force_error_max_dfr_n << ',' << s.terrain_rms_final_m * 1e3 << ','
-            << s.tracking_rms_m * 1e3 << ',' << s.update_packets_per_s << ',' << s.patches << ','
-            << s.estimates << ',' << s.bytes_per_s_to_operator << ',' << s.max_update_step_n << ','
-            << s.passivity_max_mmt_j << ',' << s.passivity_max_dfr_j << ','
-            << s.force_scale_final << '\n';
-        if (!o.quiet)
-          std::cout << "terracut mmt: RTT " << format_number(rtt) << " ms, loss "
-                    << format_number(loss * 100) << " %, deadband " << format_number(db * 100)
-                    << " %: MMT " << format_number(s.force_error_rms_mmt_n) << " N, direct "
-                    << format_number(s.force_error_rms_dfr_n) << " N RMS\n";
+      std::vector<session::MmtSummary> runs;
+      std::optional<session::MmtSummary> banded;
+      for (double seed : seeds)
+        for (double db : {0.0, jnd}) {
+          if (db > 0.0 && (loss != losses.front() || seed != seeds.front())) continue;
+          Options one = o;
+          one.rtt_ms = rtt;
+          one.loss = loss;
+          one.deadband = db;
+          one.seed = (long long)seed;
+          session::MmtRun run(sc, overrides_of(one));
+          run.run();
+          const session::MmtSummary s = run.summary();
+          if (db > 0.0)
+            banded = s;
+          else
+            runs.push_back(s);
+          csv << format_number(rtt) << ',' << format_number(loss) << ',' << format_number(seed)
+              << ',' << format_number(db) << ',' << s.force_rms_remote_n << ','
+              << s.force_error_rms_mmt_n << ',' << s.force_error_max_mmt_n << ','
+              << s.force_error_rms_dfr_n << ',' << s.force_error_max_dfr_n << ','
+              << s.force_rms_remote_after_1s_n << ',' << s.force_error_rms_mmt_after_1s_n << ','
+              << s.force_error_rms_dfr_after_1s_n << ',' << s.force_error_rel_mmt_after_1s << ','
+              << s.force_error_rel_dfr_after_1s << ',' << s.reidentified_after_s << ','
+              << s.terrain_rms_final_m * 1e3 << ',' << s.tracking_rms_m * 1e3 << ','
+              << s.update_packets_per_s << ',' << s.patches << ',' << s.estimates << ','
+              << s.bytes_per_s_to_operator << ',' << s.max_update_step_n << ','
+              << s.passivity_max_mmt_j << ',' << s.passivity_max_dfr_j << ',' << s.stalled_ticks;
+          for (int f = 0; f < kSoilFieldCount; ++f) {
+            const SoilField field = SoilField(f);
+            csv << ',' << field_value(s.estimate.material, field) << ','
+                << s.estimate.sd[std::size_t(f)] << ',' << field_value(s.remote_material, field)
+                << ',' << int(s.estimate.is_identifiable(field));
+          }
+          csv << '\n';
+          if (!o.quiet)
+            std::cout << "terracut mmt: RTT " << fixed(rtt, 0) << " ms, loss "
+                      << fixed(loss * 100, 1) << " %, seed " << fixed(seed, 0) << ", deadband "
+                      << fixed(db * 100, 0) << " %: after 1 s of cutting MMT "
+                      << fixed(100 * s.force_error_rel_mmt_after_1s, 1) << " %, direct "
+                      << fixed(100 * s.force_error_rel_dfr_after_1s, 1) << " % of "
+                      << fixed(s.force_rms_remote_after_1s_n, 1) << " N RMS\n";
+        }
+      // Over the seeds: the mean and the worst (of the runs whose window
+      // held a cut: see MmtSummary).
+      double mmt_mean = 0.0, mmt_worst = 0.0, dfr_mean = 0.0, dfr_worst = 0.0, reid_worst = -1.0,
+             packets = 0.0;
+      int within = 0, identifiable = 0, measured = 0;
+      bool mmt_better = true;
+      for (const session::MmtSummary& s : runs) {
+        packets += s.update_packets_per_s / double(runs.size());
+        reid_worst = std::max(reid_worst, s.reidentified_after_s);
+        if (s.force_error_rel_mmt_after_1s >= 0.0) {
+          ++measured;
+          mmt_mean += s.force_error_rel_mmt_after_1s;
+          dfr_mean += s.force_error_rel_dfr_after_1s;
+          mmt_worst = std::max(mmt_worst, s.force_error_rel_mmt_after_1s);
+          dfr_worst = std::max(dfr_worst, s.force_error_rel_dfr_after_1s);
+          mmt_better = mmt_better && s.force_error_rms_mmt_after_1s_n < s.force_error_rms_dfr_after_1s_n;
+        }
+        for (int f = 0; f < kSoilFieldCount; ++f) {
+          const SoilField field = SoilField(f);
+          if (!s.estimate.is_identifiable(field)) continue;
+          ++identifiable;
+          within += std::fabs(field_value(s.estimate.material, field) -
+                              field_value(s.remote_material, field)) <=
+                    2.0 * s.estimate.sd[std::size_t(f)];
+        }
       }
-      const session::MmtSummary& s = pair.front();
-      auto f = [](double v, int digits) {
-        std::ostringstream t;
-        t << std::fixed << std::setprecision(digits) << v;
-        return t.str();
-      };
-      md << "| " << format_number(rtt) << " | " << format_number(loss * 100) << " % | "
-         << f(s.force_error_rms_mmt_n, 1) << " | " << f(s.force_error_rms_dfr_n, 1) << " | "
-         << f(s.force_error_max_mmt_n, 0) << " | " << f(s.force_error_max_dfr_n, 0) << " | "
-         << f(s.terrain_rms_final_m * 1e3, 2) << " | " << f(s.update_packets_per_s, 1) << " | "
-         << (pair.size() > 1 ? f(pair[1].update_packets_per_s, 1) + " (MMT " +
-                                   f(pair[1].force_error_rms_mmt_n, 1) + " N)"
-                             : std::string("")) << " |\n";
+      const std::string none = "n/a (no cut left after the change)";
+      if (measured > 0) {
+        mmt_mean /= measured;
+        dfr_mean /= measured;
+      }
+      md << "| " << fixed(rtt, 0) << " | " << fixed(loss * 100, 0) << " % | "
+         << (measured > 0 ? fixed(100 * mmt_mean, 1) + " / " + fixed(100 * mmt_worst, 1) : none)
+         << " | "
+         << (measured > 0 ? fixed(100 * dfr_mean, 1) + " / " + fixed(100 * dfr_worst, 1) : none)
+         << " | " << (measured == 0 ? "-" : mmt_better ? "yes" : "no") << " | "
+         << (reid_worst >= 0.0 ? fixed(reid_worst, 3) : std::string("-")) << " | " << within
+         << " of " << identifiable << " | " << fixed(packets, 1) << " | "
+         << (banded ? fixed(banded->update_packets_per_s, 1) +
+                          (banded->force_error_rel_mmt_after_1s >= 0.0
+                               ? " (" + fixed(100 * banded->force_error_rel_mmt_after_1s, 1) + " %)"
+                               : std::string(""))
+                    : std::string("")) << " |\n";
     }
   }
   csv.close();
@@ -229,6 +327,8 @@ Command add_mmt_command(CLI::App& app) {
   sub->add_option("--rtts", opt->rtts, "Study: round trips, ms, comma-separated")
       ->capture_default_str();
   sub->add_option("--losses", opt->losses, "Study: losses, fractions, comma-separated")
+      ->capture_default_str();
+  sub->add_option("--seeds", opt->seeds, "Study: link seeds, comma-separated")
       ->capture_default_str();
   sub->add_option("--role", opt->role,
                   "Two processes: 'remote' (listens on --listen) or 'operator' (connects to\n"

@@ -108,11 +108,11 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
       operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, *udp_.endpoint, id, oo);
     } else {
       remote_scenario_ = std::make_unique<session::Scenario>(session::load_remote_scenario(op));
-      link_ = std::make_unique<net::EmulatedLink>(mmt.to_remote, mmt.to_operator);
-      operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, link_->a(), 1u, oo);
-      remote_ = std::make_unique<session::RemoteStation>(
-          *remote_scenario_, mmt, op.base.soil.material,
-          operator_->simulation().grid(), link_->b(), 2u, session::RemoteOptions{false});
+      session::StationPair pair =
+          session::make_station_pair(op, *remote_scenario_, mmt, *device_, oo, session::RemoteOptions{false});
+      link_ = std::move(pair.link);
+      operator_ = std::move(pair.operator_station);
+      remote_ = std::move(pair.remote_station);
     }
     mmt_live_.emulated_rtt_s.store(mmt.to_remote.delay_s + mmt.to_operator.delay_s);
   } else {
@@ -271,8 +271,14 @@ void LoopDriver::publish_mmt() {
   m.estimates.store(oc.estimates, std::memory_order_relaxed);
   m.rejected.store(oc.rejected.total() + (remote_ ? remote_->counters().rejected.total() : 0),
                   std::memory_order_relaxed);
-  m.scale_applied.store(r.scale_applied, std::memory_order_relaxed);
-  m.scale_target.store(r.scale_target, std::memory_order_relaxed);
+  const net::Estimate& e = operator_->last_estimate();
+  for (int f = 0; f < kSoilFieldCount; ++f) {
+    const std::size_t i = std::size_t(f);
+    m.material_applied[i].store(field_value(r.material, SoilField(f)), std::memory_order_relaxed);
+    m.estimate[i].store(field_value(e.material, SoilField(f)), std::memory_order_relaxed);
+    m.estimate_sd[i].store(e.sd[i], std::memory_order_relaxed);
+  }
+  m.identifiable.store(e.identifiable, std::memory_order_relaxed);
   m.link_silent.store(r.link_silent, std::memory_order_relaxed);
 }
 

@@ -36,6 +36,7 @@
 // frame carries their poses.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -106,8 +107,14 @@ struct MmtLive {
   /// aligned figure is `terracut mmt`'s).
   std::atomic<double> force_error_rms_n{0.0};
   std::atomic<double> remote_force_n{0.0};  ///< |remote's newest measured force|, world N
-  std::atomic<double> scale_applied{1.0};   ///< the soil factor the operator applies
-  std::atomic<double> scale_target{1.0};    ///< the remote's newest estimate
+  /// The material of the operator's model (moving to the remote's
+  /// estimate) and the remote's newest estimate with its standard
+  /// uncertainties, by SoilField (unit weight N/m^3, cohesion Pa, adhesion
+  /// Pa, phi deg, delta deg); identifiable: SoilEstimate's bits.
+  std::array<std::atomic<double>, 5> material_applied{};
+  std::array<std::atomic<double>, 5> estimate{};
+  std::array<std::atomic<double>, 5> estimate_sd{};
+  std::atomic<std::uint32_t> identifiable{0};
   std::atomic<bool> link_silent{false};
 };
 

@@ -149,7 +149,22 @@ void ViewerApp::draw_mmt_section() {
   ImGui::Text("commands lost %.1f %% (last second)", m.command_loss.load() * 100.0);
   ImGui::Text("updates: %lld patches, %lld estimates", static_cast<long long>(m.patches.load()),
               static_cast<long long>(m.estimates.load()));
-  ImGui::Text("soil factor %.3f (remote says %.3f)", m.scale_applied.load(), m.scale_target.load());
+  // The soil: what the local model uses, and the remote's estimate with its
+  // uncertainty ("?" after a field its cuts have not identified).
+  auto mark = [&](int f) { return (m.identifiable.load() >> f) & 1u ? "" : " ?"; };
+  ImGui::Text("soil %.2f kN/m3, c %.2f, ca %.2f kPa", m.material_applied[0].load() * 1e-3,
+              m.material_applied[1].load() * 1e-3, m.material_applied[2].load() * 1e-3);
+  ImGui::Text("     phi %.1f, delta %.1f deg", m.material_applied[3].load(),
+              m.material_applied[4].load());
+  if (m.estimates.load() > 0) {
+    ImGui::TextDisabled("remote: %.2f+-%.2f%s c %.2f+-%.2f%s ca %.2f+-%.2f%s",
+                        m.estimate[0].load() * 1e-3, m.estimate_sd[0].load() * 1e-3, mark(0),
+                        m.estimate[1].load() * 1e-3, m.estimate_sd[1].load() * 1e-3, mark(1),
+                        m.estimate[2].load() * 1e-3, m.estimate_sd[2].load() * 1e-3, mark(2));
+    ImGui::TextDisabled("        phi %.1f+-%.1f%s delta %.1f+-%.1f%s", m.estimate[3].load(),
+                        m.estimate_sd[3].load(), mark(3), m.estimate[4].load(),
+                        m.estimate_sd[4].load(), mark(4));
+  }
   ImGui::Text("force error %.1f N RMS (remote %.1f N)", m.force_error_rms_n.load(),
               m.remote_force_n.load());
   if (m.rejected.load() > 0)

@@ -50,7 +50,20 @@ void bind_mmt(py::module_& m) {
         d["max_update_step_n"] = s.max_update_step_n;
         d["passivity_max_mmt_j"] = s.passivity_max_mmt_j;
         d["passivity_max_dfr_j"] = s.passivity_max_dfr_j;
-        d["force_scale_final"] = s.force_scale_final;
+        d["force_error_rel_mmt_after_1s"] = s.force_error_rel_mmt_after_1s;
+        d["force_error_rel_dfr_after_1s"] = s.force_error_rel_dfr_after_1s;
+        d["reidentified_after_s"] = s.reidentified_after_s;
+        d["estimate"] = material_dict(s.estimate.material);
+        py::dict sd;
+        py::list identifiable;
+        for (int f = 0; f < kSoilFieldCount; ++f) {
+          const std::string name(to_string(SoilField(f)));
+          sd[py::str(name)] = s.estimate.sd[std::size_t(f)];
+          if (s.estimate.is_identifiable(SoilField(f))) identifiable.append(name);
+        }
+        d["estimate_sd"] = sd;
+        d["estimate_identifiable"] = identifiable;
+        d["remote_material"] = material_dict(s.remote_material);
         return d;
       }, py::arg("scenario"), py::arg("out_dir") = py::none(), py::arg("rtt_s") = py::none(),
       py::arg("loss") = py::none(), py::arg("deadband") = py::none(), py::arg("seed") = py::none(),

@@ -268,6 +268,14 @@ void Simulation::remove_listener(StepListener& listener) {
   listeners_.erase(std::remove(listeners_.begin(), listeners_.end(), &listener), listeners_.end());
 }
 
+void Simulation::set_force_material(const SoilMaterial& material) {
+  if (in_step_) throw std::logic_error("Simulation::set_force_material: not during a step");
+  EarthmovingParams p = tool_params_.earthmoving;
+  p.soil = material;
+  if (std::string e = validate(p); !e.empty()) throw InputError(e);
+  tool_params_.earthmoving.soil = material;
+}
+
 void Simulation::reset() {
   grid_.reset();
   if (soil_) {
@@ -280,6 +288,7 @@ void Simulation::reset() {
     soil_->set_obstacles(obstacles);
     soil_->set_ceiling(ceiling);
   }
+  tool_params_ = tool_force_params(params_);
   has_previous_ = false;
   has_previous_velocity_ = false;
   heading_ = {};

@@ -169,7 +169,8 @@ void Pacer::record_compute(double compute_s) { recorded_compute_s_ = compute_s >
 
 double Pacer::end_tick() {
   const double end = clock_->now_s();
-  compute_.record(recorded_compute_s_ >= 0.0 ? recorded_compute_s_ : end - tick_.start_s);
+  last_compute_s_ = recorded_compute_s_ >= 0.0 ? recorded_compute_s_ : end - tick_.start_s;
+  compute_.record(last_compute_s_);
   recorded_compute_s_ = -1.0;
   ++ticks_;
   return end;
@@ -207,6 +208,10 @@ Tick Pacer::wait_next() {
     // The work ran past this deadline: start at once, on the latest slot
     // that has begun, and drop the slots that passed entirely.
     ++missed_;
+    // Why: the work alone took longer than a period, or the tick had
+    // started late (woken late, or after an overrun) and its work, shorter
+    // than a period, still ended past the deadline.
+    if (last_compute_s_ > period_s_) ++missed_by_compute_;
     std::int64_t latest = std::int64_t(std::floor((end - origin_s_) / period_s_));
     latest = std::max(latest, slot);
     while (origin_s_ + double(latest) * period_s_ > end && latest > slot) --latest;  // rounding
@@ -238,6 +243,8 @@ LoopStats Pacer::stats() const {
   s.rate_hz = settings_.rate_hz;
   s.ticks = ticks_;
   s.missed_deadlines = missed_;
+  s.missed_by_compute = missed_by_compute_;
+  s.missed_by_late_start = missed_ - missed_by_compute_;
   s.skipped_slots = skipped_;
   s.compute = time_stats(compute_);
   s.period_jitter = time_stats(jitter_);
@@ -248,6 +255,7 @@ LoopStats Pacer::stats() const {
 void Pacer::reset_stats() {
   ticks_ = 0;
   missed_ = 0;
+  missed_by_compute_ = 0;
   skipped_ = 0;
   compute_.clear();
   jitter_.clear();

@@ -100,10 +100,14 @@ std::size_t encode_measurement(Header header, const Measurement& m, std::uint8_t
 std::size_t encode_estimate(Header header, const Estimate& e, std::uint8_t* out) noexcept {
   std::uint8_t* p = out + kHeaderSize;
   put_f64(p + 0, e.t_s);
-  put_f64(p + 8, e.force_scale);
-  put_f64(p + 16, e.variance);
-  put_u32(p + 24, e.samples);
-  put_u32(p + 28, e.flags);
+  put_f64(p + 8, e.material.unit_weight_n_per_m3);
+  put_f64(p + 16, e.material.cohesion_pa);
+  put_f64(p + 24, e.material.adhesion_pa);
+  put_f64(p + 32, e.material.internal_friction_deg);
+  put_f64(p + 40, e.material.soil_tool_friction_deg);
+  for (std::size_t i = 0; i < e.sd.size(); ++i) put_f64(p + 48 + 8 * i, e.sd[i]);
+  put_u32(p + 88, e.samples);
+  put_u32(p + 92, e.identifiable);
   return finish(header, MessageType::kEstimate, kEstimatePayloadSize, out);
 }
 
@@ -221,13 +225,20 @@ Reject decode_estimate(const std::uint8_t* data, std::size_t, Estimate& out) noe
   if (payload_size(data) != kEstimatePayloadSize) return Reject::kBadLength;
   const std::uint8_t* p = payload_of(data);
   out.t_s = get_f64(p + 0);
-  out.force_scale = get_f64(p + 8);
-  out.variance = get_f64(p + 16);
-  out.samples = get_u32(p + 24);
-  out.flags = get_u32(p + 28);
-  if (!std::isfinite(out.t_s) || !(out.force_scale > 0.0) || !std::isfinite(out.force_scale) ||
-      !std::isfinite(out.variance) || out.variance < 0.0)
-    return Reject::kBadPayload;
+  out.material = SoilMaterial{};
+  out.material.unit_weight_n_per_m3 = get_f64(p + 8);
+  out.material.cohesion_pa = get_f64(p + 16);
+  out.material.adhesion_pa = get_f64(p + 24);
+  out.material.internal_friction_deg = get_f64(p + 32);
+  out.material.soil_tool_friction_deg = get_f64(p + 40);
+  for (std::size_t i = 0; i < out.sd.size(); ++i) out.sd[i] = get_f64(p + 48 + 8 * i);
+  out.samples = get_u32(p + 88);
+  out.identifiable = get_u32(p + 92);
+  // A material the scenario reader would refuse (core/material.hpp's
+  // ranges), a negative or non-finite uncertainty: no estimate.
+  if (!std::isfinite(out.t_s) || !validate(out.material).empty()) return Reject::kBadPayload;
+  for (double sd : out.sd)
+    if (!std::isfinite(sd) || sd < 0.0) return Reject::kBadPayload;
   return Reject::kNone;
 }
 

@@ -58,18 +58,20 @@ Json json_percentiles(const TimePercentiles& s) {
 
 }  // namespace
 
+std::vector<int> followed_cuts(const Scenario& scenario, const HapticSettings& settings) {
+  const io::Scenario& sc = scenario.base;
+  if (settings.cut.empty()) return sc.sequence;
+  const int index = sc.find_cut(settings.cut);
+  return index < 0 ? std::vector<int>{} : std::vector<int>{index};
+}
+
 DevicePath followed_path(const Scenario& scenario, const HapticSettings& settings,
                          const std::string& source, std::optional<double> rate_hz) {
   const io::Scenario& sc = scenario.base;
   std::vector<Motion> strokes;
-  if (!settings.cut.empty()) {
-    const int index = sc.find_cut(settings.cut);
-    if (index < 0)
-      throw InputError(source + ": haptics.cut: no cut named '" + settings.cut + "' in the scenario");
-    strokes.push_back(sc.cuts[std::size_t(index)]);
-  } else {
-    for (int index : sc.sequence) strokes.push_back(sc.cuts[std::size_t(index)]);
-  }
+  for (int index : followed_cuts(scenario, settings)) strokes.push_back(sc.cuts[std::size_t(index)]);
+  if (strokes.empty() && !settings.cut.empty())
+    throw InputError(source + ": haptics.cut: no cut named '" + settings.cut + "' in the scenario");
   if (strokes.empty())
     throw InputError(source + ": haptics.cut: the " + std::string(to_string(settings.device)) +
                      " device follows a cut, and the scenario has none");
@@ -250,9 +252,23 @@ std::vector<std::string> HapticSession::run_warnings() const {
                 " device samples were not finite (ignored, answered with zero force)");
   if (s.nonfinite > 0)
     w.push_back(std::to_string(s.nonfinite) + " non-finite forces were replaced by zero");
-  if (c.missed_deadlines > 0)
-    w.push_back(std::to_string(c.missed_deadlines) +
-                " ticks started late: the tick before ran past their deadline (see timing_us)");
+  if (c.missed_deadlines > 0) {
+    // Say which it was: a tick whose work took longer than a period, or a
+    // tick that had itself started late (the OS woke the loop late) and
+    // ran past the next deadline with less work than a period.
+    const LoopStats& ps = l.pacer_stats();
+    std::string why;
+    if (ps.missed_by_compute > 0)
+      why += std::to_string(ps.missed_by_compute) + " after a tick that computed longer than a period (" +
+             format_number(std::round(ps.compute.max_s * 1e7) / 10.0) + " us at most; timing_us.compute)";
+    if (ps.missed_by_late_start > 0)
+      why += std::string(why.empty() ? "" : ", ") + std::to_string(ps.missed_by_late_start) +
+             " after a tick that had started late and computed less than a period (the OS woke the "
+             "loop up to " + format_number(std::round(ps.wake_latency.max_s * 1e7) / 10.0) +
+             " us after its deadline; timing_us.wake_latency)";
+    w.push_back(std::to_string(c.missed_deadlines) + " ticks started late: " +
+                (why.empty() ? std::string("the tick before ran past their deadline") : why));
+  }
   // The waits before the device's first sample and after its last are
   // expected (the safety limiter holds zero force then); a silence in between
   // is not.
@@ -315,6 +331,8 @@ std::string HapticSession::summary_json() const {
                     {"wake_latency", json_percentiles(ps.wake_latency)},
                     {"period", json_percentiles(l.period())},
                     {"missed_deadlines", ps.missed_deadlines},
+                    {"missed_by_compute", ps.missed_by_compute},
+                    {"missed_by_late_start", ps.missed_by_late_start},
                     {"skipped_slots", ps.skipped_slots}};
   j["loop"] = {{"samples", c.samples},           {"silent_ticks", c.silent_ticks},
                {"bad_samples", c.bad_samples},   {"reconnects", c.reconnects},

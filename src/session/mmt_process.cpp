@@ -292,11 +292,10 @@ int run_remote_process(const Scenario& op, const ProcessOptions& o) {
   j["link"] = link_json(s.to_operator);
   j["udp"] = udp_json(*carrier, o.key);
   j["connections"] = carrier->counters().connections;
-  j["force_scale"] = station.force_scale();
-  j["estimate"] = {{"force_scale", station.force_scale()},
-                   {"samples", station.estimate_samples()},
-                   {"outliers_left_out", station.estimate_outliers()},
-                   {"capped_left_out", station.estimate_capped()}};
+  j["estimate"] = detail::estimate_json(station.estimate(), &station.true_material());
+  j["remote_arm"] = {{"force_limit_n", s.arm_force_limit_n},
+                     {"follower_time_constant_s", s.follower_time_constant_s},
+                     {"stalled_ticks", station.stalled_ticks()}};
   j["worked"] = rect_json(station.worked());
   write_json(o.out / "summary.json", j);
   // What the remote's camera sees at the end: the report's terrain error.
@@ -378,6 +377,7 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
   csv.finish();
   nlohmann::ordered_json j = station_json(station.counters(), *udp.endpoint, ran);
   j["role"] = "operator";
+  j["rate_hz"] = station.rate_hz();
   j["ended"] = {{"how", to_string(ended)}, {"t_s", ran}};
   j["link"] = link_json(s.to_remote);
   j["round_trip"] = {{"measured_s", station.rtt_s()},
@@ -395,6 +395,7 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
   j["udp"] = udp_json(carrier, o.key);
   j["max_force_step_at_update_n"] = station.max_update_step_n();
   j["max_force_step_while_updating_n"] = station.max_step_while_updating_n();
+  j["material_applied"] = detail::material_json(station.simulation().force_material());
   j["passivity_max_energy_into_hand_j"] = passivity;
   j["worked"] = rect_json(station.worked());
   write_json(o.out / "summary.json", j);

@@ -81,10 +81,21 @@ Table read_table(const std::filesystem::path& path) {
   return t;
 }
 
+// The five fields of a material from five columns, first at `at`.
+SoilMaterial material_at(const std::vector<double>& r, std::size_t at) {
+  SoilMaterial m;
+  m.unit_weight_n_per_m3 = r[at];
+  m.cohesion_pa = r[at + 1];
+  m.adhesion_pa = r[at + 2];
+  m.internal_friction_deg = r[at + 3];
+  m.soil_tool_friction_deg = r[at + 4];
+  return m;
+}
+
 std::vector<OperatorRecord> operator_records(const Table& t) {
   const std::size_t ct = t.at("t"), x = t.at("x"), fx = t.at("fx"), fdx = t.at("fdx"),
-                    rfx = t.at("remote_fx"), cl = t.at("contact_length"), sa = t.at("scale_applied"),
-                    st = t.at("scale_target"), up = t.at("updating"), ls = t.at("link_silent"),
+                    rfx = t.at("remote_fx"), cl = t.at("contact_length"), uw = t.at("unit_weight"),
+                    mb = t.at("material_blend"), up = t.at("updating"), ls = t.at("link_silent"),
                     pj = t.at("passivity_j"), pd = t.at("passivity_dfr_j"), cu = t.at("compute_us"),
                     cs = t.at("command_sequence"), rt = t.at("round_trip_s"), lo = t.at("command_loss");
   std::vector<OperatorRecord> out;
@@ -97,8 +108,8 @@ std::vector<OperatorRecord> operator_records(const Table& t) {
     o.force_device_n = {r[fdx], r[fdx + 1], r[fdx + 2]};
     o.remote_force_world_n = {r[rfx], r[rfx + 1], r[rfx + 2]};
     o.contact_length_m = r[cl];
-    o.scale_applied = r[sa];
-    o.scale_target = r[st];
+    o.material = material_at(r, uw);
+    o.material_blend = r[mb];
     o.updating = r[up] != 0.0;
     o.link_silent = r[ls] != 0.0;
     o.passivity_j = r[pj];
@@ -115,8 +126,10 @@ std::vector<OperatorRecord> operator_records(const Table& t) {
 std::vector<RemoteRecord> remote_records(const Table& t) {
   const std::size_t ct = t.at("t"), cs = t.at("command_sequence"), cx = t.at("cmd_x"), x = t.at("x"),
                     fx = t.at("fx"), cl = t.at("contact_length"), cd = t.at("cut_depth"),
-                    fs = t.at("force_scale"), ho = t.at("holding"), ac = t.at("active"),
-                    cu = t.at("compute_us");
+                    eu = t.at("est_unit_weight"), su = t.at("sd_unit_weight"), id = t.at("identifiable"),
+                    es = t.at("estimate_samples"), ee = t.at("estimate_error"),
+                    ic = t.at("in_changed_soil"), st = t.at("stalled"), ho = t.at("holding"),
+                    ac = t.at("active"), cu = t.at("compute_us");
   std::vector<RemoteRecord> out;
   out.reserve(t.rows.size());
   for (const auto& r : t.rows) {
@@ -128,7 +141,14 @@ std::vector<RemoteRecord> remote_records(const Table& t) {
     o.force_world_n = {r[fx], r[fx + 1], r[fx + 2]};
     o.contact_length_m = r[cl];
     o.cut_depth_m = r[cd];
-    o.force_scale = r[fs];
+    o.estimate.material = material_at(r, eu);
+    for (std::size_t f = 0; f < std::size_t(kSoilFieldCount); ++f) o.estimate.sd[f] = r[su + f];
+    o.estimate.identifiable = std::uint32_t(std::llround(r[id]));
+    o.estimate.samples = std::llround(r[es]);
+    o.estimate.known = o.estimate.samples > 0;
+    o.estimate_error = r[ee];
+    o.in_changed_soil = r[ic] != 0.0;
+    o.stalled = r[st] != 0.0;
     o.holding = r[ho] != 0.0;
     o.active = r[ac] != 0.0;
     o.compute_s = r[cu] * 1e-6;
@@ -185,22 +205,47 @@ net::RejectCounts rejected_of(const nlohmann::ordered_json& j) {
 }  // namespace
 
 void compare_records(const std::vector<OperatorRecord>& op, const std::vector<RemoteRecord>& rm,
-                     MmtSummary& s) {
-  std::vector<double> e_mmt, e_dfr, f_rem;
+                     double rate_hz, double follower_lag_s, MmtSummary& s) {
+  const std::size_t lag = std::size_t(std::max<long long>(0, std::llround(follower_lag_s * rate_hz)));
+  s.aligned_after_s = double(lag) / rate_hz;
+  // The remote's cutting: from its first tick with a cut on.
+  double first_cut_s = -1.0, change_s = -1.0;
+  for (const RemoteRecord& r : rm) {
+    if (first_cut_s < 0.0 && r.active && r.cut_depth_m > 0.0 && r.estimate_error >= 0.0)
+      first_cut_s = r.t_s;
+    if (change_s < 0.0 && r.in_changed_soil) change_s = r.t_s;
+  }
+  s.cutting_from_s = first_cut_s < 0.0 ? -1.0 : first_cut_s + 1.0;
+  s.settle_excluded_from_s = s.settle_excluded_to_s = 0.0;
+  if (change_s >= 0.0) {
+    s.settle_excluded_from_s = change_s;
+    s.settle_excluded_to_s = change_s + s.rtt_s + 0.5;
+  }
+  std::vector<double> e_mmt, e_dfr, f_rem, e_mmt1, e_dfr1, f_rem1;
   std::size_t j = 0;  // the remote's first tick that followed command i (or a newer one)
   for (std::size_t i = 0; i < op.size(); ++i) {
     const std::uint32_t q = op[i].command_sequence;
     while (j < rm.size() && !(rm[j].active && std::int32_t(rm[j].command_sequence - q) >= 0)) ++j;
-    if (j >= rm.size()) break;
+    if (j + lag >= rm.size()) break;
+    const RemoteRecord& r = rm[j + lag];
     // Over the ticks where some force is felt or measured: the time in
     // soil, not the idle time before and after, so that runs of different
     // lengths compare.
     if (length(op[i].force_world_n) == 0.0 && length(op[i].remote_force_world_n) == 0.0 &&
-        length(rm[j].force_world_n) == 0.0)
+        length(r.force_world_n) == 0.0)
       continue;
-    e_mmt.push_back(length(op[i].force_world_n - rm[j].force_world_n));
-    e_dfr.push_back(length(op[i].remote_force_world_n - rm[j].force_world_n));
-    f_rem.push_back(length(rm[j].force_world_n));
+    const double em = length(op[i].force_world_n - r.force_world_n);
+    const double ed = length(op[i].remote_force_world_n - r.force_world_n);
+    const double fr = length(r.force_world_n);
+    e_mmt.push_back(em);
+    e_dfr.push_back(ed);
+    f_rem.push_back(fr);
+    if (first_cut_s >= 0.0 && r.t_s >= s.cutting_from_s &&
+        !(change_s >= 0.0 && r.t_s >= s.settle_excluded_from_s && r.t_s < s.settle_excluded_to_s)) {
+      e_mmt1.push_back(em);
+      e_dfr1.push_back(ed);
+      f_rem1.push_back(fr);
+    }
   }
   s.force_rms_remote_n = rms_of(f_rem);
   s.force_error_rms_mmt_n = rms_of(e_mmt);
@@ -208,6 +253,29 @@ void compare_records(const std::vector<OperatorRecord>& op, const std::vector<Re
   s.force_error_max_mmt_n = s.force_error_max_dfr_n = 0.0;
   for (double e : e_mmt) s.force_error_max_mmt_n = std::max(s.force_error_max_mmt_n, e);
   for (double e : e_dfr) s.force_error_max_dfr_n = std::max(s.force_error_max_dfr_n, e);
+  s.force_rms_remote_after_1s_n = rms_of(f_rem1);
+  s.force_error_rms_mmt_after_1s_n = rms_of(e_mmt1);
+  s.force_error_rms_dfr_after_1s_n = rms_of(e_dfr1);
+  // A window with less than 0.1 s of the remote cutting (a change of soil
+  // whose left-out round trip reaches past the end of the cut) has no
+  // figure: -1.
+  std::size_t cutting_ticks = 0;
+  for (double f : f_rem1) cutting_ticks += f > 1.0;
+  s.force_error_rel_mmt_after_1s = s.force_error_rel_dfr_after_1s = -1.0;
+  if (s.force_rms_remote_after_1s_n > 0.0 && double(cutting_ticks) >= 0.1 * rate_hz) {
+    s.force_error_rel_mmt_after_1s = s.force_error_rms_mmt_after_1s_n / s.force_rms_remote_after_1s_n;
+    s.force_error_rel_dfr_after_1s = s.force_error_rms_dfr_after_1s_n / s.force_rms_remote_after_1s_n;
+  }
+  // Re-identification: from the blade entering the new soil to the last
+  // tick, while it cuts, whose estimate was more than 5 % off the measured
+  // horizontal force.
+  s.reidentified_after_s = -1.0;
+  if (change_s >= 0.0) {
+    double last_off_s = change_s;
+    for (const RemoteRecord& r : rm)
+      if (r.t_s >= change_s && r.estimate_error > 0.05) last_off_s = r.t_s;
+    s.reidentified_after_s = last_off_s - change_s;
+  }
   std::vector<double> track;
   for (const RemoteRecord& r : rm)
     if (r.active) track.push_back(length(r.tool_m - r.commanded_m));
@@ -219,7 +287,7 @@ void compare_records(const std::vector<OperatorRecord>& op, const std::vector<Re
     s.passivity_max_mmt_j = std::max(s.passivity_max_mmt_j, r.passivity_j);
     s.passivity_max_dfr_j = std::max(s.passivity_max_dfr_j, r.passivity_dfr_j);
   }
-  s.force_scale_applied = op.empty() ? 1.0 : op.back().scale_applied;
+  if (!op.empty()) s.material_applied = op.back().material;
   std::vector<double> c;
   for (const OperatorRecord& r : op) c.push_back(r.compute_s);
   s.operator_compute = timing_stats(c);
@@ -252,7 +320,8 @@ nlohmann::ordered_json summary_json(const MmtSummary& s) {
                       {"mmt_max_n", s.force_error_max_mmt_n},
                       {"direct_rms_n", s.force_error_rms_dfr_n},
                       {"direct_max_n", s.force_error_max_dfr_n},
-                      {"aligned_by", "command_sequence"}};
+                      {"aligned_by", "command_sequence"},
+                      {"aligned_after_s", s.aligned_after_s}};
   j["terrain_error"] = {{"final_rms_m", s.terrain_rms_final_m}, {"max_rms_m", s.terrain_rms_max_m}};
   j["tracking"] = {{"rms_m", s.tracking_rms_m}, {"max_m", s.tracking_max_m}};
   j["traffic"] = {{"to_remote_packets_per_s", s.packets_per_s_to_remote},
@@ -268,11 +337,18 @@ nlohmann::ordered_json summary_json(const MmtSummary& s) {
                   {"estimates_applied", s.estimates_applied},
                   {"max_force_step_at_update_n", s.max_update_step_n},
                   {"max_force_step_while_updating_n", s.max_step_while_updating_n}};
-  j["estimate"] = {{"force_scale", s.force_scale_final},
-                   {"force_scale_applied", s.force_scale_applied},
-                   {"samples", s.estimate_samples},
-                   {"outliers_left_out", s.estimate_outliers},
-                   {"capped_left_out", s.estimate_capped}};
+  j["force_error_after_1s"] = {{"from_s", s.cutting_from_s},
+                               {"left_out_from_s", s.settle_excluded_from_s},
+                               {"left_out_to_s", s.settle_excluded_to_s},
+                               {"remote_force_rms_n", s.force_rms_remote_after_1s_n},
+                               {"mmt_rms_n", s.force_error_rms_mmt_after_1s_n},
+                               {"direct_rms_n", s.force_error_rms_dfr_after_1s_n},
+                               {"mmt_relative", s.force_error_rel_mmt_after_1s},
+                               {"direct_relative", s.force_error_rel_dfr_after_1s}};
+  j["estimate"] = detail::estimate_json(s.estimate, &s.remote_material);
+  j["estimate"]["material_applied_by_operator"] = detail::material_json(s.material_applied);
+  j["estimate"]["reidentified_after_s"] = s.reidentified_after_s;
+  j["remote_arm"] = {{"force_limit_n", s.arm_force_limit_n}, {"stalled_ticks", s.stalled_ticks}};
   j["passivity"] = {{"window_s", 1.0},
                     {"mmt_max_energy_into_hand_j", s.passivity_max_mmt_j},
                     {"direct_max_energy_into_hand_j", s.passivity_max_dfr_j}};
@@ -298,7 +374,8 @@ MmtSummary write_two_process_report(const std::filesystem::path& operator_dir,
   s.rtt_s = number_at<double>(js_op, operator_dir, {"round_trip", "emulated_s"});
   s.rtt_measured_s = number_at<double>(js_op, operator_dir, {"round_trip", "measured_s"});
   s.loss = number_at<double>(js_op, operator_dir, {"link", "loss"});
-  compare_records(op, rm, s);
+  compare_records(op, rm, number_at<double>(js_op, operator_dir, {"rate_hz"}),
+                  number_at<double>(js_rm, remote_dir, {"remote_arm", "follower_time_constant_s"}), s);
   // The terrain at the end: the local model against what the remote's camera
   // saw, over every sample either station worked.
   int rows_a = 0, cols_a = 0, rows_b = 0, cols_b = 0;
@@ -340,10 +417,14 @@ MmtSummary write_two_process_report(const std::filesystem::path& operator_dir,
   (void)d_op;
   s.max_update_step_n = number_at<double>(js_op, operator_dir, {"max_force_step_at_update_n"});
   s.max_step_while_updating_n = number_at<double>(js_op, operator_dir, {"max_force_step_while_updating_n"});
-  s.force_scale_final = number_at<double>(js_rm, remote_dir, {"estimate", "force_scale"});
-  s.estimate_samples = number_at<std::int64_t>(js_rm, remote_dir, {"estimate", "samples"});
-  s.estimate_outliers = number_at<std::int64_t>(js_rm, remote_dir, {"estimate", "outliers_left_out"});
-  s.estimate_capped = number_at<std::int64_t>(js_rm, remote_dir, {"estimate", "capped_left_out"});
+  if (!js_rm.contains("estimate")) throw InputError((remote_dir / "summary.json").string() + ": no estimate");
+  s.estimate = detail::estimate_from_json(js_rm["estimate"], remote_dir / "summary.json", &s.remote_material);
+  // The station's own figure (its CSV rounds to 9 digits).
+  if (!js_op.contains("material_applied"))
+    throw InputError((operator_dir / "summary.json").string() + ": no material_applied");
+  s.material_applied = detail::material_from_json(js_op["material_applied"], operator_dir / "summary.json");
+  s.arm_force_limit_n = number_at<double>(js_rm, remote_dir, {"remote_arm", "force_limit_n"});
+  s.stalled_ticks = number_at<std::int64_t>(js_rm, remote_dir, {"remote_arm", "stalled_ticks"});
   s.rejected_operator = rejected_of(js_op);
   s.rejected_remote = rejected_of(js_rm);
 

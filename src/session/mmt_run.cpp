@@ -65,11 +65,13 @@ namespace {
 
 constexpr const char* kOperatorCsvHeader =
     "t,x,y,z,fx,fy,fz,fdx,fdy,fdz,remote_fx,remote_fy,remote_fz,contact_length,"
-    "scale_applied,scale_target,updating,link_silent,passivity_j,passivity_dfr_j,"
-    "compute_us,command_sequence,round_trip_s,command_loss";
+    "unit_weight,cohesion,adhesion,phi,delta,material_blend,updating,link_silent,passivity_j,"
+    "passivity_dfr_j,compute_us,command_sequence,round_trip_s,command_loss";
 constexpr const char* kRemoteCsvHeader =
     "t,command_sequence,cmd_x,cmd_y,cmd_z,x,y,z,fx,fy,fz,contact_length,cut_depth,"
-    "force_scale,holding,active,compute_us";
+    "est_unit_weight,est_cohesion,est_adhesion,est_phi,est_delta,sd_unit_weight,sd_cohesion,"
+    "sd_adhesion,sd_phi,sd_delta,identifiable,estimate_samples,estimate_error,in_changed_soil,"
+    "stalled,holding,active,compute_us";
 
 }  // namespace
 
@@ -103,22 +105,43 @@ StationCsv StationCsv::remote_csv(const std::filesystem::path& path) {
 }
 
 void StationCsv::add(const OperatorRecord& r) {
+  const SoilMaterial& m = r.material;
   file_->row({r.t_s, r.tool_m.x, r.tool_m.y, r.tool_m.z, r.force_world_n.x, r.force_world_n.y,
               r.force_world_n.z, r.force_device_n.x, r.force_device_n.y, r.force_device_n.z,
               r.remote_force_world_n.x, r.remote_force_world_n.y, r.remote_force_world_n.z,
-              r.contact_length_m, r.scale_applied, r.scale_target, r.updating, r.link_silent,
-              r.passivity_j, r.passivity_dfr_j, r.compute_s * 1e6, r.command_sequence,
-              r.round_trip_s, r.command_loss});
+              r.contact_length_m, m.unit_weight_n_per_m3, m.cohesion_pa, m.adhesion_pa,
+              m.internal_friction_deg, m.soil_tool_friction_deg, r.material_blend, r.updating,
+              r.link_silent, r.passivity_j, r.passivity_dfr_j, r.compute_s * 1e6,
+              r.command_sequence, r.round_trip_s, r.command_loss});
 }
 
 void StationCsv::add(const RemoteRecord& r) {
+  const SoilMaterial& m = r.estimate.material;
+  const auto& sd = r.estimate.sd;
+  static_assert(kSoilFieldCount == 5, "the header names five standard uncertainties");
   file_->row({r.t_s, r.command_sequence, r.commanded_m.x, r.commanded_m.y, r.commanded_m.z,
               r.tool_m.x, r.tool_m.y, r.tool_m.z, r.force_world_n.x, r.force_world_n.y,
-              r.force_world_n.z, r.contact_length_m, r.cut_depth_m, r.force_scale, r.holding,
-              r.active, r.compute_s * 1e6});
+              r.force_world_n.z, r.contact_length_m, r.cut_depth_m, m.unit_weight_n_per_m3,
+              m.cohesion_pa, m.adhesion_pa, m.internal_friction_deg, m.soil_tool_friction_deg,
+              sd[0], sd[1], sd[2], sd[3], sd[4], r.estimate.identifiable, r.estimate.samples,
+              r.estimate_error, r.in_changed_soil, r.stalled, r.holding, r.active,
+              r.compute_s * 1e6});
 }
 
 void StationCsv::finish() { file_->close(); }
+
+StationPair make_station_pair(const Scenario& op, const Scenario& remote, const MmtSettings& settings,
+                              haptics::Device& device, const OperatorOptions& operator_options,
+                              const RemoteOptions& remote_options) {
+  StationPair p;
+  p.link = std::make_unique<net::EmulatedLink>(settings.to_remote, settings.to_operator);
+  p.operator_station =
+      std::make_unique<OperatorStation>(op, settings, device, p.link->a(), 1u, operator_options);
+  p.remote_station = std::make_unique<RemoteStation>(remote, settings, op.base.soil.material,
+                                                     p.operator_station->simulation().grid(),
+                                                     p.link->b(), 2u, remote_options);
+  return p;
+}
 
 MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
   if (!op.mmt) throw InputError(no_mmt_section(op));
@@ -134,10 +157,10 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
                      ": haptics.device: a real device over udp runs in real time: run the "
                      "stations as two processes (--role remote / --role operator)");
   device_ = make_operator_device(*op_);
-  link_ = std::make_unique<net::EmulatedLink>(settings_.to_remote, settings_.to_operator);
-  operator_ = std::make_unique<OperatorStation>(*op_, settings_, *device_, link_->a(), 1u);
-  remote_ = std::make_unique<RemoteStation>(*remote_scn_, settings_, op_->base.soil.material,
-                                            operator_->simulation().grid(), link_->b(), 2u);
+  StationPair pair = make_station_pair(*op_, *remote_scn_, settings_, *device_);
+  link_ = std::move(pair.link);
+  operator_ = std::move(pair.operator_station);
+  remote_ = std::move(pair.remote_station);
   rate_hz_ = operator_->rate_hz();
   // After the path: a round trip, a sensing period and a blend for the last
   // updates to land, and on a lossy link three retransmissions more.
@@ -205,7 +228,8 @@ MmtSummary MmtRun::summary() const {
   s.rtt_measured_s = operator_->rtt_s();
   s.loss = settings_.to_remote.loss;
   s.deadband = settings_.deadband;
-  compare_records(operator_->records(), remote_->records(), s);
+  compare_records(operator_->records(), remote_->records(), rate_hz_,
+                  settings_.follower_time_constant_s, s);
   for (const auto& [t, e] : terrain_error_) s.terrain_rms_max_m = std::max(s.terrain_rms_max_m, e);
   s.terrain_rms_final_m = terrain_error_.empty() ? 0.0 : terrain_error_.back().second;
   const double d = std::max(s.duration_s, 1e-9);
@@ -224,10 +248,11 @@ MmtSummary MmtRun::summary() const {
   s.update_packets_per_s = double(remote_->update_packets()) / d;
   s.max_update_step_n = operator_->max_update_step_n();
   s.max_step_while_updating_n = operator_->max_step_while_updating_n();
-  s.force_scale_final = remote_->force_scale();
-  s.estimate_samples = remote_->estimate_samples();
-  s.estimate_outliers = remote_->estimate_outliers();
-  s.estimate_capped = remote_->estimate_capped();
+  s.estimate = remote_->estimate();
+  s.remote_material = remote_->true_material();
+  s.material_applied = operator_->simulation().force_material();
+  s.arm_force_limit_n = settings_.arm_force_limit_n;
+  s.stalled_ticks = remote_->stalled_ticks();
   s.rejected_operator = operator_->counters().rejected;
   s.rejected_remote = remote_->counters().rejected;
   return s;
@@ -254,6 +279,15 @@ void MmtRun::write_outputs(const std::filesystem::path& dir) const {
   j["operator"] = {{"blend_s", settings_.blend_s},
                    {"max_update_step_n", settings_.max_update_step_n},
                    {"deadband", settings_.deadband}};
+  j["remote_soil"] = {{"material", detail::material_json(remote_->base_material())},
+                      {"changed_to", settings_.change_soil
+                                         ? detail::material_json(remote_->changed_material())
+                                         : nlohmann::ordered_json()},
+                      {"change_z_below_m", settings_.change_soil ? nlohmann::ordered_json(settings_.change_z_m)
+                                                                 : nlohmann::ordered_json()},
+                      {"changed_at_s", s.settle_excluded_from_s > 0.0
+                                           ? nlohmann::ordered_json(s.settle_excluded_from_s)
+                                           : nlohmann::ordered_json()}};
   j.update(summary_json(s));
   std::ofstream out = open_out(dir / "summary.json");
   out << j.dump(2) << "\n";

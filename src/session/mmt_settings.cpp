@@ -25,6 +25,9 @@ constexpr Range kRanges[] = {
     {"remote.sense_period_s", 0.0, 10.0, RangeEnds::kOpenLow},
     {"remote.sense_radius_m", 0.0, 100.0, RangeEnds::kOpenLow},
     {"remote.forgetting", 0.0, 1.0, RangeEnds::kOpenLow},
+    {"remote.estimate_period_s", 1e-6, 1.0, RangeEnds::kClosed},
+    {"remote.arm_force_limit_n", 0.0, 1e7, RangeEnds::kOpenLow},
+    {"remote.soil_change.z_below_m", -1e6, 1e6, RangeEnds::kClosed},
     {"link.seed", 0, 1e9, RangeEnds::kClosed, true},
     {"operator.blend_s", 0.0, 10.0, RangeEnds::kClosed},
     {"operator.max_update_step_n", 0.0, 100.0, RangeEnds::kOpenLow},
@@ -65,6 +68,9 @@ std::string validate(const MmtSettings& s) {
   if (!(m = check("remote.sense_period_s", s.sense_period_s)).empty()) return m;
   if (!(m = check("remote.sense_radius_m", s.sense_radius_m)).empty()) return m;
   if (!(m = check("remote.forgetting", s.forgetting)).empty()) return m;
+  if (!(m = check("remote.estimate_period_s", s.estimate_period_s)).empty()) return m;
+  if (!(m = check("remote.arm_force_limit_n", s.arm_force_limit_n)).empty()) return m;
+  if (!(m = check("remote.soil_change.z_below_m", s.change_z_m)).empty()) return m;
   if (std::string p = net::validate(s.to_remote); !p.empty()) return "link." + p;
   if (std::string p = net::validate(s.to_operator); !p.empty()) return "link." + p;
   if (!(m = check("operator.blend_s", s.blend_s)).empty()) return m;
@@ -93,7 +99,8 @@ void MmtReader::read(const YAML::Node& value, const std::string& file) {
   const yaml::Map remote =
       top.section("remote", {"scenario", "soil", "follower_speed_m_per_s",
                              "follower_time_constant_s", "sense_period_s",
-                             "sense_radius_m", "estimate", "forgetting"});
+                             "sense_radius_m", "estimate", "forgetting",
+                             "estimate_period_s", "arm_force_limit_n", "soil_change"});
   if (const auto f = remote.get("scenario")) {
     const std::filesystem::path p = f->text();
     s.remote_scenario = p.is_absolute() ? p : std::filesystem::path(file).parent_path() / p;
@@ -101,6 +108,18 @@ void MmtReader::read(const YAML::Node& value, const std::string& file) {
   if (const auto f = remote.get("soil"))
     s.remote_soil = f->choice({SoilPreset::kDrySand, SoilPreset::kLooseSand, SoilPreset::kClay,
                                SoilPreset::kGravel});
+  const yaml::Map change = remote.section("soil_change", {"z_below_m", "soil"});
+  if (const auto f = change.get("soil")) {
+    s.change_soil = f->choice({SoilPreset::kDrySand, SoilPreset::kLooseSand, SoilPreset::kClay,
+                               SoilPreset::kGravel});
+    const auto z = change.get("z_below_m");
+    if (!z) f->fail("soil_change needs z_below_m: where along z the soil changes");
+    s.change_z_m = z->number();
+  } else if (change.get("z_below_m")) {
+    change.get("z_below_m")->fail("soil_change needs soil: the soil beyond z_below_m");
+  }
+  remote.read_number("estimate_period_s", s.estimate_period_s);
+  remote.read_number("arm_force_limit_n", s.arm_force_limit_n);
   remote.read_number("follower_speed_m_per_s", s.follower_speed_m_per_s);
   remote.read_number("follower_time_constant_s", s.follower_time_constant_s);
   remote.read_number("sense_period_s", s.sense_period_s);

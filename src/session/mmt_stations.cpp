@@ -16,8 +16,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-Vec3 horizontal(Vec3 v) { return {v.x, 0.0, v.z}; }
-
 std::uint64_t to_ns(double t_s) { return std::uint64_t(std::llround(std::max(0.0, t_s) * 1e9)); }
 
 // The loop's parameters of a scenario, with the scenario named in errors.
@@ -29,19 +27,11 @@ haptics::LoopParams loop_params(const Scenario& sc) {
   }
 }
 
-// The orientation of the first keyframe of the followed cut, or identity.
+// The orientation of the first keyframe of the followed cut, or identity
+// (a remote world with no cut of its own).
 Quat first_orientation(const Scenario& sc) {
-  const io::Scenario& b = sc.base;
-  const Motion* cut = nullptr;
-  if (!sc.haptics.cut.empty()) {
-    const int i = b.find_cut(sc.haptics.cut);
-    if (i >= 0) cut = &b.cuts[std::size_t(i)];
-  } else if (!b.sequence.empty()) {
-    cut = &b.cuts[std::size_t(b.sequence.front())];
-  } else if (!b.cuts.empty()) {
-    cut = &b.cuts.front();
-  }
-  return cut ? cut->keyframes.front().pose.orientation : Quat{};
+  const std::vector<int> cuts = followed_cuts(sc, sc.haptics);
+  return cuts.empty() ? Quat{} : sc.base.cuts[std::size_t(cuts.front())].keyframes.front().pose.orientation;
 }
 
 // Adds a rectangle to the rectangle of everything worked so far.
@@ -72,6 +62,14 @@ double in_flight_s(const net::LinkConditions& c) {
 
 constexpr std::size_t kInboxSlots = 32;  // datagrams arriving in one tick, made room for
 
+// The horizontal cutting force a material gives at a sample's cut, N.
+double predicted_horizontal_n(const SoilMaterial& m, const SoilSample& s) {
+  EarthmovingParams p;
+  p.soil = m;
+  p.rake_angle_deg = s.rake_deg;
+  return earthmoving_force(p, s.width_m, s.depth_m, m.unit_weight_n_per_m3 * s.pile_m).horizontal_n;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -97,10 +95,17 @@ class FollowerDevice final : public haptics::Device {
   }
   /// Link silent: stay where the arm is.
   void hold() { target_ = pose_; }
+  /// The arm's force limit reached: it does not move this tick (a stalled
+  /// arm holds where it is while the load exceeds what it can push).
+  void set_stalled(bool stalled) { stalled_ = stalled; }
   const BladePose& pose() const { return pose_; }
 
   bool read(double, haptics::DeviceSample& out) noexcept override {
     if (!has_pose_) return false;
+    if (stalled_) {
+      workspace_.fill_sample(pose_, out);
+      return true;
+    }
     // A first-order servo (time constant tau: the step is the error x dt /
     // tau), limited to the arm's speed.
     Vec3 d = (target_.position_m - pose_.position_m) * gain_;
@@ -119,6 +124,7 @@ class FollowerDevice final : public haptics::Device {
   double gain_;    // dt / tau, at most 1
   BladePose pose_{}, target_{};
   bool has_pose_ = false;
+  bool stalled_ = false;
 };
 
 // ---------------------------------------------------------------------------
@@ -156,58 +162,92 @@ class LinkGuardDevice final : public haptics::Device {
 };
 
 // ---------------------------------------------------------------------------
-// The soil estimate on the operator's side: the factor scales the soil's
-// horizontal cutting force before the low-speed cap, min(cap, factor x
-// soil), and the listener adds the difference from the model's own,
-// min(cap, soil), along it. Scaling after the cap would render factor x cap
-// where both worlds give the cap (a slow tool). The factor applied moves
-// toward the remote's estimate by at most max_update_step_n of device force
-// per tick. It reads the model's force of the previous tick (the loop
-// computes this tick's after the listeners): one tick late, well inside
-// the blend.
+// The soil estimate on the operator's side: the local model's material
+// moves from the one it had to the remote's estimate (every fitted field
+// along the same fraction s of the way, the operator's own repose kept),
+// through Simulation::set_force_material between steps, so the physical
+// force and everything rendered from it follow. s advances by as much as
+// keeps the change of the cutting force at the newest cut under
+// max_update_step_n of device force per tick; out of a cut the new material
+// applies at once (no force to jump).
 // ---------------------------------------------------------------------------
 
-class ScaleCorrection final : public StepListener {
+class MaterialBlend {
  public:
-  ScaleCorrection(const haptics::HapticLoop& loop, double max_step_n)
-      : loop_(loop), max_step_n_(max_step_n) {}
-  void set_target(double k) { target_ = k; }
-  double applied() const { return applied_; }
-  double target() const { return target_; }
-  bool moving() const { return moving_; }
-
-  Vec3 on_step(const StepOutput&) noexcept override {
-    const haptics::LoopRecord& last = loop_.last();
-    const Vec3 model_h = horizontal(last.cutting_force_world_n);
-    const double model_n = length(model_h);
-    const double soil_n = last.cutting_uncapped_n, cap_n = last.cutting_cap_n;
-    const double scale = loop_.force_model().params().force_scale;
-    // A change of the factor changes min(cap, factor x soil) by at most the
-    // change x soil.
-    const double device_n = soil_n * scale;
-    const double max_change = device_n > 1e-12 ? max_step_n_ / device_n : 1e300;
-    const double change = std::clamp(target_ - applied_, -max_change, max_change);
-    moving_ = change != 0.0;
-    const double before_n = std::min(cap_n, applied_ * soil_n);
-    applied_ += change;
-    const double rendered_n = std::min(cap_n, applied_ * soil_n);
-    // What the update itself changed in the rendered force this tick, device N.
-    last_step_n_ = std::fabs(rendered_n - before_n) * scale;
-    // The model's own force scaled by the factor's effect under the cap (a
-    // factor of 1 adds nothing, whatever else the model's force holds: the
-    // drag's viscous part, a vertical motion).
-    const double own_n = std::min(cap_n, soil_n);
-    if (!(model_n > 0.0) || !(own_n > 0.0)) return {};
-    return model_h * (rendered_n / own_n - 1.0);
+  MaterialBlend(Simulation& sim, const haptics::HapticLoop& loop, double max_step_n)
+      : sim_(sim), loop_(loop), max_step_n_(max_step_n), from_(sim.force_material()),
+        to_(sim.force_material()) {}
+  /// A new estimate: the blend restarts from the material in use.
+  void set_target(const SoilMaterial& estimate) {
+    from_ = sim_.force_material();
+    to_ = from_;
+    to_.unit_weight_n_per_m3 = estimate.unit_weight_n_per_m3;
+    to_.cohesion_pa = estimate.cohesion_pa;
+    to_.adhesion_pa = estimate.adhesion_pa;
+    to_.internal_friction_deg = estimate.internal_friction_deg;
+    to_.soil_tool_friction_deg = estimate.soil_tool_friction_deg;
+    s_ = 0.0;
   }
-  /// The device force the factor's change added this tick, N (<= max_step_n).
+  const SoilMaterial& applied() const { return sim_.force_material(); }
+  double fraction() const { return s_; }
+  bool moving() const { return moving_; }
+  /// The device force the change added this tick, N (<= max_step_n).
   double last_step_n() const { return last_step_n_; }
 
+  /// Before a step: moves the material on.
+  void tick() {
+    moving_ = false;
+    last_step_n_ = 0.0;
+    if (s_ >= 1.0) return;
+    moving_ = true;
+    const ToolForce& f = sim_.last().force;
+    if (!(f.engaged_width_m > 0.0) || !(f.cut_depth_m > 0.0)) {
+      s_ = 1.0;
+      sim_.set_force_material(to_);
+      return;
+    }
+    const double scale = loop_.force_model().params().force_scale;
+    const Vec3 now = force_at(s_, f);
+    const double remaining_n = length(force_at(1.0, f) - now) * scale;
+    double next = 1.0;
+    if (remaining_n > max_step_n_) {
+      // The force is nearly linear in s over a tick's step; halve until the
+      // step's own change is under the bound.
+      next = s_ + (1.0 - s_) * max_step_n_ / remaining_n;
+      for (int i = 0; i < 8 && length(force_at(next, f) - now) * scale > max_step_n_; ++i)
+        next = s_ + 0.5 * (next - s_);
+    }
+    last_step_n_ = length(force_at(next, f) - now) * scale;
+    s_ = next;
+    sim_.set_force_material(material_at(s_));
+  }
+
  private:
+  SoilMaterial material_at(double s) const {
+    SoilMaterial m = to_;
+    auto mix = [s](double a, double b) { return a + (b - a) * s; };
+    m.unit_weight_n_per_m3 = mix(from_.unit_weight_n_per_m3, to_.unit_weight_n_per_m3);
+    m.cohesion_pa = mix(from_.cohesion_pa, to_.cohesion_pa);
+    m.adhesion_pa = mix(from_.adhesion_pa, to_.adhesion_pa);
+    m.internal_friction_deg = mix(from_.internal_friction_deg, to_.internal_friction_deg);
+    m.soil_tool_friction_deg = mix(from_.soil_tool_friction_deg, to_.soil_tool_friction_deg);
+    return m;
+  }
+  // The cutting force (horizontal, vertical) at the cut f with material(s).
+  Vec3 force_at(double s, const ToolForce& f) const {
+    EarthmovingParams p;
+    p.soil = material_at(s);
+    p.rake_angle_deg = sim_.params().blade.rake_angle_deg;
+    const EarthmovingResult r = earthmoving_force(p, f.engaged_width_m, f.cut_depth_m,
+                                                  p.soil.unit_weight_n_per_m3 * f.pile_m);
+    return {r.horizontal_n, r.vertical_n, 0.0};
+  }
+
+  Simulation& sim_;
   const haptics::HapticLoop& loop_;
   double max_step_n_;
-  double target_ = 1.0;
-  double applied_ = 1.0;
+  SoilMaterial from_, to_;
+  double s_ = 1.0;
   bool moving_ = false;
   double last_step_n_ = 0.0;
 };
@@ -221,8 +261,6 @@ RemoteStation::RemoteStation(const Scenario& remote, const MmtSettings& settings
                              net::Endpoint& link, std::uint32_t session,
                              const RemoteOptions& options)
     : settings_(settings), link_(link), session_(session), options_(options) {
-  nominal_.soil = nominal;
-  nominal_.rake_angle_deg = remote.base.blade.rake_angle_deg;
   const haptics::LoopParams params = loop_params(remote);
   device_ = std::make_unique<FollowerDevice>(params.settings().workspace,
                                              settings_.follower_speed_m_per_s,
@@ -234,6 +272,29 @@ RemoteStation::RemoteStation(const Scenario& remote, const MmtSettings& settings
   const HeightGrid& grid = rig_->world().simulation().grid();
   if (grid.cols() != operator_initial.cols() || grid.rows() != operator_initial.rows())
     throw InputError("mmt.remote.scenario: the remote grid must have the operator's samples");
+  // The soil, and the one beyond the change along the path.
+  base_material_ = simulation().force_material();
+  changed_material_ = base_material_;
+  if (settings_.change_soil) {
+    const SoilMaterial m = soil_preset(*settings_.change_soil);
+    changed_material_ = m;
+    EarthmovingParams check;
+    check.soil = m;
+    check.rake_angle_deg = simulation().params().blade.rake_angle_deg;
+    if (std::string e = validate(check); !e.empty())
+      throw InputError("mmt.remote.soil_change.soil: " + e);
+  }
+  // The estimate: from the operator's material (what the operator's model
+  // starts from), a sample every estimate_period_s, its candidates spread
+  // over the ticks to the next sample.
+  SoilEstimatorSettings es;
+  es.prior = nominal;
+  estimate_every_ = std::max<std::int64_t>(
+      1, std::llround(settings_.estimate_period_s * params.rate_hz()));
+  es.forgetting_per_sample = std::pow(settings_.forgetting, double(estimate_every_));
+  estimator_ = std::make_unique<SoilEstimator>(es);
+  estimate_slice_ = int((estimator_->candidate_count() + estimate_every_ - 1) / estimate_every_);
+  sent_ = nominal;
   mirror_.assign(operator_initial.initial(),
                  operator_initial.initial() + grid.spec().sample_count());
   // The buffers of the working traffic, made now: patches of their working
@@ -312,34 +373,41 @@ Rect RemoteStation::window_around(Vec3 p) const {
   return w;
 }
 
-// Recursive least squares of one factor: the remote's physical horizontal
-// cutting force (its earthmoving H, the pile's surcharge in it) = factor x
-// the operator's material's H at the same cut (width, depth, pile). Forces
-// in units of 100 N. The physical force is never capped or rendered, so
-// every sample with a cut counts.
-void RemoteStation::update_estimate(const haptics::LoopRecord&) {
-  const ToolForce& f = simulation().last().force;
-  if (!settings_.estimate || !(f.engaged_width_m > 0.0) || !(f.cut_depth_m > 0.0)) return;
-  const EarthmovingResult nominal = earthmoving_force(
-      nominal_, f.engaged_width_m, f.cut_depth_m, nominal_.soil.unit_weight_n_per_m3 * f.pile_m);
-  const double x = nominal.horizontal_n / 100.0;
-  const double y = f.earthmoving.horizontal_n / 100.0;
-  if (!(x > 0.01) || !std::isfinite(y)) return;  // below 1 N the ratio says little
-  // Once it has settled, a sample more than kOutlier times off the estimate
-  // is something no soil does (the plate striking a rock: Bullet's impact
-  // is a hundred times the cut): left out, or it would be carried into the
-  // operator's soil for the next second.
-  constexpr double kOutlier = 4.0;
-  constexpr std::int64_t kSettled = 200;
-  if (rls_samples_ >= kSettled && (y > kOutlier * theta_ * x || kOutlier * y < theta_ * x)) {
-    ++rls_outliers_;
-    return;
+const SoilMaterial& RemoteStation::true_material() const { return simulation().force_material(); }
+
+// The remote's soil where its blade is: the base soil, or soil_change's
+// beyond z_below_m (set between steps, through the simulation's owner).
+void RemoteStation::choose_material() {
+  if (!settings_.change_soil || !has_command_) return;
+  const bool in = device_->pose().position_m.z < settings_.change_z_m;
+  if (in == in_changed_soil_) return;
+  in_changed_soil_ = in;
+  rig_->world().simulation().set_force_material(in ? changed_material_ : base_material_);
+}
+
+// The soil estimate: a sample of the step's physical cutting force every
+// estimate_every_ ticks (when the estimator is free and the tool cuts),
+// its candidates taken a slice per tick. Only the physical force of the
+// step enters (soil_sample: the cutting and surcharge parts of
+// StepOutput::force), never what the remote's own loop renders. Also how
+// far the estimate's force is from this tick's measured one.
+void RemoteStation::update_estimate() {
+  estimate_error_ = -1.0;
+  const StepOutput& out = simulation().last();
+  const BladeSpec& blade = simulation().params().blade;
+  const StepSample s = soil_sample(out.force, out.motion, blade.rake_angle_deg, blade.edge_thickness_m);
+  if (settings_.estimate) {
+    if (s.valid && !estimator_->busy() && ticks_ % estimate_every_ == 0)
+      estimator_->begin(s.sample);
+    estimator_->advance(estimate_slice_);
   }
-  const double lambda = settings_.forgetting;
-  const double k = p_ * x / (lambda + x * p_ * x);
-  theta_ = std::clamp(theta_ + k * (y - theta_ * x), 0.02, 50.0);
-  p_ = (p_ - k * x * p_) / lambda;
-  ++rls_samples_;
+  if (s.valid && s.sample.horizontal_n > 1.0) {
+    last_sample_ = s.sample;
+    has_sample_ = true;
+    estimate_error_ = std::fabs(predicted_horizontal_n(estimate().material, s.sample) -
+                                s.sample.horizontal_n) /
+                      s.sample.horizontal_n;
+  }
 }
 
 // The sensed patch: the rectangle changed since the last one and the square
@@ -396,28 +464,42 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
   send_estimate(t_s);
 }
 
-// The estimate, when it moved (by the JND fraction with the deadband).
+// The estimate, when it changed (with the deadband: when it changes the
+// horizontal force at the newest cut by more than the JND fraction).
 void RemoteStation::send_estimate(double t_s) {
-  if (rls_samples_ > 0) {
-    const double moved = std::fabs(theta_ - theta_sent_);
-    const bool send = settings_.deadband > 0.0 ? moved > settings_.deadband * theta_sent_
-                                               : (moved > 1e-9 || !estimate_sent_);
-    if (send) {
-      net::Estimate e;
-      e.t_s = t_s;
-      e.force_scale = theta_;
-      e.variance = p_;
-      e.samples = std::uint32_t(std::min<std::int64_t>(rls_samples_, 0xFFFFFFFF));
-      std::uint8_t out[net::kHeaderSize + net::kEstimatePayloadSize + net::kCrcSize];
-      net::Header h{net::MessageType::kEstimate, settings_.link_id, session_, seq_estimate_++,
-                    to_ns(t_s)};
-      const std::size_t n = net::encode_estimate(h, e, out);
-      link_.send(net::Channel::kReliable, out, n, t_s);
-      theta_sent_ = theta_;
-      estimate_sent_ = true;
-      ++counters_.estimates;
+  const SoilEstimate& est = estimate();
+  // The first samples of the first cut fit many materials that
+  // agree at those few depths and nowhere else: the estimate goes out once
+  // kFirstSent samples (0.1 s of cutting at the default period) are in.
+  constexpr std::int64_t kFirstSent = 10;
+  if (!est.known || est.samples < kFirstSent) return;
+  const SoilMaterial& m = est.material;
+  bool send = !estimate_sent_;
+  if (!send && settings_.deadband > 0.0) {
+    if (has_sample_) {
+      const double was = predicted_horizontal_n(sent_, last_sample_);
+      send = std::fabs(predicted_horizontal_n(m, last_sample_) - was) >
+             settings_.deadband * std::max(was, 1e-9);
     }
+  } else if (!send) {
+    for (int f = 0; f < kSoilFieldCount; ++f)
+      send = send || field_value(m, SoilField(f)) != field_value(sent_, SoilField(f));
   }
+  if (!send) return;
+  net::Estimate e;
+  e.t_s = t_s;
+  e.material = m;
+  e.sd = est.sd;
+  e.samples = std::uint32_t(std::min<std::int64_t>(est.samples, 0xFFFFFFFF));
+  e.identifiable = est.identifiable;
+  std::uint8_t out[net::kHeaderSize + net::kEstimatePayloadSize + net::kCrcSize];
+  net::Header h{net::MessageType::kEstimate, settings_.link_id, session_, seq_estimate_++,
+                to_ns(t_s)};
+  const std::size_t n = net::encode_estimate(h, e, out);
+  link_.send(net::Channel::kReliable, out, n, t_s);
+  sent_ = m;
+  estimate_sent_ = true;
+  ++counters_.estimates;
 }
 
 void RemoteStation::tick(double t_s) {
@@ -433,12 +515,19 @@ void RemoteStation::tick(double t_s) {
   const Simulation& sim = simulation();
   const std::int64_t steps_before = sim.step_count();
   const auto start = std::chrono::steady_clock::now();
+  // The arm stalls while the force on it exceeds what it can push (the
+  // previous tick's physical force: a sensor's newest reading).
+  const bool stalled = length(loop.last().physical_force_world_n) > settings_.arm_force_limit_n;
+  device_->set_stalled(stalled);
+  if (stalled) ++stalled_ticks_;
+  choose_material();
   loop.step1(t_s);
   const haptics::LoopRecord& r =
       loop.step2(ticked_ ? t_s - previous_t_s_ : 0.0, seconds_since(start), false);
   previous_t_s_ = t_s;
   ticked_ = true;
-  if (sim.step_count() > steps_before) {
+  const bool stepped = sim.step_count() > steps_before;
+  if (stepped) {
     include_rect(dirty_, sim.last().changed);
     include_rect(worked_, sim.last().changed);
   }
@@ -449,7 +538,8 @@ void RemoteStation::tick(double t_s) {
     m.command_sequence = command_sequence_;
     m.flags = holding ? net::kMeasurementHolding : 0u;
     m.pose = r.tool;
-    m.force_world_n = r.force_world_n;
+    // What a force sensor on the arm reads: the physical force.
+    m.force_world_n = r.physical_force_world_n;
     m.contact_length_m = r.contact_length_m;
     m.cut_depth_m = r.cut_depth_m;
     m.commands_received = std::uint32_t(commands_received_);
@@ -458,8 +548,9 @@ void RemoteStation::tick(double t_s) {
                   seq_measurement_++, to_ns(t_s)};
     const std::size_t n = net::encode_measurement(h, m, out);
     link_.send(net::Channel::kUnreliable, out, n, t_s);
-    update_estimate(r);
+    if (stepped) update_estimate();
   }
+  ++ticks_;
   if (t_s + 1e-9 >= next_sense_s_) {
     sense(t_s, r);
     next_sense_s_ += settings_.sense_period_s;
@@ -469,13 +560,16 @@ void RemoteStation::tick(double t_s) {
   rec.command_sequence = command_sequence_;
   rec.commanded_m = commanded_m_;
   rec.tool_m = r.tool.position_m;
-  rec.force_world_n = has_command_ ? r.force_world_n : Vec3{};
+  rec.force_world_n = has_command_ ? r.physical_force_world_n : Vec3{};
   rec.contact_length_m = r.contact_length_m;
   rec.cut_depth_m = r.cut_depth_m;
-  rec.force_scale = theta_;
+  rec.estimate = estimate();
+  rec.estimate_error = stepped ? estimate_error_ : -1.0;
+  rec.in_changed_soil = in_changed_soil_;
+  rec.stalled = stalled;
   rec.holding = holding;
   rec.active = has_command_;
-  rec.compute_s = seconds_since(tick_start);  // the whole tick: what arrived, the loop, what it sent
+  rec.compute_s = seconds_since(tick_start);  // the whole tick: what arrived, the loop, the estimate, what it sent
   last_ = rec;
   if (options_.keep_records) records_.push_back(rec);
 }
@@ -497,8 +591,8 @@ OperatorStation::OperatorStation(const Scenario& op, const MmtSettings& settings
   // Round trips of up to 8 s at 1 kHz are measured.
   command_sent_s_.assign(std::size_t(8.0 * params.rate_hz()) + 1, 0.0);
   rig_ = std::make_unique<HapticRig>(op, params, first_orientation(op), *guard_, ro);
-  correction_ = std::make_unique<ScaleCorrection>(rig_->loop(), settings_.max_update_step_n);
-  rig_->world().simulation().add_listener(*correction_);
+  blend_ = std::make_unique<MaterialBlend>(rig_->world().simulation(), rig_->loop(),
+                                           settings_.max_update_step_n);
   const GridSpec& g = rig_->world().simulation().grid().spec();
   stamp_s_.assign(std::size_t(g.sample_count()), -1e30f);
   protect_s_ = protection_s();
@@ -527,9 +621,7 @@ OperatorStation::OperatorStation(const Scenario& op, const MmtSettings& settings
   }
 }
 
-OperatorStation::~OperatorStation() {
-  rig_->world().simulation().remove_listener(*correction_);
-}
+OperatorStation::~OperatorStation() = default;
 
 const Simulation& OperatorStation::simulation() const { return rig_->world().simulation(); }
 double OperatorStation::rate_hz() const { return rig_->loop().params().rate_hz(); }
@@ -558,6 +650,14 @@ void OperatorStation::receive(double t_s) {
           break;
         case net::MessageType::kEstimate:
           r = net::decode_estimate(d.data(), d.size(), e);
+          // A material this blade cannot cut (rake + delta + phi leaves no
+          // failure wedge) is no estimate for this model.
+          if (r == net::Reject::kNone) {
+            EarthmovingParams check;
+            check.soil = e.material;
+            check.rake_angle_deg = simulation().params().blade.rake_angle_deg;
+            if (!validate(check).empty()) r = net::Reject::kBadPayload;
+          }
           filter = &estimates_;
           break;
         default:
@@ -613,7 +713,8 @@ void OperatorStation::receive(double t_s) {
       }
       case net::MessageType::kEstimate:
         ++counters_.estimates;
-        correction_->set_target(e.force_scale);
+        blend_->set_target(e.material);
+        last_estimate_ = e;
         break;
       default:
         break;
@@ -764,6 +865,7 @@ void OperatorStation::tick(double t_s) {
   haptics::HapticLoop& loop = rig_->loop();
   Simulation& sim = rig_->world().simulation();
   const std::int64_t steps_before = sim.step_count();
+  blend_->tick();  // the material, moved on between steps
   loop.step1(t_s);
   const double period = ticks_ == 0 ? 0.0 : t_s - previous_t_s_;
   const haptics::LoopRecord& r = loop.step2(period, seconds_since(start), false);
@@ -809,8 +911,8 @@ void OperatorStation::tick(double t_s) {
   power_dfr_[power_at_] = power_dfr;
   power_at_ = (power_at_ + 1) % power_.size();
 
-  const bool updating = updating_terrain || correction_->moving();
-  max_update_step_n_ = std::max(max_update_step_n_, correction_->last_step_n());
+  const bool updating = updating_terrain || blend_->moving();
+  max_update_step_n_ = std::max(max_update_step_n_, blend_->last_step_n());
   if (updating && has_previous_)
     max_step_while_updating_n_ =
         std::max(max_step_while_updating_n_, length(r.force_device_n - previous_force_device_n_));
@@ -826,12 +928,12 @@ void OperatorStation::tick(double t_s) {
   rec.t_s = t_s;
   rec.tool_m = r.tool.position_m;
   rec.device_m = r.device_position_m;
-  rec.force_world_n = r.force_world_n;
+  rec.force_world_n = r.physical_force_world_n;
   rec.force_device_n = r.force_device_n;
   rec.remote_force_world_n = remote_force_;
   rec.contact_length_m = r.contact_length_m;
-  rec.scale_applied = correction_->applied();
-  rec.scale_target = correction_->target();
+  rec.material = blend_->applied();
+  rec.material_blend = blend_->fraction();
   rec.updating = updating;
   rec.link_silent = silent;
   rec.passivity_j = window_j_;

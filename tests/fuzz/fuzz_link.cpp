@@ -95,15 +95,22 @@ Reject decode_and_check(const std::uint8_t* data, std::size_t size, Patch& patch
       Estimate e;
       const Reject r = decode_estimate(data, size, e);
       if (r != Reject::kNone) return r;
-      check(std::isfinite(e.t_s) && std::isfinite(e.force_scale) && std::isfinite(e.variance), kTarget,
-            "an accepted estimate holds a non-finite value");
+      check(std::isfinite(e.t_s) && validate(e.material).empty() &&
+                std::all_of(e.sd.begin(), e.sd.end(), [](double v) { return std::isfinite(v) && v >= 0.0; }),
+            kTarget, "an accepted estimate holds an impossible material or uncertainty");
       const std::size_t n = encode_estimate(h, e, again);
       Header h2;
       Estimate e2;
       check(decode_header(again, n, kLink, h2) == Reject::kNone && decode_estimate(again, n, e2) == Reject::kNone,
             kTarget, "a re-encoded estimate is refused");
-      check(same_bits(e.force_scale, e2.force_scale) && same_bits(e.variance, e2.variance) &&
-                e.samples == e2.samples,
+      check(same_bits(e.material.unit_weight_n_per_m3, e2.material.unit_weight_n_per_m3) &&
+                same_bits(e.material.cohesion_pa, e2.material.cohesion_pa) &&
+                same_bits(e.material.adhesion_pa, e2.material.adhesion_pa) &&
+                same_bits(e.material.internal_friction_deg, e2.material.internal_friction_deg) &&
+                same_bits(e.material.soil_tool_friction_deg, e2.material.soil_tool_friction_deg) &&
+                std::equal(e.sd.begin(), e.sd.end(), e2.sd.begin(),
+                           [](double a, double b) { return same_bits(a, b); }) &&
+                e.samples == e2.samples && e.identifiable == e2.identifiable,
             kTarget, "an estimate does not survive re-encoding");
       return r;
     }

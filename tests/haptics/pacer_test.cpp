@@ -216,6 +216,27 @@ TEST(Pacer, OverrunIsCountedAndTheGridKept) {
   EXPECT_EQ(s.skipped_slots, 1);
   EXPECT_NEAR(s.compute.max_s, 2.5e-3, 1e-9);
   EXPECT_NEAR(s.wake_latency.max_s, 0.5e-3, 1e-9);
+  EXPECT_EQ(s.missed_by_compute, 1);  // its work alone took 2.5 periods
+  EXPECT_EQ(s.missed_by_late_start, 0);
+}
+
+// A tick woken 0.8 ms late whose 0.3 ms of work is well inside a period
+// still ends past the next deadline: that overrun is the late wake's, not
+// the compute's, and is counted as such.
+TEST(Pacer, AnOverrunAfterALateWakeIsNotBlamedOnTheCompute) {
+  auto clock = std::make_shared<FakeClock>();
+  clock->oversleep_s = {0, 0, 0, 0.8e-3};  // every fourth sleep wakes 0.8 ms late
+  Pacer pacer(settings(1000.0, 0.0), clock);
+  pacer.start();
+  for (int i = 0; i < 40; ++i) {
+    clock->work(0.3e-3);
+    pacer.wait_next();
+  }
+  LoopStats s = pacer.stats();
+  EXPECT_GT(s.missed_deadlines, 5);
+  EXPECT_EQ(s.missed_by_compute, 0);
+  EXPECT_EQ(s.missed_by_late_start, s.missed_deadlines);
+  EXPECT_NEAR(s.compute.max_s, 0.3e-3, 1e-9);
 }
 
 // A compute time given by the loop replaces the measured one for that tick only.

@@ -82,16 +82,52 @@ TEST(Messages, MeasurementAndEstimateRoundTrip) {
 
   Estimate e;
   e.t_s = 3.0;
-  e.force_scale = 2.5;
-  e.variance = 0.01;
+  e.material = soil_preset(SoilPreset::kClay);
+  e.sd = {500.0, 120.0, 90.0, 1.5, 1.2};
   e.samples = 400;
+  e.identifiable = 0b10111;
   std::vector<std::uint8_t> de(kHeaderSize + kEstimatePayloadSize + kCrcSize);
   ASSERT_EQ(encode_estimate(header(2), e, de.data()), de.size());
   Estimate eb;
   ASSERT_EQ(decode_header(de.data(), de.size(), kLink, h), Reject::kNone);
   ASSERT_EQ(decode_estimate(de.data(), de.size(), eb), Reject::kNone);
-  EXPECT_EQ(eb.force_scale, 2.5);
+  EXPECT_EQ(eb.material.unit_weight_n_per_m3, e.material.unit_weight_n_per_m3);
+  EXPECT_EQ(eb.material.cohesion_pa, e.material.cohesion_pa);
+  EXPECT_EQ(eb.material.adhesion_pa, e.material.adhesion_pa);
+  EXPECT_EQ(eb.material.internal_friction_deg, e.material.internal_friction_deg);
+  EXPECT_EQ(eb.material.soil_tool_friction_deg, e.material.soil_tool_friction_deg);
+  EXPECT_EQ(eb.sd, e.sd);
   EXPECT_EQ(eb.samples, 400u);
+  EXPECT_EQ(eb.identifiable, 0b10111u);
+}
+
+// An estimate whose material the scenario reader would refuse, or whose
+// uncertainty is negative or not finite, is a bad payload.
+TEST(Messages, EstimateOfAnImpossibleMaterialIsRefused) {
+  auto refused = [](const Estimate& e) {
+    std::vector<std::uint8_t> d(kHeaderSize + kEstimatePayloadSize + kCrcSize);
+    encode_estimate(header(3), e, d.data());
+    Estimate back;
+    return decode_estimate(d.data(), d.size(), back);
+  };
+  Estimate e;
+  e.material = soil_preset(SoilPreset::kGravel);
+  EXPECT_EQ(refused(e), Reject::kNone);
+  Estimate bad = e;
+  bad.material.unit_weight_n_per_m3 = 0.0;
+  EXPECT_EQ(refused(bad), Reject::kBadPayload);
+  bad = e;
+  bad.material.internal_friction_deg = 95.0;
+  EXPECT_EQ(refused(bad), Reject::kBadPayload);
+  bad = e;
+  bad.material.cohesion_pa = -1.0;
+  EXPECT_EQ(refused(bad), Reject::kBadPayload);
+  bad = e;
+  bad.sd[3] = std::nan("");
+  EXPECT_EQ(refused(bad), Reject::kBadPayload);
+  bad = e;
+  bad.sd[0] = -1.0;
+  EXPECT_EQ(refused(bad), Reject::kBadPayload);
 }
 
 TEST(Messages, PatchRoundTripIsExactAndCompressed) {
@@ -130,6 +166,8 @@ TEST(Messages, FormatErrorsAreNamed) {
   EXPECT_EQ(decode_header(magic.data(), magic.size(), kLink, h), Reject::kBadMagic);
   auto version = good;
   version[4] = std::uint8_t(kVersion + 1);
+  EXPECT_EQ(decode_header(version.data(), version.size(), kLink, h), Reject::kBadVersion);
+  version[4] = std::uint8_t(kVersion - 1);  // a version whose command, measurement or estimate differ
   EXPECT_EQ(decode_header(version.data(), version.size(), kLink, h), Reject::kBadVersion);
   auto flipped = good;
   flipped[60] ^= 0x01;

@@ -48,7 +48,7 @@ TEST(MmtReport, EachOperatorTickMeetsTheRemotesFirstTickFollowingItsCommand) {
     rm.push_back(r);
   }
   MmtSummary s;
-  compare_records(op, rm, s);
+  compare_records(op, rm, 1000.0, 0.0, s);
   // A lost command is met by the next that arrived: its force differs by
   // that command's change (50 x 0.01 N a command at most, a few commands
   // at most): the error is kError within that.
@@ -64,7 +64,7 @@ TEST(MmtReport, EachOperatorTickMeetsTheRemotesFirstTickFollowingItsCommand) {
     rm[std::size_t(j)].command_sequence = std::uint32_t(arriving);
     rm[std::size_t(j)].force_world_n = {force_of(std::uint32_t(arriving)), 0.0, 0.0};
   }
-  compare_records(op, rm, s);
+  compare_records(op, rm, 1000.0, 0.0, s);
   EXPECT_NEAR(s.force_error_rms_mmt_n, kError, 1e-9);
   EXPECT_NEAR(s.force_error_max_mmt_n, kError, 1e-9);
 }
@@ -77,7 +77,7 @@ TEST(MmtReport, NoRemoteTickFollowedAnyCommandNoErrorToReport) {
   }
   std::vector<RemoteRecord> rm(100);  // never active
   MmtSummary s;
-  compare_records(op, rm, s);
+  compare_records(op, rm, 1000.0, 0.0, s);
   EXPECT_EQ(s.force_error_rms_mmt_n, 0.0);
   EXPECT_EQ(s.tracking_rms_m, 0.0);
 }

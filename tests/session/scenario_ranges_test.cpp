@@ -72,7 +72,8 @@ bodies:
   - {shape: cylinder, radius_m: 0.05, height_m: 0.1, mass_kg: 1, position_m: [0.9, 0.5, 0.3]}
 mmt:
   remote: {follower_speed_m_per_s: 1.5, follower_time_constant_s: 0.02, sense_period_s: 0.05,
-           sense_radius_m: 0.3, forgetting: 0.999}
+           sense_radius_m: 0.3, forgetting: 0.999, estimate_period_s: 0.01,
+           arm_force_limit_n: 5000, soil_change: {z_below_m: 0.0, soil: clay}}
   link: {delay_s: 0.05, jitter_s: 0.001, loss: 0.01, reorder: 0.01, reorder_delay_s: 0.005,
          retransmit_s: 0.2, seed: 3,
          burst: {p_good_to_bad: 0.01, p_bad_to_good: 0.5, loss_good: 0, loss_bad: 0.5}}

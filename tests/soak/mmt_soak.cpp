@@ -224,8 +224,13 @@ class HostileEndpoint final : public net::Endpoint {
       case net::MessageType::kEstimate: {
         net::Estimate e;
         e.t_s = h.timestamp_ns * 1e-9;
+        // Materials from feather-light to absurd; a bad value where asked.
         const double scales[] = {1e-6, 0.1, 3.0, 1e3, 1e9};
-        e.force_scale = nan ? bad : scales[pick(5)];
+        e.material.unit_weight_n_per_m3 = 16e3 * scales[pick(5)];
+        e.material.cohesion_pa = 1e3 * scales[pick(5)];
+        e.material.internal_friction_deg = 40.0 * uniform();
+        e.material.soil_tool_friction_deg = e.material.internal_friction_deg * uniform();
+        if (nan) e.material.cohesion_pa = bad;
         e.samples = 10;
         d.resize(net::encode_estimate(h, e, d.data()));
         break;

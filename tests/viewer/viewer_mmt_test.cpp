@@ -9,6 +9,7 @@
 // --remote.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,7 @@
 
 #include "loop_driver.hpp"
 #include "terracut/core/error.hpp"
+#include "terracut/session/mmt.hpp"
 #include "terracut/session/scenario.hpp"
 #include "../support/scenario_text.hpp"
 #include "../support/spawn.hpp"
@@ -101,6 +103,62 @@ TEST(ViewerMmt, RemotePatchesReachTheDrawnLocalModel) {
   expect_patches_drawn(trench_with_lower_remote(), "", 0.0);
 }
 
+
+// The viewer's operator mode learns the remote's soil with the same
+// estimator as `terracut mmt` (the pair of stations of one process,
+// session::make_station_pair): the clay of mmt_learn_clay, cut by the
+// script device over the same link in lock-step, gives the viewer's panel
+// the estimate the single-process run's operator received at the same
+// tick, field by field, with the same uncertainties and identifiable
+// fields, and the material its model applies. Not to the last bit: the
+// viewer's device plays the path through its own device (ViewerDevice),
+// whose positions differ from the script device's in their last bits; the
+// estimates then agree to about 1e-8 (measured: 17907.9976 against
+// 17907.9972 N/m^3, whose uncertainty is 602 N/m^3), so 1e-6 relative. (The two-process stations'
+// figures are held to the same run by tests/session/mmt_two_process_test.sh.)
+TEST(ViewerMmt, TheOperatorModeLearnsTheSoilAsTheSingleProcessRunDoes) {
+  const session::Scenario sc =
+      session::load_scenario(fs::path(TERRACUT_SOURCE_DIR) / "scenarios" / "mmt_learn_clay.yaml");
+  DriverOptions o;
+  o.paced = false;
+  o.source = ToolSource::kScript;
+  o.mmt = true;
+  LoopDriver d(sc, viewer_settings(sc.haptics), o, nullptr);
+  ASSERT_NE(d.remote_station(), nullptr);
+  // Into the cut: the plunge, the first estimates and a second of cutting.
+  const std::int64_t ticks = std::llround(2.5 * d.rate_hz());
+  d.start();
+  d.run_until_tick(ticks);
+  while (d.ticks_done() < ticks) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  d.stop();
+
+  ASSERT_EQ(d.ticks_done(), ticks);
+  session::MmtRun run(sc);
+  while (run.ticks_run() < ticks) run.tick();
+  const net::Estimate& want = run.operator_station().last_estimate();
+  const MmtLive& m = d.mmt_live();
+  ASSERT_GT(m.estimates.load(), 0);
+  EXPECT_EQ(m.estimates.load(), run.operator_station().counters().estimates);
+  EXPECT_EQ(m.identifiable.load(), want.identifiable);
+  const SoilMaterial applied = run.operator_station().last_record().material;
+  for (int f = 0; f < kSoilFieldCount; ++f) {
+    const std::size_t i = std::size_t(f);
+    const SoilField field = SoilField(f);
+    auto near = [](double a, double b) { return std::fabs(a - b) <= 1e-6 * std::max(std::fabs(b), 1.0); };
+    EXPECT_PRED2(near, m.estimate[i].load(), field_value(want.material, field)) << to_string(field);
+    EXPECT_PRED2(near, m.estimate_sd[i].load(), want.sd[i]) << to_string(field);
+    EXPECT_PRED2(near, m.material_applied[i].load(), field_value(applied, field)) << to_string(field);
+  }
+  // And it is the clay's: every identifiable field within two of its
+  // standard uncertainties of the remote's true material.
+  const SoilMaterial& truth = d.remote_station()->true_material();
+  for (int f = 0; f < kSoilFieldCount; ++f) {
+    const SoilField field = SoilField(f);
+    if (!((m.identifiable.load() >> f) & 1u)) continue;
+    EXPECT_NEAR(m.estimate[std::size_t(f)].load(), field_value(truth, field), 2.0 * m.estimate_sd[std::size_t(f)].load())
+        << to_string(field);
+  }
+}
 
 // The window prints how the loop is scheduled: in MMT the stations tick on
 // the driver's own thread, and that is said (it printed an empty line).

@@ -174,9 +174,25 @@ class Simulation {
   /// Total volume cut since construction or reset, cubic metres.
   double removed_volume_m3() const { return removed_volume_m3_; }
 
-  /// Restores the initial terrain, time and counters, and tells every
-  /// listener that the whole grid changed (StepListener::on_edit).
+  /// Restores the initial terrain, time and counters (and the force's
+  /// material to the parameters' soil), and tells every listener that the
+  /// whole grid changed (StepListener::on_edit).
   void reset();
+
+  /// The material the physical force is computed with (StepOutput::force:
+  /// cutting, surcharge, penetration, twist, a bucket's load); starts as
+  /// params().soil.material. The soil flow keeps the parameters' material
+  /// (its angle of repose).
+  const SoilMaterial& force_material() const { return tool_params_.earthmoving.soil; }
+  /// Replaces it between steps: what a teleoperation station's local model
+  /// does when it adopts an estimate of the remote's soil, or a remote world
+  /// whose soil changes along the path (session/mmt.hpp). The one exception
+  /// to the parameters being read-only during a run, and through the owner:
+  /// the next step's force uses it. Throws InputError naming the field when
+  /// the material is invalid (validate(SoilMaterial)) or the blade's rake
+  /// with its friction angles leaves no failure wedge (rake + delta + phi
+  /// must be < 179 degrees); std::logic_error during a step.
+  void set_force_material(const SoilMaterial& material);
 
   /// Replaces the heights of a rectangle of samples between steps (an
   /// excavation made by hand, a terrain loaded from elsewhere): values_m

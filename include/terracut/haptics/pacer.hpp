@@ -119,6 +119,13 @@ struct LoopStats {
   std::int64_t ticks = 0;             ///< ticks ended (calls to wait_next)
   /// Ticks whose work ran past the next tick's deadline (overruns).
   std::int64_t missed_deadlines = 0;
+  /// Of those, the ticks whose compute time alone was longer than a period
+  /// (the work was too slow), and the ticks that had started late
+  /// themselves, so that a compute shorter than a period still ended past
+  /// the next deadline (the OS woke the loop late, or an overrun before
+  /// carried on): missed_by_compute + missed_by_late_start = missed_deadlines.
+  std::int64_t missed_by_compute = 0;
+  std::int64_t missed_by_late_start = 0;
   /// Schedule slots dropped entirely after overruns (ticks that never ran).
   std::int64_t skipped_slots = 0;
   TimeStats compute;                  ///< compute time per tick
@@ -198,6 +205,8 @@ class Pacer {
   double recorded_compute_s_ = -1.0;  // record_compute's value for the current tick, < 0 if none
   std::int64_t ticks_ = 0;
   std::int64_t missed_ = 0;
+  std::int64_t missed_by_compute_ = 0;
+  double last_compute_s_ = 0.0;  // the compute time of the tick end_tick() ended
   std::int64_t skipped_ = 0;
   DurationHistogram compute_;
   DurationHistogram jitter_;

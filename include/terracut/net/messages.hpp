@@ -6,7 +6,7 @@
 //
 //   offset size type  field
 //   0      4    u32   magic = 0x4D4D4354 (the bytes "TCMM")
-//   4      2    u16   version = 2
+//   4      2    u16   version = 3
 //   6      2    u16   type (MessageType)
 //   8      4    u32   link: chosen for the pair of stations (a packet of another link is "foreign")
 //   12     4    u32   session: chosen by the sender at start (a new value = the station restarted)
@@ -36,21 +36,23 @@
 #include "terracut/core/blade.hpp"
 #include "terracut/core/enum_names.hpp"
 #include "terracut/core/grid.hpp"
+#include "terracut/core/material.hpp"
 #include "terracut/core/math.hpp"
 #include "terracut/core/wire.hpp"
 
 namespace terracut::net {
 
 inline constexpr std::uint32_t kMagic = 0x4D4D4354u;  // "TCMM" in memory order
-/// 2: the command carries the operator's round trip, the measurement the
-/// commands the remote received (2026-12: measured, not configured).
-inline constexpr std::uint16_t kVersion = 2;
+/// 3: the command carries the operator's round trip, the measurement the
+/// commands the remote received, and the estimate is a soil material with
+/// its uncertainty (2026-12; 2 had one of the two, 1 neither).
+inline constexpr std::uint16_t kVersion = 3;
 inline constexpr std::size_t kHeaderSize = 40;
 inline constexpr std::size_t kCrcSize = 4;
 inline constexpr std::size_t kCommandPayloadSize = 72;
 inline constexpr std::size_t kMeasurementPayloadSize = 120;
 inline constexpr std::size_t kPatchFixedSize = 32;  ///< before the compressed heights
-inline constexpr std::size_t kEstimatePayloadSize = 32;
+inline constexpr std::size_t kEstimatePayloadSize = 96;
 /// Largest patch, samples (2048 x 2048); a patch declaring more is refused.
 inline constexpr std::int64_t kMaxPatchSamples = std::int64_t(1) << 22;
 
@@ -117,16 +119,20 @@ struct Patch {
   std::vector<float> heights;  ///< rect rows x cols, row-major, metres
 };
 
-/// The remote's estimate of the soil (32 bytes): t_s f64 at 40, force_scale
-/// f64 at 48, variance f64 at 56, samples u32 at 64, flags u32 at 68.
+/// The remote's estimate of its soil (96 bytes): t_s f64 at 40; the
+/// material's unit_weight_n_per_m3, cohesion_pa, adhesion_pa,
+/// internal_friction_deg, soil_tool_friction_deg f64 at 48, 56, 64, 72, 80;
+/// their standard uncertainties f64 at 88 ... 120 (same order and units);
+/// samples u32 at 128, identifiable u32 at 132 (bit i: field i, in
+/// core/soil_estimator.hpp's SoilField order). The repose angle is not
+/// sent: the force does not depend on it and the operator keeps its own.
 struct Estimate {
   double t_s = 0.0;
-  /// Measured force / the operator's model's force at the same cut: the
-  /// factor the operator's cutting force should be multiplied by, > 0.
-  double force_scale = 1.0;
-  double variance = 0.0;       ///< RLS covariance of force_scale
-  std::uint32_t samples = 0;   ///< samples the estimate has seen
-  std::uint32_t flags = 0;
+  /// The fitted fields; repose_deg is not part of the message.
+  SoilMaterial material{};
+  std::array<double, 5> sd{};    ///< standard uncertainties, >= 0
+  std::uint32_t samples = 0;     ///< samples the estimate has taken in
+  std::uint32_t identifiable = 0;
 };
 
 /// Why a datagram was rejected. Format reasons come from the decoders; the

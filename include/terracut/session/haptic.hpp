@@ -32,6 +32,14 @@
 
 namespace terracut::session {
 
+/// Which cuts a device follows (indices into scenario.base.cuts, in order):
+/// the one settings.cut names, or else every cut of the scenario's
+/// sequence. Empty when the named cut is not in the scenario or the
+/// scenario has none (followed_path says which). The one answer of the
+/// device factory, the MMT stations' starting orientation and
+/// terracut-device.
+std::vector<int> followed_cuts(const Scenario& scenario, const haptics::HapticSettings& settings);
+
 /// The path a scripted or simulated device follows (`terracut haptics`, the
 /// MMT operator): the cut named by haptics.cut, or else every cut of the
 /// scenario's sequence, played as `terracut run` steps them (the tool

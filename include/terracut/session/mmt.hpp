@@ -7,13 +7,14 @@
 //    operator's commands at a limited speed (a real arm lags); it measures
 //    the tool force and pose every tick and, every sensing period, the
 //    heights around the tool and those it changed (a dirty rectangle, sent
-//    reliably as a zstd patch), and it estimates the soil: a recursive
-//    least-squares fit of the factor between its measured force and the
-//    operator's force model at the same cut.
+//    reliably as a zstd patch), and it estimates its soil's material from
+//    its physical cutting force (core/soil_estimator.hpp), sent with its
+//    uncertainty.
 //  - OperatorStation: the haptic loop (HapticRig) on the local model with a
 //    device of the caller's. It sends the tool pose every tick and merges
 //    what comes back without force jumps: patches blend in over blend_s,
-//    the soil factor moves at a bounded rate of force change.
+//    its model's material moves to the remote's estimate at a bounded rate
+//    of force change.
 //  - MmtRun: both stations in one process over an in-memory link, stepped
 //    in lock-step at the loop rate in simulated time (reproducible for a
 //    seed), with per-tick records, the summary of `terracut mmt`, and its
@@ -32,6 +33,7 @@
 #include <vector>
 
 #include "terracut/core/forces.hpp"
+#include "terracut/core/soil_estimator.hpp"
 #include "terracut/core/wire.hpp"
 #include "terracut/core/stats.hpp"
 #include "terracut/haptics/device.hpp"
@@ -57,10 +59,18 @@ struct RemoteRecord {
   std::uint32_t command_sequence = 0;  ///< newest command followed
   Vec3 commanded_m{};                  ///< its position, world
   Vec3 tool_m{};                       ///< the follower's position, world
-  Vec3 force_world_n{};                ///< measured force on the tool, world N
+  /// Measured force on the tool: the physical force (StepOutput::force),
+  /// world N; nothing rendered, nothing capped.
+  Vec3 force_world_n{};
   double contact_length_m = 0.0;
   double cut_depth_m = 0.0;
-  double force_scale = 1.0;  ///< the estimate
+  /// The estimate of the soil at this tick (its material and uncertainty).
+  SoilEstimate estimate{};
+  /// |H(estimate) - H| / H at this tick's cut: how far the estimate's
+  /// horizontal cutting force is from the one measured; -1 without a cut.
+  double estimate_error = -1.0;
+  bool in_changed_soil = false;  ///< the remote blade is in mmt.remote.soil_change's soil
+  bool stalled = false;          ///< the arm's force limit held the tool
   bool holding = false;      ///< link silent: holding still
   bool active = false;       ///< a command has arrived
   double compute_s = 0.0;    ///< the whole tick (receiving, the loop, sensing, sending), s
@@ -71,12 +81,16 @@ struct OperatorRecord {
   double t_s = 0.0;
   Vec3 tool_m{};               ///< commanded tool position, world
   Vec3 device_m{};             ///< device handle, device frame
-  Vec3 force_world_n{};        ///< the local model's force (MMT), world N
+  /// The local model's physical force (MMT's prediction of the remote's),
+  /// world N: StepOutput::force, nothing rendered or capped.
+  Vec3 force_world_n{};
   Vec3 force_device_n{};       ///< rendered, device frame, device N
   Vec3 remote_force_world_n{}; ///< newest measured force received (direct reflection), world N
   double contact_length_m = 0.0;
-  double scale_applied = 1.0;
-  double scale_target = 1.0;
+  /// The material the local model's force uses (moving to the remote's
+  /// estimate), and how far along its blend from the previous one, [0, 1].
+  SoilMaterial material{};
+  double material_blend = 1.0;
   bool updating = false;      ///< an update was being merged this tick
   bool link_silent = false;
   double passivity_j = 0.0;      ///< energy into the hand over the last window, MMT, J
@@ -99,7 +113,7 @@ struct StationCounters {
 
 class FollowerDevice;
 class LinkGuardDevice;
-class ScaleCorrection;
+class MaterialBlend;
 
 /// What a remote station does beyond its settings.
 struct RemoteOptions {
@@ -112,7 +126,7 @@ struct RemoteOptions {
 class RemoteStation {
  public:
   /// remote: the remote world (load_remote_scenario); nominal: the
-  /// operator's soil material (the soil estimate is against it); mirror: the
+  /// operator's soil material (where the soil estimate starts); mirror: the
   /// operator's initial heights (what the deadband compares against).
   /// Throws InputError naming the field.
   RemoteStation(const Scenario& remote, const MmtSettings& settings,
@@ -134,14 +148,16 @@ class RemoteStation {
   const HapticRig& rig() const { return *rig_; }
   /// Every sample the remote changed so far.
   const Rect& worked() const { return worked_; }
-  double force_scale() const { return theta_; }
-  std::int64_t estimate_samples() const { return rls_samples_; }
-  /// Samples the estimate left out as outliers (more than 4 times off it,
-  /// once 200 samples had settled it).
-  std::int64_t estimate_outliers() const { return rls_outliers_; }
-  /// Samples the estimate left out because the low-speed cap, not the soil,
-  /// set the force (in either world, by the current estimate).
-  std::int64_t estimate_capped() const { return rls_capped_; }
+  /// The newest estimate of the soil.
+  const SoilEstimate& estimate() const { return estimator_->estimate(); }
+  /// The material the remote's force uses now (its soil, or soil_change's).
+  const SoilMaterial& true_material() const;
+  /// The remote's soil before mmt.remote.soil_change, and beyond it (the
+  /// same without a change).
+  const SoilMaterial& base_material() const { return base_material_; }
+  const SoilMaterial& changed_material() const { return changed_material_; }
+  /// Ticks the arm's force limit held the tool.
+  std::int64_t stalled_ticks() const { return stalled_ticks_; }
   /// Packets sent that carried model updates (patches + estimates).
   std::int64_t update_packets() const { return counters_.patches + counters_.estimates; }
   /// Commands of the current operator session that arrived (accepted, or
@@ -156,13 +172,13 @@ class RemoteStation {
 
  private:
   void receive(double t_s);
-  void update_estimate(const haptics::LoopRecord& r);
+  void update_estimate();
+  void choose_material();
   void sense(double t_s, const haptics::LoopRecord& r);
   void send_estimate(double t_s);
   Rect window_around(Vec3 p) const;
 
   MmtSettings settings_;
-  EarthmovingParams nominal_;  // the operator's material, with the remote's blade
   net::Endpoint& link_;
   std::uint32_t session_;
   std::unique_ptr<FollowerDevice> device_;
@@ -180,11 +196,18 @@ class RemoteStation {
   double next_sense_s_ = 0.0;
   Rect dirty_{};
   Rect worked_{};
-  double theta_ = 1.0, p_ = 10.0, theta_sent_ = 1.0;
-  std::int64_t rls_samples_ = 0;
-  std::int64_t rls_outliers_ = 0;
-  std::int64_t rls_capped_ = 0;
+  std::unique_ptr<SoilEstimator> estimator_;
+  int estimate_slice_ = 1;           // candidates per tick
+  std::int64_t estimate_every_ = 1;  // ticks per sample
+  std::int64_t ticks_ = 0;
+  SoilMaterial sent_{};              // the material last sent
   bool estimate_sent_ = false;
+  SoilMaterial base_material_{}, changed_material_{};
+  bool in_changed_soil_ = false;
+  double estimate_error_ = -1.0;
+  std::int64_t stalled_ticks_ = 0;
+  SoilSample last_sample_{};  // the newest cut with a force
+  bool has_sample_ = false;
   double previous_t_s_ = 0.0;
   bool ticked_ = false;
   std::vector<RemoteRecord> records_;
@@ -259,12 +282,15 @@ class OperatorStation {
   const Simulation& simulation() const;
   const Rect& worked() const { return worked_; }
   /// Largest change of the device force an update caused in one tick,
-  /// device N: the soil factor's (bounded by max_update_step_n); terrain
+  /// device N: the material's (bounded by max_update_step_n); terrain
   /// patches do not touch the samples the tool feels while in contact.
   double max_update_step_n() const { return max_update_step_n_; }
   /// Largest tick-to-tick change of the device force (whatever its cause:
   /// motion included) on ticks while an update was being merged, device N.
   double max_step_while_updating_n() const { return max_step_while_updating_n_; }
+  /// The newest estimate received from the remote (its material, the
+  /// uncertainty, what is identifiable); samples 0 before one.
+  const net::Estimate& last_estimate() const { return last_estimate_; }
   /// Ticks of the run, duration (path + settle).
   std::int64_t ticks() const { return ticks_; }
   double rate_hz() const;
@@ -287,7 +313,8 @@ class OperatorStation {
   std::uint32_t session_;
   std::unique_ptr<LinkGuardDevice> guard_;
   std::unique_ptr<HapticRig> rig_;
-  std::unique_ptr<ScaleCorrection> correction_;
+  std::unique_ptr<MaterialBlend> blend_;
+  net::Estimate last_estimate_{};
   std::vector<float> stamp_s_;  // time each sample was last changed by the local tool
   double protect_s_ = 0.0;      // a local cut this recent is not yet in what the remote sends
   // The blends in arrival order: [0, active_blends_) are merging, the rest
@@ -366,6 +393,9 @@ struct MmtSummary {
   double force_error_max_mmt_n = 0.0;
   double force_error_rms_dfr_n = 0.0;  ///< direct force reflection
   double force_error_max_dfr_n = 0.0;
+  /// Each operator tick meets the remote's tick that followed its command
+  /// this much later (the remote arm's time constant), s.
+  double aligned_after_s = 0.0;
   double terrain_rms_max_m = 0.0;    ///< local - remote over the worked region, largest
   double terrain_rms_final_m = 0.0;  ///< at the end
   double tracking_rms_m = 0.0;
@@ -377,11 +407,30 @@ struct MmtSummary {
   double max_update_step_n = 0.0;
   double max_step_while_updating_n = 0.0;
   double passivity_max_mmt_j = 0.0, passivity_max_dfr_j = 0.0;
-  double force_scale_final = 1.0;    ///< the remote's estimate
-  double force_scale_applied = 1.0;  ///< what the operator applied at the end
-  std::int64_t estimate_samples = 0;
-  std::int64_t estimate_outliers = 0;  ///< samples the estimate left out (remote's estimate_outliers)
-  std::int64_t estimate_capped = 0;    ///< samples left out where the low-speed cap set the force
+  /// The force error after the first second of the remote's cutting (the
+  /// study's targets): RMS of |F_op - F_remote| and of the remote's force
+  /// over the ticks from the remote's first cut + 1 s on, N, and their
+  /// ratio (-1 when the window holds less than 0.1 s of the remote
+  /// cutting); the same for direct reflection. settle_excluded_s: a window
+  /// after a change of soil left out (a round trip plus 0.5 s: the soil no
+  /// model could know yet), 0 without one.
+  double cutting_from_s = 0.0;
+  double settle_excluded_from_s = 0.0, settle_excluded_to_s = 0.0;
+  double force_rms_remote_after_1s_n = 0.0;
+  double force_error_rms_mmt_after_1s_n = 0.0;
+  double force_error_rms_dfr_after_1s_n = 0.0;
+  double force_error_rel_mmt_after_1s = 0.0;
+  double force_error_rel_dfr_after_1s = 0.0;
+  /// The remote's final estimate and the material its force used then.
+  SoilEstimate estimate{};
+  SoilMaterial remote_material{};
+  SoilMaterial material_applied{};  ///< what the operator's model used at the end
+  /// For a change of soil: the time from the remote blade entering the new
+  /// soil to the estimate's horizontal force staying within 5 % of the
+  /// measured one (s; -1: never, or no change).
+  double reidentified_after_s = -1.0;
+  double arm_force_limit_n = 0.0;  ///< the remote arm's (mmt.remote.arm_force_limit_n)
+  std::int64_t stalled_ticks = 0;  ///< ticks the remote arm's force limit held it
   std::int64_t patches_merged = 0, estimates_applied = 0;  ///< by the operator
   std::int64_t lost_to_remote = 0, lost_to_operator = 0;   ///< emulated losses
   net::RejectCounts rejected_operator{}, rejected_remote{};
@@ -389,17 +438,40 @@ struct MmtSummary {
 };
 
 /// The figures of a session that its two stations' records give: the force
-/// errors, the remote's force, tracking, passivity, the factor applied at
-/// the end and the tick timing, into s. Each operator tick is compared with
-/// the remote's first tick that followed its command or a newer one (the
-/// same commanded motion, by command sequence: the measured delay, not a
-/// configured one), over the ticks where some force is felt or measured.
+/// errors (over the whole run and after the first second of cutting), the
+/// remote's force, tracking, passivity, the material applied at the end,
+/// the re-identification time of a change of soil and the tick timing,
+/// into s (s.rtt_s set: a change of soil leaves out a round trip plus
+/// 0.5 s). Each operator tick is compared with the remote's first tick that
+/// followed its command or a newer one (the same commanded motion, by
+/// command sequence: the measured delay, not a configured one), then
+/// follower_lag_s later (the remote arm, a first-order servo, follows a
+/// steady motion one time constant behind: 0 for none), over the ticks
+/// where some force is felt or measured. rate_hz: the stations' tick rate.
 void compare_records(const std::vector<OperatorRecord>& op, const std::vector<RemoteRecord>& rm,
-                     MmtSummary& s);
+                     double rate_hz, double follower_lag_s, MmtSummary& s);
 
 /// "SCENARIO: mmt: the scenario has no mmt: section ...": the one refusal
 /// of every MMT entry point.
 std::string no_mmt_section(const Scenario& sc);
+
+/// The teleoperation pair of one process: the emulated link and both
+/// stations on it.
+struct StationPair {
+  std::unique_ptr<net::EmulatedLink> link;
+  std::unique_ptr<OperatorStation> operator_station;
+  std::unique_ptr<RemoteStation> remote_station;
+};
+/// The pair as the single-process run and the viewer's operator mode build
+/// it: the link of settings.to_remote and to_operator, the operator station
+/// (session 1) over op's world with device, and the remote station (session
+/// 2) in the remote world (load_remote_scenario), its estimate starting from
+/// the operator's soil material and its deadband from the operator's
+/// initial heights. device and remote must outlive the pair. Throws
+/// InputError naming the field.
+StationPair make_station_pair(const Scenario& op, const Scenario& remote, const MmtSettings& settings,
+                              haptics::Device& device, const OperatorOptions& operator_options = {},
+                              const RemoteOptions& remote_options = {});
 
 /// Both stations in one process.
 class MmtRun {

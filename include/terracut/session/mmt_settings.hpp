@@ -31,10 +31,25 @@ struct MmtSettings {
   double sense_period_s = 0.05;
   /// Half side of the square sensed around the remote tool, m, (0, 100].
   double sense_radius_m = 0.3;
-  /// The remote estimates the soil factor and sends it.
+  /// A change of the remote's soil along the path: where the remote
+  /// blade's centre is at z below change_z_m the remote's soil is
+  /// change_soil (a line across the trench; the failure wedge is not split).
+  std::optional<SoilPreset> change_soil;
+  double change_z_m = 0.0;  ///< world m, finite
+  /// The remote estimates its soil's material (core/soil_estimator.hpp) and
+  /// sends it.
   bool estimate = true;
-  /// RLS forgetting factor, (0, 1].
+  /// Forgetting of the estimate per loop tick, (0, 1]: a memory of about
+  /// 1 / (1 - forgetting) ticks (0.999: a second at 1 kHz).
   double forgetting = 0.999;
+  /// The estimate takes a sample of the physical cutting force every
+  /// estimate_period_s, s, [loop period, 1]; the work on one sample is
+  /// spread over the ticks to the next.
+  double estimate_period_s = 0.01;
+  /// The largest force the remote's arm exerts, N, (0, 1e7]: when the tool
+  /// force on it exceeds this the arm stalls (holds its pose) instead of
+  /// pushing on. 1e7: no limit.
+  double arm_force_limit_n = 1e7;
   /// Conditions operator -> remote and remote -> operator.
   net::LinkConditions to_remote{};
   net::LinkConditions to_operator{};
