@@ -476,24 +476,40 @@ inline bool SoilFlow::blade_blocks(int hc, int hr, int lc, int lr, float top_m) 
   const double len = blade_.len;
   // Signed distances to the edge's line (their numerators na, nb over
   // len), and the half width of a cell across it (blade_.half): a cell
-  // closer than that is inside the blade. Most pairs lie on one side,
-  // outside the blade, and are told so without a division: the sign of
-  // na / len is na's, and |nb| away from the half width's numerator by more
-  // than rounding (blade_.half_lo, half_hi) compares as |nb| / len would.
+  // closer than that is inside the blade (the edge passes through it).
+  // Most pairs lie on one side, outside the blade, and are told so without
+  // a division: the sign of na / len is na's, and a |n| away from the half
+  // width's numerator by more than rounding (blade_.half_lo, half_hi)
+  // compares as |n| / len would.
   const double na = blade_.dx * za - blade_.dz * xa;
   const double nb = blade_.dx * zb - blade_.dz * xb;
   const double half = blade_.half;
-  const double q = std::abs(nb);
-  const bool low_inside = q < blade_.half_lo ? true : q > blade_.half_hi ? false : std::abs(nb / len) < half;
-  if (!low_inside && (na > 0.0) == (nb > 0.0)) return false;  // one side, outside the blade
-  const double da = na / len, db = nb / len;
-  // Where along the edge: at the low cell when it is inside the blade, else
-  // where the pair's segment meets the line.
+  const auto inside = [&](double n) {
+    const double q = std::abs(n);
+    return q < blade_.half_lo ? true : q > blade_.half_hi ? false : std::abs(n / len) < half;
+  };
+  const bool low_inside = inside(nb);
+  // A source inside the blade is on neither side: its soil stands against
+  // the blade (the cut takes it when the edge passes its centre), and the
+  // side a centre on or next to the edge's line falls on is a matter of
+  // rounding (a centre exactly on the line gave na = 0, counted on the
+  // negative side, and a pile stood against the blade collapsed into the
+  // cut behind it). It sheds nothing across or along the blade.
+  const bool high_inside = inside(na);
+  if (!low_inside && !high_inside && (na > 0.0) == (nb > 0.0)) return false;  // one side, outside the blade
+  // Where along the edge: at the low cell when it is inside the blade, at
+  // the source when it is, else where the pair's segment meets the line.
   double px = xb, pz = zb;
   if (!low_inside) {
-    const double w = da / (da - db);
-    px = xa + (xb - xa) * w;
-    pz = za + (zb - za) * w;
+    if (high_inside) {
+      px = xa;
+      pz = za;
+    } else {
+      const double da = na / len, db = nb / len;
+      const double w = da / (da - db);
+      px = xa + (xb - xa) * w;
+      pz = za + (zb - za) * w;
+    }
   }
   const double t = (px * blade_.dx + pz * blade_.dz) / len2;
   if (t < 0.0 || t > 1.0) return false;  // around an end of the blade
@@ -571,10 +587,20 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
     layers.height_m[cell] = value;
     last_put = cell;
   };
+  // Whether the centre of cell (c, r) lies behind the edge (on the side it
+  // came from, past the half cell its line passes through), within its
+  // length: the cut behind the blade, where no displaced soil may go.
+  const double edge_len2 = e.x * e.x + e.z * e.z;
+  const auto behind_blade = [&](int c, int r) {
+    if (!(edge_len2 > 0.0)) return false;
+    const double x = spec.origin_m.x + (c + 0.5) * dx_ - to.a.x, z = spec.origin_m.z + (r + 0.5) * dz_ - to.a.z;
+    const double t = (x * e.x + z * e.z) / edge_len2;
+    return t >= 0.0 && t <= 1.0 && x * nx + z * nz < -0.5 * cell;
+  };
   // Puts `add` metres on `cell`, never above the ceiling (a Bullet
   // heightfield's upper bound would clamp, and so delete, soil above it):
   // what would rise above it goes to the nearest cells around with room,
-  // ring by ring, none under a body.
+  // ring by ring, none under a body nor behind the blade.
   const auto put_down = [&](std::int64_t cell, float add) {
     float v = std::max(0.0f, layers.height_m[cell] + add);
     float over = v > ceiling_m_ ? v - ceiling_m_ : 0.0f;
@@ -589,9 +615,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           if (c < 0 || r < 0 || c >= cols_ || r >= rows_) continue;
           const std::int64_t j = std::int64_t(r) * cols_ + c;
           const float room = ceiling_m_ - layers.height_m[j];
-          if (obstacle_[j] != 0 || !(room > 0.0f)) continue;
+          if (obstacle_[j] != 0 || !(room > 0.0f) || behind_blade(c, r)) continue;
           const float give = std::min(over, room);
-          write(j, layers.height_m[j] + give);
+          // (h + (ceiling - h) may round an ulp above the ceiling.)
+          write(j, std::min(layers.height_m[j] + give, ceiling_m_));
           over -= give;
           out.changed.include(c, r);
           activate(std::uint32_t(j));
@@ -798,8 +825,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
     }
   // Give back the rounding of the writes on the last cell written.
   if (last_put >= 0 && put != taken) {
-    const float corrected = float(std::max(0.0, double(layers.height_m[last_put]) + (taken - put)));
-    layers.height_m[last_put] = corrected;
+    give_back(layers.height_m[last_put], taken - put);
   }
 }
 
@@ -895,14 +921,29 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
   return n;
 }
 
+void SoilFlow::drop_blocked_fluxes(std::uint32_t a, std::size_t end, const float* h) {
+  const std::uint8_t fa = queued_[a];
+  const bool blade = blade_.present && (fa & kNearBlade);
+  if (!blade && hull_cells_.empty() && obstacles_.empty()) return;
+  const int ca = col_of(a), ra = row_of(a);
+  for (std::size_t j = applied_; j < end; ++j) {
+    Flux& f = fluxes_[j];
+    if (f.to == kOutside) continue;
+    const std::uint8_t fb = queued_[f.to];
+    const bool across = blade && (fb & kNearBlade) && blade_blocks(ca, ra, col_of(f.to), row_of(f.to), h[a]);
+    const bool into_hull = (fb & kHull) && h[a] > hull_under(f.to);
+    if (across || into_hull) hold(a);
+    if (across || into_hull || (!obstacles_.empty() && obstructed(f.to))) f.excess = 0.0f;
+  }
+}
+
 void SoilFlow::finish_pass(HeightGrid& grid, SoilStepResult& out) {
   // The fluxes cancel exactly; the float heights do not quite: what the
   // pass gained or lost by rounding was measured in double and is given
   // back to the highest cell it changed, so no bias builds up over a run.
   const HeightGrid::EditLayers layers = grid.edit_layers();
   if (pass_gained_m_ != 0.0 && pass_highest_h_ > 0.0f) {
-    float& hh = layers.height_m[pass_highest_];
-    hh = float(std::max(0.0, double(hh) - pass_gained_m_));
+    give_back(layers.height_m[pass_highest_], -pass_gained_m_);
   }
   pass_gained_m_ = 0.0;
   pass_highest_h_ = -1.0f;
@@ -928,6 +969,9 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   // spread over ticks of bounded work.
   const std::int64_t cap = params_.max_pair_checks_per_step;
   std::int64_t work = 0;
+  // A pass left over from an earlier step was examined against the blade,
+  // hull and bodies of that step.
+  pass_spans_steps_ = !active_.empty();
   // The rectangle of the cells that shed soil; the cells they shed to are
   // their neighbours, so the changed rectangle is that plus a cell.
   int changed_c0 = cols_, changed_c1 = -1, changed_r0 = rows_, changed_r1 = -1;
@@ -938,6 +982,7 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       if (next_.empty()) break;
       active_.swap(next_);
       for (std::uint32_t a : active_) clear_flag(a, kQueued);
+      pass_spans_steps_ = false;
     }
     if (examined_ < active_.size()) {
       const std::size_t can = std::size_t((cap - work) / 8);
@@ -970,6 +1015,11 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
         ++applied_sources_;
         continue;
       }
+      // A pass examined in an earlier step met the blade, the hull and the
+      // bodies where they were then; they have moved since. A flux that
+      // would now cross the blade, climb into the hull or enter a body is
+      // dropped (its source is held, and examined again).
+      if (pass_spans_steps_) drop_blocked_fluxes(a, end, h);
       float total = 0.0f;
       for (std::size_t j = applied_; j < end; ++j)
         if (!any_dirty || fluxes_[j].to == kOutside || !(queued_[fluxes_[j].to] & kDirty))
@@ -1088,8 +1138,7 @@ void SoilFlow::pour(HeightGrid& grid, const Segment& lip, double volume_m3, Soil
   }
   // Give back the rounding of the writes on the last cell written.
   if (last >= 0 && put != wanted) {
-    const float corrected = float(std::max(0.0, double(layers.height_m[last]) + (wanted - put)));
-    layers.height_m[last] = corrected;
+    give_back(layers.height_m[last], wanted - put);
   }
   out.poured_m3 += volume_m3;
 }
@@ -1269,7 +1318,7 @@ void SoilFlow::shoulder(HeightGrid& grid, SoilStepResult& out) {
     }
   }
   // Give back the rounding of the writes on the last cell written.
-  if (last_put >= 0 && put != taken) h[last_put] = float(std::max(0.0, double(h[last_put]) + (taken - put)));
+  if (last_put >= 0 && put != taken) give_back(h[last_put], taken - put);
   out.shouldered_m3 += taken * spec.cell_area_m2();
 }
 

@@ -89,6 +89,7 @@
 // slides or is pushed off the terrain, counted in left_over_edge_m3.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -354,7 +355,18 @@ class SoilFlow {
   float hull_under(std::uint32_t cell) const {
     return hull_under_[hull_slot(col_of(cell), row_of(cell))];
   }
+  /// Adds delta_m, a float rounding the writes lost (or, negative, gained),
+  /// back to a cell, never below the floor nor above the ceiling (a cell
+  /// already at the ceiling keeps it: the ulp is left out of the books
+  /// rather than clamped, and so deleted, by the Bullet heightfield).
+  void give_back(float& height_m, double delta_m) const {
+    height_m = float(std::clamp(double(height_m) + delta_m, 0.0, std::max(double(ceiling_m_), double(height_m))));
+  }
   void run_passes(HeightGrid& grid, SoilStepResult& out);
+  /// Zeroes the fluxes [applied_, end) of source a that the blade, the hull
+  /// or a body now stands in the way of (the pass was examined in an
+  /// earlier step, against where they were then).
+  void drop_blocked_fluxes(std::uint32_t a, std::size_t end, const float* h);
   std::int64_t examine(std::uint32_t a, const float* h);
   void finish_pass(HeightGrid& grid, SoilStepResult& out);
 
@@ -427,6 +439,7 @@ class SoilFlow {
   std::size_t applied_ = 0;
   std::vector<Source> sources_;
   std::size_t applied_sources_ = 0;
+  bool pass_spans_steps_ = false;  // the pass in progress was examined (in part) in an earlier step
   double pass_gained_m_ = 0.0;    // height the pass's writes gained by float rounding
   std::uint32_t pass_highest_ = 0;  // the highest cell the pass raised or lowered
   float pass_highest_h_ = -1.0f;
