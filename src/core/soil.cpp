@@ -18,9 +18,6 @@
 namespace terracut {
 namespace {
 
-/// Fraction of its steepest excess a cell sheds per pass (as thermal erosion
-/// does: half moves the pair to the limit when it is the only one).
-constexpr float kShedFraction = 0.5f;
 /// Radius around the edge, in cells, of the cells whose pairs are tested
 /// against the blade (a pair is at most one diagonal long).
 constexpr double kBladeRadiusCells = 1.5;
@@ -40,6 +37,21 @@ constexpr double kToleranceOfLimit = 0.02;
 constexpr double kHeldMoveCells = 0.25;
 /// Longest run of cells the blade pushes ahead of it, per cut sample.
 constexpr int kMaxPushCells = 512;
+/// Longest fall line a source's soil slides down in one pass, cells (what
+/// lies beyond is reached in the next pass, from the line's end).
+constexpr int kMaxFallCells = 32;
+/// Rounds of the water fill after the first (each drops the cells that
+/// stand above the line); what a source would still give past them stays
+/// on it (a later pass moves it). Two settle nearly every source.
+constexpr int kMaxExtraRounds = 2;
+/// The most one examination can cost, in visits: its 8 neighbours, its
+/// fall lines, and their cells read again in each further round. The work
+/// cap admits a cell only with this much room left, so a step never passes
+/// it (and the minimum cap, 1000, leaves room for one).
+constexpr std::int64_t kMostExamineVisits = 8 + 8 * kMaxFallCells * (1 + kMaxExtraRounds);
+static_assert(kMostExamineVisits <= 1000);
+/// Fluxes a pass may hold per cell of the reserved active set.
+constexpr std::size_t kFluxesPerActiveCell = 8;
 /// The work cap's charge for a source's fall test (lowered): its 8
 /// neighbours read again.
 constexpr std::int64_t kFallTestVisits = 8;
@@ -232,8 +244,13 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   const std::size_t active = std::min(n, std::max<std::size_t>(std::size_t(1) << 16, 4 * footprint));
   active_.reserve(active);
   next_.reserve(active);
-  fluxes_.reserve(4 * active);  // up to 8 per cell; 4 covers a collapsing block
+  // A source's fall lines give up to 8 x kMaxFallCells fluxes, a handful as
+  // a rule: a pass holds at most kFluxesPerActiveCell x active of them (a
+  // larger one is split, examine's loop), and the table that sums what
+  // each cell receives has twice as many slots.
+  fluxes_.reserve(kFluxesPerActiveCell * active);
   sources_.reserve(active);
+  incoming_.init(2 * kFluxesPerActiveCell * active);
   held_.reserve(footprint);
   dirty_.reserve(footprint);
   if (blade.bucket.enabled()) {
@@ -384,7 +401,21 @@ void SoilFlow::wake(const Rect& rect) {
     }
 }
 
-void SoilFlow::before_cut(const HeightGrid& grid, const Segment& from, const Segment& to) {
+void SoilFlow::deliver(float* h) {
+  // Each cell's sum in one rounding; the rounding is what the pass gained.
+  incoming_.drain([&](std::uint32_t cell, double add) {
+    const float old = h[cell];
+    h[cell] = float(double(old) + add);
+    pass_gained_m_ += double(h[cell]) - double(old) - add;
+    delivered_.include(col_of(cell), row_of(cell));
+  });
+}
+
+void SoilFlow::before_cut(HeightGrid& grid, const Segment& from, const Segment& to) {
+  // What a pass spread over steps has sent so far lands before the blade
+  // moves: soil sent to a cell ahead of it must be there when the cut
+  // comes, not arrive after it (behind the blade).
+  if (!incoming_.empty()) deliver(grid.edit_layers().height_m);
   // The bounding rectangle of the four endpoints, plus a cell.
   const GridSpec& spec = grid.spec();
   double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
@@ -650,6 +681,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       const std::int64_t i = std::int64_t(row) * cols_ + c;
       const float cut = before_[k] - after_cut_[k];
       if (!(cut > 0.0f)) continue;
+      // Ground: the part of the cut below the initial surface.
+      out.cut_from_ground_m3 +=
+          std::max(0.0, std::min(double(before_[k]), double(layers.initial_m[i])) - double(after_cut_[k])) *
+          spec.cell_area_m2();
       dirty(std::uint32_t(i));
       lowered(std::uint32_t(i), layers.height_m);  // its walls may now be too steep
       const float kept = keep >= 1.0 ? cut : float(double(cut) * keep);
@@ -830,9 +865,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
 }
 
 std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
-  // Cell a sheds half of its steepest excess, shared among its lower
-  // neighbours in proportion to their excess (from the heights frozen at
-  // the pass's start): its fluxes are appended to the pass's list.
+  // Cell a, if it stands steeper than the repose angle toward some
+  // neighbours, lets the soil above the repose line slide down its fall
+  // lines (fall_lines): its fluxes, from the heights frozen at the pass's
+  // start, are appended to the pass's list.
   // One byte holds the cell's flags (border, near the blade, ...).
   const std::uint8_t flags = queued_[a];
   const float ha = h[a];
@@ -883,14 +919,12 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
   const int ca = blade ? col_of(a) : 0, ra = blade ? row_of(a) : 0;
   const bool obstacles = !obstacles_.empty();
   const bool hull = !hull_cells_.empty();
+  int dirs[8];
   int n = 0;
-  float top = 0.0f, sum = 0.0f;
   for (unsigned bits = steep; bits != 0; bits &= bits - 1) {
     const int k = std::countr_zero(bits);
-    const float e = excess[k];
-    std::uint32_t b = kOutside;
     if (!(outside & (1u << k))) {
-      b = std::uint32_t(std::int64_t(a) + offset_[k]);
+      const std::uint32_t b = std::uint32_t(std::int64_t(a) + offset_[k]);
       if (blade || obstacles || hull) {
         const std::uint8_t fb = queued_[b];
         // The blade is a wall between the cells on its two sides, and soil
@@ -911,14 +945,107 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
         }
       }
     }
-    fluxes_.push_back({b, e});
-    ++n;
-    top = std::max(top, e);
-    sum += e;
+    dirs[n++] = k | int((outside >> k) & 1u) << 8;
   }
   if (n == 0) return 0;
-  sources_.push_back({a, std::uint32_t(n), kShedFraction * top / sum});
-  return n;
+  return fall_lines(a, ha, h, dirs, n);
+}
+
+std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, const int* dirs, int n) {
+  // The soil above the repose line through the source slides down its fall
+  // lines and comes to rest where the line meets the ground: along each
+  // steep direction k the cells from the neighbour on, as long as they
+  // stand below the source by more than the repose drop back to it (their
+  // reach, height + drop, under the source's height), up to the first that
+  // does not, the grid's edge, the blade, the hull's underside or a body.
+  // The source comes down to s and every cell of those runs whose reach is
+  // below s comes up to s less its drop:
+  // one line at the repose slope from the source down each fall line (the
+  // 1-D water fill of fill_ahead, from a point). s balances the volume:
+  // s = (h_a + sum of the reaches taken) / (1 + their count). The drop per
+  // cell is the pair's limit less the tolerance, so the lines it leaves
+  // stand a tolerance gentler than the threshold that moves them.
+  struct Line {
+    std::uint32_t cell[kMaxFallCells];
+    float reach[kMaxFallCells];
+    int length = 0;
+  };
+  // A reach marked as left out (a hump).
+  constexpr float kHump = std::numeric_limits<float>::infinity();
+  Line lines[8];
+  const float tol = tolerance_m_;
+  // A fall line from a cell far from the blade may still run into it.
+  const bool blade = blade_.present;
+  double total = ha;
+  int count = 1;
+  for (int j = 0; j < n; ++j) {
+    const int k = dirs[j] & 0xff;
+    const float drop = limit8_[k] - tol;
+    Line& line = lines[j];
+    if (dirs[j] >> 8) {
+      // Beyond an open edge: bare ground at height 0 that takes what comes.
+      line.cell[0] = kOutside;
+      line.reach[0] = drop;
+      line.length = 1;
+    } else {
+      std::uint32_t cur = std::uint32_t(std::int64_t(a) + offset_[k]);
+      for (int m = 1;; ++m) {
+        const float reach = h[cur] + drop * float(m);
+        if (!(reach < ha)) break;
+        line.cell[line.length] = cur;
+        line.reach[line.length++] = reach;
+        if (line.length == kMaxFallCells || (queued_[cur] & kEdge)) break;
+        const std::uint32_t next = std::uint32_t(std::int64_t(cur) + offset_[k]);
+        const std::uint8_t fn = queued_[next];
+        if (!obstacles_.empty() && obstructed(next)) break;
+        if ((fn & kHull) && ha > hull_under(next)) break;
+        if (blade && (queued_[cur] & kNearBlade) && (fn & kNearBlade) &&
+            blade_blocks(col_of(cur), row_of(cur), col_of(next), row_of(next), ha))
+          break;
+        cur = next;
+      }
+    }
+    fall_visits_ += line.length;
+    for (int m = 0; m < line.length; ++m) total += line.reach[m];
+    count += line.length;
+  }
+  // A cell whose reach is at or above s stands above the final line (a
+  // hump) and takes nothing; without it s comes lower, until no more drop
+  // out (as in fill_ahead). s only comes down as cells drop out, and at
+  // least one cell stays (every reach is below h_a). Two or three rounds
+  // settle nearly every source; after 1 + kMaxExtraRounds a cell still at
+  // or above s gets nothing (its share would not be positive) and the
+  // source keeps that soil for a later pass.
+  double s = total / count;
+  for (int round = 0; round <= kMaxExtraRounds; ++round) {
+    bool changed = false;
+    const bool first = round == 0;
+    for (int j = 0; j < n; ++j) {
+      Line& line = lines[j];
+      if (!first) fall_visits_ += line.length;  // a further round reads every cell again
+      for (int m = 0; m < line.length; ++m)
+        if (line.reach[m] < kHump && double(line.reach[m]) >= s) {
+          total -= line.reach[m];
+          --count;
+          line.reach[m] = kHump;
+          changed = true;
+        }
+    }
+    s = total / count;
+    if (!changed) break;
+  }
+  std::uint32_t fluxes = 0;
+  for (int j = 0; j < n; ++j)
+    for (int m = 0; m < lines[j].length; ++m) {
+      if (!(lines[j].reach[m] < kHump)) continue;
+      const float give = float(s - double(lines[j].reach[m]));
+      if (!(give > 0.0f)) continue;
+      fluxes_.push_back({lines[j].cell[m], give});
+      ++fluxes;
+    }
+  if (fluxes == 0) return 0;
+  sources_.push_back({a, fluxes, 1.0f});
+  return fluxes;
 }
 
 void SoilFlow::drop_blocked_fluxes(std::uint32_t a, std::size_t end, const float* h) {
@@ -941,12 +1068,16 @@ void SoilFlow::finish_pass(HeightGrid& grid, SoilStepResult& out) {
   // The fluxes cancel exactly; the float heights do not quite: what the
   // pass gained or lost by rounding was measured in double and is given
   // back to the highest cell it changed, so no bias builds up over a run.
+  // When two cells tie for highest (a mirror image would pick the other),
+  // it waits for a pass with one highest cell: which cell takes it depends
+  // on the heights alone, so a mirrored terrain gives it to the mirrored cell.
   const HeightGrid::EditLayers layers = grid.edit_layers();
-  if (pass_gained_m_ != 0.0 && pass_highest_h_ > 0.0f) {
+  if (pass_gained_m_ != 0.0 && pass_highest_h_ > 0.0f && !pass_highest_tied_) {
     give_back(layers.height_m[pass_highest_], -pass_gained_m_);
+    pass_gained_m_ = 0.0;
   }
-  pass_gained_m_ = 0.0;
   pass_highest_h_ = -1.0f;
+  pass_highest_tied_ = false;
   for (std::uint32_t cell : dirty_) clear_flag(cell, kDirty);
   dirty_.clear();
   active_.clear();
@@ -985,14 +1116,30 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       pass_spans_steps_ = false;
     }
     if (examined_ < active_.size()) {
-      const std::size_t can = std::size_t((cap - work) / 8);
-      const std::size_t end = std::min(active_.size(), examined_ + can);
+      // 8 visits per cell examined and one per cell of the fall lines it
+      // walks (fall_visits_), cell by cell while the cap leaves room for one
+      // more examination and a full fall line each way.
       std::int64_t moved = 0;
-      for (std::size_t j = examined_; j < end; ++j) moved += examine(active_[j], h);
+      // A pass whose fluxes would outgrow their list is split: the cells
+      // not examined yet go on to the next pass (a pass that large is a
+      // collapse of most of a reserved active set, or a grid's worth).
+      while (examined_ < active_.size() && work + kMostExamineVisits <= cap &&
+             fluxes_.size() + 8 * kMaxFallCells <= fluxes_.capacity()) {
+        fall_visits_ = 0;
+        moved += examine(active_[examined_++], h);
+        work += 8 + fall_visits_;
+      }
       out.moved_pairs += moved;
-      work += 8 * std::int64_t(end - examined_);
-      examined_ = end;
-      if (examined_ < active_.size()) break;  // the rest in the next step
+      if (examined_ < active_.size()) {
+        if (work + kMostExamineVisits <= cap) {
+          // Split: the rest of the list is examined in the next pass.
+          for (std::size_t j = examined_; j < active_.size(); ++j) activate(active_[j]);
+          active_.truncate(examined_);
+        } else {
+          out.reached_cap = true;
+          break;  // the rest in the next step
+        }
+      }
     }
     while (applied_sources_ < sources_.size()) {
       // A source's fluxes are contiguous: applied together, then its fall
@@ -1007,6 +1154,7 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       const std::int64_t cost = std::int64_t(end - applied_) + (stale ? 0 : kFallTestVisits);
       if (work + cost > cap) {
         out_of_work = true;
+        out.reached_cap = true;
         break;
       }
       work += cost;
@@ -1020,21 +1168,27 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       // would now cross the blade, climb into the hull or enter a body is
       // dropped (its source is held, and examined again).
       if (pass_spans_steps_) drop_blocked_fluxes(a, end, h);
-      float total = 0.0f;
+      // Summed in double, so that the order of the source's fall lines
+      // (which a mirror image permutes) does not round the total.
+      double total_d = 0.0;
       for (std::size_t j = applied_; j < end; ++j)
         if (!any_dirty || fluxes_[j].to == kOutside || !(queued_[fluxes_[j].to] & kDirty))
-          total += share * fluxes_[j].excess;
+          total_d += double(share * fluxes_[j].excess);
+      const float total = float(total_d);
       // What the cell can give: never below the floor (the blade may have
       // cut it since the pass was examined).
       const float before = h[a];
       const float scale = total > before ? before / total : 1.0f;
-      const float now = total > before ? 0.0f : before - total;
+      const float now = total > before ? 0.0f : float(double(before) - total_d);
       h[a] = now;
       // The grid's change in double: float rounding is what it gains.
       double gained = double(now) - double(before);
       if (now > pass_highest_h_) {
         pass_highest_h_ = now;
         pass_highest_ = a;
+        pass_highest_tied_ = false;
+      } else if (now == pass_highest_h_) {
+        pass_highest_tied_ = true;
       }
       const int ca = col_of(a), ra = row_of(a);
       changed_c0 = std::min(changed_c0, ca);
@@ -1050,9 +1204,11 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
           gained += double(give);  // what left is no rounding gain
           continue;
         }
-        const float old = h[f.to], raised = old + give;
-        h[f.to] = raised;
-        gained += double(raised) - double(old);
+        // What each cell receives is summed (incoming_) and added when the
+        // pass ends, in one rounding: the order of the sources, which a
+        // mirror image reverses, does not round it.
+        incoming_.add(f.to, double(give));
+        gained += double(give);
         activate(f.to);
       }
       pass_gained_m_ += gained;
@@ -1060,9 +1216,13 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       lowered(a, h);
     }
     if (applied_sources_ < sources_.size()) break;
+    deliver(h);
     finish_pass(grid, out);
   }
   out.pair_checks += work;
+  // The cells the fall lines delivered to (here, or before this step's cut).
+  out.changed.include(delivered_);
+  delivered_ = {};
   if (changed_c1 >= 0) {
     out.changed.include(std::max(changed_c0 - 1, 0), std::max(changed_r0 - 1, 0));
     out.changed.include(std::min(changed_c1 + 1, cols_ - 1), std::min(changed_r1 + 1, rows_ - 1));
@@ -1096,6 +1256,9 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     shoulder(grid, out);
   }
   wake_held(&to);
+  // What before_cut delivered is this step's change even when no pass runs.
+  out.changed.include(delivered_);
+  delivered_ = {};
   // The blade's wall matters only to a pass: marked only when one runs.
   if (pending()) {
     mark_blade(grid, to);

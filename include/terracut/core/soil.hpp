@@ -148,6 +148,8 @@ class CellList {
   std::size_t capacity() const { return buf_.size() - 1; }
   bool empty() const { return size_ == 0; }
   void clear() { size_ = 0; }
+  /// Keeps the first n elements (n <= size()).
+  void truncate(std::size_t n) { size_ = std::min(size_, n); }
   void reserve(std::size_t n) {
     if (n + 1 > buf_.size()) buf_.resize(n + 1);
   }
@@ -169,6 +171,62 @@ class CellList {
  private:
   std::vector<std::uint32_t> buf_;  // buf_.size() is the capacity
   std::size_t size_ = 0;
+};
+
+/// Sums per cell of what a relaxation pass delivers, in double, in a table
+/// of open addressing (linear probing) sized once: add() in any order gives
+/// every cell the same sum to double rounding, so a pass whose sources are
+/// met in another order (a mirror image) writes the same floats. drain()
+/// visits the cells in the order they were first added and empties it.
+class CellSums {
+ public:
+  /// Room for n cells (rounded up to a power of two, at least 64).
+  void init(std::size_t n) {
+    std::size_t cap = 64;
+    while (cap < n) cap *= 2;
+    cell_.assign(cap, kEmpty);
+    sum_.assign(cap, 0.0);
+    order_.clear();
+    order_.reserve(cap / 2);
+  }
+  void add(std::uint32_t cell, double v) {
+    if (2 * (order_.size() + 1) > cell_.size()) grow();
+    std::size_t i = slot(cell);
+    if (cell_[i] == kEmpty) {
+      cell_[i] = cell;
+      order_.push_back(std::uint32_t(i));
+    }
+    sum_[i] += v;
+  }
+  template <typename F>
+  void drain(F&& f) {
+    for (std::uint32_t i : order_) {
+      f(cell_[i], sum_[i]);
+      cell_[i] = kEmpty;
+      sum_[i] = 0.0;
+    }
+    order_.clear();
+  }
+  bool empty() const { return order_.empty(); }
+
+ private:
+  static constexpr std::uint32_t kEmpty = 0xffffffffu;
+  std::size_t slot(std::uint32_t cell) const {
+    const std::size_t mask = cell_.size() - 1;
+    std::size_t i = (std::size_t(cell) * 0x9E3779B1u) & mask;  // Fibonacci hashing
+    while (cell_[i] != kEmpty && cell_[i] != cell) i = (i + 1) & mask;
+    return i;
+  }
+  void grow() {
+    std::vector<std::uint32_t> cells;
+    std::vector<double> sums;
+    for (std::uint32_t i : order_) cells.push_back(cell_[i]), sums.push_back(sum_[i]);
+    init(2 * cell_.size());
+    for (std::size_t k = 0; k < cells.size(); ++k) add(cells[k], sums[k]);
+  }
+  std::vector<std::uint32_t> cell_{std::vector<std::uint32_t>(64, kEmpty)};
+  std::vector<double> sum_{std::vector<double>(64, 0.0)};
+  std::vector<std::uint32_t> order_;
 };
 
 }  // namespace detail
@@ -219,10 +277,18 @@ std::string validate(const SoilFlowParams& params);
 /// What the soil phase did in one step.
 struct SoilStepResult {
   double displaced_volume_m3 = 0.0;  ///< cut soil put down ahead of the blade (soil pushed again counts again), m^3
+  /// The part of the step's cut that lay below the initial surface, m^3:
+  /// ground the blade cut, not pile it cut again (soil that slid back into
+  /// the cut and is cut again counts again).
+  double cut_from_ground_m3 = 0.0;
   int passes = 0;                    ///< relaxation passes run
   std::int64_t pair_checks = 0;      ///< work done, in neighbour visits (see max_pair_checks_per_step)
   std::int64_t moved_pairs = 0;      ///< pairs that exchanged soil
   std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
+  /// The relaxation stopped at the work cap (max_pair_checks_per_step) with
+  /// work left; the rest is carried over (a safety bound a normal push on
+  /// the documented cases does not reach: docs/soil.md).
+  bool reached_cap = false;
   double left_over_edge_m3 = 0.0;    ///< soil that left over an open edge, m^3
   double bucket_in_m3 = 0.0;         ///< cut soil the bucket took in this step, m^3
   double poured_m3 = 0.0;            ///< soil poured from the bucket's lip this step, m^3
@@ -274,10 +340,11 @@ class SoilFlow {
   /// field on bad params.
   SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const BladeSpec& blade = {});
 
-  /// Before the cut of a step: remembers the heights under the region the
-  /// edge may sweep from `from` to `to` (their bounding rectangle plus a
-  /// cell), so that the cut's change of each sample is known afterwards.
-  void before_cut(const HeightGrid& grid, const Segment& from, const Segment& to);
+  /// Before the cut of a step: lands what a pass in progress has sent so
+  /// far, and remembers the heights under the region the edge may sweep
+  /// from `from` to `to` (their bounding rectangle plus a cell), so that
+  /// the cut's change of each sample is known afterwards.
+  void before_cut(HeightGrid& grid, const Segment& from, const Segment& to);
 
   /// After the cut: displacement of what was cut ahead of the edge `to`
   /// (moving from `from`) or into the bucket, the bucket's pour at its
@@ -363,11 +430,18 @@ class SoilFlow {
     height_m = float(std::clamp(double(height_m) + delta_m, 0.0, std::max(double(ceiling_m_), double(height_m))));
   }
   void run_passes(HeightGrid& grid, SoilStepResult& out);
+  /// Adds what the pass's fluxes delivered (incoming_) to the heights.
+  void deliver(float* h);
   /// Zeroes the fluxes [applied_, end) of source a that the blade, the hull
   /// or a body now stands in the way of (the pass was examined in an
   /// earlier step, against where they were then).
   void drop_blocked_fluxes(std::uint32_t a, std::size_t end, const float* h);
   std::int64_t examine(std::uint32_t a, const float* h);
+  /// The fluxes of source a (height ha) down its steep directions dirs[0,
+  /// n) (the direction in the low byte, bit 8 set for one beyond an open
+  /// edge); returns their count.
+  std::int64_t fall_lines(std::uint32_t a, float ha, const float* h, const int* dirs, int n);
+  std::int64_t fall_visits_ = 0;  // cells the last examination's fall lines walked
   void finish_pass(HeightGrid& grid, SoilStepResult& out);
 
   SoilFlowParams params_;
@@ -439,10 +513,13 @@ class SoilFlow {
   std::size_t applied_ = 0;
   std::vector<Source> sources_;
   std::size_t applied_sources_ = 0;
+  detail::CellSums incoming_;  // what the pass's fluxes deliver to each cell, added when it ends
+  Rect delivered_{};           // the cells deliver() wrote since the last step's result took them
   bool pass_spans_steps_ = false;  // the pass in progress was examined (in part) in an earlier step
   double pass_gained_m_ = 0.0;    // height the pass's writes gained by float rounding
   std::uint32_t pass_highest_ = 0;  // the highest cell the pass raised or lowered
   float pass_highest_h_ = -1.0f;
+  bool pass_highest_tied_ = false;  // another cell the pass changed stands as high (the rounding waits)
   detail::CellList next_;    // cells to examine in the next pass (kQueued set)
   // The per-cell flags' byte: an enumeration, not std::uint8_t, because a
   // store through a character type may alias any object, so each flag
