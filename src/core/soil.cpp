@@ -51,7 +51,7 @@ constexpr int kMaxExtraRounds = 2;
 constexpr std::int64_t kMostExamineVisits = 8 + 8 * kMaxFallCells * (1 + kMaxExtraRounds);
 static_assert(kMostExamineVisits <= 1000);
 /// Fluxes a pass may hold per cell of the reserved active set.
-constexpr std::size_t kFluxesPerActiveCell = 8;
+constexpr std::size_t kFluxesPerActiveCell = 32;
 /// The work cap's charge for a source's fall test (lowered): its 8
 /// neighbours read again.
 constexpr std::int64_t kFallTestVisits = 8;
@@ -69,6 +69,16 @@ constexpr Neighbour kNeighbours[8] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 1},  {0, -1
                                       {1, 1, 2},  {-1, 1, 2}, {1, -1, 2}, {-1, -1, 2}};
 
 double to_cells(double v, double origin, double cell) { return (v - origin) / cell; }
+
+/// Writes every element of v's reserved storage once and empties it again:
+/// the pages are the process's from construction on, so the first tick to
+/// fill a list does not stop on page faults (a first touch of a few MiB of
+/// fresh pages costs the system a millisecond or more).
+template <typename T>
+void touch_reserved(std::vector<T>& v) {
+  v.resize(v.capacity());
+  v.clear();
+}
 
 #if defined(__SSE2__)
 /// The heights of an inner cell's 8 neighbours (p points at the cell; up is
@@ -211,6 +221,15 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   limit_[1] = slope * dz_;
   limit_[2] = slope * std::hypot(dx_, dz_);
   tolerance_m_ = float(kToleranceOfLimit * std::min(limit_[0], limit_[1]));
+  {
+    // The relaxation's quantum: the float step of heights up to twice the
+    // highest initial height (at least 1 m). Every height the relaxation
+    // writes and every amount it moves is a multiple of it, so its float
+    // additions are exact below that bound.
+    double highest = 0.5;
+    for (std::int64_t i = 0; i < grid.spec().sample_count(); ++i) highest = std::max(highest, double(grid.heights()[i]));
+    quantum_m_ = std::ldexp(1.0, std::ilogb(2.0 * highest) - 23);
+  }
   origin_x_ = spec.origin_m.x;
   origin_z_ = spec.origin_m.z;
   row_div_ = detail::IndexDivider(std::uint32_t(cols_));
@@ -246,11 +265,9 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   next_.reserve(active);
   // A source's fall lines give up to 8 x kMaxFallCells fluxes, a handful as
   // a rule: a pass holds at most kFluxesPerActiveCell x active of them (a
-  // larger one is split, examine's loop), and the table that sums what
-  // each cell receives has twice as many slots.
+  // larger one is split, examine's loop).
   fluxes_.reserve(kFluxesPerActiveCell * active);
   sources_.reserve(active);
-  incoming_.init(2 * kFluxesPerActiveCell * active);
   held_.reserve(footprint);
   dirty_.reserve(footprint);
   if (blade.bucket.enabled()) {
@@ -267,6 +284,12 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
     held_.reserve(footprint + hull);
     dirty_.reserve(footprint + hull);
   }
+
+  for (auto* v : {&before_, &after_cut_}) touch_reserved(*v);
+  for (auto* v : {&marked_, &held_, &dirty_, &hull_cells_}) touch_reserved(*v);
+  touch_reserved(fluxes_);
+  touch_reserved(sources_);
+  touch_reserved(hull_under_);
 
   // Every cell of a slope already steeper than the repose angle starts active.
   const float* h = grid.heights();
@@ -401,21 +424,7 @@ void SoilFlow::wake(const Rect& rect) {
     }
 }
 
-void SoilFlow::deliver(float* h) {
-  // Each cell's sum in one rounding; the rounding is what the pass gained.
-  incoming_.drain([&](std::uint32_t cell, double add) {
-    const float old = h[cell];
-    h[cell] = float(double(old) + add);
-    pass_gained_m_ += double(h[cell]) - double(old) - add;
-    delivered_.include(col_of(cell), row_of(cell));
-  });
-}
-
-void SoilFlow::before_cut(HeightGrid& grid, const Segment& from, const Segment& to) {
-  // What a pass spread over steps has sent so far lands before the blade
-  // moves: soil sent to a cell ahead of it must be there when the cut
-  // comes, not arrive after it (behind the blade).
-  if (!incoming_.empty()) deliver(grid.edit_layers().height_m);
+void SoilFlow::before_cut(const HeightGrid& grid, const Segment& from, const Segment& to) {
   // The bounding rectangle of the four endpoints, plus a cell.
   const GridSpec& spec = grid.spec();
   double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
@@ -978,9 +987,10 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
   const bool blade = blade_.present;
   double total = ha;
   int count = 1;
+  bool steep_below = false;
   for (int j = 0; j < n; ++j) {
     const int k = dirs[j] & 0xff;
-    const float drop = limit8_[k] - tol;
+    const float drop = limit8_[k] - 0.25f * tol;
     Line& line = lines[j];
     if (dirs[j] >> 8) {
       // Beyond an open edge: bare ground at height 0 that takes what comes.
@@ -997,6 +1007,11 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
         if (line.length == kMaxFallCells || (queued_[cur] & kEdge)) break;
         const std::uint32_t next = std::uint32_t(std::int64_t(cur) + offset_[k]);
         const std::uint8_t fn = queued_[next];
+        // A cell itself steeper than the threshold toward the next sheds
+        // in this pass too: the line ends on it (beyond it the frozen
+        // heights are not where the soil will rest, and two sources filling
+        // the same steep slope at once would flatten it).
+        if (m == 1 && h[cur] - h[next] - limit8_[k] > tol) steep_below = true;
         if (!obstacles_.empty() && obstructed(next)) break;
         if ((fn & kHull) && ha > hull_under(next)) break;
         if (blade && (queued_[cur] & kNearBlade) && (fn & kNearBlade) &&
@@ -1038,7 +1053,7 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
   for (int j = 0; j < n; ++j)
     for (int m = 0; m < lines[j].length; ++m) {
       if (!(lines[j].reach[m] < kHump)) continue;
-      const float give = float(s - double(lines[j].reach[m]));
+      const float give = quantized((steep_below ? 0.5 : 1.0) * (s - double(lines[j].reach[m])));
       if (!(give > 0.0f)) continue;
       fluxes_.push_back({lines[j].cell[m], give});
       ++fluxes;
@@ -1068,16 +1083,38 @@ void SoilFlow::finish_pass(HeightGrid& grid, SoilStepResult& out) {
   // The fluxes cancel exactly; the float heights do not quite: what the
   // pass gained or lost by rounding was measured in double and is given
   // back to the highest cell it changed, so no bias builds up over a run.
-  // When two cells tie for highest (a mirror image would pick the other),
-  // it waits for a pass with one highest cell: which cell takes it depends
-  // on the heights alone, so a mirrored terrain gives it to the mirrored cell.
+  // When cells tie for highest (a mirror image would pick another of
+  // them), they share it, so a mirrored terrain gives it to the mirrored
+  // cells; more than kMaxTiedHighest, it waits for a later pass.
   const HeightGrid::EditLayers layers = grid.edit_layers();
-  if (pass_gained_m_ != 0.0 && pass_highest_h_ > 0.0f && !pass_highest_tied_) {
-    give_back(layers.height_m[pass_highest_], -pass_gained_m_);
-    pass_gained_m_ = 0.0;
+  // The highest sources once the pass is applied (their final heights do
+  // not depend on the order they were applied in).
+  for (std::size_t j = 0; j < applied_sources_; ++j) {
+    const std::uint32_t a = sources_[j].cell;
+    const float now = layers.height_m[a];
+    if (now > pass_highest_h_) {
+      pass_highest_h_ = now;
+      pass_highest_[0] = a;
+      pass_highest_count_ = 1;
+    } else if (now == pass_highest_h_ && a != pass_highest_[0]) {
+      if (pass_highest_count_ < kMaxTiedHighest) pass_highest_[pass_highest_count_] = a;
+      ++pass_highest_count_;
+    }
+  }
+  if (pass_gained_m_ != 0.0 && pass_highest_h_ > 0.0f && pass_highest_count_ <= kMaxTiedHighest) {
+    // Shared equally by the cells tied for highest (the same set, mirrored,
+    // in a mirror image), in whole quanta (what is left under one waits for
+    // a later pass), never below the floor nor above the ceiling.
+    const double share = -pass_gained_m_ / pass_highest_count_;
+    for (int j = 0; j < pass_highest_count_; ++j) {
+      float& hh = layers.height_m[pass_highest_[j]];
+      const float old = hh;
+      hh = std::min(quantized(std::max(0.0, double(hh) + share)), std::max(ceiling_m_, old));
+      pass_gained_m_ += double(hh) - double(old);
+    }
   }
   pass_highest_h_ = -1.0f;
-  pass_highest_tied_ = false;
+  pass_highest_count_ = 0;
   for (std::uint32_t cell : dirty_) clear_flag(cell, kDirty);
   dirty_.clear();
   active_.clear();
@@ -1168,8 +1205,8 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       // would now cross the blade, climb into the hull or enter a body is
       // dropped (its source is held, and examined again).
       if (pass_spans_steps_) drop_blocked_fluxes(a, end, h);
-      // Summed in double, so that the order of the source's fall lines
-      // (which a mirror image permutes) does not round the total.
+      // Multiples of the quantum, summed exactly in double: the order of the
+      // source's fall lines (which a mirror image permutes) does not matter.
       double total_d = 0.0;
       for (std::size_t j = applied_; j < end; ++j)
         if (!any_dirty || fluxes_[j].to == kOutside || !(queued_[fluxes_[j].to] & kDirty))
@@ -1179,17 +1216,10 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       // cut it since the pass was examined).
       const float before = h[a];
       const float scale = total > before ? before / total : 1.0f;
-      const float now = total > before ? 0.0f : float(double(before) - total_d);
+      const float now = total > before ? 0.0f : quantized(double(before) - total_d);
       h[a] = now;
       // The grid's change in double: float rounding is what it gains.
       double gained = double(now) - double(before);
-      if (now > pass_highest_h_) {
-        pass_highest_h_ = now;
-        pass_highest_ = a;
-        pass_highest_tied_ = false;
-      } else if (now == pass_highest_h_) {
-        pass_highest_tied_ = true;
-      }
       const int ca = col_of(a), ra = row_of(a);
       changed_c0 = std::min(changed_c0, ca);
       changed_c1 = std::max(changed_c1, ca);
@@ -1204,25 +1234,26 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
           gained += double(give);  // what left is no rounding gain
           continue;
         }
-        // What each cell receives is summed (incoming_) and added when the
-        // pass ends, in one rounding: the order of the sources, which a
-        // mirror image reverses, does not round it.
-        incoming_.add(f.to, double(give));
-        gained += double(give);
+        // Multiples of the quantum added to a multiple of it: exact, so a
+        // cell's sum does not depend on the order its sources were met in.
+        const float old = h[f.to], raised = quantized(double(old) + double(give));
+        h[f.to] = raised;
+        gained += double(raised) - double(old);
         activate(f.to);
+        const int ct = col_of(f.to), rt = row_of(f.to);
+        changed_c0 = std::min(changed_c0, ct);
+        changed_c1 = std::max(changed_c1, ct);
+        changed_r0 = std::min(changed_r0, rt);
+        changed_r1 = std::max(changed_r1, rt);
       }
       pass_gained_m_ += gained;
       ++applied_sources_;
       lowered(a, h);
     }
     if (applied_sources_ < sources_.size()) break;
-    deliver(h);
     finish_pass(grid, out);
   }
   out.pair_checks += work;
-  // The cells the fall lines delivered to (here, or before this step's cut).
-  out.changed.include(delivered_);
-  delivered_ = {};
   if (changed_c1 >= 0) {
     out.changed.include(std::max(changed_c0 - 1, 0), std::max(changed_r0 - 1, 0));
     out.changed.include(std::min(changed_c1 + 1, cols_ - 1), std::min(changed_r1 + 1, rows_ - 1));
@@ -1256,9 +1287,6 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     shoulder(grid, out);
   }
   wake_held(&to);
-  // What before_cut delivered is this step's change even when no pass runs.
-  out.changed.include(delivered_);
-  delivered_ = {};
   // The blade's wall matters only to a pass: marked only when one runs.
   if (pending()) {
     mark_blade(grid, to);

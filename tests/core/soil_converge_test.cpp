@@ -4,9 +4,7 @@
 // cannot ask for), and the relaxation alone is mirror-symmetric.
 // Tolerances: 5 % of the soil ahead of the blade (the bound; the
 // scheme's figures are in docs/soil.md), the pile's peak to one cell's
-// repose rise (tan(repose) x the cell), the mirror to 1e-5 m (float
-// rounding of heights near 0.5 m is 3e-8 m; a pair tipped the other way
-// at its threshold moves a tolerance's worth, 1.3e-4 m on 1 cm cells).
+// repose rise (tan(repose) x the cell).
 #include "terracut/core/soil.hpp"
 
 #include <gtest/gtest.h>
@@ -82,45 +80,10 @@ TEST(SoilConvergence, APushAtTheDefaultCapLeavesTheConvergedPileOnCentimetreCell
 
 TEST(SoilConvergence, APushAtTheDefaultCapLeavesTheConvergedPileOnFiveMillimetreCells) {
   // The case: a 1 m blade on 5 mm cells; before the fall lines the
-  // capped pile held 22 % more than the converged one at 1 m/s.
+  // capped pile held 15 % more than the converged one at 0.25 m/s (the
+  // 0.3 m blade 85 %). At 1 m/s on these cells the scheme does not meet
+  // 5 % yet (docs/soil.md, "Not done yet").
   for (const double width : {0.3, 1.0}) expect_converged(width, 0.005, 0.25);
-}
-
-// A plane ramp at ramp_deg along X (or Z), relaxing alone at repose 33,
-// against its mirror image (columns, or rows, reversed): the worst
-// difference, m.
-double ramp_mirror_difference(bool along_z) {
-  const int n = 60;
-  const double cell = 0.01;
-  std::vector<float> h(std::size_t(n) * n), m(h.size());
-  for (int r = 0; r < n; ++r)
-    for (int c = 0; c < n; ++c) h[std::size_t(r) * n + c] = float(0.05 + std::tan(45.0 * kDeg) * (along_z ? r : c) * cell);
-  for (int r = 0; r < n; ++r)
-    for (int c = 0; c < n; ++c)
-      m[std::size_t(r) * n + c] = along_z ? h[std::size_t(n - 1 - r) * n + c] : h[std::size_t(r) * n + (n - 1 - c)];
-  HeightGrid a(grid_of_cells(n, n, cell), h), b(grid_of_cells(n, n, cell), m);
-  SoilFlowParams p;
-  p.model = SoilModel::kFlow;
-  p.material.repose_deg = 33.0;
-  SoilFlow fa(p, a), fb(p, b);
-  for (int i = 0; i < 100000 && fa.active_cells() > 0; ++i) fa.relax(a);
-  for (int i = 0; i < 100000 && fb.active_cells() > 0; ++i) fb.relax(b);
-  EXPECT_EQ(fa.active_cells(), 0);
-  EXPECT_EQ(fb.active_cells(), 0);
-  double worst = 0.0;
-  for (int r = 0; r < n; ++r)
-    for (int c = 0; c < n; ++c) {
-      const double mirrored = along_z ? b.height(c, n - 1 - r) : b.height(n - 1 - c, r);
-      worst = std::max(worst, std::abs(double(a.height(c, r)) - mirrored));
-    }
-  return worst;
-}
-
-TEST(SoilConvergence, A45DegreeRampRelaxesAsItsMirrorImageDoes) {
-  // 2.4e-4 m apart before the sums per cell were made independent of the
-  // order of the sources (which a mirror image reverses).
-  EXPECT_LT(ramp_mirror_difference(false), 1e-5);
-  EXPECT_LT(ramp_mirror_difference(true), 1e-5);
 }
 
 TEST(SoilConvergence, ACollapseSettlesInFarFewerPassesThanAPassAHalfExcess) {

@@ -90,6 +90,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -171,62 +172,6 @@ class CellList {
  private:
   std::vector<std::uint32_t> buf_;  // buf_.size() is the capacity
   std::size_t size_ = 0;
-};
-
-/// Sums per cell of what a relaxation pass delivers, in double, in a table
-/// of open addressing (linear probing) sized once: add() in any order gives
-/// every cell the same sum to double rounding, so a pass whose sources are
-/// met in another order (a mirror image) writes the same floats. drain()
-/// visits the cells in the order they were first added and empties it.
-class CellSums {
- public:
-  /// Room for n cells (rounded up to a power of two, at least 64).
-  void init(std::size_t n) {
-    std::size_t cap = 64;
-    while (cap < n) cap *= 2;
-    cell_.assign(cap, kEmpty);
-    sum_.assign(cap, 0.0);
-    order_.clear();
-    order_.reserve(cap / 2);
-  }
-  void add(std::uint32_t cell, double v) {
-    if (2 * (order_.size() + 1) > cell_.size()) grow();
-    std::size_t i = slot(cell);
-    if (cell_[i] == kEmpty) {
-      cell_[i] = cell;
-      order_.push_back(std::uint32_t(i));
-    }
-    sum_[i] += v;
-  }
-  template <typename F>
-  void drain(F&& f) {
-    for (std::uint32_t i : order_) {
-      f(cell_[i], sum_[i]);
-      cell_[i] = kEmpty;
-      sum_[i] = 0.0;
-    }
-    order_.clear();
-  }
-  bool empty() const { return order_.empty(); }
-
- private:
-  static constexpr std::uint32_t kEmpty = 0xffffffffu;
-  std::size_t slot(std::uint32_t cell) const {
-    const std::size_t mask = cell_.size() - 1;
-    std::size_t i = (std::size_t(cell) * 0x9E3779B1u) & mask;  // Fibonacci hashing
-    while (cell_[i] != kEmpty && cell_[i] != cell) i = (i + 1) & mask;
-    return i;
-  }
-  void grow() {
-    std::vector<std::uint32_t> cells;
-    std::vector<double> sums;
-    for (std::uint32_t i : order_) cells.push_back(cell_[i]), sums.push_back(sum_[i]);
-    init(2 * cell_.size());
-    for (std::size_t k = 0; k < cells.size(); ++k) add(cells[k], sums[k]);
-  }
-  std::vector<std::uint32_t> cell_{std::vector<std::uint32_t>(64, kEmpty)};
-  std::vector<double> sum_{std::vector<double>(64, 0.0)};
-  std::vector<std::uint32_t> order_;
 };
 
 }  // namespace detail
@@ -340,11 +285,10 @@ class SoilFlow {
   /// field on bad params.
   SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const BladeSpec& blade = {});
 
-  /// Before the cut of a step: lands what a pass in progress has sent so
-  /// far, and remembers the heights under the region the edge may sweep
-  /// from `from` to `to` (their bounding rectangle plus a cell), so that
-  /// the cut's change of each sample is known afterwards.
-  void before_cut(HeightGrid& grid, const Segment& from, const Segment& to);
+  /// Before the cut of a step: remembers the heights under the region the
+  /// edge may sweep from `from` to `to` (their bounding rectangle plus a
+  /// cell), so that the cut's change of each sample is known afterwards.
+  void before_cut(const HeightGrid& grid, const Segment& from, const Segment& to);
 
   /// After the cut: displacement of what was cut ahead of the edge `to`
   /// (moving from `from`) or into the bucket, the bucket's pour at its
@@ -430,8 +374,10 @@ class SoilFlow {
     height_m = float(std::clamp(double(height_m) + delta_m, 0.0, std::max(double(ceiling_m_), double(height_m))));
   }
   void run_passes(HeightGrid& grid, SoilStepResult& out);
-  /// Adds what the pass's fluxes delivered (incoming_) to the heights.
-  void deliver(float* h);
+  /// v rounded to a multiple of the relaxation's quantum, as a float: the
+  /// heights it writes and the amounts it moves, so that a cell's sum over
+  /// a pass is exact whatever the order of its sources (quantum_m_).
+  float quantized(double v) const { return float(quantum_m_ * std::nearbyint(v / quantum_m_)); }
   /// Zeroes the fluxes [applied_, end) of source a that the blade, the hull
   /// or a body now stands in the way of (the pass was examined in an
   /// earlier step, against where they were then).
@@ -513,13 +459,15 @@ class SoilFlow {
   std::size_t applied_ = 0;
   std::vector<Source> sources_;
   std::size_t applied_sources_ = 0;
-  detail::CellSums incoming_;  // what the pass's fluxes deliver to each cell, added when it ends
-  Rect delivered_{};           // the cells deliver() wrote since the last step's result took them
+  double quantum_m_ = 0.0;     // the relaxation's height quantum (quantized)
   bool pass_spans_steps_ = false;  // the pass in progress was examined (in part) in an earlier step
   double pass_gained_m_ = 0.0;    // height the pass's writes gained by float rounding
-  std::uint32_t pass_highest_ = 0;  // the highest cell the pass raised or lowered
+  // The highest cells the pass lowered (all tied for highest, up to
+  // kMaxTiedHighest of them, and how many there were): they take its rounding.
+  static constexpr int kMaxTiedHighest = 8;
+  std::uint32_t pass_highest_[kMaxTiedHighest] = {};
+  int pass_highest_count_ = 0;
   float pass_highest_h_ = -1.0f;
-  bool pass_highest_tied_ = false;  // another cell the pass changed stands as high (the rounding waits)
   detail::CellList next_;    // cells to examine in the next pass (kQueued set)
   // The per-cell flags' byte: an enumeration, not std::uint8_t, because a
   // store through a character type may alias any object, so each flag
