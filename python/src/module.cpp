@@ -528,10 +528,13 @@ py::dict run_result_dict(const session::RunResult& r, const io::Scenario& sc) {
   out["step_timing"] = timing_dict(r.step_timing);
   if (r.soil) {
     py::dict d;
+    d["cut_from_ground_m3"] = r.soil->cut_from_ground_m3;
     d["displaced_volume_m3"] = r.soil->displaced_volume_m3;
+    d["net_moved_m3"] = r.soil->net_moved_m3;
     d["left_over_edge_m3"] = r.soil->left_over_edge_m3;
     d["passes"] = r.soil->passes;
     d["final_backlog_cells"] = r.soil->final_backlog_cells;
+    d["capped_steps"] = r.soil->capped_steps;
     out["soil"] = d;
   }
   out["warnings"] = r.warnings;
@@ -831,9 +834,11 @@ reader's message, "FILE:LINE: field: what".)doc")
       .def_property_readonly("max_depth_m", [](const StepResult& r) { return r.out.contact.max_depth_m; },
                              "Largest depth of the edge below the surface, m.")
       .def_property_readonly("removed_volume_m3", [](const StepResult& r) { return r.out.cut.removed_volume_m3; },
-                             "Volume the step's sweep cut, m^3.")
+                             "Volume the step's sweep cut, m^3 (with soil flow: a pile cut again counts again).")
+      .def_property_readonly("cut_from_ground_m3", [](const StepResult& r) { return r.out.soil.cut_from_ground_m3; },
+                             "The part of the step's cut below the initial surface (soil flow), m^3.")
       .def_property_readonly("displaced_volume_m3", [](const StepResult& r) { return r.out.soil.displaced_volume_m3; },
-                             "Soil put down ahead of the blade (soil flow), m^3.")
+                             "Soil put down ahead of the blade (soil flow; a pile pushed on counts at every step), m^3.")
       .def_property_readonly("cells_visited", [](const StepResult& r) {
             return r.out.contact.cells_visited + r.out.cut.cells_visited;
           }, "Cells examined by the contact query and the cut.")

@@ -64,16 +64,19 @@ def test_terracut_run_writes_the_clis_files(cli, exp1, tmp_path):
 
 
 def test_run_returns_the_soils_warnings(tmp_path):
-    # Cells of 4:1 and a work cap too small for the cut: both named; the
-    # same run on square cells with the cap lifted has nothing to say.
+    # Cells of 4:1 and a work cap too small for the cut: the steps the cap
+    # stopped, the unsettled end and the cells all named; the same run on
+    # square cells with the cap lifted has nothing to say.
     d = small_exp1_dict()
     d["terrain"]["resolution"] = [40, 10]
     d["soil"] = {"model": "flow", "repose_deg": 34, "max_pair_checks_per_step": 1000}
     result = terracut.run(terracut.Scenario.from_dict(d), tmp_path / "oblong")
     warnings = result["warnings"]
-    assert len(warnings) == 2, warnings
-    assert "the relaxation was not done at the end" in warnings[0]
-    assert "let planes up to 40.9 degrees stand" in warnings[1]
+    assert len(warnings) == 3, warnings
+    assert "work cap" in warnings[0] and "stopped it in" in warnings[0]
+    assert result["soil"]["capped_steps"] > 0
+    assert "the relaxation was not done at the end" in warnings[1]
+    assert "let planes up to 40.9 degrees stand" in warnings[2]
     summary = json.loads((tmp_path / "oblong" / "summary.json").read_text())
     assert summary["warnings"] == warnings
     d["terrain"]["resolution"] = 20
