@@ -9,7 +9,8 @@ of dry sand (repose 34 degrees) on 5 mm cells, pushed 0.8 m along +Z and then
 held still for 0.2 s, at 0.25 m/s and at 1 m/s, each twice: at the default
 work cap (soil.max_pair_checks_per_step = 50000, what a 1 kHz step does) and
 with the cap lifted (1e9: the converged answer). It plots the centre-line
-profiles of the four piles and prints, for each speed, the soil above the
+profiles of the four piles, their sections across the push 10 cm ahead of
+the edge (where they differ: the pile's ends), and prints, for each speed, the soil above the
 layer ahead of the blade within its width and the pile's peak.
 Default output: docs/images/soil_capped_vs_converged.png.
 
@@ -32,6 +33,7 @@ WIDTH, DEPTH, LAYER, TRAVEL, HOLD = 1.0, 0.04, 0.2, 0.8, 0.2
 COLS = int(round((WIDTH + 1.6) / CELL))
 ROWS = int(round((TRAVEL + 1.4) / CELL))
 X, Z0 = 0.5 * COLS * CELL, 0.4
+ACROSS_M = 0.1
 
 
 def push(speed, cap):
@@ -78,15 +80,27 @@ def main(argv):
             return 0
         else:
             fail(f"unknown argument {a!r} (see --help)")
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), sharey=True)
+    fig, grid = plt.subplots(2, 2, figsize=(12, 8.0), sharey="row")
+    axes, across = grid[0], grid[1]
     z = (np.arange(ROWS) + 0.5) * CELL - (Z0 + TRAVEL)
+    x = (np.arange(COLS) + 0.5) * CELL - X
     centre = int(X / CELL)
-    for ax, speed in zip(axes, (0.25, 1.0)):
+    # The row ACROSS_M ahead of the edge: the pile's ends, where the capped
+    # run differs (the centre line is the same in both).
+    row = int((Z0 + TRAVEL + ACROSS_M) / CELL)
+    for ax, ax_x, speed in zip(axes, across, (0.25, 1.0)):
         lines = []
         for cap, label, style in ((50000, "default work cap (1 kHz)", "-"), (10**9, "cap lifted (converged)", "--")):
             h, ahead, peak = push(speed, cap)
             ax.plot(z, h[:, centre] - LAYER, style, lw=1.4, label=f"{label}: {ahead * 1e3:.2f} l ahead, peak {peak * 100:.1f} cm")
+            ax_x.plot(x, h[row, :] - LAYER, style, lw=1.4, label=label)
             lines.append((ahead, peak))
+        ax_x.axvline(-0.5 * WIDTH, color="gray", lw=0.8)
+        ax_x.axvline(0.5 * WIDTH, color="gray", lw=0.8)
+        ax_x.set_xlabel("across the push, from the blade's centre (m); grey: the blade's ends")
+        ax_x.set_title(f"{speed:g} m/s: the section {100 * ACROSS_M:g} cm ahead of the edge", fontsize=10)
+        ax_x.grid(alpha=0.3)
+        ax_x.legend(fontsize=8, loc="upper right")
         rel = lines[0][0] / lines[1][0] - 1.0
         if not quiet:
             print(f"{speed:g} m/s: ahead {lines[0][0]:.6f} (capped) vs {lines[1][0]:.6f} m^3 (converged), "
@@ -98,6 +112,7 @@ def main(argv):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="upper right")
     axes[0].set_ylabel("height above the layer, centre line (m)")
+    across[0].set_ylabel("height above the layer (m)")
     fig.suptitle("1 m blade, 4 cm cut, 0.8 m push on 5 mm cells, then 0.2 s still: "
                  "the pile at the default work cap and with the cap lifted", fontsize=10)
     fig.tight_layout()

@@ -107,5 +107,39 @@ TEST(SoilConvergence, ACollapseSettlesInFarFewerPassesThanAPassAHalfExcess) {
   EXPECT_NEAR(grid.volume_m3(), before, 1e-6 * before);
 }
 
+TEST(SoilConvergence, TheStepSaysWhenTheWorkCapStoppedIt) {
+  // The same block at a small cap: every tick until it settles stops at the
+  // cap (and says so) within its work, the last does not; lifted, the one
+  // tick that settles it never reaches the cap.
+  const int side = 120;
+  std::vector<float> h(std::size_t(side) * side, 0.0f);
+  for (int r = 50; r < 70; ++r)
+    for (int c = 50; c < 70; ++c) h[std::size_t(r) * side + c] = 0.3f;
+  SoilFlowParams p;
+  p.model = SoilModel::kFlow;
+  p.max_pair_checks_per_step = 5000;
+  HeightGrid grid(grid_of_cells(side, side, 0.01), h);
+  SoilFlow flow(p, grid);
+  int ticks = 0, capped = 0;
+  SoilStepResult last;
+  while (flow.active_cells() > 0 && ticks < 100000) {
+    last = flow.relax(grid);
+    ++ticks;
+    EXPECT_LE(last.pair_checks, p.max_pair_checks_per_step);
+    if (last.reached_cap) {
+      ++capped;
+      EXPECT_GT(last.backlog_cells, 0) << "tick " << ticks;
+    }
+  }
+  EXPECT_GT(capped, 1);
+  EXPECT_FALSE(last.reached_cap);
+  EXPECT_EQ(flow.active_cells(), 0);
+  p.max_pair_checks_per_step = kLifted;
+  HeightGrid lifted(grid_of_cells(side, side, 0.01), h);
+  SoilFlow once(p, lifted);
+  EXPECT_FALSE(once.relax(lifted).reached_cap);
+  EXPECT_EQ(once.active_cells(), 0);
+}
+
 }  // namespace
 }  // namespace terracut
