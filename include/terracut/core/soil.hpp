@@ -403,7 +403,7 @@ class SoilFlow {
   double origin_x_ = 0.0;
   double origin_z_ = 0.0;
   detail::IndexDivider row_div_;  // cell index / cols_
-  // The 8 neighbours as index offsets and their repose limits (soil.cpp's kNeighbours order).
+  // The 8 neighbours as index offsets and their repose limits (soil_internal.hpp's kNeighbours order).
   std::int64_t offset_[8] = {};
   float limit8_[8] = {};
 
