@@ -38,6 +38,7 @@
 
 #include "terracut/core/simulation.hpp"
 #include "terracut/core/soil.hpp"
+#include "soil_scenes.hpp"
 
 namespace {
 
@@ -89,14 +90,13 @@ void drive(Simulation& sim, const Vec3& start, const Vec3& travel, int steps, Sa
 }
 
 Stats bulldoze(int side, double cell = 0.01, double blade_m = 2.0) {
-  SimParams p;
-  p.grid = grid_of_cells(side, side, cell);
-  p.blade.length_m = blade_m;
-  p.soil.model = SoilModel::kFlow;
-  Simulation sim(p, std::vector<float>(std::size_t(side) * side, 0.2f));
-  const double x = 0.5 * side * cell, z0 = 0.5 * side * cell - 0.5;
+  const scenes::Bulldoze scene{side, side, cell, blade_m, 0.2, 0.05};
+  SoilFlowParams soil;
+  soil.model = SoilModel::kFlow;
+  Simulation sim(scene.params(soil), scene.heights());
+  const double z0 = 0.5 * side * cell - 0.5;
   Samples s;
-  drive(sim, {x, 0.15, z0}, {0.0, 0.0, 1.0}, int(std::lround(1.0 / 0.0006)), s);
+  drive(sim, scene.pose(z0).position_m, {0.0, 0.0, 1.0}, int(std::lround(1.0 / 0.0006)), s);
   return s.stats();
 }
 
@@ -139,11 +139,7 @@ WorstTick collapse_worst;
 
 Stats collapse() {
   const int side = 300;
-  const GridSpec spec = grid_of_cells(side, side, 0.01);
-  std::vector<float> h(std::size_t(side) * side, 0.0f);
-  for (int r = 100; r < 200; ++r)
-    for (int c = 100; c < 200; ++c) h[std::size_t(r) * side + c] = 0.5f;
-  HeightGrid grid(spec, h);
+  HeightGrid grid(grid_of_cells(side, side, 0.01), scenes::block(side, 100, 200, 0.5f));
   SoilFlowParams p;
   p.model = SoilModel::kFlow;
   SoilFlow flow(p, grid);

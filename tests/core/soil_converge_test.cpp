@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "terracut/core/simulation.hpp"
+#include "soil_scenes.hpp"
 
 namespace terracut {
 namespace {
@@ -35,19 +36,18 @@ struct Pile {
 Pile push(double width_m, double cell_m, double speed_m_per_s, std::int64_t cap, double hold_s = 0.2) {
   const double travel = 0.8, depth = 0.04, layer = 0.2;
   const int cols = int(std::lround((width_m + 1.6) / cell_m)), rows = int(std::lround((travel + 1.4) / cell_m));
-  SimParams p;
-  p.grid = grid_of_cells(cols, rows, cell_m);
-  p.blade.length_m = width_m;
-  p.soil.model = SoilModel::kFlow;
-  p.soil.material.repose_deg = 34.0;
-  p.soil.max_pair_checks_per_step = cap;
-  Simulation sim(p, std::vector<float>(std::size_t(cols) * rows, float(layer)));
-  const double x = 0.5 * cols * cell_m, z0 = 0.4;
+  const scenes::Bulldoze scene{cols, rows, cell_m, width_m, layer, depth};
+  SoilFlowParams soil;
+  soil.model = SoilModel::kFlow;
+  soil.material.repose_deg = 34.0;
+  soil.max_pair_checks_per_step = cap;
+  Simulation sim(scene.params(soil), scene.heights());
+  const double x = scene.x_m(), z0 = 0.4;
   const int steps = int(std::lround(travel / speed_m_per_s * 1000.0));
   Pile pile;
   for (int i = 0; i <= steps + int(std::lround(hold_s * 1000.0)); ++i) {
     const double s = std::min(1.0, double(i) / steps);
-    const StepOutput& out = sim.step({{x, layer - depth, z0 + travel * s}, Quat{}});
+    const StepOutput& out = sim.step(scene.pose(z0 + travel * s));
     pile.capped_steps += out.soil.reached_cap ? 1 : 0;
   }
   const HeightGrid& g = sim.grid();
@@ -92,10 +92,7 @@ TEST(SoilConvergence, ACollapseSettlesInFarFewerPassesThanAPassAHalfExcess) {
   // to the neighbours moved it a cell a pass (13 828 ticks of 50 000
   // visits, about 3000 passes).
   const int side = 300;
-  std::vector<float> h(std::size_t(side) * side, 0.0f);
-  for (int r = 100; r < 200; ++r)
-    for (int c = 100; c < 200; ++c) h[std::size_t(r) * side + c] = 0.5f;
-  HeightGrid grid(grid_of_cells(side, side, 0.01), h);
+  HeightGrid grid(grid_of_cells(side, side, 0.01), scenes::block(side, 100, 200, 0.5f));
   SoilFlowParams p;
   p.model = SoilModel::kFlow;
   p.max_pair_checks_per_step = kLifted;
@@ -112,9 +109,7 @@ TEST(SoilConvergence, TheStepSaysWhenTheWorkCapStoppedIt) {
   // cap (and says so) within its work, the last does not; lifted, the one
   // tick that settles it never reaches the cap.
   const int side = 120;
-  std::vector<float> h(std::size_t(side) * side, 0.0f);
-  for (int r = 50; r < 70; ++r)
-    for (int c = 50; c < 70; ++c) h[std::size_t(r) * side + c] = 0.3f;
+  const std::vector<float> h = scenes::block(side, 50, 70, 0.3f);
   SoilFlowParams p;
   p.model = SoilModel::kFlow;
   p.max_pair_checks_per_step = 5000;
