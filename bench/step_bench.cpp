@@ -28,6 +28,7 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -102,6 +103,9 @@ class Runner {
  public:
   explicit Runner(const Case& c)
       : case_(c), sim_(params_for(c), plane_terrain(c.side)) {
+    // The brute force (the paper's) edits a grid of its own: the
+    // simulation's terrain is changed only by the simulation.
+    if (c.brute_force) brute_grid_.emplace(sim_.grid().spec(), plane_terrain(c.side));
     const double deg = std::numbers::pi / 180.0;
     const Quat yaw = quat_from_axis_angle({0.0, 1.0, 0.0}, c.yaw_deg * deg);
     orientation_ = yaw * quat_from_axis_angle({0.0, 0.0, 1.0}, c.tilt_deg * deg);
@@ -133,6 +137,7 @@ class Runner {
     s_ += kTravelPerStepM;
     if (s_ > s_hi_) {
       sim_.reset();
+      if (brute_grid_) brute_grid_->reset();
       has_previous_ = false;
       s_ = s_lo_;
     }
@@ -149,8 +154,8 @@ class Runner {
       return o.contact.cells_visited + o.cut.cells_visited;
     }
     Segment edge = blade_segment(sim_.params().blade, pose);
-    ContactResult contact = measure_contact_brute_force(sim_.grid(), case_.representation, edge);
-    CutResult cut = cut_sweep_brute_force(sim_.grid(), case_.representation,
+    ContactResult contact = measure_contact_brute_force(*brute_grid_, case_.representation, edge);
+    CutResult cut = cut_sweep_brute_force(*brute_grid_, case_.representation,
                                           has_previous_ ? previous_ : edge, edge);
     benchmark::DoNotOptimize(contact);
     previous_ = edge;
@@ -166,6 +171,7 @@ class Runner {
  private:
   Case case_;
   Simulation sim_;
+  std::optional<HeightGrid> brute_grid_;  // the brute-force cases' terrain
   Quat orientation_{};
   Vec3 origin_{}, travel_{};  ///< the blade's centre is origin_ + travel_ * s_ (ground plane)
   double s_ = 0.0, s_lo_ = 0.0, s_hi_ = 0.0;

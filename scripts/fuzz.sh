@@ -19,7 +19,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${1:-3600}
 shift || true
 targets=("$@")
-[[ ${#targets[@]} -gt 0 ]] || targets=(scenario png npy bridge differential link)
+[[ ${#targets[@]} -gt 0 ]] || targets=(scenario png npy bridge differential link secure)
 build=${TERRACUT_FUZZ_BUILD_DIR:-$root/build-fuzz}
 jobs=${TERRACUT_JOBS:-$(nproc)}            # for the build
 fuzz_jobs=${TERRACUT_FUZZ_JOBS:-$(nproc)}  # targets run at once

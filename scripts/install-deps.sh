@@ -7,12 +7,13 @@ packages=(
   build-essential cmake pkg-config
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   libpng-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
-  libeigen3-dev libbullet-dev libasio-dev libenet-dev libzstd-dev
+  libeigen3-dev libbullet-dev libasio-dev libenet-dev libzstd-dev libsodium-dev
   libglfw3-dev libepoxy-dev libimgui-dev
   libgl1-mesa-dri libegl-mesa0 libegl-dev xvfb xauth
   python3 python3-numpy python3-matplotlib gnuplot-nox
   pybind11-dev python3-dev python3-pytest python3-scipy python3-distributed python3-dask
   clang libclang-rt-14-dev
+  liggghts
 )
 
 missing=()

@@ -57,7 +57,7 @@ if [[ $step != test ]]; then
     -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1" -DCMAKE_C_FLAGS_SANITIZE="-O1" \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 \
     -DTERRACUT_BUILD_BENCH=OFF -DTERRACUT_BUILD_VIEWER=OFF -DCMAKE_CXX_FLAGS="$flags" \
-    -DTERRACUT_TEST_SUITES="core;io;haptics;net;bullet;session;apps;fuzz;soak;python" -DTERRACUT_PROGRAM_CXX_FLAGS=-O0 \
+    -DTERRACUT_TEST_SUITES="core;io;haptics;net;bullet;session;validation;apps;fuzz;soak;python" -DTERRACUT_PROGRAM_CXX_FLAGS=-O0 \
     -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=$sanitizers" \
     -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=$sanitizers" \
     -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=$sanitizers" >/dev/null
@@ -72,9 +72,9 @@ fi
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ctest --test-dir "$build" --output-on-failure -j"$jobs" --timeout 600
-# Every fuzz target for a bounded time (30 s of wall time, all six at once;
+# Every fuzz target for a bounded time (30 s of wall time, all seven at once;
 # docs/reliability.md).
 if [[ $fuzz == ON && $seconds != 0 ]]; then
   echo "== $(date -u +%H:%M:%S) sanitize.sh: the fuzz runs"
-  TERRACUT_FUZZ_JOBS=${TERRACUT_FUZZ_JOBS:-6} "$root/scripts/fuzz.sh" "$seconds"
+  TERRACUT_FUZZ_JOBS=${TERRACUT_FUZZ_JOBS:-7} "$root/scripts/fuzz.sh" "$seconds"
 fi

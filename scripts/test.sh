@@ -2,7 +2,8 @@
 # The README's test command: installs dependencies, builds everything
 # (Release: the programs, the viewer, the Python module, the benchmarks) and
 # runs with CTest the suites that need this build (the viewer's renders, the
-# install test, the ThreadSanitizer build of the threaded tests); then every
+# install test, the ThreadSanitizer build of the threaded tests, the DEM
+# reference's smoke run in LIGGGHTS); then every
 # C++ suite and the Python tests under AddressSanitizer and
 # UndefinedBehaviorSanitizer, and every libFuzzer target for 30 s
 # (scripts/sanitize.sh, its own builds, beside the Release build and suites).
@@ -15,9 +16,9 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/install-deps.sh"
-suites="viewer;install;tsan"
+suites="viewer;install;tsan;dem"
 if [[ ${TERRACUT_SANITIZE:-1} == 0 || ${TERRACUT_FULL_SUITE:-0} != 0 ]]; then
-  suites="core;io;haptics;net;bullet;session;apps;viewer;install;fuzz;soak;tsan;python"
+  suites="core;io;haptics;net;bullet;session;validation;apps;viewer;install;fuzz;soak;tsan;dem;python"
 fi
 build=${TERRACUT_BUILD_DIR:-$root/build}
 # Each step's start in the log, for docs/reliability.md's "CI time".
@@ -29,7 +30,7 @@ release_tests() {
 # soil estimate drifts back toward 1 when the machine is loaded (a known
 # limit, docs/teleoperation.md, "Not done yet"): beside the sanitizer
 # builds it runs after them, on an otherwise idle machine.
-wall_clock_test='^session_mmt_two_process$'
+wall_clock_test='^session_mmt_(two_process|lifetime|flood)$'
 
 if [[ ${TERRACUT_SANITIZE:-1} == 0 ]]; then
   "$root/scripts/build.sh" -DTERRACUT_TEST_SUITES="$suites"

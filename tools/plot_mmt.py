@@ -3,12 +3,13 @@
 
 Usage: /usr/bin/python3 tools/plot_mmt.py DIR [--out FILE.png] [--quiet]
 
-A single run (DIR/operator.csv, DIR/remote.csv, DIR/terrain_error.csv)
-gives DIR/mmt.png, against time:
+A single run (DIR/operator.csv, DIR/remote.csv, DIR/terrain_error.csv), or
+the report of a two-process session (`terracut mmt --report`), gives
+DIR/mmt.png, against the operator's time:
   - the horizontal force the operator's local model renders (MMT), the
-    remote's measured force shifted back by the one-way delay (what the
-    operator should feel for the same motion), and the remote's force as it
-    arrives (direct force reflection);
+    remote's measured force for the same command (its first tick following
+    it: what the operator should feel for the same motion), and the remote's
+    force as it arrives (direct force reflection);
   - the soil factor the remote estimated and the one the operator applied;
   - the RMS of local minus remote heights over the worked region.
 A study (DIR/study.csv, from `terracut mmt --sweep`) gives DIR/study.png:
@@ -41,31 +42,40 @@ def plot_run(folder, out):
     te = read_csv(os.path.join(folder, "terrain_error.csv"))
     with open(os.path.join(folder, "summary.json")) as f:
         summary = json.load(f)
-    delay = summary["link"]["delay_s_each_way"]
-    lag = int(round(delay / (op["t"][1] - op["t"][0]))) if len(op) > 1 else 0
     hz = lambda x, z: np.hypot(x, z)
     t = op["t"]
     f_op = hz(op["fx"], op["fz"])
     f_dfr = hz(op["remote_fx"], op["remote_fz"])
+    # The remote's force for the same commanded motion: its first tick that
+    # followed the operator's command (or a newer one), by command sequence,
+    # as summary.json's force error. The remote's own ticks are drawn at the
+    # operator's time of the command they followed and half the measured
+    # round trip (its clock, in a two-process session, is its own).
     f_rm = np.full_like(t, np.nan)
-    n = min(len(t), len(rm) - lag)
-    f_rm[:n] = hz(rm["fx"][lag:lag + n], rm["fz"][lag:lag + n])
-
+    seq_rm = np.where(rm["active"] > 0, rm["command_sequence"], -1.0)
+    first = np.searchsorted(np.maximum.accumulate(seq_rm), op["command_sequence"], side="left")
+    ok = first < len(rm)
+    f_rm[ok] = hz(rm["fx"][first[ok]], rm["fz"][first[ok]])
+    rtt = summary["link"].get("rtt_measured_s") or summary["link"]["rtt_s"]
+    t_rm = np.interp(rm["command_sequence"], op["command_sequence"], t) + 0.5 * rtt
     fig, ax = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
-    ax[0].plot(t, f_rm, color="black", lw=2.0, label="remote, measured (shifted by the delay)")
+    ax[0].plot(t, f_rm, color="black", lw=2.0, label="remote, measured (for the same command)")
     ax[0].plot(t, f_op, color="tab:blue", label="operator, local model (MMT)")
     ax[0].plot(t, f_dfr, color="tab:red", lw=0.8, label="direct force reflection (as received)")
     ax[0].set_ylabel("horizontal force (N)")
     fe = summary["force_error"]
-    ax[0].set_title(f"RTT {summary['link']['rtt_s'] * 1e3:.0f} ms, loss "
+    ax[0].set_title(f"RTT {rtt * 1e3:.0f} ms (measured), loss "
                     f"{summary['link']['loss'] * 100:.0f} %: force error RMS "
                     f"MMT {fe['mmt_rms_n']:.1f} N, direct {fe['direct_rms_n']:.1f} N")
     ax[0].legend(loc="upper right", fontsize=8)
-    ax[1].plot(rm["t"], rm["force_scale"], color="black", label="remote's estimate")
+    active = rm["active"] > 0
+    ax[1].plot(t_rm[active], rm["force_scale"][active], color="black", label="remote's estimate")
     ax[1].plot(t, op["scale_applied"], color="tab:blue", label="applied by the operator")
     ax[1].set_ylabel("soil factor")
     ax[1].legend(loc="lower right", fontsize=8)
-    ax[2].plot(te["t"], te["rms_m"] * 1e3, color="tab:green")
+    te_t, te_v = np.atleast_1d(te["t"]), np.atleast_1d(te["rms_m"]) * 1e3
+    ax[2].plot(te_t, te_v, color="tab:green", marker="o" if len(te_t) == 1 else None)
+    ax[2].set_ylim(bottom=0.0)
     ax[2].set_ylabel("terrain RMS error (mm)")
     ax[2].set_xlabel("time (s)")
     for a in ax:

@@ -368,6 +368,14 @@ def main(argv):
     bulldozing(out_dir, meta)
     conservation(out_dir, meta)
     bucket(out_dir, meta)
+    # The DEM section's figures, when it ran (terracut validate with DEM results).
+    if os.path.isfile(os.path.join(out_dir, "dem", "cases.csv")):
+        import plot_validate_dem
+
+        plot_validate_dem.FILES.quiet = FILES.quiet
+        plot_validate_dem.force(out_dir)
+        plot_validate_dem.profiles(out_dir)
+        plot_validate_dem.piles(out_dir)
     return 0
 
 

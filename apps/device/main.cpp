@@ -16,6 +16,7 @@
 #include <string>
 #include <thread>
 
+#include "../exit_codes.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/haptics/device_player.hpp"
 #include "terracut/haptics/pacer.hpp"
@@ -30,9 +31,9 @@ using namespace terracut::haptics;
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
 
-constexpr int kExitOk = 0;
-constexpr int kExitError = 1;
-constexpr int kExitNoAnswer = 3;  // ran, but the loop never answered
+using terracut::apps::kExitError;
+using terracut::apps::kExitOk;
+constexpr int kExitNoAnswer = terracut::apps::kExitPartial;  // ran, but the loop never answered
 
 struct Options {
   std::string scenario;
@@ -71,7 +72,7 @@ int run(const Options& opt) {
   if (!opt.connect.empty()) parse_endpoint(opt.connect, "--connect", address, port);
   if (!port || *port < 1) throw InputError("--connect: the port must be in [1, 65535]");
 
-  const double rate = opt.rate_hz > 0.0 ? opt.rate_hz : s.rate_hz;
+  const double rate = opt.rate_hz > 0.0 ? opt.rate_hz : sc.rate_hz;
   const double duration = opt.duration_s > 0.0 ? opt.duration_s : motion.duration_s() + s.settle_s;
   const std::uint32_t session =
       opt.session >= 0 ? std::uint32_t(opt.session)
@@ -160,7 +161,7 @@ int main(int argc, char** argv) {
   app.add_option("--connect,-c", opt.connect,
                  "The haptic loop's address: ADDR:PORT, PORT or [IPV6]:PORT. Default haptics.udp")
       ->type_name("ADDR:PORT");
-  app.add_option("--rate", opt.rate_hz, "Poses per second. Default haptics.rate_hz")
+  app.add_option("--rate", opt.rate_hz, "Poses per second. Default the scenario's rate_hz")
       ->type_name("HZ")
       ->check(CLI::Range(1.0, 10000.0));
   app.add_option("--duration", opt.duration_s,
@@ -177,8 +178,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0LL, 4294967295LL));
   app.add_flag("--quiet,-q", opt.quiet, "No start message");
   app.footer(
-      "Exit codes: 0 done; 1 bad input; 2 bad command line; 3 played, but no force came back.\n"
-      "\n"
+      std::string(terracut::apps::kExitCodesHelp) +
+      "\n\n"
       "Example (two shells):\n"
       "  terracut haptics scenarios/trench_dry_sand.yaml --device udp --duration 8 --out out/udp\n"
       "  terracut-device scenarios/trench_dry_sand.yaml --mode sim --start-delay 0.5");
@@ -186,7 +187,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    return code == 0 ? kExitOk : terracut::apps::kExitUsage;
   }
   try {
     return run(opt);

@@ -38,6 +38,7 @@ Command add_haptics_command(CLI::App& app) {
     std::string out;
     std::string device;
     double duration_s = 0.0;
+    double rate_hz = 0.0;
     std::string clock;
     bool no_realtime = false;
     bool no_plot = false;
@@ -51,7 +52,8 @@ Command add_haptics_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "haptics",
       "Run the haptic loop on a scenario: a device (scripted, a simulated hand, or a real one\n"
-      "over UDP) drives the blade at the loop rate (default 1 kHz) and feels the cutting force.\n"
+      "over UDP) drives the blade at the scenario's rate_hz (default 1 kHz) and feels the\n"
+      "cutting force.\n"
       "Writes the per-tick log, a summary and a force plot into an output folder.");
   sub->add_option("scenario", opt->scenario,
                   "Scenario file (YAML) with a `haptics:` section (docs/haptics.md; without one\n"
@@ -75,6 +77,11 @@ Command add_haptics_command(CLI::App& app) {
                   "duration plus haptics.settle_s (script, sim), 30 s (udp)")
       ->type_name("S")
       ->check(CLI::Range(1e-6, 86400.0));
+  sub->add_option("--rate", opt->rate_hz,
+                  "Loop rate in Hz, overriding the scenario's rate_hz for this session (the\n"
+                  "simulation steps at it too)")
+      ->type_name("HZ")
+      ->check(CLI::Range(haptics::kLoopRateRange.lo, haptics::kLoopRateRange.hi));
   sub->add_flag("--end-with-device", opt->end_with_device,
                 "End the session when the device stops sending: after its first pose, 0.5 s\n"
                 "without one (udp: the device process's own session ended). --duration still\n"
@@ -111,8 +118,8 @@ Command add_haptics_command(CLI::App& app) {
       "                  contact_length, cut_depth blade length in soil, depth cut (m)\n"
       "                  removed_volume            volume cut this tick (m^3)\n"
       "                  vel_x,vel_y,vel_z         estimated tool velocity, world m/s\n"
-      "                  fw_x,fw_y,fw_z            world force on the tool: force models +\n"
-      "                                            rigid bodies (N)\n"
+      "                  fw_x,fw_y,fw_z            the rendered force in world newtons (before\n"
+      "                                            force_scale): models + rigid bodies (N)\n"
       "                  fb_x,fb_y,fb_z            the rigid bodies' part of it (N; 0 without)\n"
       "                  fd_x,fd_y,fd_z            force sent to the device, device frame (N)\n"
       "                  clamped,rate_limited,watchdog,ramping,nonfinite  safety flags (0/1)\n"
@@ -121,6 +128,8 @@ Command add_haptics_command(CLI::App& app) {
       "                  f_penetration             the push-in resistance's part of fw_y (N)\n"
       "                  twist_torque, yaw_rate    torque about +Y on the tool (N m; not\n"
       "                                            rendered), tool yaw rate (rad/s)\n"
+      "                  fp_x,fp_y,fp_z            the physical force on the tool (N), what\n"
+      "                                            terracut run's force.csv has for the path\n"
       "  summary.json  settings used, period jitter and compute percentiles (p50, p99, max,\n"
       "                us), missed deadlines, loop and safety counters, rejected packets by\n"
       "                reason (udp), device figures, forces, cutting totals, warnings\n"
@@ -153,6 +162,7 @@ Command add_haptics_command(CLI::App& app) {
       so.udp_port = d.port;
     }
     if (opt->duration_s > 0.0) so.duration_s = opt->duration_s;
+    if (opt->rate_hz > 0.0) so.rate_hz = opt->rate_hz;
     if (!opt->clock.empty())
       so.clock = opt->clock == "fake" ? session::ClockMode::kFake : session::ClockMode::kReal;
     so.realtime = !opt->no_realtime;
@@ -198,8 +208,9 @@ Command add_haptics_command(CLI::App& app) {
     sigaction(SIGTERM, &old_term, nullptr);
 
     session.write_outputs(opt->out);
-    // (The real-time line was printed when the loop started.)
-    for (const std::string& w : session.warnings())
+    // (The real-time line was printed when the loop started, the device
+    // check's changes when the session was built: each is said once.)
+    for (const std::string& w : session.run_warnings())
       if (w.rfind("real-time:", 0) != 0) std::cerr << "terracut haptics: warning: " << w << "\n";
     if (!opt->quiet) std::cout << session.summary_line() << " -> " << opt->out << "\n";
     if (session.world().bodies()) {

@@ -117,7 +117,7 @@ Command add_heightmap_command(CLI::App& app) {
     spec.origin_m = {opt->origin[0], opt->origin[1], opt->origin[2]};
     spec.full_scale_m = opt->full_scale;
 
-    const GeneratorKind kind = *parse_generator_kind(opt->generator);
+    const GeneratorKind kind = *parse_enum<GeneratorKind>(opt->generator);
     Generator gen = default_generator(kind, spec);
 
     // Shape options apply to one generator each.

@@ -4,6 +4,8 @@
 #include <exception>
 #include <iostream>
 #include <new>
+#include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "haptics_command.hpp"
@@ -22,17 +24,18 @@ int main(int argc, char** argv) {
       "Run `terracut SUBCOMMAND --help` for the options of each subcommand.\n"
       "Units are SI (metres, seconds). World frame: right-handed, Y up, ground plane X-Z;\n"
       "heightmap column index runs along +X, row index along +Z.\n"
-      "Exit codes: 0 success; 1 bad input or failed output (validate: a check failed);\n"
-      "2 bad command line; 3 (reproduce, validate) results written but figures not made.\n"
       "Scenario format: docs/scenario-format.md. Experiments: docs/experiments.md.\n"
-      "The soil's physical checks (terracut validate): docs/validation.md.");
+      "The soil's physical checks (terracut validate): docs/validation.md.\n" +
+      std::string(terracut::apps::kExitCodesHelp));
 
   const terracut::cli::Command run = terracut::cli::add_run_command(app);
   const terracut::cli::Command heightmap = terracut::cli::add_heightmap_command(app);
   const terracut::cli::Command reproduce = terracut::cli::add_reproduce_command(app);
   const terracut::cli::Command validate = terracut::cli::add_validate_command(app);
+  const terracut::cli::Command calibrate = terracut::cli::add_calibrate_command(app);
   const terracut::cli::Command haptics = terracut::cli::add_haptics_command(app);
   const terracut::cli::Command mmt = terracut::cli::add_mmt_command(app);
+  const terracut::cli::Command key = terracut::cli::add_key_command(app);
 
   try {
     app.parse(argc, argv);
@@ -40,18 +43,35 @@ int main(int argc, char** argv) {
     // CLI11 checks the required options before the unknown ones: name an
     // unknown option first, it is the likelier mistake.
     if (dynamic_cast<const CLI::RequiredError*>(&e)) {
+      // No subcommand at all, or a word that is none: name it and list the real ones.
+      if (app.get_subcommands().empty()) {
+        std::string names;
+        for (const CLI::App* sub : app.get_subcommands({}))
+          names += (names.empty() ? "" : ", ") + sub->get_name();
+        const std::vector<std::string> extra = app.remaining();
+        if (extra.empty())
+          std::cerr << "terracut: a subcommand is required: " << names << "\n";
+        else if (!extra.front().empty() && extra.front()[0] == '-')
+          std::cerr << "terracut: unknown option " << extra.front() << " (the subcommands: " << names
+                    << ")\n";
+        else
+          std::cerr << "terracut: unknown subcommand '" << extra.front() << "'; the subcommands are "
+                    << names << "\n";
+        std::cerr << "Run `terracut --help` or `terracut SUBCOMMAND --help` for more information.\n";
+        return terracut::cli::kExitUsage;
+      }
       for (const CLI::App* sub : app.get_subcommands()) {
         const std::vector<std::string> extra = sub->remaining();
         if (extra.empty()) continue;
         std::cerr << "terracut " << sub->get_name() << ": unknown option or argument:";
         for (const std::string& x : extra) std::cerr << " " << x;
         std::cerr << "\nRun with --help for more information.\n";
-        return 2;
+        return terracut::cli::kExitUsage;
       }
     }
     const int code = app.exit(e);
-    // CLI11 uses many codes for usage errors; report them all as 2.
-    return code == 0 ? 0 : 2;
+    // CLI11 uses many codes for usage errors; report them all as one.
+    return code == 0 ? terracut::cli::kExitOk : terracut::cli::kExitUsage;
   }
 
   try {
@@ -59,8 +79,10 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("heightmap")) return heightmap();
     if (app.got_subcommand("reproduce")) return reproduce();
     if (app.got_subcommand("validate")) return validate();
+    if (app.got_subcommand("calibrate")) return calibrate();
     if (app.got_subcommand("haptics")) return haptics();
     if (app.got_subcommand("mmt")) return mmt();
+    if (app.got_subcommand("key")) return key();
   } catch (const terracut::InputError& e) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
@@ -71,6 +93,6 @@ int main(int argc, char** argv) {
     std::cerr << "terracut: error: " << e.what() << "\n";
     return terracut::cli::kExitError;
   }
-  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, validate, haptics, mmt)\n";
-  return 2;
+  std::cerr << "terracut: error: no subcommand given (run, heightmap, reproduce, validate, calibrate, haptics, mmt, key)\n";
+  return terracut::cli::kExitUsage;
 }

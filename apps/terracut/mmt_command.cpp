@@ -3,6 +3,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <atomic>
+#include <csignal>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -37,6 +39,10 @@ struct Options {
   std::string device;
   std::string role;
   std::string listen, connect;
+  std::string key;
+  bool insecure_loopback = false;
+  std::vector<std::string> report;
+  bool repeat = false;
   bool no_plot = false;
   std::string python = "/usr/bin/python3";
   std::string tools = TERRACUT_TOOLS_DIR;
@@ -74,6 +80,20 @@ session::MmtOverrides overrides_of(const Options& o) {
   v.blend_s = o.blend_s;
   v.duration_s = o.duration_s;
   return v;
+}
+
+static_assert(kExitLinkLost == session::kExitLinkLost, "one exit code for a dead link");
+
+// Set by SIGINT and SIGTERM: a station of --role ends at its next tick and
+// writes its outputs.
+std::atomic<bool> g_stop{false};
+extern "C" void request_stop(int) { g_stop.store(true); }
+void stop_on_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = request_stop;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
 }
 
 // Draws the figures of a folder with tools/plot_mmt.py; a warning when it cannot.
@@ -199,7 +219,9 @@ Command add_mmt_command(CLI::App& app) {
                   "Perceptual deadband of the updates, fraction (0.1 = 10 %); with --sweep, the\n"
                   "variant's fraction (default 0.1)");
   sub->add_option("--blend", opt->blend_s, "Blend time of terrain patches, s");
-  sub->add_option("--duration", opt->duration_s, "Run length, s (default: the path, settle and a round trip)");
+  sub->add_option("--duration", opt->duration_s,
+                  "Run length, s (default: the path, settle and a round trip); --role remote: its\n"
+                  "lifetime (default: until its operator ends the session, or SIGINT/SIGTERM)");
   sub->add_option("--device", opt->device,
                   "The operator's device: script, sim, or udp[:ADDR:PORT] (a real device over the\n"
                   "bridge, docs/bridge-protocol.md; with --role operator only); default haptics.device");
@@ -214,11 +236,40 @@ Command add_mmt_command(CLI::App& app) {
       ->check(CLI::IsMember({"remote", "operator"}));
   sub->add_option("--listen", opt->listen, "remote: ADDR:PORT to bind (default mmt.udp)");
   sub->add_option("--connect", opt->connect, "operator: ADDR:PORT of the remote (default mmt.udp)");
+  sub->add_option("--key", opt->key,
+                  "With --role: the key file both stations share (`terracut key --out FILE`; mode\n"
+                  "600). Default: the environment variable TERRACUT_MMT_KEY (64 hex digits)")
+      ->type_name("FILE");
+  sub->add_flag("--insecure-loopback", opt->insecure_loopback,
+                "With --role: no key, no authentication (any local process can take the session\n"
+                "over): a demo on 127.0.0.1 only");
+  sub->add_option("--report", opt->report,
+                  "Compare a two-process session: OPERATOR_DIR REMOTE_DIR (the stations' --out\n"
+                  "folders) -> --out: summary.json, operator.csv, remote.csv, terrain_error.csv,\n"
+                  "mmt.png, as a single-process run")
+      ->expected(2)
+      ->type_name("OPERATOR_DIR REMOTE_DIR");
+  sub->add_flag("--repeat", opt->repeat,
+                "--role operator: the script device replays its cut over and over until --duration\n"
+                "(a soak)");
   sub->add_flag("--no-plot", opt->no_plot, "Do not draw the figures");
   sub->add_option("--python", opt->python, "Python with matplotlib")->capture_default_str();
   sub->add_option("--tools-dir", opt->tools, "Folder of plot_mmt.py")->capture_default_str();
   sub->add_flag("--quiet,-q", opt->quiet, "No progress lines");
   return [opt]() -> int {
+    if (!opt->report.empty()) {
+      if (!opt->role.empty() || opt->sweep)
+        throw InputError("--report: not with --role or --sweep (it reads two stations' folders)");
+      const session::MmtSummary s = session::write_two_process_report(opt->report[0], opt->report[1], opt->out);
+      if (!opt->quiet)
+        std::cout << std::setprecision(3) << "terracut mmt: two-process session, " << s.duration_s
+                  << " s, RTT " << s.rtt_measured_s * 1e3 << " ms measured: force error RMS "
+                  << s.force_error_rms_mmt_n << " N (MMT) vs " << s.force_error_rms_dfr_n
+                  << " N (direct reflection); terrain RMS " << s.terrain_rms_final_m * 1e3
+                  << " mm at the end\n";
+      plot(*opt, opt->out);
+      return kExitOk;
+    }
     session::Scenario sc = session::load_scenario(opt->scenario);
     if (!opt->device.empty()) {
       const haptics::DeviceOption d = haptics::parse_device_option(opt->device);
@@ -232,10 +283,50 @@ Command add_mmt_command(CLI::App& app) {
       po.endpoint = opt->role == "remote" ? opt->listen : opt->connect;
       po.out = opt->out;
       po.log = opt->quiet ? nullptr : &std::cout;
+      po.warn = &std::cerr;
+      po.repeat = opt->repeat;
+      po.key = session::link_key(opt->key, opt->insecure_loopback);
+      if (po.key.insecure)
+        std::cerr << "terracut mmt: warning: --insecure-loopback: the link is NOT authenticated; any "
+                     "process on this machine can take this session over or feed it datagrams\n";
+      g_stop.store(false);
+      po.stop = &g_stop;
+      stop_on_signals();
       return opt->role == "remote" ? session::run_remote_process(sc, po)
                                    : session::run_operator_process(sc, po);
     }
+    if (!opt->key.empty() || opt->insecure_loopback)
+      throw InputError(std::string(opt->key.empty() ? "--insecure-loopback" : "--key") +
+                       ": only with --role (the single-process run has no network)");
     return opt->sweep ? run_sweep(*opt, sc) : run_one(*opt, sc);
+  };
+}
+
+Command add_key_command(CLI::App& app) {
+  struct KeyOptions {
+    std::string out, fingerprint;
+  };
+  auto opt = std::make_shared<KeyOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "key",
+      "The key of a pair of `terracut mmt --role` stations: --out FILE makes a new random key\n"
+      "(64 hex digits, mode 600; an existing file is never overwritten) and prints its\n"
+      "fingerprint; --fingerprint FILE prints an existing key's, to check that two machines\n"
+      "hold the same key without showing it. Copy the file to the other machine over a\n"
+      "channel you trust (scp). See docs/teleoperation.md, \"Keys and the threat model\".");
+  sub->add_option("--out,-o", opt->out, "The key file to make")->type_name("FILE");
+  sub->add_option("--fingerprint", opt->fingerprint, "A key file whose fingerprint to print")
+      ->type_name("FILE");
+  return [opt]() -> int {
+    if (opt->out.empty() == opt->fingerprint.empty())
+      throw InputError("key: give one of --out FILE (a new key) or --fingerprint FILE");
+    if (!opt->out.empty()) {
+      const net::LinkKey k = net::write_new_key_file(opt->out);
+      std::cout << "terracut key: wrote " << opt->out << " (fingerprint " << net::fingerprint(k) << ")\n";
+    } else {
+      std::cout << net::fingerprint(net::read_key_file(opt->fingerprint)) << "\n";
+    }
+    return kExitOk;
   };
 }
 

@@ -7,5 +7,7 @@
 namespace terracut::cli {
 
 Command add_mmt_command(CLI::App& app);
+/// `terracut key`: makes the key file of a pair of stations, or shows a key's fingerprint.
+Command add_key_command(CLI::App& app);
 
 }  // namespace terracut::cli

@@ -82,6 +82,11 @@ Command add_run_command(CLI::App& app) {
       "                                  contact, m^2\n"
       "                  max_depth       deepest point of the blade below the surface, m\n"
       "                  cells_visited   cells examined by the contact query and the cut\n"
+      "  force.csv     one row per step: the physical force on the tool, world N, whatever a\n"
+      "                device would render (docs/forces.md): t,cut, fx,fy,fz (the total),\n"
+      "                its parts cutting_*, surcharge_* (the pile), penetration_y,\n"
+      "                twist_x,twist_z,twist_torque (N m), load_* (a bucket's soil),\n"
+      "                bodies_*, and cut_depth,cut_width,pile_height (m), vx,vy,vz (m/s)\n"
       "  height.npy    final heights, float32 (rows, cols), m above ground, row r along +Z\n"
       "  removed.npy   removed material, float32 (rows, cols), m\n"
       "  height.png    final heights, 16-bit grey, pixel = height / full_scale_m\n"
@@ -90,7 +95,8 @@ Command add_run_command(CLI::App& app) {
       "                t,body,name,x,y,z,qw,qx,qy,qz,vx,vy,vz (SI; Bullet rigid bodies\n"
       "                on the same terrain; plot with tools/plot_bodies.py DIR)\n"
       "  summary.json  inputs, steps, initial/final/removed volume (m^3), conservation\n"
-      "                error, per-cut peak/mean contact and removed volume, and per-step\n"
+      "                error, per-cut peak/mean contact, removed volume and physical force\n"
+      "                (mean and peak), the soil material, and per-step\n"
       "                timing percentiles (us; the only part that differs between runs);\n"
       "                with --realtime also \"realtime\": missed_deadlines, step_time and\n"
       "                period_jitter {p50_us, p99_us, max_us, mean_us}; with soil\n"
@@ -113,7 +119,7 @@ Command add_run_command(CLI::App& app) {
     if (!opt->resolution.empty()) resolution = io::parse_resolution(opt->resolution);
     std::optional<Representation> representation;
     if (!opt->representation.empty())
-      representation = parse_representation(opt->representation);
+      representation = parse_enum<Representation>(opt->representation);
     std::optional<std::vector<std::string>> sequence;
     if (!opt->sequence.empty()) sequence = io::parse_name_list(opt->sequence);
     io::apply_overrides(scenario.base, resolution, representation, sequence);

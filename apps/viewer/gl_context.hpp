@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "../exit_codes.hpp"
 #include "png_rgb.hpp"
 
 namespace terracut::viewer {
@@ -20,8 +21,8 @@ class ContextUnavailable : public std::runtime_error {
 };
 
 /// Exit status of terracut-viewer when no OpenGL context can be made (tests
-/// skip on it instead of failing).
-inline constexpr int kExitNoContext = 77;
+/// skip on it instead of failing): the programs' table, exit_codes.hpp.
+inline constexpr int kExitNoContext = apps::kExitNoContext;
 
 /// An OpenGL 3.3 core context without any window or display: EGL on
 /// EGL_PLATFORM_SURFACELESS_MESA, made current with no surface. Draw into a

@@ -31,7 +31,7 @@ DriverOptions reset_options(const DriverOptions& previous, const ViewerDevice& d
 LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticSettings& settings,
                        const DriverOptions& options, LoopTiming* timing)
     : scenario_(scenario),
-      params_(settings, scenario.base.blade),
+      params_(settings, scenario.base.blade, scenario.base.rate_hz),
       options_(options),
       spec_(io::grid_spec(scenario.base)),
       representation_(scenario.base.representation),
@@ -89,9 +89,7 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
   ro.loop.lock_memory = false;  // the viewer's GL driver allocates; locking all memory is not ours
   ro.loop.snapshot = exchange_.get();
   if (options.mmt) {
-    if (!scenario_.mmt)
-      throw InputError(scenario_.base.source_path.string() +
-                       ": --mmt: the scenario has no mmt: section (docs/teleoperation.md)");
+    if (!scenario_.mmt) throw InputError("--mmt: " + session::no_mmt_section(scenario_));
     // The operator station runs the loop with the viewer's settings; the
     // remote world is the scenario's mmt.remote.
     session::Scenario op = scenario_;
@@ -100,16 +98,17 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
     session::OperatorOptions oo;
     oo.snapshot = exchange_.get();
     oo.keep_records = false;
+    oo.wall_clock = !options.remote.empty();
     if (!options.remote.empty()) {
       // The remote is another process; a new session id each start, as
       // `terracut mmt --role operator` has it.
+      const std::uint32_t id = session::new_station_id();
       udp_ = session::connect_operator_link(mmt, options.remote, "--remote",
-                                            options.connect_timeout_s);
-      const auto id = std::uint32_t(std::chrono::steady_clock::now().time_since_epoch().count());
-      operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, *udp_, id, oo);
+                                            options.connect_timeout_s, options.key, id);
+      operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, *udp_.endpoint, id, oo);
     } else {
       remote_scenario_ = std::make_unique<session::Scenario>(session::load_remote_scenario(op));
-      link_ = std::make_unique<net::MemoryLink>(mmt.to_remote, mmt.to_operator);
+      link_ = std::make_unique<net::EmulatedLink>(mmt.to_remote, mmt.to_operator);
       operator_ = std::make_unique<session::OperatorStation>(op, mmt, *device_, link_->a(), 1u, oo);
       remote_ = std::make_unique<session::RemoteStation>(
           *remote_scenario_, mmt, op.base.soil.material,
@@ -138,6 +137,13 @@ const haptics::HapticLoop& LoopDriver::loop() const {
   return operator_ ? operator_->rig().loop() : rig_->loop();
 }
 
+std::string LoopDriver::realtime_line() const {
+  if (operator_)
+    return "real-time: not asked (teleoperation: the stations tick on the viewer's own thread, "
+           "normal scheduling)";
+  return loop().realtime_status().message;
+}
+
 void LoopDriver::start() {
   if (started_) return;
   started_ = true;
@@ -164,9 +170,14 @@ void LoopDriver::stop() {
   started_ = false;
 }
 
+void LoopDriver::end_session() {
+  if (udp_.carrier && !started_) udp_.carrier->end_session(0.5);
+}
+
 void LoopDriver::lockstep_main() {
   // A remote in another process runs on the wall clock: each tick waits for
-  // its time (t = i / rate from the start), or the operator would run ahead.
+  // its time (i / rate from the start), or the operator would run ahead, and
+  // its time is the wall clock's (the round trip it measures is real).
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
   std::int64_t i = 0;
@@ -175,7 +186,7 @@ void LoopDriver::lockstep_main() {
       std::this_thread::sleep_for(std::chrono::microseconds(200));
       continue;
     }
-    if (udp_)
+    if (udp_.endpoint)
       std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
                                                 std::chrono::duration<double>(double(i) / rate_hz())));
     tick(i);
@@ -191,6 +202,7 @@ void LoopDriver::tick(std::int64_t i) {
   const double period = 1.0 / rate_hz();
   const double t_s = double(i) * period;
   if (operator_) {
+    if (link_) link_->release(t_s);
     operator_->tick(t_s);
     if (remote_) remote_->tick(t_s);
     publish_mmt();
@@ -202,22 +214,32 @@ void LoopDriver::tick(std::int64_t i) {
   rig_->loop().step2(i == 0 ? 0.0 : period, compute, false);
 }
 
-// MMT in real time: both stations ticked at the loop rate by absolute
-// deadlines (a late tick is not made up twice: the deadline moves on).
+// MMT in real time: both stations ticked at the loop rate, tick i at t =
+// i / rate due at that time after the start; far behind (10 periods), the
+// missed ticks are skipped and t jumps to the wall clock's, never drifting
+// behind it (the stations' time held still while the drawing thread slowed
+// the ticks, and the measured round trip read 68 ms for 100 ms emulated).
 void LoopDriver::paced_mmt_main() {
   using Clock = std::chrono::steady_clock;
-  const auto period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(1.0 / rate_hz()));
-  Clock::time_point deadline = Clock::now();
+  Clock::time_point start = Clock::now();
   std::int64_t i = 0;
   while (lockstep_running_.load(std::memory_order_relaxed)) {
+    // Paused with the remote in this process: both stations hold (their
+    // time leaves the pause out), as the plain loop does. A remote in
+    // another process runs on, so the operator keeps answering it.
+    if (!udp_.endpoint && i > 0 && device_->paused()) {
+      const Clock::time_point held = Clock::now();
+      std::this_thread::sleep_for(std::chrono::duration<double>(haptics::HapticLoop::kPausePoll_s));
+      start += Clock::now() - held;
+      continue;
+    }
     tick(i);
     ++i;
     ticks_done_.store(i);
-    deadline += period;
-    const Clock::time_point now = Clock::now();
-    if (deadline < now - 10 * period) deadline = now;  // far behind: start again from now
-    std::this_thread::sleep_until(deadline);
+    const double now_s = std::chrono::duration<double>(Clock::now() - start).count();
+    if (now_s > double(i + 10) / rate_hz()) i = std::int64_t(now_s * rate_hz());
+    std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
+                                              std::chrono::duration<double>(double(i) / rate_hz())));
   }
 }
 
@@ -230,12 +252,19 @@ void LoopDriver::publish_mmt() {
   m.force_error_rms_n.store(std::sqrt(error_ms_n2_), std::memory_order_relaxed);
   m.remote_force_n.store(length(r.remote_force_world_n), std::memory_order_relaxed);
   m.rtt_s.store(operator_->rtt_s(), std::memory_order_relaxed);
+  m.command_loss.store(operator_->command_loss_recent(), std::memory_order_relaxed);
+  if (udp_.carrier) {
+    const net::EnetCounters& c = udp_.carrier->counters();
+    m.udp_dropped.store(c.dropped_unknown_source + c.dropped_oversize + c.kernel_dropped,
+                        std::memory_order_relaxed);
+    m.peers_refused.store(c.refused_total(), std::memory_order_relaxed);
+  }
   auto loss = [](const net::LinkEmulator& e) {
     const net::EmulatorCounters& c = e.counters();
     return c.datagrams > 0 ? double(c.lost) / double(c.datagrams) : 0.0;
   };
   // With the remote in another process, its sender's losses are its own.
-  m.loss_to_remote.store(loss(udp_ ? udp_->emulator() : link_->a().emulator()),
+  m.loss_to_remote.store(loss(udp_.endpoint ? udp_.endpoint->emulator() : link_->a().emulator()),
                          std::memory_order_relaxed);
   m.loss_to_operator.store(link_ ? loss(link_->b().emulator()) : 0.0, std::memory_order_relaxed);
   m.patches.store(oc.patches, std::memory_order_relaxed);

@@ -47,9 +47,11 @@
 #include "terracut/haptics/loop.hpp"
 #include "terracut/haptics/snapshot.hpp"
 #include "terracut/io/scenario.hpp"
+#include "terracut/net/secure.hpp"
 #include "terracut/net/transport.hpp"
 #include "terracut/session/haptic.hpp"
 #include "terracut/session/mmt.hpp"
+#include "terracut/session/mmt_process.hpp"
 #include "viewer_device.hpp"
 
 namespace terracut::viewer {
@@ -78,13 +80,22 @@ struct DriverOptions {
   std::string remote;
   /// How long to wait for that remote station to answer, s.
   double connect_timeout_s = 5.0;
+  /// With remote: the key both stations share (net::insecure_key() for
+  /// --insecure-loopback).
+  net::LinkKey key;
 };
 
 /// The teleoperation link as the panel shows it, written by the driver's
 /// thread after every tick, read by the drawing thread.
 struct MmtLive {
-  std::atomic<double> rtt_s{0.0};             ///< newest measured round trip, s
+  std::atomic<double> rtt_s{0.0};             ///< newest measured round trip (wall clock), s
   std::atomic<double> emulated_rtt_s{0.0};    ///< the emulator's delays, both ways, s
+  /// Commands that did not reach the remote over about the last second.
+  std::atomic<double> command_loss{0.0};
+  /// With a remote in another process: UDP datagrams dropped before the
+  /// station (no peer's, oversize, by the kernel) and peers refused.
+  std::atomic<std::int64_t> udp_dropped{0};
+  std::atomic<std::int64_t> peers_refused{0};
   std::atomic<double> loss_to_remote{0.0};    ///< datagrams lost / sent, operator -> remote
   std::atomic<double> loss_to_operator{0.0};  ///< datagrams lost / sent, remote -> operator
   std::atomic<std::int64_t> patches{0};       ///< patches merged by the operator
@@ -118,6 +129,10 @@ class LoopDriver {
   /// Stops and joins the loop's thread (idempotent); the loop's results
   /// (loop().period() etc.) may be read afterwards.
   void stop();
+  /// With a remote station in another process: tells it the session is
+  /// over (it ends, as when `terracut mmt --role operator` finishes). After
+  /// stop(); nothing otherwise.
+  void end_session();
 
   // --- fixed after construction ---
   const GridSpec& spec() const { return spec_; }
@@ -142,6 +157,10 @@ class LoopDriver {
   ViewerDevice& device() { return *device_; }
   /// The loop (the operator station's in MMT); its results only after stop().
   const haptics::HapticLoop& loop() const;
+  /// How the loop's thread is scheduled, in the words `terracut haptics`
+  /// uses ("real-time: SCHED_FIFO priority 80, ..."); in MMT the stations
+  /// tick on this driver's own thread, which asks for no real-time.
+  std::string realtime_line() const;
   /// Teleoperation: the stations run (DriverOptions::mmt).
   bool mmt() const { return operator_ != nullptr; }
   /// The link's figures (zeros when not mmt()).
@@ -180,8 +199,8 @@ class LoopDriver {
   std::unique_ptr<session::HapticRig> rig_;  // after the device, which it uses
   // MMT: the remote world, the link and the two stations (instead of rig_).
   std::unique_ptr<session::Scenario> remote_scenario_;
-  std::unique_ptr<net::MemoryLink> link_;
-  std::unique_ptr<net::Endpoint> udp_;  // DriverOptions::remote: the link to the other process
+  std::unique_ptr<net::EmulatedLink> link_;
+  session::UdpLink udp_;  // DriverOptions::remote: the link to the other process
   std::unique_ptr<session::OperatorStation> operator_;
   std::unique_ptr<session::RemoteStation> remote_;
   MmtLive mmt_live_;

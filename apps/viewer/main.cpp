@@ -9,6 +9,7 @@
 #include <iostream>
 #include <string>
 
+#include "../exit_codes.hpp"
 #include "gl_context.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/session/mmt_process.hpp"
@@ -100,16 +101,24 @@ int main(int argc, char** argv) {
   app.add_option("--remote", opt.remote,
                  "with --mmt: the remote station is another process (`terracut mmt --role "
                  "remote`) at ADDR:PORT or PORT (UDP, IPv4), not in-process");
+  std::string key_file;
+  app.add_option("--key", key_file,
+                 "with --remote: the key file the remote was started with (`terracut key`); "
+                 "default: the environment variable TERRACUT_MMT_KEY");
+  bool insecure_loopback = false;
+  app.add_flag("--insecure-loopback", insecure_loopback,
+               "with --remote: no key, no authentication (a demo on 127.0.0.1 only)");
   bool no_realtime = false;
   app.add_flag("--no-realtime", no_realtime,
                "do not ask for SCHED_FIFO for the haptic loop's thread");
+  app.footer(terracut::apps::kExitCodesHelp);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // --help and --version exit 0; every command-line error exits 2, as
-    // docs/viewer.md says (CLI11's own codes differ by error).
+    // --help and --version exit 0; every command-line error exits with the
+    // one usage code (CLI11's own codes differ by error).
     const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    return code == 0 ? terracut::apps::kExitOk : terracut::apps::kExitUsage;
   }
   opt.realtime = !no_realtime;
 
@@ -118,6 +127,12 @@ int main(int argc, char** argv) {
       if (!opt.mmt)
         throw terracut::InputError("--remote: needs --mmt (the viewer is then the operator station)");
       terracut::session::parse_endpoint(opt.remote, "--remote", "127.0.0.1");  // refused here if bad
+      opt.key = terracut::session::link_key(key_file, insecure_loopback);
+      if (opt.key.insecure)
+        std::cerr << "terracut-viewer: warning: --insecure-loopback: the link is NOT authenticated\n";
+    } else if (!key_file.empty() || insecure_loopback) {
+      throw terracut::InputError(std::string(key_file.empty() ? "--insecure-loopback" : "--key") +
+                                 ": only with --remote");
     }
     opt.input = input;
     opt.screenshot = screenshot;
@@ -148,9 +163,17 @@ int main(int argc, char** argv) {
       opt.look_at = terracut::Vec3{x, y, z};
     }
     if (!representation.empty())
-      opt.representation = terracut::parse_representation(representation);
+      opt.representation = terracut::parse_enum<terracut::Representation>(representation);
     if (!resolution.empty()) opt.resolution = terracut::io::parse_resolution(resolution);
     if (!opt.screenshot.empty() || opt.benchmark_frames > 0) opt.headless = true;
+    // A screenshot that cannot be written is said before the whole sequence is drawn.
+    if (!opt.screenshot.empty()) {
+      const std::filesystem::path folder = opt.screenshot.parent_path();
+      std::error_code ec;
+      if (!folder.empty() && !std::filesystem::is_directory(folder, ec))
+        throw terracut::InputError("--screenshot: the folder " + folder.string() +
+                                   " does not exist (the PNG is written into an existing folder)");
+    }
     if (std::filesystem::path(input).extension() == ".png" && app.count("--extent") == 0)
       std::cerr << "terracut-viewer: " << input << " opens as " << opt.heightmap_size_m << " x "
                 << opt.heightmap_size_m << " m with white = " << opt.heightmap_full_scale_m
@@ -159,10 +182,10 @@ int main(int argc, char** argv) {
     terracut::viewer::ViewerApp viewer(opt, terracut::viewer::load_input(opt));
     return opt.headless ? viewer.run_headless() : viewer.run_window();
   } catch (const terracut::InputError& e) {
-    std::cerr << "terracut-viewer: " << e.what() << "\n";
-    return 2;
+    std::cerr << "terracut-viewer: error: " << e.what() << "\n";
+    return terracut::apps::kExitError;
   } catch (const std::exception& e) {
     std::cerr << "terracut-viewer: error: " << e.what() << "\n";
-    return 1;
+    return terracut::apps::kExitError;
   }
 }

@@ -70,12 +70,13 @@ ViewerApp::ViewerApp(ViewerOptions options, session::Scenario scenario)
   camera_.mode = options_.camera;
 }
 
-ViewerApp::~ViewerApp() { close_session(); }
+ViewerApp::~ViewerApp() { close_session(true); }
 
 void ViewerApp::open_session(const DriverOptions& driver_options) {
   driver_options_ = driver_options;
   driver_options_.mmt = options_.mmt;
   driver_options_.remote = options_.remote;
+  driver_options_.key = options_.key;
   driver_ = std::make_unique<LoopDriver>(scenario_, haptics_, driver_options_, &timing_);
   const GridSpec& spec = driver_->spec();
   const std::vector<float>& initial = driver_->initial_heights();
@@ -151,13 +152,21 @@ void ViewerApp::frame_on_tool_path() {
 
 void ViewerApp::print_realtime_line() {
   // The loop thread's scheduling, in the words `terracut haptics` uses.
-  std::cerr << "terracut-viewer: " << driver_->loop().realtime_status().message << "\n";
+  std::cerr << "terracut-viewer: " << driver_->realtime_line() << "\n";
 }
 
-void ViewerApp::close_session() {
+void ViewerApp::close_session(bool end_remote) {
   if (driver_) driver_->stop();
+  if (driver_ && end_remote) driver_->end_session();
   driver_.reset();
   terrain_.reset();
+}
+
+void ViewerApp::release_gl(bool with_glfw) {
+  close_session();
+  window_fb_.reset();
+  shutdown_imgui(with_glfw);
+  shapes_.reset();
 }
 
 bool ViewerApp::take_frame() {
@@ -254,7 +263,7 @@ void ViewerApp::apply_model_changes() {
     // The simulation's check (the material with the rake) and the loop's own
     // (InputError naming the field, or a refused rendering).
     if (const std::string e = validate(io::sim_params(sc.base)); !e.empty()) throw InputError(e);
-    const haptics::LoopParams check(pending_haptics_, sc.base.blade);
+    const haptics::LoopParams check(pending_haptics_, sc.base.blade, sc.base.rate_hz);
     close_session();
     scenario_ = sc;
     haptics_ = check.settings();
@@ -336,6 +345,16 @@ GLFWwindow* ViewerApp::open_window() {
 int ViewerApp::run_window() {
   GLFWwindow* window = open_window();
   if (!window) return kExitNoContext;
+  // The window and its context outlive everything drawn with it, on every
+  // way out (an error that opening a session throws included).
+  struct WindowScope {
+    GLFWwindow* window;
+    ~WindowScope() {
+      glfwDestroyWindow(window);
+      glfwTerminate();
+    }
+  } window_scope{window};
+  const GLScope gl_scope{*this, true};
   init_gl_objects();
   init_imgui(true, window);
 
@@ -384,13 +403,10 @@ int ViewerApp::run_window() {
                "%.1f frames/s while drawing\n",
                static_cast<long long>(drawn), open_s, static_cast<long long>(iterations),
                drawing_s > 0.0 ? double(drawn) / drawing_s : 0.0);
-  close_session();
-  window_fb_.reset();
-  shutdown_imgui(true);
-  shapes_.reset();
-  glfwDestroyWindow(window);
-  glfwTerminate();
-  return 0;
+  // The end of the session, told to a remote in another process; the GL
+  // objects and the window go with gl_scope.
+  close_session(true);
+  return apps::kExitOk;
 }
 
 bool ViewerApp::window_frame(GLFWwindow* window, double dt_s) {

@@ -65,6 +65,9 @@ struct ViewerOptions {
   /// With mmt: the remote station is `terracut mmt --role remote` at this
   /// "ADDR:PORT" or "PORT" (UDP) instead of in-process.
   std::string remote;
+  /// With remote: the key both stations share (--key, TERRACUT_MMT_KEY, or
+  /// --insecure-loopback's).
+  net::LinkKey key;
 };
 
 /// Loads the scenario (and its `haptics:` section) or the heightmap named by
@@ -94,10 +97,24 @@ class ViewerApp {
   void init_gl_objects();
   void init_imgui(bool with_glfw, GLFWwindow* window);
   void shutdown_imgui(bool with_glfw);
+  /// Deletes everything made with the OpenGL context (the session's terrain
+  /// renderer, the shapes, the window's framebuffer, ImGui's backend) while
+  /// it is still current; idempotent. Every way out of run_headless and
+  /// run_window calls it, an error included (GLScope): a GL call without a
+  /// current context aborts inside epoxy.
+  void release_gl(bool with_glfw);
+  /// Calls release_gl when it goes out of scope (declare it after the context).
+  struct GLScope {
+    ViewerApp& app;
+    bool with_glfw;
+    ~GLScope() { app.release_gl(with_glfw); }
+  };
   void open_session(const DriverOptions& driver_options);
   /// Widens the orbit camera's framing to the tool's scripted path.
   void frame_on_tool_path();
-  void close_session();
+  /// Stops the session; end_remote: also tells a remote station in another
+  /// process that its session is over (the viewer closes; not on a Reset).
+  void close_session(bool end_remote = false);
   /// Takes the newest published frame (if any), uploads its dirty rectangle
   /// and records its values; returns whether one was taken whose picture
   /// differs from the previous one.

@@ -235,13 +235,23 @@ void ViewerDevice::start(double t_s) {
   active_ = source();
 }
 
+bool ViewerDevice::paused() noexcept {
+  const bool paused = !playing_.load(std::memory_order_relaxed) &&
+                      step_requests_.load(std::memory_order_relaxed) == 0 &&
+                      !(step_budget_s_.load(std::memory_order_relaxed) > 0.0);
+  held_ = held_ || paused;
+  return paused;
+}
+
 bool ViewerDevice::read(double t_s, haptics::DeviceSample& out) noexcept {
   if (timing_) {
     const std::int64_t now = wall_ns();
-    if (previous_wall_ns_ != 0) timing_->record_period(double(now - previous_wall_ns_) * 1e-9);
+    // After a pause the gap since the last read is the pause, not a period.
+    if (previous_wall_ns_ != 0 && !held_) timing_->record_period(double(now - previous_wall_ns_) * 1e-9);
     previous_wall_ns_ = now;
     read_wall_ns_ = now;
   }
+  held_ = false;
   const double dt = std::max(0.0, t_s - previous_t_s_);
   previous_t_s_ = t_s;
 

@@ -17,9 +17,10 @@
 //    speed, renders as a buzz; docs/viewer.md.)
 //
 // Play/pause, steps and speed act on the device's own clock: paused, the
-// handle holds still (the loop keeps ticking at its rate, as a haptic loop
-// must; a still blade cuts nothing and feels no drag); a step plays a stated
-// time (request_step_s) and holds again. Speed scales the
+// handle holds still and the device says so (paused()): the paced haptic
+// loop then holds, ticking nothing and costing no CPU, until Play, a step or
+// a stop (a virtual device may pause its loop; a real one never does); a
+// step plays a stated time (request_step_s) and holds again. Speed scales the
 // script's time and the lag. The device also timestamps each read and write
 // with the wall clock, so the viewer sees the loop's period and compute time
 // live (LoopStats) without touching the loop's own records.
@@ -129,6 +130,9 @@ class ViewerDevice final : public haptics::Device {
   void start(double t_s) override;
   bool read(double t_s, haptics::DeviceSample& out) noexcept override;
   void write(const haptics::DeviceCommand& command) noexcept override;
+  /// Paused and no step to play: the paced loop holds (Device::paused).
+  /// Called by the loop's thread.
+  bool paused() noexcept override;
 
   // --- controls, from any thread ---
   void set_playing(bool playing) { playing_.store(playing); }
@@ -189,6 +193,7 @@ class ViewerDevice final : public haptics::Device {
   bool in_transit_ = false;
   std::int64_t read_wall_ns_ = 0;
   std::int64_t previous_wall_ns_ = 0;
+  bool held_ = false;  // the loop held for a pause: the next read's gap is no period
 
   // Shared.
   std::atomic<bool> playing_{true};

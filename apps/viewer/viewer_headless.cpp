@@ -30,6 +30,9 @@ int ViewerApp::run_headless() {
     std::cerr << "terracut-viewer: cannot create an OpenGL 3.3 context: " << e.what() << "\n";
     return kExitNoContext;
   }
+  // What is drawn with the context goes before it, also when a step below
+  // throws (a session the scenario cannot open, a PNG that cannot be written).
+  const GLScope gl_scope{*this, false};
   const int w = options_.width, h = options_.height;
   Framebuffer fb(w, h, options_.benchmark_frames > 0 ? 0 : options_.msaa);
   fb.bind();
@@ -50,9 +53,7 @@ int ViewerApp::run_headless() {
                   static_cast<long long>(driver_->ticks_done()));
     }
   }
-  close_session();
-  shutdown_imgui(false);
-  shapes_.reset();
+  close_session(true);  // the end of the session, told to a remote; the GL objects go with gl_scope
   return status;
 }
 
@@ -180,7 +181,7 @@ void ViewerApp::print_loop_summary() {
       us(ps.period_jitter.max_s), us(ps.compute.p50_s), us(ps.compute.p99_s), us(ps.compute.max_s),
       static_cast<long long>(ps.missed_deadlines), static_cast<long long>(ps.skipped_slots),
       static_cast<long long>(t.ticks), t.period_p50_us, t.period_p99_us, t.period_max_us,
-      loop.realtime_status().message.c_str());
+      driver_->realtime_line().c_str());
 }
 
 void ViewerApp::run_lockstep(int w, int h) {

@@ -144,8 +144,9 @@ void ViewerApp::draw_mmt_section() {
   section("Teleoperation (MMT)");
   ImGui::Text("RTT %.0f ms measured (%.0f ms emulated)", m.rtt_s.load() * 1e3,
               m.emulated_rtt_s.load() * 1e3);
-  ImGui::Text("loss %.1f %% to remote, %.1f %% back", m.loss_to_remote.load() * 100.0,
+  ImGui::Text("loss %.1f %% to remote, %.1f %% back (emulated)", m.loss_to_remote.load() * 100.0,
               m.loss_to_operator.load() * 100.0);
+  ImGui::Text("commands lost %.1f %% (last second)", m.command_loss.load() * 100.0);
   ImGui::Text("updates: %lld patches, %lld estimates", static_cast<long long>(m.patches.load()),
               static_cast<long long>(m.estimates.load()));
   ImGui::Text("soil factor %.3f (remote says %.3f)", m.scale_applied.load(), m.scale_target.load());
@@ -153,6 +154,10 @@ void ViewerApp::draw_mmt_section() {
               m.remote_force_n.load());
   if (m.rejected.load() > 0)
     ImGui::TextDisabled("%lld datagrams rejected", static_cast<long long>(m.rejected.load()));
+  if (m.udp_dropped.load() > 0 || m.peers_refused.load() > 0)
+    ImGui::TextDisabled("UDP: %lld datagrams dropped, %lld peers refused",
+                        static_cast<long long>(m.udp_dropped.load()),
+                        static_cast<long long>(m.peers_refused.load()));
   if (m.link_silent.load())
     ImGui::TextColored(ImVec4(1.0f, 0.45f, 0.35f, 1.0f), "link silent: force fading out");
 }

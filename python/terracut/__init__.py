@@ -16,7 +16,8 @@ Scenarios come from files (Scenario.load), dicts with the same schema
 also from a numpy array (Simulation.from_heights). terracut.run() is
 `terracut run` (the same files on disk); terracut.sweep() runs many cases,
 locally or on a Dask cluster. Errors are terracut.InputError (a ValueError)
-with the C++ library's messages.
+with the C++ library's messages. terracut.__version__ is the library's
+version, as `terracut --version` prints it.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from pathlib import Path
 from typing import Any, Union
 
 from ._terracut import (  # noqa: F401
+    __version__,
     ForceModel,
     InputError,
     SafetyLimiter,
@@ -33,6 +35,8 @@ from ._terracut import (  # noqa: F401
     Simulation,
     StepResult,
     bodies_available,
+    calibrate_record,
+    calibrate_tests,
     earthmoving_force,
     soil_preset,
 )
@@ -93,6 +97,6 @@ from .sweep import SweepResult, register_override, sweep  # noqa: E402,F401
 __all__ = [
     "run_mmt",
     "ForceModel", "InputError", "SafetyLimiter", "Scenario", "Simulation", "StepResult",
-    "SweepResult", "bodies_available", "earthmoving_force", "from_dict", "load_mapping",
-    "register_override", "run", "soil_preset", "sweep",
+    "SweepResult", "bodies_available", "calibrate_record", "calibrate_tests", "earthmoving_force",
+    "from_dict", "load_mapping", "register_override", "run", "soil_preset", "sweep",
 ]

@@ -16,10 +16,12 @@ OUT_DIR/sweep.csv and OUT_DIR/sweep.json.
 Overrides are named (see OVERRIDES: resolution, representation, rate_hz,
 blade_length_m, sequence, soil, repose_deg) or field paths of the scenario
 schema in the reader's own notation, e.g. "terrain.size_m[0]" or
-"cuts[*].keyframes[*].position_m[1]" ([*]: every element). A new name is
-added with register_override(); the teleoperation link's network delay is
-meant to arrive that way (register_override("delay", ...)) once its
-scenario section exists -- it is not there yet.
+"cuts[*].keyframes[*].position_m[1]" ([*]: every element). resolution takes
+N, [cols, rows] or the command line's "COLSxROWS". A new name is added with
+register_override(). The teleoperation link's conditions (rtt_ms, loss,
+deadband, seed) are options of a teleoperation run, not scenario fields: a
+case with one of them, or a scenario with an `mmt:` section, runs both
+stations (terracut.run_mmt) and its row holds that run's figures.
 
 Without a client the cases run in a local process pool (processes workers,
 default: the machine's cores; processes=1 runs them in this process). With a
@@ -47,7 +49,7 @@ from typing import Any, Optional, Union
 import numpy as np
 
 from ._scenarios import from_dict, load_mapping, scenario_text
-from ._terracut import InputError, Scenario
+from ._terracut import InputError, Scenario, _parse_resolution
 
 # --- Overrides ---------------------------------------------------------------
 
@@ -131,8 +133,16 @@ def _repose(m: dict, value: Any) -> None:
     soil["repose_deg"] = value
 
 
+def _resolution(m: dict, value: Any) -> None:
+    """N, [cols, rows], or the command line's text "N" / "COLSxROWS" (read by
+    the command line's own parser, io::parse_resolution)."""
+    if isinstance(value, str):
+        value = list(_parse_resolution(value))
+    m.setdefault("terrain", {})["resolution"] = value
+
+
 OVERRIDES: dict[str, OverrideFn] = {
-    "resolution": _set_path("terrain.resolution"),
+    "resolution": _resolution,
     "representation": _set_path("representation"),
     "rate_hz": _set_path("rate_hz"),
     "blade_length_m": _set_path("blade.length_m"),
@@ -285,19 +295,53 @@ _NUMERIC = ["steps", "removed_volume_m3", "initial_volume_m3", "final_volume_m3"
             "step_p50_us", "wall_s"]
 
 
+_NOT_FIGURES = frozenset({"case", "status", "error", "overrides", "out_dir"})
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
+
+
+def _figure_names(rows: list[dict], teleoperation: bool, overrides: Iterable[str] = ()) -> list[str]:
+    """The table's figure columns: a run's (_NUMERIC) unless the sweep is of
+    teleoperation runs, then every other number the rows that ran hold, in
+    the order they hold them (a teleoperation case's force errors, packet
+    rates, ...), and wall_s. A figure named as an override (a teleoperation
+    run's loss) is the override's column."""
+    names = [] if teleoperation else list(_NUMERIC)
+    skip = _NOT_FIGURES | set(overrides)
+    for r in rows:
+        if r["status"] != "ok":
+            continue
+        for k, v in r.items():
+            if k not in skip and k not in names and _is_number(v):
+                names.append(k)
+    if "wall_s" not in names:
+        names.append("wall_s")
+    return names
+
+
 class SweepResult:
     """The rows of a sweep, one per case in case order.
 
     rows: list of dicts: case, status ('ok' or 'error'), error (the message),
-    overrides (the case's dict), steps, removed/initial/final_volume_m3
-    (m^3), volume_error_m3, max_sample_error_m (m), peak_contact_m and
-    mean_contact_m (m), step_p50_us (us), wall_s (s), out_dir.
+    overrides (the case's dict), the case's figures and out_dir. A run's
+    figures: steps, removed/initial/final_volume_m3 (m^3), volume_error_m3,
+    max_sample_error_m (m), peak_contact_m and mean_contact_m (m),
+    step_p50_us (us), wall_s (s); a teleoperation case's: terracut.run_mmt's
+    (force errors of MMT and of direct force reflection, N; terrain and
+    tracking errors, m; packet rates, per s; passivity, J; ...) and wall_s.
+    figures: the table's figure columns (default: those the rows hold).
     """
 
-    def __init__(self, rows: list[dict], out_dir: Path, names: list[str]):
+    def __init__(self, rows: list[dict], out_dir: Path, names: list[str],
+                 figures: Optional[list[str]] = None):
         self.rows = rows
         self.out_dir = out_dir
         self.override_names = names
+        if figures is None:
+            figures = _figure_names(rows, any(r["status"] == "ok" and "steps" not in r for r in rows), names)
+        self.figures = list(figures)
 
     @property
     def ok(self) -> list[dict]:
@@ -308,16 +352,17 @@ class SweepResult:
         return [r for r in self.rows if r["status"] != "ok"]
 
     def column(self, name: str) -> np.ndarray:
-        """One figure or override over the cases (NaN where a case failed or lacks it)."""
+        """One figure or override over the cases, one entry per case: float64 when
+        every value is a number (NaN where a case failed or lacks it), else text
+        (a string as it is, anything else, such as [cols, rows], as its JSON)."""
         if name in self.override_names:
             vals = [r["overrides"].get(name) for r in self.rows]
         else:
             vals = [r.get(name) for r in self.rows]
-        try:
-            return np.array([np.nan if v is None else v for v in vals], dtype=float)
-        except (TypeError, ValueError):
-            return np.array(["" if v is None else json.dumps(_plain(v)) if not isinstance(v, str) else v
-                             for v in vals])
+        if all(v is None or _is_number(v) for v in vals):
+            return np.array([np.nan if v is None else float(v) for v in vals], dtype=float)
+        return np.array(["" if v is None else v if isinstance(v, str) else json.dumps(_plain(v))
+                         for v in vals], dtype=str)
 
     def table(self) -> np.ndarray:
         """The rows as a numpy structured array: case, status, error, one field per
@@ -327,9 +372,9 @@ class SweepResult:
         for name in ["status", "error"] + self.override_names:
             col = self.column(name) if name in self.override_names else np.array([r[name] for r in self.rows])
             data[name] = col
-        for name in _NUMERIC:
+        for name in self.figures:
             data[name] = self.column(name)
-        for name in ["status", "error"] + self.override_names + _NUMERIC:
+        for name in ["status", "error"] + self.override_names + self.figures:
             col = data[name]
             fields.append((name, col.dtype if col.dtype.kind != "U" else f"U{max(1, col.dtype.itemsize // 4)}"))
         out = np.empty(len(self.rows), dtype=fields)
@@ -451,6 +496,8 @@ def sweep(scenario: Union[str, os.PathLike, Mapping],
                                      math.nan, specs[i]["out_dir"])
                 finished(i, row)
 
-    result = SweepResult([r for r in rows if r is not None], root, names)
+    done_rows = [r for r in rows if r is not None]
+    teleoperation = "mmt" in mapping or any(n in NETWORK_OVERRIDES for n in names)
+    result = SweepResult(done_rows, root, names, _figure_names(done_rows, teleoperation, names))
     _write_table(result)
     return result

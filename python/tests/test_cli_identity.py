@@ -8,7 +8,7 @@ import subprocess
 import numpy as np
 
 import terracut
-from conftest import small_exp1_dict
+from conftest import SOURCE, small_exp1_dict
 
 FIELDS = ["t", None, "x", "y", "z", "qw", "qx", "qy", "qz", "contact_length", "removed_volume",
           "section_area", "max_depth", "cells_visited"]
@@ -93,3 +93,24 @@ def test_run_errors_name_the_output(tmp_path, exp1):
         assert str(blocker) in str(e)
     else:
         raise AssertionError("a file as the output folder was accepted")
+
+
+def test_the_version_is_the_command_lines(cli):
+    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
+    out = subprocess.run([cli, "--version"], check=True, capture_output=True, text=True, env=env).stdout
+    assert out.split() == ["terracut", terracut.__version__]
+
+
+def test_the_readmes_csv_recipe_reads_the_cut_names_as_text(cli, exp1, tmp_path):
+    # The README's line for reading contact.csv, run as written: the cut
+    # column must compare equal to the cut's name (bytes would never).
+    readme = (SOURCE / "README.md").read_text()
+    recipe = next(line for line in readme.splitlines() if "numpy.genfromtxt(" in line)
+    call = recipe[recipe.index("numpy.genfromtxt("):]
+    call = call[:call.index(")`") + 1].replace("DIR/", str(tmp_path / "cli") + "/")
+    cli_run(cli, exp1, tmp_path / "cli", "--resolution", "20")
+    rows = eval(call, {"numpy": np})
+    assert rows.shape == (2001,)
+    assert (rows["cut"] == "horizontal").all()
+    assert rows["contact_length"].max() > 0.0
+

@@ -35,6 +35,16 @@ def test_a_sweep_over_the_round_trip_shows_direct_reflection_degrade(tmp_path):
     assert slow["force_error_rms_dfr_n"] > 3.0 * fast["force_error_rms_dfr_n"]
     assert slow["force_error_rms_mmt_n"] < slow["force_error_rms_dfr_n"]
     assert (tmp_path / "sweep" / "case_001" / "operator.csv").exists()
+    # The table and sweep.csv hold the teleoperation figures, as the rows do.
+    table = result.table()
+    for name in ("force_error_rms_mmt_n", "force_error_rms_dfr_n", "update_packets_per_s", "wall_s"):
+        assert list(table[name]) == [fast[name], slow[name]], name
+    assert "steps" not in table.dtype.names  # a batch run's figures are not a teleoperation run's
+    lines = (tmp_path / "sweep" / "sweep.csv").read_text().splitlines()
+    head = lines[0].split(",")
+    k = head.index("force_error_rms_dfr_n")
+    assert [float(line.split(",")[k]) for line in lines[1:]] == [fast["force_error_rms_dfr_n"],
+                                                                 slow["force_error_rms_dfr_n"]]
 
 
 def test_a_bad_network_value_is_the_case_error_not_a_crash(tmp_path):

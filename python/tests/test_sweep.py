@@ -113,3 +113,24 @@ def test_dask_local_cluster_gives_the_pools_rows(tmp_path):
             assert a["removed_volume_m3"] == b["removed_volume_m3"]
             assert (tmp_path / "dask" / f"case_{a['case']:03d}" / "height.npy").read_bytes() == \
                 (tmp_path / "local" / f"case_{a['case']:03d}" / "height.npy").read_bytes()
+
+
+def test_list_valued_and_command_line_resolutions_make_a_table(tmp_path):
+    # [cols, rows] and the command line's "COLSxROWS" are the same override;
+    # a list value is one text field of the table, not a broadcast error.
+    result = terracut.sweep(small_exp1_dict(), grid={"resolution": [[12, 8], "12x8", [8, 12], "8x"]},
+                            out_dir=tmp_path / "r", processes=1)
+    assert [r["status"] for r in result.rows] == ["ok", "ok", "ok", "error"], result.failed
+    assert "resolution" in result.rows[3]["error"]
+    table = result.table()
+    assert table.shape == (4,)
+    assert list(table["resolution"]) == ["[12, 8]", "12x8", "[8, 12]", "8x"]
+    # The text form runs exactly the scenario the list form does.
+    a, b = (tmp_path / "r" / f"case_00{i}" for i in (0, 1))
+    assert np.array_equal(np.load(a / "height.npy"), np.load(b / "height.npy"))
+    assert np.load(a / "height.npy").shape == (8, 12)  # (rows, cols)
+    assert np.load(tmp_path / "r" / "case_002" / "height.npy").shape == (12, 8)
+    assert table["removed_volume_m3"][0] == table["removed_volume_m3"][1]
+    lines = (tmp_path / "r" / "sweep.csv").read_text().splitlines()
+    assert len(lines) == 5 and lines[0].startswith("case,status,error,resolution,steps")
+

@@ -8,25 +8,6 @@
 
 namespace terracut {
 
-std::string_view to_string(BodyShape shape) {
-  switch (shape) {
-    case BodyShape::kBox:
-      return "box";
-    case BodyShape::kSphere:
-      return "sphere";
-    case BodyShape::kCylinder:
-      return "cylinder";
-  }
-  return "unknown";
-}
-
-std::optional<BodyShape> parse_body_shape(std::string_view name) {
-  if (name == "box") return BodyShape::kBox;
-  if (name == "sphere") return BodyShape::kSphere;
-  if (name == "cylinder") return BodyShape::kCylinder;
-  return std::nullopt;
-}
-
 namespace {
 
 bool valid_name(const std::string& name) {

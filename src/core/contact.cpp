@@ -28,16 +28,6 @@
 
 namespace terracut {
 
-std::string_view to_string(Representation representation) {
-  return representation == Representation::kColumns ? "columns" : "surface";
-}
-
-std::optional<Representation> parse_representation(std::string_view name) {
-  if (name == "columns") return Representation::kColumns;
-  if (name == "surface") return Representation::kSurface;
-  return std::nullopt;
-}
-
 namespace {
 
 using detail::GridFrame;

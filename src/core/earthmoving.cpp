@@ -73,9 +73,9 @@ struct WedgeConstants {
 
 std::string validate(const EarthmovingParams& params) {
   if (std::string m = validate(params.soil); !m.empty()) return "soil." + m;
-  if (!(std::isfinite(params.rake_angle_deg) && params.rake_angle_deg > 0.0 &&
-        params.rake_angle_deg < 180.0))
-    return must_be("rake_angle_deg", "in (0, 180)", params.rake_angle_deg);
+  if (std::string m = check(find_range(kEarthmovingRanges, "rake_angle_deg"), params.rake_angle_deg);
+      !m.empty())
+    return m;
   // A planar wedge needs a failure-plane angle with D > 0: beta < 180 - alpha
   // - delta - phi. Ask for at least one degree of room.
   const double sum = params.rake_angle_deg + params.soil.soil_tool_friction_deg +

@@ -8,6 +8,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/core/ranges.hpp"
 
 namespace terracut {
 
@@ -75,35 +76,6 @@ double passive_stiffness_limit_n_per_m(double inherent_damping_n_s_per_m,
   return 2.0 * (inherent_damping_n_s_per_m - std::abs(virtual_damping_n_s_per_m)) * rate_hz;
 }
 
-std::string_view to_string(CuttingModel model) {
-  switch (model) {
-    case CuttingModel::kNone:
-      return "none";
-    case CuttingModel::kContactDrag:
-      return "contact_drag";
-    case CuttingModel::kEarthmoving:
-      return "earthmoving";
-  }
-  return "none";
-}
-
-std::optional<CuttingModel> parse_cutting_model(std::string_view name) {
-  if (name == "none") return CuttingModel::kNone;
-  if (name == "contact_drag") return CuttingModel::kContactDrag;
-  if (name == "earthmoving") return CuttingModel::kEarthmoving;
-  return std::nullopt;
-}
-
-std::string_view to_string(LimitPolicy policy) {
-  return policy == LimitPolicy::kRefuse ? "refuse" : "clamp";
-}
-
-std::optional<LimitPolicy> parse_limit_policy(std::string_view name) {
-  if (name == "refuse") return LimitPolicy::kRefuse;
-  if (name == "clamp") return LimitPolicy::kClamp;
-  return std::nullopt;
-}
-
 std::string validate(const ForceModelParams& params) {
   if (auto m = nested("contact_drag", validate(params.contact_drag)); !m.empty()) return m;
   if (auto m = nested("surface", validate(params.surface)); !m.empty()) return m;
@@ -114,10 +86,7 @@ std::string validate(const ForceModelParams& params) {
   if (auto m = check_positive("workspace_scale", params.workspace_scale); !m.empty()) return m;
   if (auto m = check_positive("max_contact_length_m", params.max_contact_length_m); !m.empty())
     return m;
-  if (!(std::isfinite(params.loop_rate_hz) && params.loop_rate_hz > 0.0 &&
-        params.loop_rate_hz <= 1e6)) {
-    return must_be("loop_rate_hz", "in (0, 1e6]", params.loop_rate_hz);
-  }
+  if (std::string e = check(kRateRange, params.loop_rate_hz, "loop_rate_hz"); !e.empty()) return e;
   return nested("device", validate(params.device));
 }
 

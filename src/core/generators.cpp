@@ -9,25 +9,6 @@
 
 namespace terracut {
 
-std::string_view to_string(GeneratorKind kind) {
-  switch (kind) {
-    case GeneratorKind::kMound:
-      return "mound";
-    case GeneratorKind::kBox:
-      return "box";
-    case GeneratorKind::kPlane:
-      return "plane";
-  }
-  return "unknown";
-}
-
-std::optional<GeneratorKind> parse_generator_kind(std::string_view name) {
-  if (name == "mound") return GeneratorKind::kMound;
-  if (name == "box") return GeneratorKind::kBox;
-  if (name == "plane") return GeneratorKind::kPlane;
-  return std::nullopt;
-}
-
 Generator default_generator(GeneratorKind kind, const GridSpec& spec) {
   Generator g;
   g.kind = kind;

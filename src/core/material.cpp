@@ -20,17 +20,6 @@ constexpr Range kRanges[] = {
     {"repose_deg", 1.0, 80.0, RangeEnds::kClosed},
 };
 
-struct PresetName {
-  SoilPreset preset;
-  std::string_view name;
-};
-constexpr std::array<PresetName, 4> kPresetNames{{{SoilPreset::kDrySand, "dry_sand"},
-                                                   {SoilPreset::kLooseSand, "loose_sand"},
-                                                   {SoilPreset::kClay, "clay"},
-                                                   {SoilPreset::kGravel, "gravel"}}};
-constexpr std::array<SoilPreset, 4> kPresets{SoilPreset::kDrySand, SoilPreset::kLooseSand,
-                                             SoilPreset::kClay, SoilPreset::kGravel};
-
 }  // namespace
 
 SoilMaterial soil_preset(SoilPreset preset) {
@@ -80,20 +69,6 @@ SoilMaterial soil_preset(SoilPreset preset) {
   m.soil_tool_friction_deg = m.internal_friction_deg * 2.0 / 3.0;
   return m;
 }
-
-std::string_view to_string(SoilPreset preset) {
-  for (const PresetName& p : kPresetNames)
-    if (p.preset == preset) return p.name;
-  return "dry_sand";
-}
-
-std::optional<SoilPreset> parse_soil_preset(std::string_view name) {
-  for (const PresetName& p : kPresetNames)
-    if (p.name == name) return p.preset;
-  return std::nullopt;
-}
-
-std::span<const SoilPreset> soil_presets() { return kPresets; }
 
 std::span<const Range> material_ranges() { return kRanges; }
 

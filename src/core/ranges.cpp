@@ -2,7 +2,6 @@
 #include "terracut/core/ranges.hpp"
 
 #include <cmath>
-#include <stdexcept>
 
 #include "terracut/core/format.hpp"
 
@@ -40,12 +39,6 @@ std::string check(const Range& r, double v, std::string_view field) {
   else
     what = "in " + range_text(r.lo, r.hi, r.ends);
   return must_be(name, what, v);
-}
-
-const Range& find_range(std::span<const Range> table, std::string_view path) {
-  for (const Range& r : table)
-    if (r.path == path) return r;
-  throw std::logic_error("no range declared for '" + std::string(path) + "'");
 }
 
 }  // namespace terracut

@@ -8,6 +8,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/core/ranges.hpp"
 #include "terracut/core/soil_ahead.hpp"
 
 namespace terracut {
@@ -44,23 +45,23 @@ Segment reach_back(const Segment& from, const Segment& to, double back) {
 
 std::string validate(const SimParams& params) {
   if (std::string e = validate(params.grid); !e.empty()) return e;
-  if (!(std::isfinite(params.rate_hz) && params.rate_hz > 0.0 && params.rate_hz <= 1e6))
-    return must_be("rate_hz", "in (0, 1e6]", params.rate_hz);
-  if (!(std::isfinite(params.blade.length_m) && params.blade.length_m > 0.0))
-    return must_be("blade.length_m", "finite and > 0", params.blade.length_m);
-  if (!(params.max_arc_error_cells > 0.0 && params.max_arc_error_cells <= 1.0))
-    return must_be("max_arc_error_cells", "in (0, 1]", params.max_arc_error_cells);
+  const auto check_field = [](std::string_view path, double value) {
+    return check(find_range(kSimParamsRanges, path), value);
+  };
+  if (std::string e = check_field("rate_hz", params.rate_hz); !e.empty()) return e;
+  if (std::string e = check_field("blade.length_m", params.blade.length_m); !e.empty()) return e;
+  if (std::string e = check_field("max_arc_error_cells", params.max_arc_error_cells); !e.empty())
+    return e;
   const BucketSpec& bucket = params.blade.bucket;
-  if (!(std::isfinite(bucket.depth_m) && bucket.depth_m >= 0.0))
-    return must_be("blade.bucket.depth_m", "finite and >= 0", bucket.depth_m);
+  if (std::string e = check_field("blade.bucket.depth_m", bucket.depth_m); !e.empty()) return e;
   if (bucket.enabled()) {
-    if (!(std::isfinite(bucket.height_m) && bucket.height_m > 0.0))
-      return must_be("blade.bucket.height_m", "finite and > 0", bucket.height_m);
+    if (std::string e = check_field("blade.bucket.height_m", bucket.height_m); !e.empty()) return e;
     if (params.soil.model != SoilModel::kFlow)
       return "blade.bucket: a bucket carries soil, so it needs soil model flow (soil: {model: flow})";
   }
-  if (!(std::isfinite(params.blade.edge_thickness_m) && params.blade.edge_thickness_m > 0.0))
-    return must_be("blade.edge_thickness_m", "finite and > 0", params.blade.edge_thickness_m);
+  if (std::string e = check_field("blade.edge_thickness_m", params.blade.edge_thickness_m);
+      !e.empty())
+    return e;
   if (params.representation != Representation::kColumns &&
       params.representation != Representation::kSurface)
     return "representation must be columns or surface";
@@ -215,7 +216,9 @@ const StepOutput& Simulation::finish_step() {
   // The listeners see the finished step (its cut and changed rectangle) and
   // may push on the tool.
   Vec3 listener_force{};
+  in_listener_ = true;
   for (StepListener* listener : listeners_) listener_force = listener_force + listener->on_step(out_);
+  in_listener_ = false;
   out_.listener_force_world_n = listener_force;
   out_.force.bodies_n = listener_force;
   out_.force.total_n = out_.force.total_n + listener_force;
@@ -224,6 +227,20 @@ const StepOutput& Simulation::finish_step() {
   out_.timers.listeners_s = end - force_end;
   out_.timers.total_s = end - begin_clock_s_;
   return out_;
+}
+
+float Simulation::lower_sample(std::int64_t i, float height_m) {
+  if (!in_listener_)
+    throw std::logic_error("Simulation::lower_sample: only from a listener's on_step or on_edit");
+  return grid_.lower(i, height_m);
+}
+
+void Simulation::move_height(std::int64_t from, std::int64_t to, float amount_m) {
+  if (!in_listener_)
+    throw std::logic_error("Simulation::move_height: only from a listener's on_step or on_edit");
+  float* h = grid_.edit_layers().height_m;
+  h[from] -= amount_m;
+  h[to] += amount_m;
 }
 
 void Simulation::include_changed(const Rect& rect) {
@@ -270,6 +287,14 @@ void Simulation::reset() {
   step_count_ = 0;
   removed_volume_m3_ = 0.0;
   out_ = {};
+  // Whoever caches heights (the Bullet world) hears of the whole grid.
+  tell_edited({0, 0, grid_.cols(), grid_.rows()});
+}
+
+void Simulation::tell_edited(const Rect& changed) {
+  in_listener_ = true;
+  for (StepListener* listener : listeners_) listener->on_edit(changed);
+  in_listener_ = false;
 }
 
 Rect Simulation::edit_heights(const Rect& rect, std::span<const float> values_m) {
@@ -297,7 +322,7 @@ Rect Simulation::edit_heights(const Rect& rect, std::span<const float> values_m)
   }
   const Rect changed = grid_.set_heights(rect, values_m.data());
   if (soil_) soil_->wake(changed);
-  for (StepListener* listener : listeners_) listener->on_edit(changed);
+  tell_edited(changed);
   return changed;
 }
 

@@ -18,18 +18,6 @@ namespace terracut {
 
 using namespace soil_internal;
 
-std::string_view to_string(SoilModel model) {
-  return model == SoilModel::kFlow ? "flow" : "vanish";
-}
-
-std::string_view to_string(SoilEdge edge) { return edge == SoilEdge::kOpen ? "open" : "wall"; }
-
-std::optional<SoilModel> parse_soil_model(std::string_view name) {
-  if (name == "vanish") return SoilModel::kVanish;
-  if (name == "flow") return SoilModel::kFlow;
-  return std::nullopt;
-}
-
 std::string validate(const SoilFlowParams& p) {
   if (p.model != SoilModel::kVanish && p.model != SoilModel::kFlow)
     return "soil.model must be vanish or flow";
@@ -38,9 +26,10 @@ std::string validate(const SoilFlowParams& p) {
   // material is a liquid, out of the model's reach (a repose of 1e-300
   // degrees made the tolerance 0, and float noise kept the cells moving).
   if (std::string m = validate(p.material); !m.empty()) return "soil." + m;
-  if (!(p.max_pair_checks_per_step >= 1000 && p.max_pair_checks_per_step <= 1000000000))
-    return must_be("soil.max_pair_checks_per_step", "in [1000, 1e9]",
-                   p.max_pair_checks_per_step);
+  if (std::string m = check(find_range(kSoilFlowRanges, "max_pair_checks_per_step"),
+                             double(p.max_pair_checks_per_step), "soil.max_pair_checks_per_step");
+      !m.empty())
+    return m;
   return {};
 }
 

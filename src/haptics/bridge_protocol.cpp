@@ -73,32 +73,6 @@ std::size_t encode_force(const PacketHeader& header, const ForcePayload& force,
   return finish_packet(header, PacketType::kForce, kForcePayloadSize, out);
 }
 
-std::string_view to_string(Reject reason) {
-  switch (reason) {
-    case Reject::kNone:
-      return "none";
-    case Reject::kTruncated:
-      return "truncated";
-    case Reject::kBadLength:
-      return "bad_length";
-    case Reject::kBadMagic:
-      return "bad_magic";
-    case Reject::kBadVersion:
-      return "bad_version";
-    case Reject::kBadChecksum:
-      return "bad_checksum";
-    case Reject::kBadType:
-      return "bad_type";
-    case Reject::kDuplicate:
-      return "duplicate";
-    case Reject::kReordered:
-      return "reordered";
-    case Reject::kStale:
-      return "stale";
-  }
-  return "unknown";
-}
-
 Reject decode_pose(const std::uint8_t* data, std::size_t size, PacketHeader& header,
                    PosePayload& pose) noexcept {
   const Reject r = check_format(data, size, PacketType::kPose, kPosePayloadSize, header);

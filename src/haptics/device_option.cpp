@@ -36,7 +36,7 @@ void parse_endpoint(std::string_view text, std::string_view option,
 DeviceOption parse_device_option(std::string_view text) {
   DeviceOption d;
   const std::string_view head = text.substr(0, text.find(':'));
-  const std::optional<DeviceKind> kind = parse_device_kind(head);
+  const std::optional<DeviceKind> kind = parse_enum<DeviceKind>(head);
   if (!kind)
     throw InputError("--device: unknown device '" + std::string(text) +
                      "'; allowed: script, sim, udp, udp:PORT, udp:ADDR:PORT");

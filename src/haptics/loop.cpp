@@ -16,9 +16,16 @@
 namespace terracut::haptics {
 namespace {
 
-HapticSettings validated(HapticSettings settings, const BladeSpec& blade) {
+// The settings checked alone, then against the loop's rate.
+HapticSettings validated(HapticSettings settings, const BladeSpec& blade, double rate_hz) {
+  if (std::string m = check(kLoopRateRange, rate_hz); !m.empty())
+    throw InputError(m + " (a haptic loop's rate)");
   if (std::string m = validate(settings); !m.empty()) throw InputError("haptics." + m);
-  return with_derived_fields(std::move(settings), blade.length_m);
+  if (!(settings.velocity_cutoff_hz < rate_hz / 2.0))
+    throw InputError(must_be("haptics.velocity_cutoff_hz",
+                             "below rate_hz / 2 = " + format_number(rate_hz / 2.0),
+                             settings.velocity_cutoff_hz));
+  return with_derived_fields(std::move(settings), blade.length_m, rate_hz);
 }
 
 ForceModel built_model(const ForceModelParams& params) {
@@ -31,8 +38,8 @@ ForceModel built_model(const ForceModelParams& params) {
 
 }  // namespace
 
-LoopParams::LoopParams(const HapticSettings& settings, const BladeSpec& blade)
-    : settings_(validated(settings, blade)), model_(built_model(settings_.forces)) {}
+LoopParams::LoopParams(const HapticSettings& settings, const BladeSpec& blade, double rate_hz)
+    : settings_(validated(settings, blade, rate_hz)), model_(built_model(settings_.forces)) {}
 
 HapticLoop::HapticLoop(const LoopParams& params, Simulation& sim, Quat default_orientation,
                        Device& device, const LoopOptions& options)
@@ -50,7 +57,7 @@ HapticLoop::HapticLoop(const LoopParams& params, Simulation& sim, Quat default_o
                              options_.end_after_silence_s));
   if (sim_.params().rate_hz != params_.rate_hz())
     throw InputError("haptics: the simulation steps at " + format_number(sim_.params().rate_hz) +
-                     " Hz, the loop runs at haptics.rate_hz " + format_number(params_.rate_hz()) +
+                     " Hz, the loop runs at " + format_number(params_.rate_hz()) +
                      " Hz: build the simulation at the loop's rate");
   if (settings.tool_rotation_deg) {
     fixed_orientation_ = quat_from_euler_deg(*settings.tool_rotation_deg);
@@ -430,10 +437,23 @@ void HapticLoop::thread_main(std::promise<void>& ready) {
         options_.clock ? options_.clock : steady_pacer_clock();
     Pacer pacer(ps, clock);
     Tick tick = pacer.start();
-    const double origin = tick.start_s;
+    double origin = tick.start_s;
     for (std::int64_t i = 0; i < options_.ticks; ++i) {
       if (stop_requested_.load(std::memory_order_relaxed)) break;
-      if (i > 0) tick = pacer.wait_next();
+      if (i > 0 && device_.paused()) {
+        // Held while the device is paused (the viewer's Pause): no ticks,
+        // a short sleep at a time to see Play or a stop. The loop's time
+        // leaves the pause out: the next tick is one period after the last.
+        const double last_start = tick.start_s;
+        pacer.hold();
+        while (device_.paused() && !stop_requested_.load(std::memory_order_relaxed))
+          clock->sleep_until(clock->now_s() + kPausePoll_s);
+        if (stop_requested_.load(std::memory_order_relaxed)) break;
+        tick = pacer.resume();
+        origin += tick.start_s - last_start - tick.period_s;
+      } else if (i > 0) {
+        tick = pacer.wait_next();
+      }
       paced_tick(pacer, *clock, tick, origin, false);
     }
     pacer_stats_ = pacer.stats();

@@ -16,6 +16,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
+#include "terracut/core/ranges.hpp"
 
 namespace terracut::haptics {
 
@@ -68,8 +69,7 @@ std::shared_ptr<PacerClock> steady_pacer_clock() {
 }
 
 std::string validate(const PacerSettings& settings) {
-  if (!(std::isfinite(settings.rate_hz) && settings.rate_hz > 0.0 && settings.rate_hz <= 1e6))
-    return must_be("pacer.rate_hz", "in (0, 1e6]", settings.rate_hz);
+  if (std::string e = check(kRateRange, settings.rate_hz, "pacer.rate_hz"); !e.empty()) return e;
   if (!(std::isfinite(settings.spin_s) && settings.spin_s >= 0.0 &&
         settings.spin_s <= 1.0 / settings.rate_hz))
     return must_be("pacer.spin_s",
@@ -167,13 +167,37 @@ Tick Pacer::start() {
 
 void Pacer::record_compute(double compute_s) { recorded_compute_s_ = compute_s >= 0.0 ? compute_s : 0.0; }
 
-Tick Pacer::wait_next() {
-  if (!started_) return start();
-  // End the current tick.
-  double end = clock_->now_s();
+double Pacer::end_tick() {
+  const double end = clock_->now_s();
   compute_.record(recorded_compute_s_ >= 0.0 ? recorded_compute_s_ : end - tick_.start_s);
   recorded_compute_s_ = -1.0;
   ++ticks_;
+  return end;
+}
+
+void Pacer::hold() {
+  if (!started_ || held_) return;
+  end_tick();
+  held_ = true;
+}
+
+Tick Pacer::resume() {
+  if (!started_) return start();
+  if (!held_) end_tick();
+  held_ = false;
+  // The next slot starts now: the grid moves so that its deadline is the
+  // present time (and the slots of the pause are neither run nor skipped).
+  const double now = clock_->now_s();
+  const std::int64_t slot = tick_.slot + 1;
+  origin_s_ = now - double(slot) * period_s_;
+  tick_ = Tick{tick_.index + 1, slot, now, now, period_s_, false};
+  return tick_;
+}
+
+Tick Pacer::wait_next() {
+  if (!started_) return start();
+  // End the current tick.
+  double end = end_tick();
 
   std::int64_t slot = tick_.slot + 1;
   double deadline = origin_s_ + double(slot) * period_s_;

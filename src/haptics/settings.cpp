@@ -7,42 +7,12 @@
 
 namespace terracut::haptics {
 
-std::string_view to_string(DeviceKind kind) {
-  switch (kind) {
-    case DeviceKind::kScript:
-      return "script";
-    case DeviceKind::kSim:
-      return "sim";
-    case DeviceKind::kUdp:
-      return "udp";
-  }
-  return "unknown";
-}
-
-std::optional<DeviceKind> parse_device_kind(std::string_view name) {
-  if (name == "script") return DeviceKind::kScript;
-  if (name == "sim") return DeviceKind::kSim;
-  if (name == "udp") return DeviceKind::kUdp;
-  return std::nullopt;
-}
-
-std::string_view to_string(SurfaceReference reference) {
-  return reference == SurfaceReference::kGround ? "ground" : "terrain";
-}
-
-std::optional<SurfaceReference> parse_surface_reference(std::string_view name) {
-  if (name == "ground") return SurfaceReference::kGround;
-  if (name == "terrain") return SurfaceReference::kTerrain;
-  return std::nullopt;
-}
-
 namespace {
 
 // The ranges of HapticSettings' own numbers (forces and safety have theirs,
 // core/forces.hpp and core/safety.hpp). velocity_cutoff_hz must also be
-// below rate_hz / 2, a check across fields.
+// below the loop's rate / 2, which LoopParams checks.
 constexpr Range kRanges[] = {
-    {"rate_hz", 10.0, 10000.0, RangeEnds::kClosed},
     {"duration_s", 0.0, 86400.0, RangeEnds::kOpenLow},
     {"settle_s", 0.0, 3600.0, RangeEnds::kClosed},
     {"workspace.scale", 0.0, kRangeMax, RangeEnds::kOpenLow},
@@ -63,7 +33,6 @@ std::string check(std::string_view field, double value) {
 
 std::string validate(const HapticSettings& s) {
   std::string m;
-  if (!(m = check("rate_hz", s.rate_hz)).empty()) return m;
   if (s.device != DeviceKind::kScript && s.device != DeviceKind::kSim &&
       s.device != DeviceKind::kUdp)
     return "device must be script, sim or udp";
@@ -75,9 +44,6 @@ std::string validate(const HapticSettings& s) {
   if (s.tool_rotation_deg && !is_finite(*s.tool_rotation_deg))
     return "tool.rotation_deg must be finite";
   if (!(m = check("velocity_cutoff_hz", s.velocity_cutoff_hz)).empty()) return m;
-  if (!(s.velocity_cutoff_hz < s.rate_hz / 2.0))
-    return must_be("velocity_cutoff_hz", "below rate_hz / 2 = " + format_number(s.rate_hz / 2.0),
-                   s.velocity_cutoff_hz);
   if (s.surface_reference != SurfaceReference::kGround &&
       s.surface_reference != SurfaceReference::kTerrain)
     return "surface_reference must be ground or terrain";
@@ -100,9 +66,10 @@ std::string validate(const HapticSettings& s) {
 
 std::span<const Range> haptic_settings_ranges() { return kRanges; }
 
-HapticSettings with_derived_fields(HapticSettings settings, double blade_length_m) {
+HapticSettings with_derived_fields(HapticSettings settings, double blade_length_m,
+                                   double rate_hz) {
   settings.forces.workspace_scale = settings.workspace.scale;
-  settings.forces.loop_rate_hz = settings.rate_hz;
+  settings.forces.loop_rate_hz = rate_hz;
   settings.forces.max_contact_length_m = blade_length_m;
   return settings;
 }

@@ -15,11 +15,12 @@ namespace yaml = io::yaml;
 namespace {
 
 // A key of the old layout, where a field that moved is named: its new home.
-void moved(const yaml::Map& map, std::string_view key, std::string_view to) {
+void moved(const yaml::Map& map, std::string_view key, std::string_view to,
+           std::string_view why = "the soil's material and the blade's shape are written once, "
+                                  "for every force and program") {
   if (const auto f = map.get(key))
-    f->fail("moved to " + std::string(to) +
-            " (the soil's material and the blade's shape are written once, for every force and "
-            "program: docs/scenario-format.md)");
+    f->fail("moved to " + std::string(to) + " (" + std::string(why) +
+            ": docs/scenario-format.md)");
 }
 
 void parse_forces(const yaml::Map& f, ForceModelParams& p) {
@@ -74,7 +75,9 @@ HapticSettings parse_haptics(const YAML::Node& node, const std::string& file) {
              "velocity_cutoff_hz", "surface_reference", "cut_depth", "forces", "safety", "hand",
              "udp"});
 
-  top.read_number("rate_hz", s.rate_hz);
+  moved(top, "rate_hz", "the top-level rate_hz",
+        "one rate for the simulation and its haptic loop; `terracut haptics --rate` overrides it "
+        "for a session");
   if (const auto f = top.get("device"))
     s.device = f->choice({DeviceKind::kScript, DeviceKind::kSim, DeviceKind::kUdp});
   top.read_text("cut", s.cut);

@@ -2,6 +2,7 @@
 #include "terracut/io/recording.hpp"
 
 #include <cerrno>
+#include <charconv>
 #include <cstring>
 
 #include "terracut/core/error.hpp"
@@ -15,11 +16,34 @@ namespace {
 
 }  // namespace
 
-CsvFile::CsvFile(std::filesystem::path path, const std::string& header) : path_(std::move(path)) {
+std::string_view CsvFile::Cell::print(char* out) const noexcept {
+  char* const end = out + kMaxNumberChars;
+  std::to_chars_result r{out, std::errc()};
+  switch (kind_) {
+    case Kind::kText:
+      return text_;
+    case Kind::kNumber:  // as printf's %.9g
+      r = std::to_chars(out, end, number_, std::chars_format::general, 9);
+      break;
+    case Kind::kWhole:
+      r = std::to_chars(out, end, whole_);
+      break;
+    case Kind::kExactDouble:
+      r = std::to_chars(out, end, number_);
+      break;
+    case Kind::kExactFloat:
+      r = std::to_chars(out, end, float(number_));
+      break;
+  }
+  return {out, std::size_t(r.ptr - out)};
+}
+
+CsvFile::CsvFile(std::filesystem::path path, std::string_view header) : path_(std::move(path)) {
   file_ = std::fopen(path_.c_str(), "wb");
   if (!file_) fail_file(path_, std::string("cannot create: ") + std::strerror(errno));
   std::setvbuf(file_, nullptr, _IOFBF, 1 << 20);
-  if (std::fputs(header.c_str(), file_) < 0 || std::fputc('\n', file_) == EOF)
+  if (std::fwrite(header.data(), 1, header.size(), file_) != header.size() ||
+      std::fputc('\n', file_) == EOF)
     fail_file(path_, std::string("write failed: ") + std::strerror(errno));
 }
 
@@ -27,19 +51,29 @@ CsvFile::~CsvFile() {
   if (file_) std::fclose(file_);
 }
 
-void CsvFile::row(std::initializer_list<Cell> cells) {
+bool CsvFile::put_row(std::span<const Cell> cells) noexcept {
+  if (!file_) return false;
+  char number[Cell::kMaxNumberChars];
   bool first = true;
-  int bad = 0;
+  bool bad = false;
   for (const Cell& c : cells) {
     if (!first) bad |= std::fputc(',', file_) == EOF;
     first = false;
-    if (c.text)
-      bad |= std::fputs(c.text->c_str(), file_) < 0;
-    else
-      bad |= std::fprintf(file_, "%.9g", c.number) < 0;
+    const std::string_view text = c.print(number);
+    bad |= std::fwrite(text.data(), 1, text.size(), file_) != text.size();
   }
   bad |= std::fputc('\n', file_) == EOF;
-  if (bad) fail_file(path_, std::string("write failed: ") + std::strerror(errno));
+  return !bad;
+}
+
+void CsvFile::row(std::span<const Cell> cells) {
+  if (!put_row(cells)) fail_file(path_, std::string("write failed: ") + std::strerror(errno));
+}
+
+bool CsvFile::try_row(std::initializer_list<Cell> cells) noexcept {
+  if (put_row(std::span(cells.begin(), cells.size()))) return true;
+  if (failed_errno_ == 0) failed_errno_ = errno != 0 ? errno : EIO;
+  return false;
 }
 
 void CsvFile::close() {
@@ -47,6 +81,8 @@ void CsvFile::close() {
   const bool bad = std::ferror(file_) != 0;
   const int rc = std::fclose(file_);
   file_ = nullptr;
+  if (failed_errno_ != 0)
+    fail_file(path_, std::string("write failed: ") + std::strerror(failed_errno_));
   if (bad || rc != 0) fail_file(path_, std::string("write failed: ") + std::strerror(errno));
 }
 

@@ -16,6 +16,7 @@
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
 #include "terracut/io/scenario_ranges.hpp"
+#include "terracut/io/soil_yaml.hpp"
 #include "terracut/io/yaml_reader.hpp"
 
 namespace terracut::io {
@@ -48,13 +49,16 @@ using Ends = yaml::Field::Ends;
 constexpr double kMax = yaml::kMaxMagnitude;
 
 // Every number of the file with a range of its own (scenario_ranges.hpp).
+// The simulation's and the soil's are their structs' entries
+// (kSimParamsRanges, kSoilFlowRanges), read here through the same entry.
 constexpr yaml::Range kRanges[] = {
-    {"rate_hz", 0.0, 1e6, Ends::kOpenLow},
-    {"blade.length_m", 0.0, kMax, Ends::kOpenLow},
-    {"blade.rake_angle_deg", 0.0, 180.0, Ends::kOpen},
-    {"blade.edge_thickness_m", 0.0, kMax, Ends::kOpenLow},
+    find_range(kSimParamsRanges, "rate_hz"),
+    find_range(kSimParamsRanges, "blade.length_m"),
+    find_range(kSimParamsRanges, "blade.rake_angle_deg"),
+    find_range(kSimParamsRanges, "blade.edge_thickness_m"),
+    // The file's own: a bucket: section is a bucket (the struct's depth 0 is none).
     {"blade.bucket.depth_m", 0.0, kMax, Ends::kOpenLow},
-    {"blade.bucket.height_m", 0.0, kMax, Ends::kOpenLow},
+    find_range(kSimParamsRanges, "blade.bucket.height_m"),
     {"terrain.size_m[0]", 0.0, kMax, Ends::kOpenLow},
     {"terrain.size_m[1]", 0.0, kMax, Ends::kOpenLow},
     {"terrain.full_scale_m", 0.0, kMax, Ends::kOpenLow},
@@ -63,7 +67,7 @@ constexpr yaml::Range kRanges[] = {
     {"terrain.mound.radius_m", 0.0, kMax, Ends::kOpenLow},
     {"terrain.plane.height_m", 0.0, kMax, Ends::kClosed},
     {"cuts[].keyframes[].t_s", 0.0, kMax, Ends::kClosed},
-    {"soil.max_pair_checks_per_step", 1000, 1e9, Ends::kClosed, true},
+    at_path(find_range(kSoilFlowRanges, "max_pair_checks_per_step"), "soil.max_pair_checks_per_step"),
     {"reference.mound.radius_m", 0.0, kMax, Ends::kOpenLow},
     {"reference.mound.height_m", 0.0, kMax, Ends::kOpenLow},
 };
@@ -106,30 +110,6 @@ void read_xz(const Map& map, std::string_view key, double& x_m, double& z_m) {
     x_m = v[0];
     z_m = v[1];
   }
-}
-
-// The soil's material: a preset's values (dry sand's without one), each
-// replaced by a field given; density or unit weight, not both.
-void read_material(const Map& soil, SoilMaterial& m) {
-  if (const auto p = soil.get("preset"))
-    m = soil_preset(p->choice({SoilPreset::kDrySand, SoilPreset::kLooseSand, SoilPreset::kClay,
-                               SoilPreset::kGravel},
-                              "soil preset"));
-  const auto in = [&](std::string_view key, double& out) {
-    if (const auto f = soil.get(key)) out = f->in(find_range(material_ranges(), key));
-  };
-  in("unit_weight_n_per_m3", m.unit_weight_n_per_m3);
-  if (const auto f = soil.get("density_kg_per_m3")) {
-    if (soil.get("unit_weight_n_per_m3"))
-      f->fail("give the density or the unit weight (= density x 9.81), not both");
-    m.unit_weight_n_per_m3 =
-        f->in(find_range(material_ranges(), "density_kg_per_m3")) * kStandardGravity_m_per_s2;
-  }
-  in("internal_friction_deg", m.internal_friction_deg);
-  in("cohesion_pa", m.cohesion_pa);
-  in("soil_tool_friction_deg", m.soil_tool_friction_deg);
-  in("adhesion_pa", m.adhesion_pa);
-  in("repose_deg", m.repose_deg);
 }
 
 bool valid_cut_name(const std::string& name) {
@@ -619,12 +599,12 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
   // its values) and what happens to the cut soil (soil.hpp): vanish, or flow
   // to the repose angle.
   if (const auto f = top.get("soil")) {
-    const Map soil(*f, {"model", "preset", "unit_weight_n_per_m3", "density_kg_per_m3",
-                        "internal_friction_deg", "cohesion_pa", "soil_tool_friction_deg", "adhesion_pa",
-                        "repose_deg", "max_pair_checks_per_step", "edge"});
+    std::vector<std::string_view> keys = soil_material_keys();
+    keys.insert(keys.end(), {"model", "max_pair_checks_per_step", "edge"});
+    const Map soil(*f, keys);
     if (const auto m = soil.get("model"))
       sc.soil.model = m->choice({SoilModel::kVanish, SoilModel::kFlow}, "soil model");
-    read_material(soil, sc.soil.material);
+    read_soil_material(soil, sc.soil.material);
     if (const auto w = soil.get("max_pair_checks_per_step"))
       sc.soil.max_pair_checks_per_step =
           static_cast<std::int64_t>(w->in(range("soil.max_pair_checks_per_step")));

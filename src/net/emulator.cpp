@@ -46,10 +46,17 @@ std::string validate(const LinkConditions& c) {
 
 std::span<const Range> link_ranges() { return kRanges; }
 
+double retransmit_timeout_s(const LinkConditions& c, double round_trip_s) {
+  return c.retransmit_s.value_or(round_trip_s + kRetransmitMargin_s);
+}
+
 LinkEmulator::LinkEmulator(const LinkConditions& conditions)
-    : c_(conditions), rng_(conditions.seed) {
+    : c_(conditions), round_trip_s_(emulated_round_trip_s(conditions)), rng_(conditions.seed) {
   if (const std::string problem = validate(c_); !problem.empty()) throw InputError(problem);
-  retransmit_s_ = c_.retransmit_s.value_or(2.0 * c_.delay_s + 0.02);
+}
+
+void LinkEmulator::set_round_trip_s(double round_trip_s) noexcept {
+  if (std::isfinite(round_trip_s) && round_trip_s >= 0.0) round_trip_s_ = round_trip_s;
 }
 
 double LinkEmulator::uniform() noexcept {
@@ -77,7 +84,7 @@ std::optional<double> LinkEmulator::schedule(double now_s, bool reliable) noexce
     int tries = 0;
     for (; tries < 50 && lose(); ++tries) {
       ++counters_.retransmits;
-      extra_s += retransmit_s_;
+      extra_s += retransmit_s();
     }
     counters_.max_retransmits = std::max(counters_.max_retransmits, tries);
   } else if (lose()) {

@@ -58,24 +58,6 @@ std::size_t payload_size(const std::uint8_t* data) { return get_u32(data + 32); 
 
 }  // namespace
 
-std::string_view to_string(Reject reason) {
-  switch (reason) {
-    case Reject::kNone: return "none";
-    case Reject::kTruncated: return "truncated";
-    case Reject::kBadLength: return "bad_length";
-    case Reject::kBadMagic: return "bad_magic";
-    case Reject::kBadVersion: return "bad_version";
-    case Reject::kBadChecksum: return "bad_checksum";
-    case Reject::kBadType: return "bad_type";
-    case Reject::kForeign: return "foreign";
-    case Reject::kBadPayload: return "bad_payload";
-    case Reject::kDuplicate: return "duplicate";
-    case Reject::kReordered: return "reordered";
-    case Reject::kStale: return "stale";
-  }
-  return "unknown";
-}
-
 Reject to_reject(wire::Order order) {
   switch (order) {
     case wire::Order::kAccepted: return Reject::kNone;
@@ -97,7 +79,7 @@ std::size_t encode_command(Header header, const Command& c, std::uint8_t* out) n
   put_f64(p + 0, c.t_s);
   put_pose(p + 8, c.pose);
   put_u32(p + 64, c.flags);
-  put_u32(p + 68, 0);
+  put_u32(p + 68, c.round_trip_us);
   return finish(header, MessageType::kCommand, kCommandPayloadSize, out);
 }
 
@@ -110,6 +92,8 @@ std::size_t encode_measurement(Header header, const Measurement& m, std::uint8_t
   wire::put_vec3(p + 72, m.force_world_n);
   put_f64(p + 96, m.contact_length_m);
   put_f64(p + 104, m.cut_depth_m);
+  put_u32(p + 112, m.commands_received);
+  put_u32(p + 116, 0);
   return finish(header, MessageType::kMeasurement, kMeasurementPayloadSize, out);
 }
 
@@ -211,6 +195,7 @@ Reject decode_command(const std::uint8_t* data, std::size_t, Command& out) noexc
   out.t_s = get_f64(p + 0);
   out.pose = get_pose(p + 8);
   out.flags = get_u32(p + 64);
+  out.round_trip_us = get_u32(p + 68);
   if (!std::isfinite(out.t_s) || !finite_pose(out.pose)) return Reject::kBadPayload;
   return Reject::kNone;
 }
@@ -225,6 +210,7 @@ Reject decode_measurement(const std::uint8_t* data, std::size_t, Measurement& ou
   out.force_world_n = wire::get_vec3(p + 72);
   out.contact_length_m = get_f64(p + 96);
   out.cut_depth_m = get_f64(p + 104);
+  out.commands_received = get_u32(p + 112);
   if (!std::isfinite(out.t_s) || !finite_pose(out.pose) || !is_finite(out.force_world_n) ||
       !std::isfinite(out.contact_length_m) || !std::isfinite(out.cut_depth_m))
     return Reject::kBadPayload;

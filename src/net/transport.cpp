@@ -1,7 +1,6 @@
-// The in-memory link (transport.hpp): each side's emulator stamps what it
-// sends with its arrival time and puts it in the other side's held queue,
-// which hands datagrams out in arrival order (ties in sending order). Also
-// the pooled buffers both carriers use (Inbox, HeldQueue).
+// The in-memory link (transport.hpp): what a side sends waits in the other
+// side's queue, in sending order, until that side receives. Also the pooled
+// buffers the carriers and the emulator use (Inbox, HeldQueue).
 #include "terracut/net/transport.hpp"
 
 #include <algorithm>
@@ -86,18 +85,15 @@ void Endpoint::receive(double now_s, std::vector<std::vector<std::uint8_t>>& out
 
 class MemoryLink::Side final : public Endpoint {
  public:
-  explicit Side(const LinkConditions& c) : emulator_(c) {}
-
-  void send(Channel channel, const std::uint8_t* data, std::size_t size, double now_s) override {
+  void send(Channel, const std::uint8_t* data, std::size_t size, double) override {
     ++traffic_.sent;
     traffic_.sent_bytes += std::int64_t(size);
-    const auto arrive = emulator_.schedule(now_s, channel == Channel::kReliable);
-    if (!arrive) return;
-    peer_->inbox_.hold(*arrive, 0, data, size);
+    // One time for all: the queue keeps sending order (ties in holding order).
+    peer_->inbox_.hold(0.0, 0, data, size);
   }
 
-  void receive(double now_s, Inbox& out) override {
-    while (!inbox_.empty() && inbox_.front_s() <= now_s) {
+  void receive(double, Inbox& out) override {
+    while (!inbox_.empty()) {
       ++traffic_.received;
       traffic_.received_bytes += std::int64_t(inbox_.front_bytes().size());
       out.push(inbox_.front_bytes().data(), inbox_.front_bytes().size());
@@ -106,8 +102,7 @@ class MemoryLink::Side final : public Endpoint {
   }
   using Endpoint::receive;
 
-  const LinkEmulator& emulator() const override { return emulator_; }
-  // What this side sends is held in its peer's queue.
+  // What this side sends waits in its peer's queue.
   void reserve_in_flight(std::size_t datagrams, std::size_t bytes) override {
     peer_->inbox_.reserve(datagrams, bytes);
   }
@@ -115,12 +110,10 @@ class MemoryLink::Side final : public Endpoint {
   Side* peer_ = nullptr;
 
  private:
-  LinkEmulator emulator_;
   HeldQueue inbox_;
 };
 
-MemoryLink::MemoryLink(const LinkConditions& a_to_b, const LinkConditions& b_to_a)
-    : a_(std::make_unique<Side>(a_to_b)), b_(std::make_unique<Side>(b_to_a)) {
+MemoryLink::MemoryLink() : a_(std::make_unique<Side>()), b_(std::make_unique<Side>()) {
   a_->peer_ = b_.get();
   b_->peer_ = a_.get();
 }

@@ -78,15 +78,15 @@ constexpr ForceColumn kForceColumns[] = {
 // force.csv: t, cut and the force columns, one row per step.
 class ForceCsv {
  public:
-  explicit ForceCsv(const std::filesystem::path& path) : file_(path, header()) {}
+  explicit ForceCsv(const std::filesystem::path& path) : file_(path, header()) {
+    cells_.reserve(std::size(kForceColumns) + 2);
+  }
   void row(const StepOutput& out, const std::string& cut_name) {
-    line_.clear();
-    for (const ForceColumn& c : kForceColumns) {
-      char cell[32];
-      std::snprintf(cell, sizeof cell, ",%.9g", c.get(out));
-      line_ += cell;
-    }
-    file_.row({out.t_s, cut_name + line_});
+    cells_.clear();
+    cells_.emplace_back(out.t_s);
+    cells_.emplace_back(cut_name);
+    for (const ForceColumn& c : kForceColumns) cells_.emplace_back(c.get(out));
+    file_.row(cells_);
   }
   void close() { file_.close(); }
 
@@ -97,7 +97,7 @@ class ForceCsv {
     return h;
   }
   io::CsvFile file_;
-  std::string line_;
+  std::vector<io::CsvFile::Cell> cells_;  // a row's, reserved once
 };
 
 // A cut's force statistics, summed step by step.
@@ -153,6 +153,52 @@ Json material_json(const SoilMaterial& m) {
 }  // namespace
 
 std::span<const ForceColumn> force_columns() { return kForceColumns; }
+
+namespace {
+
+// Whether segment a-b, seen from above (X-Z), meets the rectangle [x0, x1] x
+// [z0, z1] (Liang-Barsky clipping of the segment's parameter).
+bool crosses_from_above(const Vec3& a, const Vec3& b, double x0, double x1, double z0, double z1) {
+  double t0 = 0.0, t1 = 1.0;
+  const auto clip = [&](double p, double q) {  // the part where p t <= q
+    if (p == 0.0) return q >= 0.0;
+    const double t = q / p;
+    if (p < 0.0) t0 = std::max(t0, t);
+    else t1 = std::min(t1, t);
+    return t0 <= t1;
+  };
+  const double dx = b.x - a.x, dz = b.z - a.z;
+  return clip(-dx, a.x - x0) && clip(dx, x1 - a.x) && clip(-dz, a.z - z0) && clip(dz, z1 - a.z);
+}
+
+}  // namespace
+
+std::vector<std::string> cut_warnings(const io::Scenario& sc) {
+  std::vector<std::string> w;
+  const GridSpec g = io::grid_spec(sc);
+  const double x0 = g.origin_m.x, x1 = g.origin_m.x + g.size_x_m;
+  const double z0 = g.origin_m.z, z1 = g.origin_m.z + g.size_z_m;
+  std::vector<bool> seen(sc.cuts.size(), false);
+  for (const int index : sc.sequence) {
+    if (seen[std::size_t(index)]) continue;
+    seen[std::size_t(index)] = true;
+    const Motion& motion = sc.cuts[std::size_t(index)];
+    const std::int64_t n = cut_steps(motion, sc.rate_hz);
+    bool crosses = false;
+    for (std::int64_t i = 0; i < n && !crosses; ++i) {
+      const Segment e = blade_segment(sc.blade, motion.sample(double(i) / sc.rate_hz));
+      crosses = crosses_from_above(e.a, e.b, x0, x1, z0, z1);
+    }
+    if (crosses) continue;
+    char extent[200];
+    std::snprintf(extent, sizeof extent, "x in [%.6g, %.6g] m, z in [%.6g, %.6g] m", x0, x1, z0, z1);
+    w.push_back("cut '" + motion.name + "': the blade never crosses the terrain (" + extent +
+                ", seen from above) in any of its " + std::to_string(n) +
+                " steps, so it cuts nothing: its keyframes' position_m are world coordinates, not "
+                "offsets from the terrain's corner");
+  }
+  return w;
+}
 
 std::vector<std::string> soil_warnings(const SoilFlowParams& soil, const GridSpec& grid,
                                        std::int64_t final_backlog_cells, std::int64_t capped_steps) {
@@ -473,7 +519,11 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
     soil.net_moved_m3 *= grid.spec().cell_area_m2();
     soil.soil_timing = timing_stats(soil_s);
     result.soil = soil;
-    result.warnings = soil_warnings(sc.soil, grid.spec(), soil.final_backlog_cells, soil.capped_steps);
+  }
+  result.warnings = cut_warnings(sc);
+  if (flow) {
+    const std::vector<std::string> soil_lines = soil_warnings(sc.soil, grid.spec(), soil.final_backlog_cells, soil.capped_steps);
+    result.warnings.insert(result.warnings.end(), soil_lines.begin(), soil_lines.end());
   }
 
   io::write_npy(dir / "height.npy", grid.heights(), grid.rows(), grid.cols());

@@ -6,9 +6,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
-#include <sstream>
 #include <thread>
+
+#include <nlohmann/json.hpp>
 
 #include "bodies_json.hpp"
 #include "terracut/core/error.hpp"
@@ -25,50 +28,38 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// JSON text of a string: quoted, with quotes, backslashes and control
-// characters escaped.
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (const char ch : text) {
-    const unsigned char u = static_cast<unsigned char>(ch);
-    if (ch == '"' || ch == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (u < 0x20) {
-      char buffer[8];
-      std::snprintf(buffer, sizeof buffer, "\\u%04x", unsigned(u));
-      out += buffer;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
+using Json = nlohmann::ordered_json;
 
-// JSON text of a number (an output, so its own fixed format, not
-// format_number's); null for NaN or infinity (JSON has neither).
-std::string json_number(double value) {
-  if (!std::isfinite(value)) return "null";
+// A number as summary.json gives it: nine significant digits (an output, so
+// its own fixed precision, not format_number's shortest text), a whole
+// number where those digits are one (8, not 8.0); null for NaN or infinity
+// (JSON has neither).
+Json json_number(double value) {
+  if (!std::isfinite(value)) return nullptr;
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.9g", value);
-  return buffer;
+  if (std::strpbrk(buffer, ".e") == nullptr) return std::strtoll(buffer, nullptr, 10);
+  return std::strtod(buffer, nullptr);
 }
 
 // {"p50", "p99", "max", "mean"} in microseconds.
-std::string json_percentiles(const TimeStats& s) {
-  return "{\"p50\": " + json_number(s.p50_s * 1e6) + ", \"p99\": " + json_number(s.p99_s * 1e6) +
-         ", \"max\": " + json_number(s.max_s * 1e6) + ", \"mean\": " + json_number(s.mean_s * 1e6) +
-         "}";
+Json json_percentiles(const TimeStats& s) {
+  return {{"p50", json_number(s.p50_s * 1e6)},
+          {"p99", json_number(s.p99_s * 1e6)},
+          {"max", json_number(s.max_s * 1e6)},
+          {"mean", json_number(s.mean_s * 1e6)}};
 }
-std::string json_percentiles(const TimePercentiles& s) {
-  return "{\"p50\": " + json_number(s.p50_us) + ", \"p99\": " + json_number(s.p99_us) +
-         ", \"max\": " + json_number(s.max_us) + ", \"mean\": " + json_number(s.mean_us) + "}";
+Json json_percentiles(const TimePercentiles& s) {
+  return {{"p50", json_number(s.p50_us)},
+          {"p99", json_number(s.p99_us)},
+          {"max", json_number(s.max_us)},
+          {"mean", json_number(s.mean_us)}};
 }
 
 }  // namespace
 
 DevicePath followed_path(const Scenario& scenario, const HapticSettings& settings,
-                         const std::string& source) {
+                         const std::string& source, std::optional<double> rate_hz) {
   const io::Scenario& sc = scenario.base;
   std::vector<Motion> strokes;
   if (!settings.cut.empty()) {
@@ -84,19 +75,21 @@ DevicePath followed_path(const Scenario& scenario, const HapticSettings& setting
                      " device follows a cut, and the scenario has none");
   // A hand cannot jump from one stroke's end to the next one's start.
   if (settings.device == DeviceKind::kSim) strokes.resize(1);
-  return DevicePath(std::move(strokes), settings.rate_hz, Workspace(settings.workspace));
+  return DevicePath(std::move(strokes), rate_hz.value_or(sc.rate_hz),
+                    Workspace(settings.workspace));
 }
 
 std::unique_ptr<Device> make_device(const Scenario& scenario, const HapticSettings& settings,
-                                    int udp_port, const std::string& source) {
+                                    int udp_port, const std::string& source,
+                                    std::optional<double> rate_hz) {
   switch (settings.device) {
     case DeviceKind::kScript:
-      return std::make_unique<ScriptDevice>(followed_path(scenario, settings, source));
+      return std::make_unique<ScriptDevice>(followed_path(scenario, settings, source, rate_hz));
     case DeviceKind::kSim:
       return std::make_unique<SimHandDevice>(SimHand(settings.hand,
                                                      settings.forces.device.inherent_damping_n_s_per_m,
-                                                     followed_path(scenario, settings, source),
-                                                     settings.rate_hz));
+                                                     followed_path(scenario, settings, source, rate_hz),
+                                                     rate_hz.value_or(scenario.base.rate_hz)));
     case DeviceKind::kUdp:
       // A real device through the bridge (docs/bridge-protocol.md).
       return std::make_unique<UdpDevice>(settings.udp.address, udp_port);
@@ -153,9 +146,14 @@ HapticSession::HapticSession(const Scenario& input, const SessionOptions& option
   // the port asked for, and the loop never reads it.
   const int port = settings.udp.port;
   if (port == 0) settings.udp.port = 1;
+  // The loop's rate: the scenario's, or the command line's.
+  if (options.rate_hz)
+    if (std::string m = check(kLoopRateRange, *options.rate_hz, "--rate"); !m.empty())
+      throw InputError(m);
+  const double rate_hz = options.rate_hz.value_or(sc.rate_hz);
   std::optional<LoopParams> params;
   try {
-    params.emplace(settings, sc.blade);
+    params.emplace(settings, sc.blade, rate_hz);
   } catch (const InputError& e) {
     throw InputError(source_.string() + ": " + e.what());
   }
@@ -163,9 +161,10 @@ HapticSession::HapticSession(const Scenario& input, const SessionOptions& option
 
   // The device, and the path the script and sim devices follow: its length
   // and its first orientation (the default one).
-  device_ = make_device(input, valid, port, source_.string());
+  device_ = make_device(input, valid, port, source_.string(), rate_hz);
   std::optional<DevicePath> path;
-  if (kind_ != DeviceKind::kUdp) path.emplace(followed_path(input, valid, source_.string()));
+  if (kind_ != DeviceKind::kUdp)
+    path.emplace(followed_path(input, valid, source_.string(), rate_hz));
   cut_name_ = path ? path->strokes().front().name : "";
   const Quat default_orientation = path ? path->strokes().front().keyframes.front().pose.orientation : Quat{};
   const double path_s = path ? path->duration_s() : 0.0;
@@ -178,7 +177,7 @@ HapticSession::HapticSession(const Scenario& input, const SessionOptions& option
 
   // The world and the loop.
   RigOptions ro;
-  ro.loop.ticks = std::max<std::int64_t>(1, std::llround(duration_s_ * valid.rate_hz));
+  ro.loop.ticks = std::max<std::int64_t>(1, std::llround(duration_s_ * rate_hz));
   ro.loop.record_capacity = std::min<std::size_t>(options.max_records, std::size_t(ro.loop.ticks));
   ro.loop.realtime = options.realtime;
   ro.loop.snapshot = options.snapshot;
@@ -234,6 +233,13 @@ void HapticSession::run() {
 
 std::vector<std::string> HapticSession::warnings() const {
   std::vector<std::string> w = build_warnings_;
+  const std::vector<std::string> run = run_warnings();
+  w.insert(w.end(), run.begin(), run.end());
+  return w;
+}
+
+std::vector<std::string> HapticSession::run_warnings() const {
+  std::vector<std::string> w;
   const HapticLoop& l = rig_->loop();
   const LoopCounters& c = l.counters();
   const SafetyCounters& s = l.safety().counters();
@@ -286,110 +292,100 @@ std::string HapticSession::summary_json() const {
   }
   removed = l.simulation().removed_volume_m3();
 
-  std::ostringstream j;
-  j << "{\n";
-  j << "  \"scenario\": " << json_string(name_) << ",\n";
-  j << "  \"source\": " << json_string(source_.string()) << ",\n";
-  j << "  \"device\": " << json_string(std::string(to_string(kind_))) << ",\n";
-  j << "  \"cut\": " << json_string(cut_name_) << ",\n";
-  j << "  \"clock\": " << json_string(clock_ == ClockMode::kFake ? "fake" : "real") << ",\n";
-  j << "  \"rate_hz\": " << json_number(st.rate_hz) << ",\n";
-  j << "  \"duration_s\": " << json_number(duration_s_) << ",\n";
-  j << "  \"ticks\": " << c.ticks << ",\n";
-  j << "  \"ended_with_device\": " << (l.ended_with_device() ? "true" : "false") << ",\n";
-  j << "  \"wall_s\": " << json_number(wall_s_) << ",\n";
-  j << "  \"realtime\": {\"fifo\": " << (l.realtime_status().fifo ? "true" : "false")
-    << ", \"priority\": " << l.realtime_status().priority
-    << ", \"memory_locked\": " << (l.realtime_status().memory_locked ? "true" : "false")
-    << ", \"message\": " << json_string(l.realtime_status().message) << "},\n";
+  Json j;
+  j["scenario"] = name_;
+  j["source"] = source_.string();
+  j["device"] = std::string(to_string(kind_));
+  j["cut"] = cut_name_;
+  j["clock"] = clock_ == ClockMode::kFake ? "fake" : "real";
+  j["rate_hz"] = json_number(l.params().rate_hz());
+  j["duration_s"] = json_number(duration_s_);
+  j["ticks"] = c.ticks;
+  j["ended_with_device"] = l.ended_with_device();
+  j["wall_s"] = json_number(wall_s_);
+  j["realtime"] = {{"fifo", l.realtime_status().fifo},
+                   {"priority", l.realtime_status().priority},
+                   {"memory_locked", l.realtime_status().memory_locked},
+                   {"message", l.realtime_status().message}};
   // Timing: the pacer's histograms cover every tick; the period's
   // percentiles come from the kept records.
   const LoopStats& ps = l.pacer_stats();
-  j << "  \"timing_us\": {\n";
-  j << "    \"period_jitter\": " << json_percentiles(ps.period_jitter) << ",\n";
-  j << "    \"compute\": " << json_percentiles(ps.compute) << ",\n";
-  j << "    \"wake_latency\": " << json_percentiles(ps.wake_latency) << ",\n";
-  j << "    \"period\": " << json_percentiles(l.period()) << ",\n";
-  j << "    \"missed_deadlines\": " << ps.missed_deadlines << ",\n";
-  j << "    \"skipped_slots\": " << ps.skipped_slots << "\n  },\n";
-  j << "  \"loop\": {\"samples\": " << c.samples << ", \"silent_ticks\": " << c.silent_ticks
-    << ", \"bad_samples\": " << c.bad_samples << ", \"reconnects\": " << c.reconnects
-    << ", \"records_kept\": " << records.size() << ", \"records_dropped\": " << c.records_dropped
-    << "},\n";
-  j << "  \"safety\": {\"samples\": " << s.samples << ", \"clamped\": " << s.clamped
-    << ", \"rate_limited\": " << s.rate_limited << ", \"ramping\": " << s.ramping
-    << ", \"watchdog\": " << s.watchdog << ", \"watchdog_trips\": " << s.watchdog_trips
-    << ", \"watchdog_trips_while_active\": " << l.watchdog_trips_while_active()
-    << ", \"nonfinite\": " << s.nonfinite << ", \"restarts\": " << s.restarts << "},\n";
+  j["timing_us"] = {{"period_jitter", json_percentiles(ps.period_jitter)},
+                    {"compute", json_percentiles(ps.compute)},
+                    {"wake_latency", json_percentiles(ps.wake_latency)},
+                    {"period", json_percentiles(l.period())},
+                    {"missed_deadlines", ps.missed_deadlines},
+                    {"skipped_slots", ps.skipped_slots}};
+  j["loop"] = {{"samples", c.samples},           {"silent_ticks", c.silent_ticks},
+               {"bad_samples", c.bad_samples},   {"reconnects", c.reconnects},
+               {"records_kept", records.size()}, {"records_dropped", c.records_dropped}};
+  j["safety"] = {{"samples", s.samples},
+                 {"clamped", s.clamped},
+                 {"rate_limited", s.rate_limited},
+                 {"ramping", s.ramping},
+                 {"watchdog", s.watchdog},
+                 {"watchdog_trips", s.watchdog_trips},
+                 {"watchdog_trips_while_active", l.watchdog_trips_while_active()},
+                 {"nonfinite", s.nonfinite},
+                 {"restarts", s.restarts}};
 
   // Rejected bridge packets by reason (all zero for script and sim).
   RejectCounts rejected{};
   const auto* udp = dynamic_cast<const UdpDevice*>(device_.get());
   if (udp) rejected = udp->bridge_stats().rejected;
-  j << "  \"rejected_packets\": {";
+  Json& by_reason = j["rejected_packets"] = Json::object();
   for (std::size_t i = 1; i < kRejectReasonCount; ++i)
-    j << (i > 1 ? ", " : "") << json_string(std::string(to_string(static_cast<Reject>(i)))) << ": "
-      << rejected.by_reason[i];
-  j << ", \"total\": " << rejected.total() << "},\n";
+    by_reason[std::string(to_string(static_cast<Reject>(i)))] = rejected.by_reason[i];
+  by_reason["total"] = rejected.total();
 
-  j << "  \"device_stats\": {";
-  const std::vector<DeviceStat> ds = device_->stats();
-  for (std::size_t i = 0; i < ds.size(); ++i)
-    j << (i ? ", " : "") << json_string(ds[i].name) << ": " << json_number(ds[i].value);
-  if (udp) j << (ds.empty() ? "" : ", ") << "\"port\": " << udp->port();
-  j << "},\n";
+  Json& stats = j["device_stats"] = Json::object();
+  for (const DeviceStat& d : device_->stats()) stats[d.name] = json_number(d.value);
+  if (udp) stats["port"] = udp->port();
 
-  j << "  \"forces\": {\"cutting\": " << json_string(std::string(to_string(fp.cutting)))
-    << ", \"surface\": " << (fp.surface_enabled ? "true" : "false")
-    << ", \"surface_reference\": " << json_string(std::string(to_string(st.surface_reference)))
-    << ", \"force_scale\": " << json_number(fp.force_scale)
-    << ", \"workspace_scale\": " << json_number(fp.workspace_scale)
-    << ", \"max_device_force_n\": " << json_number(l.max_device_force_n())
-    << ", \"max_world_force_n\": " << json_number(max_world) << ",\n";
-  j << "    \"rendering\": {\"surface_stiffness_n_per_m\": "
-    << json_number(rc.surface_stiffness_n_per_m)
-    << ", \"surface_damping_n_s_per_m\": " << json_number(rc.surface_damping_n_s_per_m)
-    << ", \"passive_stiffness_n_per_m\": " << json_number(rc.passive_stiffness_n_per_m)
-    << ", \"cutting_damping_n_s_per_m\": " << json_number(rc.cutting_damping_n_s_per_m)
-    << ", \"surface_stiffness_limited\": " << (rc.surface_stiffness_limited ? "true" : "false")
-    << ", \"surface_damping_limited\": " << (rc.surface_damping_limited ? "true" : "false")
-    << ", \"cutting_damping_limited\": " << (rc.cutting_damping_limited ? "true" : "false")
-    << ", \"requested_surface_stiffness_n_per_m\": "
-    << json_number(rc.requested_surface_stiffness_n_per_m)
-    << ", \"requested_surface_damping_n_s_per_m\": "
-    << json_number(rc.requested_surface_damping_n_s_per_m)
-    << ", \"requested_cutting_damping_n_s_per_m\": "
-    << json_number(rc.requested_cutting_damping_n_s_per_m)
-    << ", \"cutting_gain\": " << json_number(rc.cutting_gain) << ", \"changes\": [";
-  const std::vector<std::string> changes = l.force_model().limit_changes();
-  for (std::size_t i = 0; i < changes.size(); ++i)
-    j << (i ? ", " : "") << json_string(changes[i]);
-  j << "]},\n";
-  j << "    \"safety_limits\": {\"max_force_n\": " << json_number(st.safety.max_force_n)
-    << ", \"max_force_rate_n_per_s\": " << json_number(st.safety.max_force_rate_n_per_s)
-    << ", \"rise_time_s\": " << json_number(st.safety.rise_time_s)
-    << ", \"watchdog_timeout_s\": " << json_number(st.safety.watchdog_timeout_s)
-    << ", \"watchdog_ramp_s\": " << json_number(st.safety.watchdog_ramp_s) << "}},\n";
-  j << "  \"cutting\": {\"removed_volume_m3\": " << json_number(removed)
-    << ", \"peak_contact_m\": " << json_number(peak_contact)
-    << ", \"ticks_in_contact\": " << in_contact << "},\n";
+  j["forces"] = {
+      {"cutting", std::string(to_string(fp.cutting))},
+      {"surface", fp.surface_enabled},
+      {"surface_reference", std::string(to_string(st.surface_reference))},
+      {"force_scale", json_number(fp.force_scale)},
+      {"workspace_scale", json_number(fp.workspace_scale)},
+      {"max_device_force_n", json_number(l.max_device_force_n())},
+      {"max_world_force_n", json_number(max_world)},
+      {"rendering",
+       {{"surface_stiffness_n_per_m", json_number(rc.surface_stiffness_n_per_m)},
+        {"surface_damping_n_s_per_m", json_number(rc.surface_damping_n_s_per_m)},
+        {"passive_stiffness_n_per_m", json_number(rc.passive_stiffness_n_per_m)},
+        {"cutting_damping_n_s_per_m", json_number(rc.cutting_damping_n_s_per_m)},
+        {"surface_stiffness_limited", rc.surface_stiffness_limited},
+        {"surface_damping_limited", rc.surface_damping_limited},
+        {"cutting_damping_limited", rc.cutting_damping_limited},
+        {"requested_surface_stiffness_n_per_m",
+         json_number(rc.requested_surface_stiffness_n_per_m)},
+        {"requested_surface_damping_n_s_per_m",
+         json_number(rc.requested_surface_damping_n_s_per_m)},
+        {"requested_cutting_damping_n_s_per_m",
+         json_number(rc.requested_cutting_damping_n_s_per_m)},
+        {"cutting_gain", json_number(rc.cutting_gain)},
+        {"changes", l.force_model().limit_changes()}}},
+      {"safety_limits",
+       {{"max_force_n", json_number(st.safety.max_force_n)},
+        {"max_force_rate_n_per_s", json_number(st.safety.max_force_rate_n_per_s)},
+        {"rise_time_s", json_number(st.safety.rise_time_s)},
+        {"watchdog_timeout_s", json_number(st.safety.watchdog_timeout_s)},
+        {"watchdog_ramp_s", json_number(st.safety.watchdog_ramp_s)}}}};
+  j["cutting"] = {{"removed_volume_m3", json_number(removed)},
+                  {"peak_contact_m", json_number(peak_contact)},
+                  {"ticks_in_contact", in_contact}};
   // The rigid bodies and the peak force they put on the tool.
   if (rig_->world().bodies())
-    j << "  \"bodies\": "
-      << detail::bodies_json(rig_->world(), detail::BodiesEntry::kLoop).dump() << ",\n";
-  const std::vector<std::string> w = warnings();
-  j << "  \"warnings\": [";
-  for (std::size_t i = 0; i < w.size(); ++i) j << (i ? ", " : "") << json_string(w[i]);
-  j << "]\n}\n";
-  return j.str();
+    j["bodies"] = detail::bodies_json(rig_->world(), detail::BodiesEntry::kLoop);
+  j["warnings"] = warnings();
+  return j.dump(2) + "\n";
 }
 
 void HapticSession::write_outputs(const fs::path& out_dir) {
   io::make_output_folder(out_dir);
   rig_->world().finish();
-  std::ostringstream csv;
-  write_haptics_csv(csv, rig_->loop().records());
-  io::write_text_file(out_dir / "haptics.csv", csv.str());
+  write_haptics_csv(out_dir / "haptics.csv", rig_->loop().records());
   io::write_text_file(out_dir / "summary.json", summary_json());
 }
 
@@ -404,7 +400,7 @@ std::string HapticSession::summary_line() const {
                 "%.1f us max %.1f us, compute p50 %.1f us p99 %.1f us, %lld missed deadlines, "
                 "max device force %.3g N, removed %.4g m^3",
                 name_.c_str(), std::string(to_string(kind_)).c_str(),
-                static_cast<long long>(l.counters().ticks), l.settings().rate_hz,
+                static_cast<long long>(l.counters().ticks), l.params().rate_hz(),
                 clock_ == ClockMode::kFake ? "fake" : "real", j.p50_s * 1e6, j.p99_s * 1e6,
                 j.max_s * 1e6, c.p50_s * 1e6, c.p99_s * 1e6,
                 static_cast<long long>(ps.missed_deadlines), l.max_device_force_n(),

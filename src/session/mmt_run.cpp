@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "mmt_json.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/core/format.hpp"
 #include "terracut/haptics/script_device.hpp"
@@ -16,13 +17,6 @@
 
 namespace terracut::session {
 namespace {
-
-double rms(const std::vector<double>& v) {
-  if (v.empty()) return 0.0;
-  double s = 0.0;
-  for (double x : v) s += x * x;
-  return std::sqrt(s / double(v.size()));
-}
 
 std::ofstream open_out(const std::filesystem::path& p) {
   std::ofstream out(p, std::ios::binary);
@@ -39,8 +33,32 @@ double operator_duration_s(const Scenario& op) {
   return followed_path(op, op.haptics, op.base.source_path.string()).duration_s() + op.haptics.settle_s;
 }
 
-std::unique_ptr<haptics::Device> make_operator_device(const Scenario& op) {
-  return make_device(op, op.haptics, op.haptics.udp.port, op.base.source_path.string());
+namespace {
+// The script device at the time modulo its round: the path over and over
+// (the soak's --repeat).
+class RepeatingScript final : public haptics::Device {
+ public:
+  explicit RepeatingScript(haptics::DevicePath path)
+      : round_s_(path.duration_s() + 0.5), script_(std::move(path)) {}
+  std::string_view kind() const override { return "script"; }
+  bool read(double t_s, haptics::DeviceSample& out) noexcept override {
+    return script_.read(std::fmod(std::max(t_s, 0.0), round_s_), out);
+  }
+  void write(const haptics::DeviceCommand& c) noexcept override { script_.write(c); }
+  std::vector<haptics::DeviceStat> stats() const override { return script_.stats(); }
+
+ private:
+  double round_s_;
+  haptics::ScriptDevice script_;
+};
+}  // namespace
+
+std::unique_ptr<haptics::Device> make_operator_device(const Scenario& op, bool repeat) {
+  if (!repeat) return make_device(op, op.haptics, op.haptics.udp.port, op.base.source_path.string());
+  if (op.haptics.device != haptics::DeviceKind::kScript)
+    throw InputError(op.base.source_path.string() +
+                     ": --repeat: only the script device replays its cut (haptics.device: script)");
+  return std::make_unique<RepeatingScript>(followed_path(op, op.haptics, op.base.source_path.string()));
 }
 
 namespace {
@@ -48,28 +66,10 @@ namespace {
 constexpr const char* kOperatorCsvHeader =
     "t,x,y,z,fx,fy,fz,fdx,fdy,fdz,remote_fx,remote_fy,remote_fz,contact_length,"
     "scale_applied,scale_target,updating,link_silent,passivity_j,passivity_dfr_j,"
-    "compute_us\n";
+    "compute_us,command_sequence,round_trip_s,command_loss";
 constexpr const char* kRemoteCsvHeader =
     "t,command_sequence,cmd_x,cmd_y,cmd_z,x,y,z,fx,fy,fz,contact_length,cut_depth,"
-    "force_scale,holding,active,compute_us\n";
-
-void write_row(std::ostream& out, const OperatorRecord& r) {
-  out << r.t_s << ',' << r.tool_m.x << ',' << r.tool_m.y << ',' << r.tool_m.z << ','
-      << r.force_world_n.x << ',' << r.force_world_n.y << ',' << r.force_world_n.z << ','
-      << r.force_device_n.x << ',' << r.force_device_n.y << ',' << r.force_device_n.z << ','
-      << r.remote_force_world_n.x << ',' << r.remote_force_world_n.y << ','
-      << r.remote_force_world_n.z << ',' << r.contact_length_m << ',' << r.scale_applied << ','
-      << r.scale_target << ',' << int(r.updating) << ',' << int(r.link_silent) << ','
-      << r.passivity_j << ',' << r.passivity_dfr_j << ',' << r.compute_s * 1e6 << '\n';
-}
-
-void write_row(std::ostream& out, const RemoteRecord& r) {
-  out << r.t_s << ',' << r.command_sequence << ',' << r.commanded_m.x << ',' << r.commanded_m.y
-      << ',' << r.commanded_m.z << ',' << r.tool_m.x << ',' << r.tool_m.y << ',' << r.tool_m.z
-      << ',' << r.force_world_n.x << ',' << r.force_world_n.y << ',' << r.force_world_n.z << ','
-      << r.contact_length_m << ',' << r.cut_depth_m << ',' << r.force_scale << ','
-      << int(r.holding) << ',' << int(r.active) << ',' << r.compute_s * 1e6 << '\n';
-}
+    "force_scale,holding,active,compute_us";
 
 }  // namespace
 
@@ -88,14 +88,7 @@ void write_remote_csv(const std::vector<RemoteRecord>& records, const std::files
 }
 
 StationCsv::StationCsv(const std::filesystem::path& path, const char* header)
-    : path_(path), buffer_(new char[std::size_t(1) << 16]), out_(std::make_unique<std::ofstream>()) {
-  // The buffer is set before the file opens (libstdc++ uses it only then).
-  out_->rdbuf()->pubsetbuf(buffer_.get(), std::streamsize(1) << 16);
-  out_->open(path, std::ios::binary);
-  if (!*out_) throw InputError(path.string() + ": cannot be written");
-  out_->precision(9);
-  *out_ << header;
-}
+    : file_(std::make_unique<io::CsvFile>(path, header)) {}
 
 StationCsv::StationCsv(StationCsv&&) noexcept = default;
 StationCsv& StationCsv::operator=(StationCsv&&) noexcept = default;
@@ -110,37 +103,38 @@ StationCsv StationCsv::remote_csv(const std::filesystem::path& path) {
 }
 
 void StationCsv::add(const OperatorRecord& r) {
-  write_row(*out_, r);
-  if (!*out_) throw InputError(path_.string() + ": cannot be written");
+  file_->row({r.t_s, r.tool_m.x, r.tool_m.y, r.tool_m.z, r.force_world_n.x, r.force_world_n.y,
+              r.force_world_n.z, r.force_device_n.x, r.force_device_n.y, r.force_device_n.z,
+              r.remote_force_world_n.x, r.remote_force_world_n.y, r.remote_force_world_n.z,
+              r.contact_length_m, r.scale_applied, r.scale_target, r.updating, r.link_silent,
+              r.passivity_j, r.passivity_dfr_j, r.compute_s * 1e6, r.command_sequence,
+              r.round_trip_s, r.command_loss});
 }
 
 void StationCsv::add(const RemoteRecord& r) {
-  write_row(*out_, r);
-  if (!*out_) throw InputError(path_.string() + ": cannot be written");
+  file_->row({r.t_s, r.command_sequence, r.commanded_m.x, r.commanded_m.y, r.commanded_m.z,
+              r.tool_m.x, r.tool_m.y, r.tool_m.z, r.force_world_n.x, r.force_world_n.y,
+              r.force_world_n.z, r.contact_length_m, r.cut_depth_m, r.force_scale, r.holding,
+              r.active, r.compute_s * 1e6});
 }
 
-void StationCsv::finish() {
-  out_->close();
-  if (!*out_) throw InputError(path_.string() + ": cannot be written");
-}
+void StationCsv::finish() { file_->close(); }
 
 MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
-  if (!op.mmt)
-    throw InputError(op.base.source_path.string() +
-                     ": mmt: the scenario has no mmt: section (the remote world and the link)");
+  if (!op.mmt) throw InputError(no_mmt_section(op));
   settings_ = apply_overrides(*op.mmt, overrides);
   op_ = std::make_unique<Scenario>(op);
   remote_scn_ = std::make_unique<Scenario>(load_remote_scenario(op));
-  if (remote_scn_->haptics.rate_hz != op_->haptics.rate_hz)
+  if (remote_scn_->base.rate_hz != op_->base.rate_hz)
     throw InputError(settings_.remote_scenario.string() +
-                     ": haptics.rate_hz: the remote must run at the operator's rate (" +
-                     format_number(op_->haptics.rate_hz) + " Hz)");
+                     ": rate_hz: the remote must run at the operator's rate (" +
+                     format_number(op_->base.rate_hz) + " Hz)");
   if (op_->haptics.device == haptics::DeviceKind::kUdp)
     throw InputError(op.base.source_path.string() +
                      ": haptics.device: a real device over udp runs in real time: run the "
                      "stations as two processes (--role remote / --role operator)");
   device_ = make_operator_device(*op_);
-  link_ = std::make_unique<net::MemoryLink>(settings_.to_remote, settings_.to_operator);
+  link_ = std::make_unique<net::EmulatedLink>(settings_.to_remote, settings_.to_operator);
   operator_ = std::make_unique<OperatorStation>(*op_, settings_, *device_, link_->a(), 1u);
   remote_ = std::make_unique<RemoteStation>(*remote_scn_, settings_, op_->base.soil.material,
                                             operator_->simulation().grid(), link_->b(), 2u);
@@ -149,7 +143,7 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
   // updates to land, and on a lossy link three retransmissions more.
   const net::LinkConditions& back = settings_.to_operator;
   const bool lossy = back.loss > 0.0 || back.burst.p_good_to_bad > 0.0;
-  const double retransmit_s = back.retransmit_s.value_or(2.0 * back.delay_s + 0.02);
+  const double retransmit_s = net::retransmit_timeout_s(back, net::emulated_round_trip_s(back));
   const double duration = overrides.duration_s.value_or(
       operator_duration_s(*op_) + settings_.to_remote.delay_s + back.delay_s +
       settings_.sense_period_s + settings_.blend_s + 0.2 + (lossy ? 3.0 * retransmit_s : 0.0));
@@ -167,6 +161,7 @@ MmtRun::~MmtRun() = default;
 
 void MmtRun::tick() {
   const double t = double(tick_) / rate_hz_;
+  link_->release(t);
   operator_->tick(t);
   remote_->tick(t);
   ++tick_;
@@ -207,38 +202,12 @@ MmtSummary MmtRun::summary() const {
   MmtSummary s;
   s.duration_s = double(tick_) / rate_hz_;
   s.rtt_s = settings_.to_remote.delay_s + settings_.to_operator.delay_s;
+  s.rtt_measured_s = operator_->rtt_s();
   s.loss = settings_.to_remote.loss;
   s.deadband = settings_.deadband;
-  const auto& op = operator_->records();
-  const auto& rm = remote_->records();
-  // The remote acts on command i one one-way delay later: compare there.
-  const std::int64_t lag = std::llround(settings_.to_remote.delay_s * rate_hz_);
-  std::vector<double> e_mmt, e_dfr, f_rem;
-  for (std::size_t i = 0; i < op.size(); ++i) {
-    const std::size_t j = i + std::size_t(lag);
-    if (j >= rm.size() || !rm[j].active) continue;
-    // Over the ticks where some force is felt or measured: the time in
-    // soil, not the idle time before and after, so that runs of different
-    // lengths compare.
-    if (length(op[i].force_world_n) == 0.0 && length(op[i].remote_force_world_n) == 0.0 &&
-        length(rm[j].force_world_n) == 0.0)
-      continue;
-    e_mmt.push_back(length(op[i].force_world_n - rm[j].force_world_n));
-    e_dfr.push_back(length(op[i].remote_force_world_n - rm[j].force_world_n));
-    f_rem.push_back(length(rm[j].force_world_n));
-  }
-  s.force_rms_remote_n = rms(f_rem);
-  s.force_error_rms_mmt_n = rms(e_mmt);
-  s.force_error_rms_dfr_n = rms(e_dfr);
-  for (double e : e_mmt) s.force_error_max_mmt_n = std::max(s.force_error_max_mmt_n, e);
-  for (double e : e_dfr) s.force_error_max_dfr_n = std::max(s.force_error_max_dfr_n, e);
+  compare_records(operator_->records(), remote_->records(), s);
   for (const auto& [t, e] : terrain_error_) s.terrain_rms_max_m = std::max(s.terrain_rms_max_m, e);
   s.terrain_rms_final_m = terrain_error_.empty() ? 0.0 : terrain_error_.back().second;
-  std::vector<double> track;
-  for (const RemoteRecord& r : rm)
-    if (r.active) track.push_back(length(r.tool_m - r.commanded_m));
-  s.tracking_rms_m = rms(track);
-  for (double e : track) s.tracking_max_m = std::max(s.tracking_max_m, e);
   const double d = std::max(s.duration_s, 1e-9);
   const net::TrafficCounters& up = link_->a().traffic();
   const net::TrafficCounters& down = link_->b().traffic();
@@ -246,26 +215,21 @@ MmtSummary MmtRun::summary() const {
   s.bytes_per_s_to_remote = double(up.sent_bytes) / d;
   s.packets_per_s_to_operator = double(down.sent) / d;
   s.bytes_per_s_to_operator = double(down.sent_bytes) / d;
+  s.lost_to_remote = link_->a().emulator().counters().lost;
+  s.lost_to_operator = link_->b().emulator().counters().lost;
   s.patches = remote_->counters().patches;
   s.estimates = remote_->counters().estimates;
+  s.patches_merged = operator_->counters().patches;
+  s.estimates_applied = operator_->counters().estimates;
   s.update_packets_per_s = double(remote_->update_packets()) / d;
   s.max_update_step_n = operator_->max_update_step_n();
   s.max_step_while_updating_n = operator_->max_step_while_updating_n();
-  for (const OperatorRecord& r : op) {
-    s.passivity_max_mmt_j = std::max(s.passivity_max_mmt_j, r.passivity_j);
-    s.passivity_max_dfr_j = std::max(s.passivity_max_dfr_j, r.passivity_dfr_j);
-  }
   s.force_scale_final = remote_->force_scale();
-  s.force_scale_applied = op.empty() ? 1.0 : op.back().scale_applied;
   s.estimate_samples = remote_->estimate_samples();
   s.estimate_outliers = remote_->estimate_outliers();
   s.estimate_capped = remote_->estimate_capped();
-  std::vector<double> c;
-  for (const OperatorRecord& r : op) c.push_back(r.compute_s);
-  s.operator_compute = timing_stats(c);
-  c.clear();
-  for (const RemoteRecord& r : rm) c.push_back(r.compute_s);
-  s.remote_compute = timing_stats(c);
+  s.rejected_operator = operator_->counters().rejected;
+  s.rejected_remote = remote_->counters().rejected;
   return s;
 }
 
@@ -284,59 +248,13 @@ void MmtRun::write_outputs(const std::filesystem::path& dir) const {
   nlohmann::ordered_json j;
   j["scenario"] = op_->base.source_path.string();
   j["remote_scenario"] = remote_scn_->base.source_path.string();
-  j["link"] = {{"rtt_s", s.rtt_s},
-               {"delay_s_each_way", settings_.to_remote.delay_s},
-               {"jitter_s", settings_.to_remote.jitter_s},
-               {"loss", settings_.to_remote.loss},
-               {"burst_p_good_to_bad", settings_.to_remote.burst.p_good_to_bad},
-               {"reorder", settings_.to_remote.reorder},
-               {"seed", settings_.to_remote.seed}};
+  j["link"] = link_json(settings_.to_remote);
+  j["link"]["rtt_s"] = s.rtt_s;
+  j["link"]["rtt_measured_s"] = s.rtt_measured_s;
   j["operator"] = {{"blend_s", settings_.blend_s},
                    {"max_update_step_n", settings_.max_update_step_n},
                    {"deadband", settings_.deadband}};
-  j["duration_s"] = s.duration_s;
-  j["force_error"] = {{"remote_force_rms_n", s.force_rms_remote_n},
-                      {"mmt_rms_n", s.force_error_rms_mmt_n},
-                      {"mmt_max_n", s.force_error_max_mmt_n},
-                      {"direct_rms_n", s.force_error_rms_dfr_n},
-                      {"direct_max_n", s.force_error_max_dfr_n},
-                      {"aligned_by_s", settings_.to_remote.delay_s}};
-  j["terrain_error"] = {{"final_rms_m", s.terrain_rms_final_m}, {"max_rms_m", s.terrain_rms_max_m}};
-  j["tracking"] = {{"rms_m", s.tracking_rms_m}, {"max_m", s.tracking_max_m}};
-  j["traffic"] = {{"to_remote_packets_per_s", s.packets_per_s_to_remote},
-                  {"to_remote_bytes_per_s", s.bytes_per_s_to_remote},
-                  {"to_operator_packets_per_s", s.packets_per_s_to_operator},
-                  {"to_operator_bytes_per_s", s.bytes_per_s_to_operator},
-                  {"update_packets_per_s", s.update_packets_per_s},
-                  {"lost_to_remote", link_->a().emulator().counters().lost},
-                  {"lost_to_operator", link_->b().emulator().counters().lost}};
-  j["updates"] = {{"patches", s.patches},
-                  {"estimates", s.estimates},
-                  {"patches_merged", operator_->counters().patches},
-                  {"estimates_applied", operator_->counters().estimates},
-                  {"max_force_step_at_update_n", s.max_update_step_n},
-                  {"max_force_step_while_updating_n", s.max_step_while_updating_n}};
-  j["estimate"] = {{"force_scale", s.force_scale_final},
-                   {"force_scale_applied", s.force_scale_applied},
-                   {"samples", s.estimate_samples},
-                   {"outliers_left_out", s.estimate_outliers},
-                   {"capped_left_out", s.estimate_capped}};
-  j["passivity"] = {{"window_s", 1.0},
-                    {"mmt_max_energy_into_hand_j", s.passivity_max_mmt_j},
-                    {"direct_max_energy_into_hand_j", s.passivity_max_dfr_j}};
-  auto rejected = [](const StationCounters& c) {
-    nlohmann::ordered_json r;
-    for (std::size_t i = 1; i < net::kRejectReasonCount; ++i)
-      r[std::string(net::to_string(net::Reject(i)))] = c.rejected.by_reason[i];
-    return r;
-  };
-  j["rejected"] = {{"operator", rejected(operator_->counters())},
-                   {"remote", rejected(remote_->counters())}};
-  auto timing = [](const TimingStats& t) {
-    return nlohmann::ordered_json{{"p50_us", t.p50_us}, {"p99_us", t.p99_us}, {"max_us", t.max_us}};
-  };
-  j["timing"] = {{"operator_tick", timing(s.operator_compute)},
-                 {"remote_tick", timing(s.remote_compute)}};
+  j.update(summary_json(s));
   std::ofstream out = open_out(dir / "summary.json");
   out << j.dump(2) << "\n";
   if (!out) throw InputError((dir / "summary.json").string() + ": cannot be written");

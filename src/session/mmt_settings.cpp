@@ -31,6 +31,7 @@ constexpr Range kRanges[] = {
     {"operator.exclusion_m", 0.0, 100.0, RangeEnds::kClosed},
     {"operator.deadband", 0.0, 1.0, RangeEnds::kOpenHigh},
     {"timeout_s", 0.0, 60.0, RangeEnds::kOpenLow},
+    {"link_lost_s", 0.0, 3600.0, RangeEnds::kOpenLow},
     {"udp.port", 1, 65535, RangeEnds::kClosed, true},
     {"link_id", 0, 1e9, RangeEnds::kClosed, true},
 };
@@ -71,6 +72,10 @@ std::string validate(const MmtSettings& s) {
   if (!(m = check("operator.exclusion_m", s.exclusion_m)).empty()) return m;
   if (!(m = check("operator.deadband", s.deadband)).empty()) return m;
   if (!(m = check("timeout_s", s.timeout_s)).empty()) return m;
+  if (!(m = check("link_lost_s", s.link_lost_s)).empty()) return m;
+  if (!(s.link_lost_s > s.timeout_s))
+    return "link_lost_s " + format_number(s.link_lost_s) + " s is not longer than timeout_s (" +
+           format_number(s.timeout_s) + " s): the link would be dead before its silence faded the force";
   if (!(m = check("udp.port", s.port)).empty()) return m;
   return {};
 }
@@ -84,7 +89,7 @@ void MmtReader::read(const YAML::Node& value, const std::string& file) {
     settings = s;
     return;
   }
-  const yaml::Map top(root, {"remote", "link", "operator", "timeout_s", "udp", "link_id"});
+  const yaml::Map top(root, {"remote", "link", "operator", "timeout_s", "link_lost_s", "udp", "link_id"});
   const yaml::Map remote =
       top.section("remote", {"scenario", "soil", "follower_speed_m_per_s",
                              "follower_time_constant_s", "sense_period_s",
@@ -116,6 +121,7 @@ void MmtReader::read(const YAML::Node& value, const std::string& file) {
   op.read_number("exclusion_m", s.exclusion_m);
   op.read_number("deadband", s.deadband);
   top.read_number("timeout_s", s.timeout_s);
+  top.read_number("link_lost_s", s.link_lost_s);
   const yaml::Map udp = top.section("udp", {"address", "port"});
   udp.read_text("address", s.address);
   udp.read_integer("port", s.port);
@@ -159,10 +165,14 @@ MmtSettings apply_overrides(MmtSettings s, const MmtOverrides& o) {
   return s;
 }
 
+std::string no_mmt_section(const Scenario& sc) {
+  return sc.base.source_path.string() +
+         ": mmt: the scenario has no mmt: section (the remote world and the link; "
+         "docs/teleoperation.md)";
+}
+
 Scenario load_remote_scenario(const Scenario& op) {
-  if (!op.mmt)
-    throw InputError(op.base.source_path.string() +
-                     ": mmt: the scenario has no mmt: section (the remote world and the link)");
+  if (!op.mmt) throw InputError(no_mmt_section(op));
   const MmtSettings& s = *op.mmt;
   Scenario remote;
   try {

@@ -23,7 +23,7 @@ std::uint64_t to_ns(double t_s) { return std::uint64_t(std::llround(std::max(0.0
 // The loop's parameters of a scenario, with the scenario named in errors.
 haptics::LoopParams loop_params(const Scenario& sc) {
   try {
-    return haptics::LoopParams(sc.haptics, sc.base.blade);
+    return haptics::LoopParams(sc.haptics, sc.base.blade, sc.base.rate_hz);
   } catch (const InputError& e) {
     throw InputError(sc.base.source_path.string() + ": " + e.what());
   }
@@ -66,7 +66,7 @@ std::size_t patch_samples(const MmtSettings& s, const GridSpec& g) {
 // How long a datagram sent one way can be held in flight, s: the delay, the
 // jitter, a hold-back and, for a reliable one, three retransmissions.
 double in_flight_s(const net::LinkConditions& c) {
-  const double retransmit_s = c.retransmit_s.value_or(2.0 * c.delay_s + 0.02);
+  const double retransmit_s = net::retransmit_timeout_s(c, net::emulated_round_trip_s(c));
   return c.delay_s + c.jitter_s + c.reorder_delay_s + 3.0 * retransmit_s;
 }
 
@@ -265,14 +265,24 @@ void RemoteStation::receive(double t_s) {
     if (r == net::Reject::kNone && h.type != net::MessageType::kCommand) r = net::Reject::kBadType;
     net::Command c;
     if (r == net::Reject::kNone) r = net::decode_command(d.data(), d.size(), c);
-    if (r == net::Reject::kNone)
+    if (r == net::Reject::kNone) {
       r = net::to_reject(commands_.check(h.session, h.sequence, h.timestamp_ns));
+      // Arrived, but older than the newest: not followed, yet not lost.
+      if ((r == net::Reject::kReordered || r == net::Reject::kStale) && h.session == commands_.session())
+        ++commands_received_;
+    }
     if (r != net::Reject::kNone) {
       counters_.rejected.add(r);
       continue;
     }
     ++counters_.accepted;
     counters_.sessions = commands_.sessions();
+    if (commands_.new_session()) commands_received_ = 0;
+    ++commands_received_;
+    if (c.round_trip_us > 0) {  // the operator's measured round trip: for the retransmissions
+      round_trip_s_ = double(c.round_trip_us) * 1e-6;
+      link_.note_round_trip_s(round_trip_s_);
+    }
     // A new operator session, or a lifted tool: the next pose is a jump.
     if ((c.flags & net::kCommandLifted) || (commands_.new_session() && has_command_))
       rig_->world().simulation().lift();
@@ -411,6 +421,7 @@ void RemoteStation::send_estimate(double t_s) {
 }
 
 void RemoteStation::tick(double t_s) {
+  const auto tick_start = std::chrono::steady_clock::now();
   receive(t_s);
   // Silence: the arm holds where it is.
   const bool holding = has_command_ && t_s - last_command_s_ > settings_.timeout_s;
@@ -425,7 +436,6 @@ void RemoteStation::tick(double t_s) {
   loop.step1(t_s);
   const haptics::LoopRecord& r =
       loop.step2(ticked_ ? t_s - previous_t_s_ : 0.0, seconds_since(start), false);
-  const double compute_s = seconds_since(start);
   previous_t_s_ = t_s;
   ticked_ = true;
   if (sim.step_count() > steps_before) {
@@ -442,6 +452,7 @@ void RemoteStation::tick(double t_s) {
     m.force_world_n = r.force_world_n;
     m.contact_length_m = r.contact_length_m;
     m.cut_depth_m = r.cut_depth_m;
+    m.commands_received = std::uint32_t(commands_received_);
     std::uint8_t out[net::kHeaderSize + net::kMeasurementPayloadSize + net::kCrcSize];
     net::Header h{net::MessageType::kMeasurement, settings_.link_id, session_,
                   seq_measurement_++, to_ns(t_s)};
@@ -464,7 +475,7 @@ void RemoteStation::tick(double t_s) {
   rec.force_scale = theta_;
   rec.holding = holding;
   rec.active = has_command_;
-  rec.compute_s = compute_s;
+  rec.compute_s = seconds_since(tick_start);  // the whole tick: what arrived, the loop, what it sent
   last_ = rec;
   if (options_.keep_records) records_.push_back(rec);
 }
@@ -490,14 +501,12 @@ OperatorStation::OperatorStation(const Scenario& op, const MmtSettings& settings
   rig_->world().simulation().add_listener(*correction_);
   const GridSpec& g = rig_->world().simulation().grid().spec();
   stamp_s_.assign(std::size_t(g.sample_count()), -1e30f);
-  // A local cut younger than a round trip (plus the sensing period and the
-  // blend) is not yet in what the remote sends: keep it.
-  protect_s_ = settings_.to_remote.delay_s + settings_.to_operator.delay_s +
-               settings_.to_remote.jitter_s + settings_.to_operator.jitter_s +
-               settings_.sense_period_s + settings_.blend_s + 0.05;
+  protect_s_ = protection_s();
   const std::size_t window = std::size_t(std::llround(params.rate_hz()));  // 1 s
   power_.assign(window, 0.0);
   power_dfr_.assign(window, 0.0);
+  loss_sequence_.assign(window, 0);
+  loss_received_.assign(window, -1);
   // The buffers of the working traffic, made now: a command every tick in
   // flight, the datagrams of a tick arriving (any may be a patch), and the
   // blends of the patches merging at once (a blend waits while protected
@@ -572,10 +581,15 @@ void OperatorStation::receive(double t_s) {
         const std::uint32_t age = seq_command_ - m.command_sequence;
         if (age > 0 && age < command_sent_s_.size() &&
             (!rtt_known_ || std::int32_t(m.command_sequence - rtt_sequence_) > 0)) {
-          rtt_s_ = t_s - command_sent_s_[m.command_sequence % command_sent_s_.size()];
+          rtt_s_ = round_trip_clock_s(t_s) - command_sent_s_[m.command_sequence % command_sent_s_.size()];
           rtt_sequence_ = m.command_sequence;
           rtt_known_ = true;
+          rtt_max_now_s_ = std::max(rtt_max_now_s_, rtt_s_);
         }
+        // How many of the commands up to the one it follows the remote received.
+        ack_sequence_ = m.command_sequence;
+        ack_received_ = m.commands_received;
+        ack_known_ = true;
         break;
       }
       case net::MessageType::kPatch: {
@@ -618,7 +632,7 @@ void OperatorStation::receive(double t_s) {
 // changed recently wait the same way (the remote has not seen that change
 // yet); every sample ends at the remote's height.
 void OperatorStation::merge(double t_s) {
-  HeightGrid& grid = rig_->world().simulation().grid();
+  const HeightGrid& grid = rig_->world().simulation().grid();
   const haptics::LoopRecord& last = rig_->loop().last();
   const bool in_contact = last.contact_length_m > 0.0;
   // The edge where the tool is now (the loop steps the simulation only
@@ -687,14 +701,65 @@ void OperatorStation::merge(double t_s) {
   active_blends_ = kept;
 }
 
+double OperatorStation::round_trip_clock_s(double t_s) const {
+  if (!options_.wall_clock) return t_s;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double OperatorStation::round_trip_bound_s() const {
+  if (!rtt_known_)
+    return settings_.to_remote.delay_s + settings_.to_operator.delay_s +
+           settings_.to_remote.jitter_s + settings_.to_operator.jitter_s;
+  const double recent = std::max(rtt_max_now_s_, rtt_max_before_s_);
+  return recent > 0.0 ? recent : rtt_s_;
+}
+
+// A local cut younger than a round trip (plus the sensing period and the
+// blend) is not yet in what the remote sends: it is kept that long.
+double OperatorStation::protection_s() const {
+  return round_trip_bound_s() + settings_.sense_period_s + settings_.blend_s + 0.05;
+}
+
+double OperatorStation::command_loss() const {
+  if (!ack_known_) return 0.0;
+  const double followed = double(ack_sequence_) + 1.0;
+  return std::clamp(1.0 - double(ack_received_) / followed, 0.0, 1.0);
+}
+
+// The round trip's buckets, the protection window, and the command loss over
+// the last second (the remote's reports a second apart).
+void OperatorStation::measure_link(double t_s) {
+  if (t_s - rtt_bucket_s_ >= 1.0) {
+    rtt_max_before_s_ = rtt_max_now_s_;
+    rtt_max_now_s_ = 0.0;
+    rtt_bucket_s_ = t_s;
+  }
+  protect_s_ = protection_s();
+  link_.note_round_trip_s(round_trip_bound_s());
+  const std::size_t at = std::size_t(ticks_) % loss_sequence_.size();
+  if (ack_known_ && loss_received_[at] >= 0) {
+    const double commands = double(std::int32_t(ack_sequence_ - loss_sequence_[at]));
+    if (commands >= 10.0)
+      loss_recent_ = std::clamp(1.0 - double(ack_received_ - loss_received_[at]) / commands, 0.0, 1.0);
+  }
+  loss_sequence_[at] = ack_sequence_;
+  loss_received_[at] = ack_known_ ? ack_received_ : -1;
+}
+
 void OperatorStation::tick(double t_s) {
   const auto start = std::chrono::steady_clock::now();
   receive(t_s);
+  measure_link(t_s);
   const bool updating_terrain = active_blends_ > 0;
   merge(t_s);
   const bool silent = heard_ && t_s - last_heard_s_ > settings_.timeout_s;
   guard_->set_silent(silent);
-  if (silent) ++counters_.silent_ticks;
+  if (silent) {
+    ++counters_.silent_ticks;
+    if (!was_silent_) ++silences_;
+    longest_silence_s_ = std::max(longest_silence_s_, t_s - last_heard_s_);
+  }
+  was_silent_ = silent;
 
   haptics::HapticLoop& loop = rig_->loop();
   Simulation& sim = rig_->world().simulation();
@@ -715,8 +780,11 @@ void OperatorStation::tick(double t_s) {
   cmd.t_s = t_s;
   cmd.pose = r.tool;
   cmd.flags = (r.flags & haptics::kFlagReconnected) ? net::kCommandLifted : 0u;
+  if (rtt_known_)
+    cmd.round_trip_us = std::uint32_t(std::clamp(round_trip_bound_s() * 1e6, 1.0, 4e9));
   std::uint8_t out[net::kHeaderSize + net::kCommandPayloadSize + net::kCrcSize];
-  command_sent_s_[seq_command_ % command_sent_s_.size()] = t_s;
+  const std::uint32_t sent_sequence = seq_command_;
+  command_sent_s_[seq_command_ % command_sent_s_.size()] = round_trip_clock_s(t_s);
   net::Header h{net::MessageType::kCommand, settings_.link_id, session_, seq_command_++,
                 to_ns(t_s)};
   const std::size_t n = net::encode_command(h, cmd, out);
@@ -769,6 +837,9 @@ void OperatorStation::tick(double t_s) {
   rec.passivity_j = window_j_;
   rec.passivity_dfr_j = window_dfr_j_;
   rec.compute_s = seconds_since(start);
+  rec.command_sequence = sent_sequence;
+  rec.round_trip_s = rtt_s_;
+  rec.command_loss = loss_recent_;
   last_ = rec;
   if (options_.keep_records) records_.push_back(rec);
 }

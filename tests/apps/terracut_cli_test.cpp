@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -101,7 +102,7 @@ void expect_clean_failure(const Result& r, const std::vector<std::string>& fragm
 TEST_F(CliTest, HelpOfEveryCommandSucceedsAndDescribesTheOptions) {
   const Result top = terracut({"--help"});
   EXPECT_EQ(top.code, 0);
-  for (const char* word : {"run", "heightmap", "reproduce", "validate", "Exit codes"})
+  for (const char* word : {"run", "heightmap", "reproduce", "validate", "calibrate", "Exit codes"})
     EXPECT_NE(top.out.find(word), std::string::npos) << word;
 
   const Result run = terracut({"run", "--help"});
@@ -131,6 +132,18 @@ TEST_F(CliTest, HelpOfEveryCommandSucceedsAndDescribesTheOptions) {
                            "conservation/volume.csv", "soil_cone.png", "degrees", "m^3",
                            "microseconds", "Exit code"})
     EXPECT_NE(val.out.find(word), std::string::npos) << word;
+  // Its checks are numbered as report.md's sections: cone, slopes,
+  // bulldozing, conservation, bucket, speed.
+  {
+    std::size_t at = 0;
+    int number = 1;
+    for (const char* section : {"cone", "slopes", "bulldozing", "conservation", "bucket", "speed"}) {
+      const std::string line = "  " + std::to_string(number++) + " " + section;
+      const std::size_t found = val.out.find(line, at);
+      EXPECT_NE(found, std::string::npos) << "validate --help lacks '" << line << "' after the previous check";
+      if (found != std::string::npos) at = found;
+    }
+  }
 
   EXPECT_EQ(terracut({"--version"}).code, 0);
 }
@@ -192,6 +205,21 @@ cuts:
   EXPECT_NEAR(last_y[1], first_y[1], 0.002);
   EXPECT_NEAR(last_x[1], 0.85, 0.002);
   EXPECT_NE(slurp(out / "summary.json").find("\"bodies\""), std::string::npos);
+}
+
+// What the device check lowers is said once, when the session is built,
+// and kept in summary.json's warnings (experiment 1's surface and cutting
+// damping exceed a Falcon's).
+TEST_F(CliTest, HapticsSaysEachDeviceCheckWarningOnce) {
+  const fs::path out = dir_ / "exp1";
+  const Result r = terracut({"haptics", scenario("paper_experiment1.yaml"), "--device", "script",
+                             "--no-plot", "--quiet", "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string line = "terracut haptics: warning: cutting damping";
+  const std::size_t first = r.err.find(line);
+  ASSERT_NE(first, std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find(line, first + 1), std::string::npos) << "said twice:\n" << r.err;
+  EXPECT_NE(slurp(out / "summary.json").find("cutting damping"), std::string::npos);
 }
 
 // `terracut haptics` on a scenario with bodies: the Bullet world is stepped
@@ -324,7 +352,10 @@ TEST_F(CliTest, BadOptionsAreReported) {
   expect_clean_failure(terracut({"run", sc, "--out", out, "--representation", "voxels"}),
                        {"--representation"}, 2);
   expect_clean_failure(terracut({"run", sc}), {"--out"}, 2);
-  expect_clean_failure(terracut({}), {"subcommand"}, 2);
+  expect_clean_failure(terracut({}), {"subcommand", "run, heightmap"}, 2);
+  // A word that is no subcommand is named, with the real ones listed.
+  expect_clean_failure(terracut({"frobnicate"}),
+                       {"unknown subcommand 'frobnicate'", "run, heightmap, reproduce, validate"}, 2);
   // An unknown option is named first, before the required ones it hides.
   expect_clean_failure(terracut({"run", "--bogus"}), {"unknown option", "--bogus"}, 2);
   expect_clean_failure(terracut({"run", sc, "--bogus"}), {"--bogus"}, 2);
@@ -439,6 +470,97 @@ TEST_F(CliTest, ValidateWritesItsOutputsAndEveryCheckPasses) {
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(report.find("FAIL"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(out / "checks.csv").find("FAIL"), std::string::npos);
+}
+
+// Calibration from material tests (docs/validation.md, "Calibration"): the
+// fitted fields with their uncertainties on stdout, calibration.json and a
+// soil.yaml that a scenario takes as its soil: section.
+TEST_F(CliTest, CalibrateFromTestsWritesASoilSectionAScenarioTakes) {
+  const fs::path tests = write("tests.json", R"({"bulk_density_kg_per_m3": [1500, 1520],
+      "repose_deg": [31, 33], "plate": [{"sigma_pa": 2000, "tau_pa": 900}],
+      "shear": [{"sigma_pa": 1000, "tau_pa": 900}, {"sigma_pa": 3000, "tau_pa": 2300},
+                {"sigma_pa": 5000, "tau_pa": 3700}]})");
+  const fs::path out = dir_ / "cal";
+  const Result r = terracut({"calibrate", "--tests", tests.string(), "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* word : {"internal_friction_deg", "cohesion_pa", "uncertainty", "soil:"})
+    EXPECT_NE(r.out.find(word), std::string::npos) << word;
+  ASSERT_TRUE(fs::exists(out / "calibration.json"));
+  const std::string soil = slurp(out / "soil.yaml");
+  // tau = 200 + 0.7 sigma exactly: phi = atan(0.7) = 34.9920 degrees.
+  EXPECT_NE(soil.find("internal_friction_deg: 34.992"), std::string::npos) << soil;
+  EXPECT_NE(soil.find("cohesion_pa: 200"), std::string::npos) << soil;
+  // The section in a scenario: `terracut run` takes it.
+  const fs::path sc = write("calibrated.yaml", "terrain:\n  generator: plane\n  resolution: 64\n"
+                                               "  size_m: [1.0, 1.0]\n  full_scale_m: 0.2\n"
+                                               "blade:\n  length_m: 0.3\n" + soil +
+                                               "cuts:\n  - name: c\n    keyframes:\n"
+                                               "      - {t_s: 0.0, position_m: [0.5, 0.15, 0.2]}\n"
+                                               "      - {t_s: 0.2, position_m: [0.5, 0.15, 0.4]}\n");
+  const Result run = terracut({"run", sc.string(), "--out", (dir_ / "run").string(), "--quiet"});
+  EXPECT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(slurp(dir_ / "run" / "summary.json").find("34.99"), std::string::npos);
+}
+
+// A force record made by `terracut run` itself (its contact.csv's poses and
+// its force.csv's force, at the scenario's rate) on a soil of 36 degrees and
+// 900 Pa gives that soil back, from a scenario that starts at dry sand's.
+TEST_F(CliTest, CalibrateFromARecordGivesTheSoilThatMadeIt) {
+  const std::string scene = "terrain:\n  generator: plane\n  resolution: 80\n  size_m: [0.8, 0.8]\n"
+                            "  full_scale_m: 0.3\nblade:\n  length_m: 0.3\n";
+  // The blade goes from 3 to 8 cm deep: two depths tell cohesion from friction.
+  const std::string cut = "cuts:\n  - name: c\n    keyframes:\n"
+                          "      - {t_s: 0.0, position_m: [0.4, 0.27, 0.05]}\n"
+                          "      - {t_s: 1.0, position_m: [0.4, 0.22, 0.45]}\n";
+  const fs::path truth = write("truth.yaml", scene + "soil:\n  internal_friction_deg: 36\n  cohesion_pa: 900\n" + cut);
+  const fs::path start = write("start.yaml", scene + "soil:\n  preset: dry_sand\n" + cut);
+  ASSERT_EQ(terracut({"run", truth.string(), "--out", (dir_ / "truth").string(), "--quiet"}).code, 0);
+  std::ifstream contact(dir_ / "truth" / "contact.csv"), force(dir_ / "truth" / "force.csv");
+  std::ofstream record(dir_ / "record.csv");
+  record << "t_s,x_m,y_m,z_m,qw,qx,qy,qz,fx_n,fy_n,fz_n\n";
+  std::string a, b;
+  std::getline(contact, a);
+  std::getline(force, b);
+  int rows = 0;
+  while (std::getline(contact, a) && std::getline(force, b)) {
+    // contact: t,cut,x,y,z,qw,qx,qy,qz,...; force: t,cut,fx,fy,fz,...
+    std::vector<std::string> c, f;
+    for (std::stringstream ss(a); std::getline(ss, a, ',');) c.push_back(a);
+    for (std::stringstream ss(b); std::getline(ss, b, ',');) f.push_back(b);
+    ASSERT_GE(c.size(), 9u);
+    ASSERT_GE(f.size(), 5u);
+    record << c[0] << "," << c[2] << "," << c[3] << "," << c[4] << "," << c[5] << "," << c[6] << "," << c[7] << ","
+           << c[8] << "," << f[2] << "," << f[3] << "," << f[4] << "\n";
+    ++rows;
+  }
+  record.close();
+  ASSERT_GT(rows, 900);
+  const Result r = terracut({"calibrate", "--record", (dir_ / "record.csv").string(), "--scenario", start.string(),
+                             "--from-s", "0.01", "--out", (dir_ / "cal").string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string soil = slurp(dir_ / "cal" / "soil.yaml");
+  const auto value = [&](const std::string& key) {
+    const std::size_t at = soil.find(key + ": ");
+    return at == std::string::npos ? -1.0 : std::stod(soil.substr(at + key.size() + 2));
+  };
+  // contact.csv and force.csv print 9 significant digits: the poses and
+  // forces are the run's to 1e-9 relative; the fit stops when a step gains
+  // less than 1e-6 of the residual.
+  EXPECT_NEAR(value("internal_friction_deg"), 36.0, 0.02) << soil;
+  EXPECT_NEAR(value("cohesion_pa"), 900.0, 2.0) << soil;
+}
+
+TEST_F(CliTest, CalibrateRefusesBadInputNamingIt) {
+  expect_clean_failure(terracut({"calibrate"}), {"give --tests FILE, --record FILE --scenario FILE, or --dem-run DIR"});
+  expect_clean_failure(terracut({"calibrate", "--record", write("r.csv", "x\n").string()}), {"needs --scenario"});
+  expect_clean_failure(terracut({"calibrate", "--record", write("r.csv", "t_s,x\n").string(), "--scenario",
+                                 scenario("mound_generator.yaml")}),
+                       {"r.csv:1: expected the header"});
+  expect_clean_failure(terracut({"calibrate", "--tests", write("t.json", R"({"shear": [{"sigma_pa": 1000, "tau_pa": 5}]})").string()}),
+                       {"shear: the Mohr-Coulomb line needs tests at two normal stresses"});
+  expect_clean_failure(terracut({"calibrate", "--tests", (dir_ / "absent.json").string()}), {"absent.json: cannot be read"});
+  const Result both = terracut({"calibrate", "--tests", "a", "--record", "b"});
+  EXPECT_EQ(both.code, 2) << both.err;
 }
 
 }  // namespace

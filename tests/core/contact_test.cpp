@@ -185,9 +185,9 @@ TEST(Contact, NonFiniteEdgeHasNoContact) {
 }
 
 TEST(Contact, RepresentationNames) {
-  EXPECT_EQ(parse_representation("columns"), Representation::kColumns);
-  EXPECT_EQ(parse_representation("surface"), Representation::kSurface);
-  EXPECT_FALSE(parse_representation("voxels").has_value());
+  EXPECT_EQ(parse_enum<Representation>("columns"), Representation::kColumns);
+  EXPECT_EQ(parse_enum<Representation>("surface"), Representation::kSurface);
+  EXPECT_FALSE(parse_enum<Representation>("voxels").has_value());
   EXPECT_EQ(to_string(Representation::kSurface), "surface");
 }
 

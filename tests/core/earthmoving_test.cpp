@@ -119,7 +119,7 @@ TEST(Earthmoving, MinimiserFindsTheMinimum) {
   // Every preset at rakes from 30 to 110 degrees, with and without side
   // failure, with and without a surcharge.
   std::vector<std::pair<EarthmovingParams, double>> cases;
-  for (SoilPreset s : soil_presets()) {
+  for (const auto& [s, preset_name] : kSoilPresetNames) {
     for (double alpha : {30.0, 45.0, 60.0, 75.0, 90.0, 110.0}) {
       for (bool side : {false, true}) {
         EarthmovingParams p;
@@ -213,7 +213,7 @@ TEST(Earthmoving, HorizontalAndVerticalBalanceTheWedge) {
   std::vector<std::pair<EarthmovingParams, double>> cases = {
       {fee(90, 20, 30, 16e3, 1e3, 0.0), 0.0}, {fee(50, 15, 28, 15e3, 2e3, 1.5e3), 400.0},
       {fee(70, 8, 13, 18e3, 4e3, 2e3), 0.0}, {fee(110, 10, 25, 17e3, 0.0, 1e3), 1e3}};
-  for (SoilPreset s : soil_presets()) {
+  for (const auto& [s, preset_name] : kSoilPresetNames) {
     EarthmovingParams p = fee(60, 0, 0, 1.0, 0.0, 0.0);
     p.soil = soil_preset(s);
     cases.push_back({p, 0.0});
@@ -280,7 +280,7 @@ TEST(Earthmoving, SurchargeRatioIsExactForACohesionlessSoil) {
 // The surcharge's part is the q terms of the same solution, with side
 // failure too: P(beta*; q) minus P(beta*; 0) at the same failure plane.
 TEST(Earthmoving, TheSurchargePartIsTheQTermsAtTheSameWedge) {
-  for (SoilPreset s : soil_presets()) {
+  for (const auto& [s, preset_name] : kSoilPresetNames) {
     EarthmovingParams p;
     p.soil = soil_preset(s);
     p.rake_angle_deg = 70.0;
@@ -419,7 +419,7 @@ TEST(SideFailure, TheCrescentsAreTheirElementsSummed) {
 // add a fixed load at each end, so the excess over the 2-D force falls as
 // d / w; a narrow blade feels more per metre of width.
 TEST(SideFailure, AWideBladeTendsToTheTwoDimensionalEquation) {
-  for (SoilPreset s : soil_presets()) {
+  for (const auto& [s, preset_name] : kSoilPresetNames) {
     for (double alpha : {45.0, 90.0}) {
       EarthmovingParams p;
       p.soil = soil_preset(s);

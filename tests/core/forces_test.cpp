@@ -191,9 +191,9 @@ TEST(ForceModel, ValidateNamesNestedFields) {
   EXPECT_THROW(ForceModel{p}, InputError);
   for (CuttingModel m :
        {CuttingModel::kNone, CuttingModel::kContactDrag, CuttingModel::kEarthmoving})
-    EXPECT_EQ(parse_cutting_model(to_string(m)), m);
+    EXPECT_EQ(parse_enum<CuttingModel>(to_string(m)), m);
   for (LimitPolicy m : {LimitPolicy::kRefuse, LimitPolicy::kClamp})
-    EXPECT_EQ(parse_limit_policy(to_string(m)), m);
+    EXPECT_EQ(parse_enum<LimitPolicy>(to_string(m)), m);
 }
 
 TEST(ForceModel, SumsModelsAndScalesToTheDevice) {

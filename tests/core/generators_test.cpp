@@ -105,8 +105,8 @@ TEST(Generators, ValidateNamesTheBadField) {
 
 TEST(Generators, KindNamesRoundTrip) {
   for (GeneratorKind k : {GeneratorKind::kMound, GeneratorKind::kBox, GeneratorKind::kPlane})
-    EXPECT_EQ(parse_generator_kind(to_string(k)), k);
-  EXPECT_FALSE(parse_generator_kind("dome").has_value());
+    EXPECT_EQ(parse_enum<GeneratorKind>(to_string(k)), k);
+  EXPECT_FALSE(parse_enum<GeneratorKind>("dome").has_value());
 }
 
 TEST(DomeGeometry, HorizontalChordMatchesTheCircleOfTheSection) {

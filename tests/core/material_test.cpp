@@ -30,14 +30,14 @@ TEST(SoilMaterial, PresetsAreCitedValuesAndOrdered) {
   EXPECT_DOUBLE_EQ(gravel.internal_friction_deg, 36.5);
   EXPECT_DOUBLE_EQ(gravel.cohesion_pa, 0.0);
   EXPECT_NEAR(gravel.density_kg_per_m3(), 1680.0, 1e-9);
-  for (SoilPreset p : soil_presets()) {
+  for (const auto& [p, preset_name] : kSoilPresetNames) {
     const SoilMaterial s = soil_preset(p);
     EXPECT_TRUE(validate(s).empty()) << to_string(p);
     EXPECT_DOUBLE_EQ(s.soil_tool_friction_deg, 2.0 / 3.0 * s.internal_friction_deg);
-    EXPECT_EQ(parse_soil_preset(to_string(p)), p);
+    EXPECT_EQ(parse_enum<SoilPreset>(to_string(p)), p);
     EXPECT_NEAR(s.density_kg_per_m3() * kStandardGravity_m_per_s2, s.unit_weight_n_per_m3, 1e-9);
   }
-  EXPECT_FALSE(parse_soil_preset("sand").has_value());
+  EXPECT_FALSE(parse_enum<SoilPreset>("sand").has_value());
   // The defaults are the dry-sand preset.
   const SoilMaterial def;
   EXPECT_DOUBLE_EQ(def.unit_weight_n_per_m3, dry.unit_weight_n_per_m3);

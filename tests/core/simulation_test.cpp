@@ -7,6 +7,9 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
 
 #include "terracut/core/error.hpp"
 #include "test_terrains.hpp"
@@ -331,6 +334,83 @@ TEST(Simulation, EditHeightsWritesItsRectangleAndTellsTheListeners) {
   // one, 8 cells of 0.1 m (the blade spans the grid).
   const StepOutput& out = sim.step({{0.5, 0.25, 0.35}, Quat{}});
   EXPECT_NEAR(out.contact.length_m, 0.8, 1e-9);
+}
+
+// Reset restores the terrain and tells every listener that the whole grid
+// changed (whoever caches heights refreshes them), as an edit does.
+TEST(Simulation, ResetTellsTheListenersTheWholeGridChanged) {
+  SimParams p;
+  p.grid = test::square_spec(6, 4);
+  Simulation sim(p, std::vector<float>(24, 0.5f));
+  EditRecorder recorder;
+  sim.add_listener(recorder);
+  sim.step({{0.5, 0.2, 0.1}, Quat{}});
+  EXPECT_TRUE(recorder.edits.empty());  // a step is no edit
+  sim.reset();
+  ASSERT_EQ(recorder.edits.size(), 1u);
+  EXPECT_EQ(recorder.edits[0], (Rect{0, 0, 6, 4}));
+}
+
+// The simulation owns the heights: grid() is read-only, and a listener
+// changes heights only through lower_sample and move_height, from inside
+// its own callbacks.
+static_assert(std::is_same_v<decltype(std::declval<Simulation&>().grid()), const HeightGrid&>,
+              "the terrain is changed through the simulation, not through grid()");
+
+struct SoilPusher final : StepListener {
+  Simulation* sim = nullptr;
+  std::int64_t from = 0, to = 0;
+  float amount_m = 0.0f, lower_to_m = 0.0f;
+  std::int64_t lowered = -1;
+  Vec3 on_step(const StepOutput&) noexcept override {
+    sim->move_height(from, to, amount_m);
+    if (lowered >= 0) sim->lower_sample(lowered, lower_to_m);
+    sim->include_changed({0, 0, 3, 1});
+    return {};
+  }
+  void on_edit(const Rect&) noexcept override {
+    if (lowered >= 0) sim->lower_sample(lowered, lower_to_m);  // e.g. a height bound
+  }
+};
+
+TEST(Simulation, AListenerChangesHeightsThroughTheSimulation) {
+  SimParams p;
+  p.grid = test::square_spec(4, 4);
+  p.blade.length_m = 0.1;
+  Simulation sim(p, std::vector<float>(16, 0.5f));
+  SoilPusher pusher;
+  pusher.sim = &sim;
+  pusher.from = sim.grid().index(0, 0);
+  pusher.to = sim.grid().index(1, 0);
+  pusher.amount_m = 0.125f;
+  pusher.lowered = sim.grid().index(2, 0);
+  pusher.lower_to_m = 0.25f;
+  sim.add_listener(pusher);
+  const double volume = sim.grid().volume_m3();
+  // A step far above the soil cuts nothing: only the listener changes heights.
+  const StepOutput& out = sim.step({{0.5, 2.0, 0.5}, Quat{}});
+  EXPECT_EQ(sim.grid().height(0, 0), 0.375f);
+  EXPECT_EQ(sim.grid().height(1, 0), 0.625f);
+  EXPECT_EQ(sim.grid().height(2, 0), 0.25f);
+  EXPECT_EQ(out.changed, (Rect{0, 0, 3, 1}));  // what the listener reported
+  // The move keeps the volume; the lowering removes a quarter of a cell's column.
+  EXPECT_NEAR(sim.grid().volume_m3(), volume - 0.25 * sim.grid().spec().cell_area_m2(), 1e-9);
+  // lower_sample never raises a sample, and never goes below the floor.
+  pusher.amount_m = 0.0f;
+  pusher.lower_to_m = 0.4f;
+  sim.step({{0.5, 2.0, 0.5}, Quat{}});
+  EXPECT_EQ(sim.grid().height(2, 0), 0.25f);
+  pusher.lower_to_m = -1.0f;
+  sim.step({{0.5, 2.0, 0.5}, Quat{}});
+  EXPECT_EQ(sim.grid().height(2, 0), 0.0f);
+  // Outside a listener's callbacks the simulation refuses.
+  EXPECT_THROW(sim.move_height(pusher.from, pusher.to, 0.1f), std::logic_error);
+  EXPECT_THROW(sim.lower_sample(pusher.lowered, 0.1f), std::logic_error);
+  // From on_edit (an edit, a reset) it may: the reset's notification lowers it again.
+  pusher.lower_to_m = 0.125f;
+  sim.reset();
+  EXPECT_EQ(sim.grid().height(2, 0), 0.125f);
+  EXPECT_EQ(sim.grid().height(0, 0), 0.5f);
 }
 
 // Bad edits are refused with a message naming what was wrong, and nothing is

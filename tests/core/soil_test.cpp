@@ -331,9 +331,9 @@ TEST(SoilFlow, RefusesBadParameters) {
   EXPECT_EQ(validate(flow(1.0)), "");
   p = flow(34.0, 10);
   EXPECT_NE(validate(p).find("soil.max_pair_checks_per_step"), std::string::npos);
-  EXPECT_EQ(parse_soil_model("flow"), SoilModel::kFlow);
-  EXPECT_EQ(parse_soil_model("vanish"), SoilModel::kVanish);
-  EXPECT_FALSE(parse_soil_model("mud"));
+  EXPECT_EQ(parse_enum<SoilModel>("flow"), SoilModel::kFlow);
+  EXPECT_EQ(parse_enum<SoilModel>("vanish"), SoilModel::kVanish);
+  EXPECT_FALSE(parse_enum<SoilModel>("mud"));
 }
 
 // A blade 1 m wide cutting d = 5 cm into a 20 cm layer of sand (repose 34)

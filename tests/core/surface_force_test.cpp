@@ -16,14 +16,6 @@ namespace terracut {
 namespace {
 
 
-// Relative tolerance for closed forms evaluated in double: a few dozen
-// roundings of O(1) trigonometric terms.
-constexpr double kRel = 1e-12;
-
-void expect_rel(double actual, double expected, double rel, const char* what) {
-  EXPECT_NEAR(actual, expected, rel * std::max(1.0, std::abs(expected))) << what;
-}
-
 HeightGrid small_grid() {
   GridSpec spec;
   spec.cols = 4;

@@ -98,7 +98,9 @@ TEST(ToolForce, TheWidthIsAcrossTheMotion) {
     }
     const ToolForce& f = sim.last().force;
     EXPECT_NEAR(f.engaged_width_m, 0.4 * std::cos(a), 0.02 * 0.4) << angle_deg;
-    if (angle_deg == 90.0) EXPECT_NEAR(std::hypot(f.total_n.x, f.total_n.z), 0.0, 1e-9);
+    if (angle_deg == 90.0) {
+      EXPECT_NEAR(std::hypot(f.total_n.x, f.total_n.z), 0.0, 1e-9);
+    }
   }
 }
 

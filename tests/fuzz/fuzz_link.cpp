@@ -68,7 +68,7 @@ Reject decode_and_check(const std::uint8_t* data, std::size_t size, Patch& patch
       Command c2;
       check(decode_header(again, n, kLink, h2) == Reject::kNone && decode_command(again, n, c2) == Reject::kNone,
             kTarget, "a re-encoded command is refused");
-      check(same_bits(c.t_s, c2.t_s) && same_bits(c.pose, c2.pose) && c.flags == c2.flags, kTarget,
+      check(same_bits(c.t_s, c2.t_s) && same_bits(c.pose, c2.pose) && c.flags == c2.flags && c.round_trip_us == c2.round_trip_us, kTarget,
             "a command does not survive re-encoding");
       return r;
     }
@@ -86,7 +86,8 @@ Reject decode_and_check(const std::uint8_t* data, std::size_t size, Patch& patch
                 decode_measurement(again, n, m2) == Reject::kNone,
             kTarget, "a re-encoded measurement is refused");
       check(same_bits(m.t_s, m2.t_s) && same_bits(m.pose, m2.pose) && same_bits(m.force_world_n, m2.force_world_n) &&
-                m.command_sequence == m2.command_sequence && m.flags == m2.flags,
+                m.command_sequence == m2.command_sequence && m.flags == m2.flags &&
+                m.commands_received == m2.commands_received,
             kTarget, "a measurement does not survive re-encoding");
       return r;
     }

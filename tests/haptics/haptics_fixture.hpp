@@ -66,7 +66,7 @@ inline LoopOptions test_loop_options(std::int64_t ticks, SnapshotExchange* snaps
 inline LoopRig make_loop_rig(const HapticSettings& settings, const io::Scenario& sc,
                              Quat default_orientation, Device& device, const LoopOptions& options,
                              const std::vector<StepListener*>& listeners = {}) {
-  const LoopParams params(settings, sc.blade);
+  const LoopParams params(settings, sc.blade, sc.rate_hz);
   LoopRig rig;
   rig.sim = std::make_unique<Simulation>(io::sim_params(sc, params.rate_hz()),
                                          io::build_initial_heights(sc));

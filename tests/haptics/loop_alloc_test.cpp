@@ -37,8 +37,8 @@ long allocations_per_run(Device& device, std::int64_t ticks, SnapshotExchange* s
   const long before = g_allocations.load();
   for (std::int64_t i = 1; i < ticks; ++i) {
     if (before_tick) before_tick(i);
-    loop.step1(double(i) / in.haptics.rate_hz);
-    loop.step2(1.0 / in.haptics.rate_hz, 0.0, false);
+    loop.step1(double(i) / in.scenario.rate_hz);
+    loop.step2(1.0 / in.scenario.rate_hz, 0.0, false);
   }
   const long during = g_allocations.load() - before;
   EXPECT_GT(loop.simulation().removed_volume_m3(), 0.0);
@@ -54,7 +54,8 @@ TEST(LoopAllocation, ScriptAndSimTicksAllocateNothing) {
   }
   {
     SimHandDevice device(
-        SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, path, s.rate_hz));
+        SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, path,
+                test::trench().scenario.rate_hz));
     const io::Scenario& sc = test::trench().scenario;
     const Simulation probe(io::sim_params(sc), io::build_initial_heights(sc));
     SnapshotExchange exchange(probe.grid());

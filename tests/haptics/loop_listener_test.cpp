@@ -85,7 +85,7 @@ struct EngineLoop {
 const Motion& trench_cut() { return trench().scenario.cuts[0]; }
 
 std::int64_t ticks_of(const HapticSettings& s) {
-  return std::llround((trench_cut().duration_s() + s.settle_s) * s.rate_hz);
+  return std::llround((trench_cut().duration_s() + s.settle_s) * trench().scenario.rate_hz);
 }
 
 EngineLoop make_loop(Device& device, std::int64_t ticks, TestEngine* engine,

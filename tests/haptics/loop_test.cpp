@@ -7,9 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <thread>
 #include <utility>
 
 #include "haptics_fixture.hpp"
@@ -33,13 +35,15 @@ test::LoopRig trench_loop(const HapticSettings& settings, Device& device, std::i
 }
 
 const Motion& trench_cut() { return trench().scenario.cuts[0]; }
+// The trench's one rate, the loop's.
+double trench_rate_hz() { return trench().scenario.rate_hz; }
 
 DevicePath trench_path(const HapticSettings& s) {
   return DevicePath(trench_cut(), Workspace(s.workspace));
 }
 
 std::int64_t ticks_of(const HapticSettings& s) {
-  return std::llround((trench_cut().duration_s() + s.settle_s) * s.rate_hz);
+  return std::llround((trench_cut().duration_s() + s.settle_s) * trench_rate_hz());
 }
 
 // The trench's soil flows: after each step, what the loop's earthmoving
@@ -347,7 +351,7 @@ TEST(HapticLoop, DeterministicRunsAreIdentical) {
         device = std::make_unique<ScriptDevice>(trench_path(s));
       else
         device = std::make_unique<SimHandDevice>(
-            SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, trench_path(s), s.rate_hz));
+            SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, trench_path(s), trench_rate_hz()));
       auto loop = trench_loop(s, *device, 3000);
       loop->run_deterministic();
       out = loop->records();
@@ -383,7 +387,7 @@ TEST(HapticLoop, BadSampleIsCountedAndAnsweredWithZeroForce) {
   // renders beta |v|, within 5 % of it after ln 20 of the filter's time constants.
   const double rebuild_s = rs[1999].force_device_n.x / s.safety.max_force_rate_n_per_s;
   const double settle_s = std::log(20.0) / (2.0 * std::numbers::pi * s.velocity_cutoff_hz);
-  const std::size_t back = 2005 + std::size_t(std::ceil((rebuild_s + settle_s) * s.rate_hz)) + 2;
+  const std::size_t back = 2005 + std::size_t(std::ceil((rebuild_s + settle_s) * trench_rate_hz())) + 2;
   EXPECT_NEAR(length(rs[back].force_device_n), length(rs[1999].force_device_n),
               0.05 * length(rs[1999].force_device_n));
   EXPECT_EQ(device.commands.size(), std::size_t(ticks));
@@ -400,8 +404,8 @@ TEST(HapticLoop, SilentDeviceTripsTheWatchdogAndSoftStartsOnReturn) {
   const std::vector<LoopRecord> rs = loop->records();
   const double f0 = length(rs[1999].force_device_n);
   ASSERT_GT(f0, 0.5);
-  const int timeout = int(std::lround(s.safety.watchdog_timeout_s * s.rate_hz));
-  const int ramp = int(std::lround(s.safety.watchdog_ramp_s * s.rate_hz));
+  const int timeout = int(std::lround(s.safety.watchdog_timeout_s * trench_rate_hz()));
+  const int ramp = int(std::lround(s.safety.watchdog_ramp_s * trench_rate_hz()));
   // Before the timeout the last force is held; after it, ramped to zero.
   EXPECT_FALSE(rs[std::size_t(1999 + timeout)].flags & kFlagWatchdog);
   EXPECT_TRUE(rs[std::size_t(2001 + timeout)].flags & kFlagWatchdog);
@@ -420,7 +424,7 @@ TEST(HapticLoop, SilentDeviceTripsTheWatchdogAndSoftStartsOnReturn) {
 TEST(HapticLoop, BadSampleDuringTheWatchdogFadeGetsZeroForce) {
   const HapticSettings& s = trench().haptics;
   ScriptDevice script(trench_path(s));
-  const int timeout = int(std::lround(s.safety.watchdog_timeout_s * s.rate_hz));
+  const int timeout = int(std::lround(s.safety.watchdog_timeout_s * trench_rate_hz()));
   const std::int64_t bad = 2000 + timeout + 10;  // silent from 2000, tripped by now, fading
   test::FaultyDevice device(
       script, [&](std::int64_t tick) { return tick == bad; },
@@ -432,7 +436,7 @@ TEST(HapticLoop, BadSampleDuringTheWatchdogFadeGetsZeroForce) {
   ASSERT_TRUE(rs[std::size_t(bad - 1)].flags & kFlagWatchdog);
   EXPECT_TRUE(rs[std::size_t(bad)].flags & kFlagBadSample);
   EXPECT_EQ(length(rs[std::size_t(bad)].force_device_n), 0.0);
-  const double step_n = s.safety.max_force_rate_n_per_s / s.rate_hz;
+  const double step_n = s.safety.max_force_rate_n_per_s / trench_rate_hz();
   EXPECT_LE(length(rs[std::size_t(bad + 1)].force_device_n), step_n * (1 + 1e-9));
   EXPECT_EQ(loop->counters().bad_samples, 1);
 }
@@ -443,7 +447,7 @@ TEST(HapticLoop, BadSampleDuringTheWatchdogFadeGetsZeroForce) {
 TEST(HapticLoop, SimHandTrenchStaysBoundedAndDigs) {
   const HapticSettings& s = trench().haptics;
   SimHandDevice device(
-      SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, trench_path(s), s.rate_hz));
+      SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, trench_path(s), trench_rate_hz()));
   auto loop = trench_loop(s, device, ticks_of(s));
   loop->run_deterministic();
   const std::vector<LoopRecord> rs = loop->records();
@@ -531,7 +535,7 @@ HoldResult hold_against_floor(HapticSettings s, double floor_stiffness_world) {
   hold.keyframes = {{0.0, {{0.0, -0.03, 0.0}, Quat{}}}};  // 2 mm below the floor, on the device
   const DevicePath path(hold, Workspace(s.workspace));
   SimHandDevice device(
-      SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, path, s.rate_hz));
+      SimHand(s.hand, s.forces.device.inherent_damping_n_s_per_m, path, trench_rate_hz()));
   LoopOptions o;
   o.ticks = 2000;
   o.realtime = false;
@@ -539,7 +543,7 @@ HoldResult hold_against_floor(HapticSettings s, double floor_stiffness_world) {
   HapticLoop& loop = *rig;
   HoldResult r;
   for (std::int64_t i = 0; i < o.ticks; ++i) {
-    loop.step1(double(i) / s.rate_hz);
+    loop.step1(double(i) / trench_rate_hz());
     const double e = holding_energy(device.hand(), loop);
     if (i == 0) r.start_j = e;
     r.max_j = std::max(r.max_j, e);
@@ -589,7 +593,7 @@ TEST(HapticLoop, StatisticsFromTheTickTimes) {
   auto loop = trench_loop(s, device, 1000);
   // A fake clock: 989 periods exactly nominal, 10 late by 500 us; compute
   // times 100 us, except one of 700 us; three missed deadlines.
-  const double T = 1.0 / s.rate_hz;
+  const double T = 1.0 / trench_rate_hz();
   for (int i = 0; i < 1000; ++i) {
     loop->step1(i * T);
     const double period = i == 0 ? 0.0 : (i % 100 == 50 ? T + 500e-6 : T);
@@ -680,6 +684,101 @@ TEST(HapticLoop, PacedLoopStatisticsWithAFakeClock) {
   EXPECT_NEAR(ps.compute.max_s, 2.5e-3, 1e-8);
   EXPECT_NEAR(ps.period_jitter.max_s, 1.5e-3, 1e-8);
   EXPECT_LT(ps.period_jitter.p50_s, 2e-6);
+}
+
+// A device its user pauses for a while (the viewer's virtual one): paused
+// from read 40 for 300 looks, then playing again.
+class PausingDevice final : public Device {
+ public:
+  explicit PausingDevice(Device& inner) : inner_(inner) {}
+  std::string_view kind() const override { return inner_.kind(); }
+  void start(double t_s) override { inner_.start(t_s); }
+  bool read(double t_s, DeviceSample& out) noexcept override {
+    ++reads;
+    return inner_.read(t_s, out);
+  }
+  void write(const DeviceCommand& command) noexcept override { inner_.write(command); }
+  bool paused() noexcept override {
+    if (reads < 40 || looks_paused >= 300) return false;
+    ++looks_paused;
+    reads_while_paused = reads;
+    return true;
+  }
+  std::int64_t reads = 0, looks_paused = 0, reads_while_paused = -1;
+
+ private:
+  Device& inner_;
+};
+
+// The threaded loop holds while its device is paused: no tick runs (the
+// device is not read), the hold sleeps in steps of kPausePoll_s, and the
+// loop's clock leaves the pause out: the tick after it is one period after
+// the tick before, with no late tick, jitter or missed deadline counted.
+TEST(HapticLoop, APausedDeviceHoldsTheLoopAndItsClock) {
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice script(trench_path(s));
+  PausingDevice device(script);
+  auto clock = std::make_shared<TestClock>();
+  const io::Scenario& sc = trench().scenario;
+  LoopOptions o;
+  o.ticks = 100;
+  o.record_capacity = 100;
+  o.realtime = false;
+  o.clock = clock;
+  const test::LoopRig rig = test::make_loop_rig(s, sc, Quat{}, device, o);
+  HapticLoop& loop = *rig;
+  const double start = clock->now_s();
+  loop.start();
+  loop.join();
+  EXPECT_EQ(device.looks_paused, 300);
+  EXPECT_EQ(device.reads_while_paused, 40);  // nothing was read while paused
+  EXPECT_EQ(loop.counters().ticks, 100);
+  // The fake clock moved through the hold: 300 looks, one poll apart.
+  EXPECT_GE(clock->now_s() - start, 299 * HapticLoop::kPausePoll_s);
+  const std::vector<LoopRecord> rs = loop.records();
+  ASSERT_EQ(rs.size(), 100u);
+  // Every period is the nominal one, to the fake clock's spin step (1 us),
+  // the one after the 1.5 s pause included.
+  const double T = 1.0 / trench_rate_hz();
+  for (std::size_t i = 1; i < rs.size(); ++i) {
+    EXPECT_NEAR(rs[i].t_s - rs[i - 1].t_s, T, 1.5e-6) << "tick " << i;
+    EXPECT_NEAR(rs[i].period_s, T, 1.5e-6) << "tick " << i;
+  }
+  EXPECT_EQ(loop.counters().missed_deadlines, 0);
+  EXPECT_EQ(loop.pacer_stats().missed_deadlines, 0);
+  EXPECT_LT(loop.pacer_stats().period_jitter.max_s, 1e-4);
+}
+
+// A stop asked for while the device is paused ends the held loop.
+TEST(HapticLoop, AStopEndsAPausedLoop) {
+  class AlwaysPaused final : public Device {
+   public:
+    explicit AlwaysPaused(Device& inner) : inner_(inner) {}
+    std::string_view kind() const override { return inner_.kind(); }
+    bool read(double t_s, DeviceSample& out) noexcept override { return inner_.read(t_s, out); }
+    void write(const DeviceCommand& command) noexcept override { inner_.write(command); }
+    bool paused() noexcept override { return true; }
+
+   private:
+    Device& inner_;
+  };
+  const HapticSettings& s = trench().haptics;
+  ScriptDevice script(trench_path(s));
+  AlwaysPaused device(script);
+  const io::Scenario& sc = trench().scenario;
+  LoopOptions o;
+  o.ticks = 1000000;
+  o.realtime = false;
+  const test::LoopRig rig = test::make_loop_rig(s, sc, Quat{}, device, o);
+  HapticLoop& loop = *rig;
+  loop.start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_TRUE(loop.running());
+  loop.request_stop();
+  loop.join();
+  EXPECT_FALSE(loop.running());
+  // The counters belong to the loop's thread until it is joined.
+  EXPECT_EQ(loop.counters().ticks, 1);  // the first tick, then held
 }
 
 TEST(HapticLoop, RecordsKeepTheNewestWhenFull) {

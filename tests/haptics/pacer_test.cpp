@@ -95,6 +95,45 @@ TEST(Pacer, ExactScheduleOnAFakeClock) {
   EXPECT_EQ(s.rate_hz, 1000.0);
 }
 
+// After a hold (the loop's device paused) the next tick starts at once, the
+// schedule moved to it: the gap counts as no period, no jitter, no latency
+// and no missed deadline, and the ticks after it are on the new grid.
+TEST(Pacer, ResumeAfterAHoldStartsANewGridWithoutCountingTheGap) {
+  auto clock = std::make_shared<FakeClock>();
+  Pacer pacer(settings(1000.0, 0.0), clock);
+  pacer.start();
+  for (int i = 0; i < 10; ++i) {
+    clock->work(0.2e-3);
+    pacer.wait_next();
+  }
+  clock->work(0.2e-3);
+  pacer.hold();
+  clock->work(3.2567);  // the hold
+  const double now = clock->t;
+  const Tick r = pacer.resume();
+  EXPECT_EQ(r.index, 11);
+  EXPECT_EQ(r.slot, 11);
+  EXPECT_EQ(r.start_s, now);
+  EXPECT_EQ(r.deadline_s, now);
+  EXPECT_EQ(r.period_s, 1e-3);
+  EXPECT_FALSE(r.after_overrun);
+  Tick t{};
+  for (int i = 0; i < 5; ++i) {
+    clock->work(0.2e-3);
+    t = pacer.wait_next();
+    EXPECT_FALSE(t.after_overrun);
+    EXPECT_NEAR(t.start_s, now + (i + 1) * 1e-3, 1e-9);
+  }
+  const LoopStats s = pacer.stats();
+  EXPECT_EQ(s.ticks, 16);
+  EXPECT_EQ(s.missed_deadlines, 0);
+  EXPECT_EQ(s.skipped_slots, 0);
+  EXPECT_LE(s.period_jitter.max_s, 1e-9);
+  EXPECT_LE(s.wake_latency.max_s, 1e-9);
+  // The tick before the hold keeps its own compute time, not the hold's.
+  EXPECT_NEAR(s.compute.max_s, 0.2e-3, 1e-9);
+}
+
 // Sleeping without a spin wakes as late as the OS makes it; a spin longer
 // than the oversleep absorbs it, to within one spin iteration.
 TEST(Pacer, SpinAbsorbsOversleep) {

@@ -36,7 +36,6 @@ std::string error_of(const std::string& text) {
 TEST(HapticsYaml, EmptySectionGivesTheDefaults) {
   const HapticSettings s = parse("haptics:\n");
   const HapticSettings d;
-  EXPECT_EQ(s.rate_hz, d.rate_hz);
   EXPECT_EQ(s.device, DeviceKind::kSim);
   EXPECT_EQ(s.safety.max_force_n, d.forces.device.max_force_n);
   EXPECT_EQ(s.forces.cutting, d.forces.cutting);
@@ -49,7 +48,6 @@ TEST(HapticsYaml, EmptySectionGivesTheDefaults) {
 TEST(HapticsYaml, ReadsEveryBlock) {
   const HapticSettings s = parse(R"(
 haptics:
-  rate_hz: 500
   device: udp
   cut: pass2
   duration_s: 12.5
@@ -73,7 +71,6 @@ haptics:
          start_offset_m: [0, 0.01, 0]}
   udp: {address: "::1", port: 50001}
 )");
-  EXPECT_EQ(s.rate_hz, 500.0);
   EXPECT_EQ(s.device, DeviceKind::kUdp);
   EXPECT_EQ(s.cut, "pass2");
   EXPECT_EQ(*s.duration_s, 12.5);
@@ -122,11 +119,15 @@ TEST(HapticsYaml, TheOldLayoutNamesTheNewField) {
   EXPECT_NE(error_of("haptics:\n  forces:\n    project_width_on_motion: false\n")
                 .find("project_width_on_motion: removed"),
             std::string::npos);
+  // The loop's rate is the scenario's one rate_hz: the old key names it.
+  EXPECT_NE(error_of("haptics:\n  rate_hz: 500\n")
+                .find("test.yaml:2: haptics.rate_hz: moved to the top-level rate_hz"),
+            std::string::npos);
 }
 
 TEST(HapticsYaml, ErrorsNameFileLineAndField) {
   // Unknown key, at its own line.
-  EXPECT_EQ(error_of("haptics:\n  rate_hz: 1000\n  rat_hz: 3\n")
+  EXPECT_EQ(error_of("haptics:\n  settle_s: 1\n  rat_hz: 3\n")
                 .rfind("test.yaml:3: haptics.rat_hz: unknown key 'rat_hz'", 0),
             0u);
   // Wrong type.
@@ -149,7 +150,7 @@ TEST(HapticsYaml, ErrorsNameFileLineAndField) {
   EXPECT_NE(error_of("haptics:\n  hand:\n    mass_kg: 0.1\n    stiffness_n_per_m: -5\n")
                 .find("test.yaml:4: haptics.hand.stiffness_n_per_m: must be finite and > 0"),
             std::string::npos);
-  EXPECT_NE(error_of("haptics:\n  rate_hz: 5\n").find("test.yaml:2: haptics.rate_hz: must be"),
+  EXPECT_NE(error_of("haptics:\n  settle_s: -1\n").find("test.yaml:2: haptics.settle_s: must be"),
             std::string::npos);
   // Nested force fields keep their path.
   EXPECT_NE(error_of("haptics:\n  forces:\n    surface:\n      stiffness_n_per_m: -1\n")
@@ -160,7 +161,7 @@ TEST(HapticsYaml, ErrorsNameFileLineAndField) {
                 .find("haptics.safety.max_force_n: must not exceed forces.device.max_force_n"),
             std::string::npos);
   // A repeated key.
-  EXPECT_NE(error_of("haptics:\n  rate_hz: 1000\n  rate_hz: 500\n").find("key given twice"),
+  EXPECT_NE(error_of("haptics:\n  settle_s: 1\n  settle_s: 2\n").find("key given twice"),
             std::string::npos);
   // Not a mapping.
   EXPECT_NE(error_of("haptics: [1, 2]\n").find("haptics: expected a mapping"), std::string::npos);
@@ -189,11 +190,11 @@ TEST(HapticsYaml, LoadHapticsErrors) {
   // No haptics key: the defaults.
   {
     std::ofstream(dir / "none.yaml") << "name: x\n";
-    EXPECT_EQ(load_haptics(dir / "none.yaml").rate_hz, 1000.0);
+    EXPECT_EQ(load_haptics(dir / "none.yaml").settle_s, HapticSettings{}.settle_s);
   }
   // Malformed YAML: the file and line.
   {
-    std::ofstream(dir / "bad.yaml") << "name: x\nhaptics: {rate_hz: [\n";
+    std::ofstream(dir / "bad.yaml") << "name: x\nhaptics: {settle_s: [\n";
     try {
       load_haptics(dir / "bad.yaml");
       ADD_FAILURE() << "no error";

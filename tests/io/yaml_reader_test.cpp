@@ -9,6 +9,7 @@
 #include <limits>
 #include <string>
 
+#include "../support/input_error.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/core/contact.hpp"
 
@@ -26,15 +27,9 @@ Field value_of(const std::string& text, std::string_view key = "v") {
   return Map(root_of(text), {key}).require(key);
 }
 
-// The message of the InputError that f throws ("" if none).
 template <typename F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+std::string error_of(F&& f) {
+  return terracut::test::input_error_of(std::forward<F>(f));
 }
 
 TEST(YamlReader, ErrorsReadFileLinePathWhat) {

@@ -30,6 +30,7 @@ std::vector<std::uint8_t> command_bytes() {
   c.pose.position_m = {0.1, 0.2, -0.3};
   c.pose.orientation = {0.5, 0.5, 0.5, 0.5};
   c.flags = kCommandLifted;
+  c.round_trip_us = 101234;
   std::vector<std::uint8_t> out(kHeaderSize + kCommandPayloadSize + kCrcSize);
   EXPECT_EQ(encode_command(header(3), c, out.data()), out.size());
   return out;
@@ -55,6 +56,7 @@ TEST(Messages, CommandRoundTrip) {
   EXPECT_EQ(c.pose.position_m.z, -0.3);
   EXPECT_EQ(c.pose.orientation.w, 0.5);
   EXPECT_EQ(c.flags, kCommandLifted);
+  EXPECT_EQ(c.round_trip_us, 101234u);
 }
 
 TEST(Messages, MeasurementAndEstimateRoundTrip) {
@@ -65,6 +67,7 @@ TEST(Messages, MeasurementAndEstimateRoundTrip) {
   m.force_world_n = {-4, 5, -6};
   m.contact_length_m = 0.4;
   m.cut_depth_m = 0.08;
+  m.commands_received = 4000000001u;
   std::vector<std::uint8_t> d(kHeaderSize + kMeasurementPayloadSize + kCrcSize);
   ASSERT_EQ(encode_measurement(header(1), m, d.data()), d.size());
   Header h;
@@ -75,6 +78,7 @@ TEST(Messages, MeasurementAndEstimateRoundTrip) {
   EXPECT_EQ(back.command_sequence, 99u);
   EXPECT_EQ(back.force_world_n.z, -6.0);
   EXPECT_EQ(back.cut_depth_m, 0.08);
+  EXPECT_EQ(back.commands_received, 4000000001u);
 
   Estimate e;
   e.t_s = 3.0;
@@ -125,7 +129,7 @@ TEST(Messages, FormatErrorsAreNamed) {
   magic[0] ^= 0xFF;
   EXPECT_EQ(decode_header(magic.data(), magic.size(), kLink, h), Reject::kBadMagic);
   auto version = good;
-  version[4] = 2;
+  version[4] = std::uint8_t(kVersion + 1);
   EXPECT_EQ(decode_header(version.data(), version.size(), kLink, h), Reject::kBadVersion);
   auto flipped = good;
   flipped[60] ^= 0x01;

@@ -132,6 +132,47 @@ TEST(SoilWarnings, NameAnUnsettledEndAndCellsTooFarFromSquare) {
   EXPECT_TRUE(soil_warnings(soil, oblong, 17).empty());
 }
 
+// A cut whose blade never crosses the terrain (seen from above) is named;
+// one that crosses it, even only at its last step or only by an end of the
+// blade, is not. The terrain covers x in [-0.6, 0.6], z in [-0.5, 0.5].
+TEST(CutWarnings, NameACutWhoseBladeNeverCrossesTheTerrain) {
+  io::Scenario sc = parse_scenario(kScenario, "small.yaml");
+  EXPECT_TRUE(cut_warnings(sc).empty());
+  // "roll" moved 2 m along +X: its 0.9 m blade spans x in [1.55, 2.45] (the
+  // tilt shortens it), past the terrain's edge at 0.6, at every step.
+  for (Keyframe& k : sc.cuts[0].keyframes) k.pose.position_m.x += 2.0;
+  std::vector<std::string> w = cut_warnings(sc);
+  ASSERT_EQ(w.size(), 1u);  // once, though the sequence runs it twice
+  EXPECT_NE(w[0].find("cut 'roll'"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("x in [-0.6, 0.6] m"), std::string::npos) << w[0];
+  // Back to 1.0 m along X: the blade's -X end (at 1.0 - 0.45 = 0.55 at the
+  // untilted start) is over the terrain once the path is in its z range.
+  for (Keyframe& k : sc.cuts[0].keyframes) k.pose.position_m.x -= 1.0;
+  EXPECT_TRUE(cut_warnings(sc).empty()) << cut_warnings(sc)[0];
+  // A path that runs beside the terrain and enters it only at its last step.
+  Motion& back = sc.cuts[1];
+  back.keyframes[0].pose.position_m = {0.0, 0.12, 2.0};
+  back.keyframes[1].pose.position_m = {0.0, 0.12, 0.5};
+  EXPECT_TRUE(cut_warnings(sc).empty());
+  back.keyframes[1].pose.position_m = {0.0, 0.12, 0.51};
+  w = cut_warnings(sc);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("cut 'back'"), std::string::npos) << w[0];
+}
+
+// The warning reaches the run's result (and summary.json's "warnings"), and
+// the run goes on.
+TEST_F(RunTest, ACutOutsideTheTerrainIsAWarningOfTheRun) {
+  Scenario sc = scenario();
+  for (Keyframe& k : sc.base.cuts[1].keyframes) k.pose.position_m.z += 5.0;
+  const RunResult r = run(sc, dir_ / "out");
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("cut 'back'"), std::string::npos) << r.warnings[0];
+  const nlohmann::json summary = nlohmann::json::parse(read_bytes(dir_ / "out" / "summary.json"));
+  ASSERT_EQ(summary["warnings"].size(), 1u);
+  EXPECT_EQ(summary["warnings"][0], r.warnings[0]);
+}
+
 TEST_F(RunTest, SameScenarioTwiceGivesBitwiseIdenticalOutputs) {
   for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
     const Scenario sc = scenario(rep);

@@ -34,7 +34,7 @@ void expect_no_allocation_once_warm(SoilModel model) {
   fs::create_directories(dir);
   const io::Scenario& sc = in.base;
   const Motion& cut = sc.cuts.at(0);
-  const double rate = in.haptics.rate_hz;
+  const double rate = sc.rate_hz;
   const std::int64_t ticks = std::llround((cut.duration_s() + in.haptics.settle_s) * rate);
   // The plate's first touch: its front face (edge + half the plate's 2 cm)
   // reaches the rock's back face at t = 2.58 s (scenarios/rock_push.yaml).
@@ -55,7 +55,7 @@ void expect_no_allocation_once_warm(SoilModel model) {
   double peak = 0.0;
   const long at_start = g_allocations.load();
   {
-    const haptics::LoopParams params(in.haptics, sc.blade);
+    const haptics::LoopParams params(in.haptics, sc.blade, sc.rate_hz);
     HapticRig rig(in, params, cut.keyframes[0].pose.orientation, device, ro);
     haptics::HapticLoop& loop = rig.loop();
     // Until the rock is first pushed (by the plate, or on flowing soil by

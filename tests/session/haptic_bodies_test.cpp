@@ -275,7 +275,7 @@ TEST_F(RockPush, BodiesCsvAndSummaryFollowTheRock) {
   }
   // The state before the first step, then one row per tick (every tick was stepped).
   EXPECT_EQ(rows, with_->records.size() + 1);
-  EXPECT_NEAR(last_t, double(with_->records.size()) / rock_scenario().haptics.rate_hz, 1e-9);
+  EXPECT_NEAR(last_t, double(with_->records.size()) / rock_scenario().base.rate_hz, 1e-9);
   EXPECT_NEAR(first[0], g.rock.position_m.x, 1e-6);
   EXPECT_NEAR(first[1], g.rock.position_m.y, 1e-6);
   EXPECT_NEAR(first[2], g.rock.position_m.z, 1e-6);
@@ -292,7 +292,7 @@ TEST_F(RockPush, BodiesCsvAndSummaryFollowTheRock) {
   const std::string& s = with_->summary;
   EXPECT_NE(s.find("\"bodies\": {"), std::string::npos) << s;
   EXPECT_NE(s.find("\"peak_tool_force_n\""), std::string::npos) << s;
-  EXPECT_NE(s.find("\"csv\":\"bodies.csv\""), std::string::npos) << s;
+  EXPECT_NE(s.find("\"csv\": \"bodies.csv\""), std::string::npos) << s;
   EXPECT_EQ(without_->summary.find("\"bodies\""), std::string::npos);
   // haptics.csv: the bodies' force columns.
   const std::string hcsv = slurp(dir_ / "with" / "haptics.csv");

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <string>
 
+#include "../support/input_error.hpp"
 #include "../support/scenario_text.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/haptics/device_option.hpp"
@@ -43,13 +44,9 @@ fs::path scratch(const std::string& name) {
   return dir;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+template <typename F>
+std::string error_of(F&& f) {
+  return terracut::test::input_error_of(std::forward<F>(f));
 }
 
 std::string read(const fs::path& p) { return terracut::test::read_text(p); }

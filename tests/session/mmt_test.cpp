@@ -215,7 +215,7 @@ struct Pair {
   MmtSettings settings;
   Scenario remote_sc;
   std::unique_ptr<haptics::Device> device;
-  net::MemoryLink link;
+  net::EmulatedLink link;
   OperatorStation op;
   RemoteStation remote;
 };
@@ -303,7 +303,7 @@ TEST(Mmt, BadPacketsOnBothStationsAreCountedNeverFatal) {
 TEST(Mmt, SilentLinkStopsTheRemoteToolAndFadesTheOperatorsForce) {
   Scenario sc = load_scenario(kTrench);
   const double timeout = sc.mmt->timeout_s;
-  const double rate = sc.haptics.rate_hz;
+  const double rate = sc.base.rate_hz;
   // The operator goes quiet at 2.0 s, mid-trench (the tool moves at 1 m/s).
   {
     Pair p(sc);
@@ -359,7 +359,7 @@ PatchUnderTool patch_under_tool(double exclusion_m) {
   sc.mmt->to_remote.delay_s = sc.mmt->to_operator.delay_s = 0.0;
   sc.mmt->to_remote.jitter_s = sc.mmt->to_operator.jitter_s = 0.0;
   sc.mmt->exclusion_m = exclusion_m;
-  const double rate = sc.haptics.rate_hz;
+  const double rate = sc.base.rate_hz;
   Pair p(sc);
   int i = 0;
   for (; i / rate < 1.8; ++i) {
@@ -460,7 +460,7 @@ TEST(Mmt, StreamedStationFilesEqualTheBatchFiles) {
     StationCsv::operator_csv(bad);
     FAIL() << "an unwritable file was accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(bad.string() + ": cannot be written"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find(bad.string() + ": cannot create"), std::string::npos)
         << e.what();
   }
 }
@@ -479,6 +479,10 @@ TEST(Mmt, BadSettingsNameTheField) {
   fails("blend_s: 0.1", "blend_s: -1", "mmt.operator.blend_s");
   fails("sense_period_s: 0.05", "sense_periods: 0.05", "sense_periods");
   fails("soil: clay", "soil: mud", "unknown");
+  // The link is dead only after a silence longer than the one that fades the force.
+  fails("timeout_s: 0.2", "timeout_s: 0.2\n  link_lost_s: 0.1",
+        "mmt.link_lost_s: 0.1 s is not longer than timeout_s (0.2 s)");
+  fails("timeout_s: 0.2", "timeout_s: 0.2\n  link_lost_s: 4000", "mmt.link_lost_s: must be in (0, 3600]");
   // A remote whose grid is not the operator's.
   const fs::path dir = fs::temp_directory_path() / "terracut_mmt_grid";
   fs::create_directories(dir);

@@ -124,7 +124,6 @@ TEST(PhysicalForce, RunAndHapticsGiveTheSameForceWhateverTheDevice) {
   for (const char* file : {"push_pile.yaml", "paper_experiment2.yaml"}) {
     SCOPED_TRACE(file);
     Scenario sc = load_scenario(kScenarios / file);
-    sc.haptics.rate_hz = sc.base.rate_hz;  // one rate: the run's
     const Forces run = run_forces(sc, file);
     expect_same(run, haptic_forces(sc, file), std::string(file) + ", its own device settings");
     expect_same(run, haptic_forces(with_other_device(sc), std::string(file) + "_other"),

@@ -50,7 +50,6 @@ soil: {model: flow, preset: dry_sand, unit_weight_n_per_m3: 16000, cohesion_pa: 
        max_pair_checks_per_step: 100000}
 reference: {mound: {centre_m: [0.6, 0.4], radius_m: 0.35, height_m: 0.3}}
 haptics:
-  rate_hz: 10000
   duration_s: 5
   settle_s: 0.5
   workspace: {scale: 12, yaw_deg: 0}
@@ -79,6 +78,7 @@ mmt:
          burst: {p_good_to_bad: 0.01, p_bad_to_good: 0.5, loss_good: 0, loss_bad: 0.5}}
   operator: {blend_s: 0.1, max_update_step_n: 0.01, exclusion_m: 0.15, deadband: 0.05}
   timeout_s: 0.2
+  link_lost_s: 5
   udp: {port: 47100}
   link_id: 1234
 )";
@@ -246,7 +246,7 @@ TEST(ScenarioRanges, TheTableCoversEverySectionAndTheBasesHoldEveryPath) {
                          [&](const Range& r) { return r.path.starts_with(prefix); });
   };
   EXPECT_EQ(count("haptics.forces."), std::ssize(force_ranges()));
-  EXPECT_EQ(count("soil.") - 1, std::ssize(material_ranges()));  // and the flow's work cap
+  EXPECT_EQ(count("soil."), std::ssize(material_ranges()) + std::ssize(kSoilFlowRanges));
   EXPECT_EQ(count("haptics.safety."), std::ssize(safety_ranges()));
   EXPECT_EQ(count("bodies[]."), std::ssize(body_ranges()));
   EXPECT_EQ(count("mmt."), std::ssize(mmt_ranges()) + std::ssize(net::link_ranges()));

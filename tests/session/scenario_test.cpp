@@ -65,16 +65,19 @@ TEST(ScenarioBodies, BodiesAreParsedAndTheirErrorsNameFileAndLine) {
 TEST(ScenarioSections, EachSectionIsReadByItsOwnLayer) {
   // The haptics section by the haptics reader; absent, its defaults.
   const Scenario plain = parse_scenario(kGood, "x.yaml");
-  EXPECT_EQ(plain.haptics.rate_hz, haptics::HapticSettings{}.rate_hz);
-  const Scenario with = parse_scenario(kGood + "haptics: {rate_hz: 500, device: script}\n", "x.yaml");
-  EXPECT_EQ(with.haptics.rate_hz, 500.0);
+  EXPECT_EQ(plain.haptics.settle_s, haptics::HapticSettings{}.settle_s);
+  const Scenario with = parse_scenario(kGood + "haptics: {settle_s: 2, device: script}\n", "x.yaml");
+  EXPECT_EQ(with.haptics.settle_s, 2.0);
   EXPECT_EQ(with.haptics.device, haptics::DeviceKind::kScript);
   // A key no layer reads is refused, and the message lists every section.
   const std::string unknown = kGood + "soil_typo: 1\n";
   expect_error(unknown, line_of(unknown, "soil_typo"), "soil_typo", "haptics");
   // An error inside a section names the section's field at its line.
-  const std::string bad = kGood + "haptics:\n  rate_hz: 5\n";
-  expect_error(bad, line_of(bad, "rate_hz: 5"), "haptics.rate_hz", "[10, 10000]");
+  const std::string bad = kGood + "haptics:\n  settle_s: -1\n";
+  expect_error(bad, line_of(bad, "settle_s: -1"), "haptics.settle_s", "[0, 3600]");
+  // The loop's rate is the scenario's one rate_hz: the old key names its home.
+  const std::string old = kGood + "haptics:\n  rate_hz: 500\n";
+  expect_error(old, line_of(old, "rate_hz: 500"), "haptics.rate_hz", "moved to the top-level rate_hz");
 }
 
 // Every shipped scenario loads, with all its sections.
@@ -86,6 +89,19 @@ TEST(ShippedScenarios, EveryScenarioFileLoads) {
     ++count;
   }
   EXPECT_GE(count, 3);
+}
+
+// docs/scenario-format.md lists every shipped scenario, one row each (a new
+// user reads there what each is for).
+TEST(ShippedScenarios, EveryScenarioFileIsListedInTheFormatDoc) {
+  const std::string doc =
+      test::read_text(fs::path(TERRACUT_SOURCE_DIR) / "docs" / "scenario-format.md");
+  ASSERT_FALSE(doc.empty());
+  for (const auto& entry : fs::directory_iterator(fs::path(TERRACUT_SOURCE_DIR) / "scenarios")) {
+    if (entry.path().extension() != ".yaml") continue;
+    const std::string row = "| `" + entry.path().filename().string() + "` | ";
+    EXPECT_NE(doc.find(row), std::string::npos) << "docs/scenario-format.md has no row " << row;
+  }
 }
 
 }  // namespace

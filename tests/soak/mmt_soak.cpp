@@ -14,8 +14,9 @@
 // forged but valid messages of a new session (far poses, absurd soil
 // factors, heights of tens of metres: accepted, as a restarted peer is);
 // floods of up to 64 at once; and outages, during which nothing the peer
-// sends arrives. In mmt-enet a raw UDP socket also sends random bytes to
-// both stations' ports (ENet itself must drop them).
+// sends arrives. In mmt-enet the stations' session is authenticated
+// (net/secure.hpp) and a raw UDP socket also sends random bytes to both
+// stations' ports: their carriers must drop and count every one.
 //
 // Asserted over the whole run (exit status 1 and a line per broken promise):
 //   - the operator's device force never exceeds safety.max_force_n nor grows
@@ -56,6 +57,7 @@
 #include "terracut/core/wire.hpp"
 #include "terracut/haptics/script_device.hpp"
 #include "terracut/haptics/workspace.hpp"
+#include "terracut/net/emulated_link.hpp"
 #include "terracut/net/enet_transport.hpp"
 #include "terracut/net/messages.hpp"
 #include "terracut/session/mmt.hpp"
@@ -106,7 +108,6 @@ class HostileEndpoint final : public net::Endpoint {
   void send(net::Channel channel, const std::uint8_t* data, std::size_t size, double now_s) override {
     inner_.send(channel, data, size, now_s);
   }
-  const net::LinkEmulator& emulator() const override { return inner_.emulator(); }
 
   using net::Endpoint::receive;
   void receive(double now_s, net::Inbox& out) override {
@@ -299,7 +300,7 @@ class HostileEndpoint final : public net::Endpoint {
         inject(std::move(base), net::Reject::kBadMagic, out);
         break;
       case 4:
-        wire::put_u16(base.data() + 4, std::uint16_t(2 + pick(100)));
+        wire::put_u16(base.data() + 4, std::uint16_t(net::kVersion + 1 + pick(100)));
         repair_crc(base);
         inject(std::move(base), net::Reject::kBadVersion, out);
         break;
@@ -397,22 +398,6 @@ class HostileEndpoint final : public net::Endpoint {
   Last last_[net::kMessageTypeCount];
 };
 
-// The operator's hand: the scenario's cut, over and over (the script device
-// at the time modulo the path's period).
-class RepeatingScript final : public haptics::Device {
- public:
-  explicit RepeatingScript(haptics::DevicePath path) : period_s_(path.duration_s() + 0.5), script_(std::move(path)) {}
-  std::string_view kind() const override { return "script"; }
-  bool read(double t_s, haptics::DeviceSample& out) noexcept override {
-    return script_.read(std::fmod(std::max(t_s, 0.0), period_s_), out);
-  }
-  void write(const haptics::DeviceCommand& c) noexcept override { script_.write(c); }
-
- private:
-  double period_s_;
-  haptics::ScriptDevice script_;
-};
-
 // Random bytes to a UDP port (ENet must drop them before they reach a station).
 class RawUdpSender {
  public:
@@ -452,20 +437,26 @@ int run_mmt_soak(const MmtSoakOptions& o) {
   op.haptics.safety.rise_time_s = std::min(op.haptics.safety.rise_time_s, 0.2);
   const session::Scenario remote_scn = session::load_remote_scenario(op);
 
-  const haptics::Workspace ws(op.haptics.workspace);
   const io::Scenario& b = op.base;
-  const Motion& cut = b.cuts[std::size_t(b.sequence.empty() ? 0 : b.sequence.front())];
-  RepeatingScript hand{haptics::DevicePath(cut, ws)};
-  const double rate_hz = op.haptics.rate_hz;
-  CheckingDevice checker(hand, op.haptics.safety, rate_hz);
+  // The operator's hand: the scenario's cut, over and over.
+  const std::unique_ptr<haptics::Device> hand = session::make_operator_device(op, true);
+  const double rate_hz = op.base.rate_hz;
+  CheckingDevice checker(*hand, op.haptics.safety, rate_hz);
 
-  std::unique_ptr<net::MemoryLink> memory;
+  std::unique_ptr<net::EmulatedLink> memory;
   std::unique_ptr<net::EnetEndpoint> enet_remote, enet_operator;
+  std::unique_ptr<net::EmulatedEndpoint> emulated_remote, emulated_operator;
   net::Endpoint* op_link = nullptr;
   net::Endpoint* remote_link = nullptr;
   if (enet) {
-    enet_remote = net::EnetEndpoint::listen("127.0.0.1", 0, s.to_operator);
-    enet_operator = net::EnetEndpoint::connect("127.0.0.1", enet_remote->port(), s.to_remote);
+    // An authenticated session (secure.hpp) under a key of the seed's.
+    net::EnetOptions eo;
+    std::mt19937 key_rng(o.seed);
+    for (auto& b : eo.key.bytes) b = std::uint8_t(key_rng());
+    eo.station_id = 2u;
+    enet_remote = net::EnetEndpoint::listen("127.0.0.1", 0, eo);
+    eo.station_id = 1u;
+    enet_operator = net::EnetEndpoint::connect("127.0.0.1", enet_remote->port(), eo);
     std::vector<std::vector<std::uint8_t>> none;
     const double start = wall_s();
     while (!enet_operator->connected() || !enet_remote->connected()) {
@@ -474,10 +465,12 @@ int run_mmt_soak(const MmtSoakOptions& o) {
       enet_remote->receive(0.0, none);
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
-    op_link = enet_operator.get();
-    remote_link = enet_remote.get();
+    emulated_remote = std::make_unique<net::EmulatedEndpoint>(*enet_remote, s.to_operator);
+    emulated_operator = std::make_unique<net::EmulatedEndpoint>(*enet_operator, s.to_remote);
+    op_link = emulated_operator.get();
+    remote_link = emulated_remote.get();
   } else {
-    memory = std::make_unique<net::MemoryLink>(s.to_remote, s.to_operator);
+    memory = std::make_unique<net::EmulatedLink>(s.to_remote, s.to_operator);
     op_link = &memory->a();
     remote_link = &memory->b();
   }
@@ -531,6 +524,7 @@ int run_mmt_soak(const MmtSoakOptions& o) {
       raw.send(enet_remote->port(), rng);
       raw.send(enet_operator->port(), rng);
     }
+    if (memory) memory->release(t);
     operator_station.tick(t);
     remote_station.tick(t);
     last_tick_s = t;
@@ -653,7 +647,24 @@ int run_mmt_soak(const MmtSoakOptions& o) {
                 static_cast<long long>(side.hostile.real_order), static_cast<long long>(side.hostile.real_framing),
                 side.hostile.first_anomaly.empty() ? "" : "; the first: ", side.hostile.first_anomaly.c_str());
   }
-  if (enet) std::printf("  raw UDP datagrams to the ENet ports: %lld\n", static_cast<long long>(raw.sent));
+  if (enet) {
+    // Every raw datagram counted by the carrier it reached, before a station
+    // saw it (the random bytes of one may read as a connection request).
+    std::printf("  raw UDP datagrams to the ENet ports: %lld;", static_cast<long long>(raw.sent));
+    std::int64_t counted_all = 0;
+    for (const net::EnetEndpoint* e : {enet_remote.get(), enet_operator.get()}) {
+      const net::EnetCounters& c = e->counters();
+      const std::int64_t counted = c.dropped_unknown_source + c.dropped_oversize + c.kernel_dropped +
+                                   c.connection_requests;
+      counted_all += counted;
+      std::printf(" %s counted %lld (no peer's %lld, kernel %lld)", e == enet_remote.get() ? "remote" : "operator",
+                  static_cast<long long>(counted), static_cast<long long>(c.dropped_unknown_source),
+                  static_cast<long long>(c.kernel_dropped));
+    }
+    std::printf("\n");
+    require(counted_all >= raw.sent, "the carriers counted " + std::to_string(counted_all) + " of " +
+                                         std::to_string(raw.sent) + " raw datagrams");
+  }
   std::printf("  %s\n", failures == 0 ? "all promises kept" : "PROMISES BROKEN");
   return failures == 0 ? 0 : 1;
 }

@@ -262,7 +262,7 @@ int run(int argc, char** argv) {
   HapticSettings settings = reader.settings;
   settings.device = DeviceKind::kUdp;
   settings.safety.rise_time_s = std::min(settings.safety.rise_time_s, 0.2);  // reach full force often
-  const LoopParams params(settings, sc.blade);
+  const LoopParams params(settings, sc.blade, sc.rate_hz);
   Simulation sim(io::sim_params(sc, params.rate_hz()), io::build_initial_heights(sc));
 
   UdpDevice udp("127.0.0.1", 0);

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdio>
+#include <ctime>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -202,6 +204,72 @@ TEST(ViewerControls, AStepPlaysItsStatedTimeThenHolds) {
   dev.request_step_s(-1.0);
   dev.request_step_s(std::nan(""));
   EXPECT_FALSE(dev.stepping());
+}
+
+// The device says paused only while neither playing nor stepping: that is
+// when the paced loop holds (haptics::Device::paused).
+TEST(ViewerControls, TheDeviceIsPausedOnlyWithNothingToPlay) {
+  const io::Scenario sc = io::parse_scenario(kLine, "line.yaml");
+  const Tour tour(sc, 1.0, 1.0);
+  const haptics::Workspace ws{haptics::WorkspaceMapping{}};
+  ViewerDevice dev(ws, tour, tour.sample(0.0), 1000.0, 1.0, 1.0, nullptr);
+  EXPECT_FALSE(dev.paused());
+  dev.set_playing(false);
+  EXPECT_TRUE(dev.paused());
+  dev.request_step_s(kStepTime_s);
+  EXPECT_FALSE(dev.paused());
+  dev.request_step_s(-1.0);  // ignored
+  EXPECT_FALSE(dev.paused());
+  dev.start(0.0);
+  haptics::DeviceSample s;
+  for (int i = 0; dev.stepping() && i < 1000; ++i) dev.read(i / 1000.0, s);
+  EXPECT_TRUE(dev.paused());
+  dev.request_steps(1);
+  EXPECT_FALSE(dev.paused());
+}
+
+// CPU time of this process, seconds.
+double process_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// Pause pauses the paced haptic loop: while paused the loop ticks nothing
+// and the process spends almost no CPU (the loop at 1 kHz spends a tenth of
+// a core spinning to its deadlines); Play starts it again, and the pause is
+// no period in the device's timing.
+TEST(ViewerControls, PauseHoldsThePacedHapticLoop) {
+  const session::Scenario sc = session::load_scenario(
+      std::filesystem::path(TERRACUT_SOURCE_DIR) / "scenarios/trench_dry_sand.yaml");
+  LoopTiming timing;
+  DriverOptions o;
+  o.paced = true;
+  o.realtime = false;
+  o.source = ToolSource::kScript;
+  LoopDriver d(sc, viewer_settings(sc.haptics), o, &timing);
+  d.start();
+  using namespace std::chrono_literals;
+  std::this_thread::sleep_for(200ms);
+  const std::int64_t playing = timing.snapshot().ticks;
+  EXPECT_GT(playing, 50);
+  d.device().set_playing(false);
+  std::this_thread::sleep_for(50ms);  // the tick in flight ends, the loop holds
+  const std::int64_t held_from = timing.snapshot().ticks;
+  const double cpu0 = process_cpu_s();
+  const auto wall0 = std::chrono::steady_clock::now();
+  std::this_thread::sleep_for(400ms);
+  const double cpu_s = process_cpu_s() - cpu0;
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  EXPECT_EQ(timing.snapshot().ticks, held_from) << "the loop ticked while paused";
+  EXPECT_LT(cpu_s, 0.02 * wall_s) << "CPU while paused: " << cpu_s << " s in " << wall_s << " s";
+  std::printf("paused: %.4f s of CPU in %.3f s (%.2f %% of a core)\n", cpu_s, wall_s, 100.0 * cpu_s / wall_s);
+  d.device().set_playing(true);
+  std::this_thread::sleep_for(200ms);
+  EXPECT_GT(timing.snapshot().ticks - held_from, 50);
+  // The 400 ms hold is not a period of the loop.
+  EXPECT_LT(timing.snapshot().period_max_us, 300e3);
+  d.stop();
 }
 
 TEST(ViewerControls, AResetKeepsThePauseTheSourceAndTheSpeed) {

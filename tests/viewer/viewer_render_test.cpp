@@ -436,11 +436,13 @@ TEST_F(ViewerRenderTest, CommandLineErrorsExitWithTwoAndHelpShowsTheDefaults) {
   EXPECT_EQ(r.code, 2) << r.err;
   r = run({sc, "--extent", "-1"});
   EXPECT_EQ(r.code, 2) << r.err;
-  // --help exits 0 and shows the heightmap defaults.
+  // --help exits 0 and shows the heightmap defaults and the exit codes.
   const fs::path out = dir_ / "stdout.txt";
   r = run({"--help"});
   EXPECT_EQ(r.code, 0);
   const std::string help = slurp(out);
+  EXPECT_NE(help.find("Exit codes"), std::string::npos) << help;
+  EXPECT_NE(help.find("77"), std::string::npos) << help;
   EXPECT_NE(help.find("--extent"), std::string::npos);
   EXPECT_NE(help.find("=1 "), std::string::npos) << help;    // --extent's default, metres
   EXPECT_NE(help.find("=0.2"), std::string::npos) << help;   // --full-scale's
@@ -449,8 +451,46 @@ TEST_F(ViewerRenderTest, CommandLineErrorsExitWithTwoAndHelpShowsTheDefaults) {
 TEST_F(ViewerRenderTest, MissingScenarioIsReportedByName) {
   Result r = run({(dir_ / "no_such.yaml").string(), "--screenshot", (dir_ / "x.png").string()});
   ASSERT_TRUE(r.exited) << "the viewer crashed";
-  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.code, 1);  // bad input, as `terracut` has it (apps/exit_codes.hpp)
   EXPECT_NE(r.err.find("no_such.yaml"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x.png"));
+}
+
+// The first hour's headless errors: each is named, with the bad-input code,
+// and never aborts (an abort is a signal: wait_exit gives no exit code).
+TEST_F(ViewerRenderTest, AScreenshotIntoAMissingFolderIsNamedBeforeDrawing) {
+  const std::string sc = (fs::path(TERRACUT_SOURCE_DIR) / "scenarios/mound_generator.yaml").string();
+  const fs::path missing = dir_ / "no_such_folder";
+  Result r = run({sc, "--screenshot", (missing / "x.png").string(), "--frames", "1"});
+  ASSERT_TRUE(r.exited) << "the viewer crashed: " << r.err;
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("--screenshot"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(missing.string()), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(missing));
+}
+
+TEST_F(ViewerRenderTest, AScreenshotThatCannotBeWrittenIsNamedAfterDrawing) {
+  // The folder exists, but the PNG's name is a folder: the write fails after
+  // the frames are drawn, with the context still holding the renderers.
+  const std::string sc = (fs::path(TERRACUT_SOURCE_DIR) / "scenarios/mound_generator.yaml").string();
+  const fs::path taken = dir_ / "taken.png";
+  fs::create_directories(taken);
+  Result r = run({sc, "--screenshot", taken.string(), "--frames", "1", "--msaa", "0"});
+  ASSERT_TRUE(r.exited) << "the viewer crashed: " << r.err;
+  if (r.code == kExitNoContext) SKIP_OR_FAIL_WITHOUT_GL("no OpenGL context: " + r.err);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("taken.png"), std::string::npos) << r.err;
+}
+
+TEST_F(ViewerRenderTest, MmtWithoutAnMmtSectionIsNamedHeadless) {
+  // The session is opened after the context exists: its refusal must not
+  // abort on the way out.
+  const std::string sc = (fs::path(TERRACUT_SOURCE_DIR) / "scenarios/trench_dry_sand.yaml").string();
+  Result r = run({sc, "--mmt", "--screenshot", (dir_ / "x.png").string(), "--frames", "1"});
+  ASSERT_TRUE(r.exited) << "the viewer crashed: " << r.err;
+  if (r.code == kExitNoContext) SKIP_OR_FAIL_WITHOUT_GL("no OpenGL context: " + r.err);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("no mmt: section"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "x.png"));
 }
 

@@ -5,9 +5,10 @@
   run.py bed --seed 1                    pour the bulldozing bed of a seed (cached in work/)
   run.py bulldoze --case NAME --seed 1   one bulldozing run -> results/bulldoze/NAME/seed1/
   run.py bulldoze --case all --seed 1    every case of a seed
-  run.py summary                         results/bulldoze/summary.csv from the runs present
+  run.py summary [--recompute]           results/bulldoze/summary.csv from the runs present
   run.py all                             everything, seeds 1 2 3
   run.py smoke                           every script, a few hundred steps on tiny beds (CI)
+  run.py digest                          markdown tables of the bulldozing summary and costs
 
 LIGGGHTS runs one process at a time under `nice -n 19`; scratch goes to
 validation/dem/work/ (git-ignored).  Use /usr/bin/python3 (numpy, scipy)."""
@@ -55,7 +56,39 @@ def cmd_bulldoze(a):
 
 
 def cmd_summary(a):
+    if a.recompute:
+        for c in bulldoze.CASES:
+            for s in range(1, 100):
+                if os.path.exists(os.path.join(bulldoze.RES, c, "seed%d" % s, "run.json")):
+                    bulldoze.recompute_metrics(c, s)
     print(bulldoze.write_summary())
+
+
+def cmd_digest(a):
+    """Markdown tables of summary.csv and costs.csv (for the README)."""
+    import csv
+    rows = list(csv.DictReader(l for l in open(os.path.join(dem.RESULTS, "bulldoze", "summary.csv"))
+                               if not l.startswith("#")))
+    print("| case | window (m) | fx mean (N) | fx std (N) | fz mean (N) | fz std (N) | pile volume (m^3) "
+          "| pile peak (m) | seeds |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    by = {}
+    for r in rows:
+        by.setdefault((r["case"], r["window_start_m"], r["window_end_m"]), {})[r["seed"]] = r
+    for (c, w0, w1), d in by.items():
+        m, sd = d.get("mean"), d.get("std")
+        if not m:
+            continue
+        print("| `%s` | %s-%s | %.1f | %.1f | %.1f | %.1f | %.2e +- %.1e | %.3f +- %.3f | %s |" % (
+            c, w0, w1, float(m["fx_mean_n"]), float(sd["fx_mean_n"]), float(m["fz_mean_n"]),
+            float(sd["fz_mean_n"]), float(m["pile_volume_m3"]), float(sd["pile_volume_m3"]),
+            float(m["pile_peak_height_m"]), float(sd["pile_peak_height_m"]), m["n_seeds"]))
+    print()
+    print("| kind | run | wall-clock (s) | note |")
+    print("| --- | --- | --- | --- |")
+    for r in csv.DictReader(open(os.path.join(dem.RESULTS, "costs.csv"))):
+        if r["kind"].startswith("bulldoze"):
+            print("| %s | %s | %s | %s |" % (r["kind"], r["tag"], r["wall_s"], r["note"]))
 
 
 def cmd_all(a):
@@ -101,10 +134,14 @@ def main():
     b.add_argument("--force", action="store_true", help="rerun even if results exist")
     b.set_defaults(fn=cmd_bulldoze)
     s = sub.add_parser("summary")
+    s.add_argument("--recompute", action="store_true",
+                   help="recompute every run's window metrics from its files and work/ dumps first")
     s.set_defaults(fn=cmd_summary)
     s = sub.add_parser("all")
     s.add_argument("--force", action="store_true")
     s.set_defaults(fn=cmd_all)
+    s = sub.add_parser("digest")
+    s.set_defaults(fn=cmd_digest)
     s = sub.add_parser("smoke")
     s.set_defaults(fn=cmd_smoke)
     a = p.parse_args()

@@ -8,55 +8,43 @@
 // body frame -> world; vx, vy, vz = linear velocity, m/s. Numbers are the
 // shortest text that reads back to the same value (Bullet's floats are
 // printed as floats, time as a double), so two identical runs give identical
-// files.
+// files. Written with io::CsvFile, terracut's one CSV writer.
 #pragma once
 
-#include <cstdio>
+#include <cstdint>
 #include <filesystem>
-#include <string>
-#include <string_view>
 
 #include "terracut/bullet/terrain_world.hpp"
+#include "terracut/io/recording.hpp"
 
 namespace terracut::bullet {
 
-/// The header line, with its trailing newline.
-std::string_view bodies_csv_header();
-
-/// Appends one row per body of `world` at time t_s to `out`. Allocates only
-/// when `out` must grow (reserve it: about 160 bytes per body).
-void append_rows(const TerrainWorld& world, double t_s, std::string& out);
+/// The columns of bodies.csv, in order.
+inline constexpr const char* kBodiesCsvColumns = "t,body,name,x,y,z,qw,qx,qy,qz,vx,vy,vz";
 
 /// Writes bodies.csv: the header at open, rows on write_step, buffered.
 class BodiesCsvWriter {
  public:
   /// Creates (replaces) the file. Throws terracut::InputError naming the path
-  /// when it cannot be opened. every_n_steps >= 1 keeps one step in n.
+  /// when it cannot be created. every_n_steps >= 1 keeps one step in n.
   explicit BodiesCsvWriter(const std::filesystem::path& path, int every_n_steps = 1);
-  ~BodiesCsvWriter();
-  BodiesCsvWriter(const BodiesCsvWriter&) = delete;
-  BodiesCsvWriter& operator=(const BodiesCsvWriter&) = delete;
 
   /// Writes the rows of the world's last step (at world.time_s()), keeping
   /// one call in every_n_steps (the first call is always written). Never
-  /// throws; a write error is remembered and reported by close().
-  void write_step(const TerrainWorld& world);
+  /// throws and allocates nothing; a write error is remembered and reported
+  /// by close().
+  void write_step(const TerrainWorld& world) noexcept;
   /// Flushes and closes; throws terracut::InputError naming the path when any
   /// write failed.
-  void close();
+  void close() { file_.close(); }
 
   std::int64_t rows_written() const { return rows_; }
 
  private:
-  void flush();
-
-  std::filesystem::path path_;
-  std::FILE* file_ = nullptr;
-  std::string buffer_;
   int every_n_ = 1;
+  io::CsvFile file_;
   std::int64_t calls_ = 0;
   std::int64_t rows_ = 0;
-  bool failed_ = false;
 };
 
 }  // namespace terracut::bullet

@@ -46,6 +46,11 @@
 // the samples under a body (which Bullet climbed). docs/bullet.md, "Piles
 // against bodies".
 //
+// The code has one room per model: src/bullet/terrain_world.cpp (the world,
+// its step, terrain edits, the tool plate), buried_bodies.cpp (holding and
+// releasing buried bodies), pile_pressure.cpp (the rings, the soil a body
+// sheds and the earth pressure; its parameters in pile_pressure.hpp).
+//
 // One step (step(out)) after each Simulation::step: terrain_changed(changed
 // rectangle), move the tool plate to the blade pose, advance Bullet by exactly
 // 1 / rate_hz (one fixed sub-step: deterministic), and sum the tool's contact
@@ -59,6 +64,7 @@
 #include <string>
 #include <vector>
 
+#include "terracut/bullet/pile_pressure.hpp"
 #include "terracut/core/bodies.hpp"
 #include "terracut/core/simulation.hpp"
 #include "terracut/core/soil.hpp"
@@ -79,38 +85,6 @@ struct ToolPlateSpec {
   double height_m = 0.1;       ///< extent above the edge along blade local +Y, metres, in (0, 100]
   double thickness_m = 0.02;   ///< extent along blade local Z, metres, in (0, 100]
   double friction = 0.5;       ///< Coulomb friction coefficient, [0, 10]
-};
-
-/// The push of soil that flows on the bodies it banks against (docs/bullet.md,
-/// "Piles against bodies"). The soil keeps one sample away from a body's
-/// footprint (soil_obstacle), so that no heightfield triangle ramps from a
-/// pile under the body's edge; the pile's push is Rankine's active earth
-/// pressure on a smooth vertical face instead, horizontal, per unit width
-///   P = 0.5 K gamma h^2,  K = tan^2(45 deg - phi / 2),
-/// acting at h / 3 above the body's lowest point along the face's inward
-/// normal, with h the soil's height above that point on the first sample
-/// outside the kept-free ring straight out from the face (at most the
-/// body's height). A box's faces are its own four side faces (a yawed box
-/// is pushed along their normals); a sphere's or a cylinder's, the four
-/// sides of its bounding box.
-struct PilePressureSpec {
-  bool enabled = false;                   ///< false: no earth pressure (soil that vanishes)
-  /// gamma: unit weight of the piled soil, N/m^3, in (0, 1e9] (the range of
-  /// SoilMaterial::unit_weight_n_per_m3). Default: dry sand, as SoilMaterial's
-  /// dry_sand preset (Das). BodiesListener sets it from the simulation's
-  /// soil material.
-  double unit_weight_n_per_m3 = 16.25e3;
-  /// phi: friction angle of the piled (loose) soil, degrees, in (0, 80]; a
-  /// loose cohesionless pile's is about its angle of repose.
-  double friction_angle_deg = 34.0;
-  /// Soil in a body's ring up to this height above what stays there
-  /// (TerrainWorld::shed_rings) is left in place, metres, in [0, 0.01].
-  /// Bullet's solver lets a resting body settle by fractions of a micrometre
-  /// every few steps; shedding that much soil changed the triangles under
-  /// the body's edge, which woke it and dropped its contacts, so it settled
-  /// again and never slept. The default is the merged heightfield's coplanar
-  /// tolerance (TerrainWorldParams::merge_tolerance_m).
-  double shed_tolerance_m = 1e-5;
 };
 
 /// Parameters of the Bullet world; validated at construction, read-only during a run.
@@ -214,17 +188,22 @@ struct WorldStepInfo {
 
 class TerrainWorld {
  public:
-  /// Builds the world over `grid` (which must outlive the world and keep its
-  /// heights array: HeightGrid guarantees that). rate_hz is the simulation's
-  /// fixed rate (Bullet advances 1 / rate_hz per step); blade gives the tool
-  /// plate's length. Throws terracut::InputError naming the bad field when
-  /// params or bodies are invalid, or the grid has fewer than 2 samples along
-  /// a side (Bullet's heightfield needs 2 x 2).
-  TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& blade,
-               std::vector<BodySpec> bodies, const TerrainWorldParams& params = {});
-  /// The same over a simulation's grid, rate and blade.
+  /// Builds the world over a simulation's grid, rate and blade. The
+  /// simulation owns the heights: the world reads them in place and changes
+  /// them only through it (Simulation::lower_sample, move_height), from its
+  /// listener's callbacks (BodiesListener). It must outlive the world.
+  /// Throws terracut::InputError naming the bad field when params or bodies
+  /// are invalid, or the grid has fewer than 2 samples along a side
+  /// (Bullet's heightfield needs 2 x 2).
   TerrainWorld(Simulation& sim, std::vector<BodySpec> bodies,
                const TerrainWorldParams& params = {});
+  /// The same over a bare grid that no simulation owns (tests, tools): the
+  /// world changes its heights itself. `grid` must outlive the world and
+  /// keep its heights array (HeightGrid guarantees that). rate_hz is the
+  /// fixed rate (Bullet advances 1 / rate_hz per step); blade gives the tool
+  /// plate's length.
+  TerrainWorld(HeightGrid& grid, double rate_hz, const BladeSpec& blade,
+               std::vector<BodySpec> bodies, const TerrainWorldParams& params = {});
   ~TerrainWorld();
   TerrainWorld(const TerrainWorld&) = delete;
   TerrainWorld& operator=(const TerrainWorld&) = delete;
@@ -301,7 +280,17 @@ class TerrainWorld {
  private:
   struct Impl;
 
-  HeightGrid& grid_;
+  TerrainWorld(const HeightGrid& grid, Simulation* owner, HeightGrid* bare, double rate_hz,
+               const BladeSpec& blade, std::vector<BodySpec> bodies,
+               const TerrainWorldParams& params);
+  // The only two edits the world makes to the heights: through the
+  // simulation that owns them, or on the bare grid it was given.
+  void lower_sample(std::int64_t i, float height_m);
+  void move_height(std::int64_t from, std::int64_t to, float amount_m);
+
+  const HeightGrid& grid_;  // read in place (Bullet's heightfield too)
+  Simulation* owner_ = nullptr;  // the simulation that owns grid_, or
+  HeightGrid* bare_ = nullptr;   // grid_ itself when no simulation owns it
   TerrainWorldParams params_;
   BladeSpec blade_;
   std::vector<BodySpec> specs_;
@@ -312,12 +301,16 @@ class TerrainWorld {
   std::int64_t steps_ = 0;
   bool tool_teleport_ = true;
   int pending_woken_ = 0;
+
+  // Buried bodies (buried_bodies.cpp): Impl::held marks the held ones.
   int pending_released_ = 0;
   Rect pending_released_rect_{};
   /// Releases the held bodies the blade reached this step (changed: the
   /// step's cut), before Bullet advances.
   void release_reached(const Rect& changed);
   void release(int i);
+
+  // Piles against the bodies (pile_pressure.cpp).
   /// Applies the piles' earth pressure (params_.pile) to the dynamic bodies,
   /// for the next advance; wakes a sleeping body when the soil that presses
   /// on it changed since the last call (SoilView::band_changed). Sums the
@@ -336,11 +329,14 @@ class TerrainWorld {
   double pending_shed_m3_ = 0.0;
   Rect pending_shed_rect_{};
   std::vector<SoilObstacle> obstacles_;  // per body, this step's soil_obstacle (reserved)
-  /// The samples whose centres lie under a world box's X-Z extent (clipped).
-  Rect samples_under(const btVector3& lo, const btVector3& hi) const;
   /// The samples that press on body i's sides (apply_pile_pressure): its
   /// soil_obstacle and one more all round (clipped).
   Rect pile_band(const SoilObstacle& o) const;
+
+  // What each body sees of the soil (terrain_world.cpp; the piles' band
+  // fields are pile_pressure.cpp's).
+  /// The samples whose centres lie under a world box's X-Z extent (clipped).
+  Rect samples_under(const btVector3& lo, const btVector3& hi) const;
   /// What a dynamic body last saw of the soil round it: the samples whose
   /// triangles reach its box and two more all round (its pile band), and
   /// their heights. A reported change wakes the body (and drops its terrain

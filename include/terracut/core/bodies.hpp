@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/grid.hpp"
 #include "terracut/core/math.hpp"
 #include "terracut/core/ranges.hpp"
@@ -28,10 +29,13 @@ enum class BodyShape {
   kCylinder,  ///< a cylinder of radius radius_m and full height height_m along local Y
 };
 
-/// "box", "sphere" or "cylinder".
-std::string_view to_string(BodyShape shape);
-/// The shape named by name; nullopt for anything else.
-std::optional<BodyShape> parse_body_shape(std::string_view name);
+/// Its names (enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<BodyShape> kBodyShapeNames[] = {
+    {BodyShape::kBox, "box"},
+    {BodyShape::kSphere, "sphere"},
+    {BodyShape::kCylinder, "cylinder"},
+};
+constexpr std::span<const EnumName<BodyShape>> enum_names(BodyShape) { return kBodyShapeNames; }
 
 /// Longest accepted body name, characters.
 inline constexpr std::size_t kMaxBodyNameLength = 64;

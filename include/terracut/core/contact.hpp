@@ -6,6 +6,7 @@
 #include <string_view>
 #include <optional>
 
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/blade.hpp"
 #include "terracut/core/grid.hpp"
 
@@ -24,9 +25,12 @@ enum class Representation {
   kSurface,
 };
 
-std::string_view to_string(Representation representation);
-/// "columns" or "surface"; nullopt for anything else.
-std::optional<Representation> parse_representation(std::string_view name);
+/// Its names (enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<Representation> kRepresentationNames[] = {
+    {Representation::kColumns, "columns"},
+    {Representation::kSurface, "surface"},
+};
+constexpr std::span<const EnumName<Representation>> enum_names(Representation) { return kRepresentationNames; }
 
 /// What one contact query found.
 struct ContactResult {

@@ -43,6 +43,13 @@ struct EarthmovingParams {
   bool side_failure = true;
 };
 
+/// The ranges of EarthmovingParams' own numbers (core/ranges.hpp; the
+/// soil's: material_ranges()). The blade's rake (SimParams' blade.rake_angle_deg,
+/// kSimParamsRanges) is this entry.
+inline constexpr Range kEarthmovingRanges[] = {
+    {"rake_angle_deg", 0.0, 180.0, RangeEnds::kOpen},
+};
+
 /// Returns an empty string when params are valid, else a message naming the
 /// field ("rake_angle_deg ...", "soil.internal_friction_deg ...").
 std::string validate(const EarthmovingParams& params);

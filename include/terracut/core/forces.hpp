@@ -27,6 +27,7 @@
 #include <string_view>
 #include <vector>
 
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/drag.hpp"
 #include "terracut/core/earthmoving.hpp"
 #include "terracut/core/math.hpp"
@@ -78,9 +79,13 @@ enum class CuttingModel {
   kContactDrag,  ///< the paper's proposal: a drag per metre of blade in the soil
   kEarthmoving,  ///< the physical soil force (cutting, the pile's surcharge)
 };
-/// "none", "contact_drag" or "earthmoving".
-std::string_view to_string(CuttingModel model);
-std::optional<CuttingModel> parse_cutting_model(std::string_view name);
+/// Its names (enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<CuttingModel> kCuttingModelNames[] = {
+    {CuttingModel::kNone, "none"},
+    {CuttingModel::kContactDrag, "contact_drag"},
+    {CuttingModel::kEarthmoving, "earthmoving"},
+};
+constexpr std::span<const EnumName<CuttingModel>> enum_names(CuttingModel) { return kCuttingModelNames; }
 
 /// What to do when the requested rendering is beyond the device (stiffness or
 /// damping above the limits or the passivity rule).
@@ -91,9 +96,12 @@ enum class LimitPolicy {
   /// is lowered to b / 2 first.
   kClamp,
 };
-/// "refuse" or "clamp".
-std::string_view to_string(LimitPolicy policy);
-std::optional<LimitPolicy> parse_limit_policy(std::string_view name);
+/// Its names (enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<LimitPolicy> kLimitPolicyNames[] = {
+    {LimitPolicy::kRefuse, "refuse"},
+    {LimitPolicy::kClamp, "clamp"},
+};
+constexpr std::span<const EnumName<LimitPolicy>> enum_names(LimitPolicy) { return kLimitPolicyNames; }
 
 /// Parameters of the rendering; read-only during a run.
 struct ForceModelParams {

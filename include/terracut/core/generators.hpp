@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/blade.hpp"
 #include "terracut/core/grid.hpp"
 
@@ -24,10 +25,13 @@ enum class GeneratorKind {
   kPlane,  ///< a constant height everywhere
 };
 
-/// "mound", "box" or "plane".
-std::string_view to_string(GeneratorKind kind);
-/// The kind named by name ("mound", "box", "plane"); nullopt for anything else.
-std::optional<GeneratorKind> parse_generator_kind(std::string_view name);
+/// Its names (enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<GeneratorKind> kGeneratorKindNames[] = {
+    {GeneratorKind::kMound, "mound"},
+    {GeneratorKind::kBox, "box"},
+    {GeneratorKind::kPlane, "plane"},
+};
+constexpr std::span<const EnumName<GeneratorKind>> enum_names(GeneratorKind) { return kGeneratorKindNames; }
 
 /// A dome (half of an ellipsoid of revolution):
 ///   h(x, z) = height_m * sqrt(1 - (r / radius_m)^2)  for r < radius_m, else 0,

@@ -14,6 +14,7 @@
 #include <string>
 #include <string_view>
 
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/ranges.hpp"
 
 namespace terracut {
@@ -53,12 +54,15 @@ enum class SoilPreset {
 
 /// The material of a preset.
 SoilMaterial soil_preset(SoilPreset preset);
-/// "dry_sand", "loose_sand", "clay" or "gravel".
-std::string_view to_string(SoilPreset preset);
-/// Inverse of to_string; nullopt for anything else.
-std::optional<SoilPreset> parse_soil_preset(std::string_view name);
-/// Every preset, in the order of the enumeration.
-std::span<const SoilPreset> soil_presets();
+/// Its names (enum_names.hpp: to_string, parse_enum), every preset in the
+/// order of the enumeration.
+inline constexpr EnumName<SoilPreset> kSoilPresetNames[] = {
+    {SoilPreset::kDrySand, "dry_sand"},
+    {SoilPreset::kLooseSand, "loose_sand"},
+    {SoilPreset::kClay, "clay"},
+    {SoilPreset::kGravel, "gravel"},
+};
+constexpr std::span<const EnumName<SoilPreset>> enum_names(SoilPreset) { return kSoilPresetNames; }
 
 /// The ranges of SoilMaterial's fields, by their names in it (and in a
 /// scenario's `soil:` section): "unit_weight_n_per_m3", "repose_deg", ...

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 
@@ -36,6 +37,10 @@ struct Range {
   bool whole = false;  ///< a whole number (lo and hi whole too)
 };
 
+/// Every rate of a step or a tick, Hz: the simulation's, the haptic loop's,
+/// the pacer's, the Bullet world's and the force model's take it from here.
+inline constexpr Range kRateRange{"rate_hz", 0.0, 1e6, RangeEnds::kOpenLow};
+
 /// "(0, 1000]": the range written with its ends.
 std::string range_text(double lo, double hi, RangeEnds ends);
 
@@ -52,7 +57,20 @@ bool in_range(const Range& range, double value) noexcept;
 std::string check(const Range& range, double value, std::string_view field = {});
 
 /// The entry of table for path; a path missing from the table is a
-/// programming error (std::logic_error).
-const Range& find_range(std::span<const Range> table, std::string_view path);
+/// programming error (std::logic_error; at compile time, no constant). A
+/// reader's own table takes its entries from the struct's table this way:
+///   constexpr Range kFileRanges[] = {find_range(kSimParamsRanges, "rate_hz"), ...};
+constexpr const Range& find_range(std::span<const Range> table, std::string_view path) {
+  for (const Range& r : table)
+    if (r.path == path) return r;
+  throw std::logic_error("no range declared for '" + std::string(path) + "'");
+}
+
+/// The entry at another path (a struct's field read under a section's name,
+/// "max_pair_checks_per_step" as "soil.max_pair_checks_per_step").
+constexpr Range at_path(Range range, std::string_view path) {
+  range.path = path;
+  return range;
+}
 
 }  // namespace terracut

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "terracut/core/cut.hpp"
+#include "terracut/core/ranges.hpp"
 #include "terracut/core/soil.hpp"
 #include "terracut/core/step_listener.hpp"
 #include "terracut/core/tool_force.hpp"
@@ -33,7 +34,10 @@ namespace terracut {
 struct SimParams {
   GridSpec grid{};
   Representation representation = Representation::kSurface;
-  double rate_hz = 1000.0;  ///< fixed step rate, Hz, in (0, 1e6]
+  /// The fixed step rate, Hz, in (0, 1e6]: the one rate of a run (the
+  /// scenario's rate_hz). A haptic loop steps the simulation at it too,
+  /// unless its program overrides it (session::WorldOptions::rate_hz).
+  double rate_hz = 1000.0;
   BladeSpec blade{};
   /// A step whose rotation would move a blade end off its straight path by
   /// more than this fraction of a cell is split into sub-steps (slerp), so a
@@ -43,6 +47,21 @@ struct SimParams {
   /// force and the flow read, and what happens to what the blade cuts
   /// (soil.hpp); kVanish by default.
   SoilFlowParams soil{};
+};
+
+/// The ranges of SimParams' own numbers (core/ranges.hpp): validate()
+/// checks the fields through this table and the scenario reader reads the
+/// file's same fields through its entries. The grid and the soil have their
+/// own checks (validate(GridSpec), kSoilFlowRanges); the blade's rake is the
+/// earthmoving model's entry, which validate() checks with the material.
+inline constexpr Range kSimParamsRanges[] = {
+    kRateRange,
+    {"max_arc_error_cells", 0.0, 1.0, RangeEnds::kOpenLow},
+    {"blade.length_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    at_path(find_range(kEarthmovingRanges, "rake_angle_deg"), "blade.rake_angle_deg"),
+    {"blade.edge_thickness_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"blade.bucket.depth_m", 0.0, kRangeMax, RangeEnds::kClosed},  // 0: no bucket
+    {"blade.bucket.height_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
 };
 
 /// Returns an empty string when params are valid, else a message naming the field.
@@ -93,8 +112,9 @@ class Simulation {
   Simulation(const SimParams& params, std::vector<float> initial_heights_m);
 
   const SimParams& params() const { return params_; }
+  /// The terrain, read-only: the simulation owns the heights and changes
+  /// them itself (steps, edit_heights, reset) or for a listener (below).
   const HeightGrid& grid() const { return grid_; }
-  HeightGrid& grid() { return grid_; }
 
   /// Lifts the blade out of the soil: the next step starts a new stroke and
   /// sweeps nothing from the previous pose (used between separate cuts).
@@ -126,11 +146,26 @@ class Simulation {
     return finish_step();
   }
 
-  /// For a step listener that edits heights during its on_step (the Bullet
-  /// world lowering the soil a released buried body stood in, with
-  /// HeightGrid::lower): adds the rectangle to this step's
-  /// StepOutput::changed, which the listeners after it and whoever reads
-  /// last() see. std::logic_error outside a step.
+  // --- A step listener that changes the terrain -------------------------
+  // (Jolt's HeightFieldShape::SetHeights: the owner makes the edit, so that
+  // whoever caches the heights hears of it.) The Bullet world lowers the
+  // soil a released buried body stood in, pushes soil out of the ring round
+  // a body and keeps heights inside its bounds. It does so only through
+  // these, from inside its own callbacks (on_step, on_edit; std::logic_error
+  // anywhere else: an internal error), reads the heights with grid(), and
+  // reports what it changed during a step with include_changed.
+
+  /// Lowers sample i (index = r * cols + c) to height_m when that is lower,
+  /// never below 0 (the rigid floor); returns the height removed, metres (0
+  /// when nothing changed).
+  float lower_sample(std::int64_t i, float height_m);
+  /// Moves amount_m metres of height from sample `from` to sample `to` (soil
+  /// pushed aside): the volume is kept. amount_m in (0, height at from].
+  void move_height(std::int64_t from, std::int64_t to, float amount_m);
+  /// For a step listener that changed heights during its on_step: adds the
+  /// rectangle to this step's StepOutput::changed, which the listeners after
+  /// it and whoever reads last() see, and the soil phase re-examines it (and
+  /// its neighbours) from the next step on. std::logic_error outside a step.
   void include_changed(const Rect& rect);
 
   const StepOutput& last() const { return out_; }
@@ -139,7 +174,8 @@ class Simulation {
   /// Total volume cut since construction or reset, cubic metres.
   double removed_volume_m3() const { return removed_volume_m3_; }
 
-  /// Restores the initial terrain, time and counters.
+  /// Restores the initial terrain, time and counters, and tells every
+  /// listener that the whole grid changed (StepListener::on_edit).
   void reset();
 
   /// Replaces the heights of a rectangle of samples between steps (an
@@ -154,11 +190,15 @@ class Simulation {
   Rect edit_heights(const Rect& rect, std::span<const float> values_m);
 
  private:
+  /// StepListener::on_edit for every listener (they may change heights there).
+  void tell_edited(const Rect& changed);
+
   SimParams params_;
   HeightGrid grid_;
   BladePose previous_pose_{};
   bool has_previous_ = false;
   bool in_step_ = false;
+  bool in_listener_ = false;  // a listener's on_step or on_edit is running
   std::int64_t step_count_ = 0;
   double removed_volume_m3_ = 0.0;
   StepOutput out_{};

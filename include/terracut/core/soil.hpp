@@ -100,6 +100,7 @@
 #include <utility>
 #include <vector>
 
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/blade.hpp"
 #include "terracut/core/grid.hpp"
 #include "terracut/core/material.hpp"
@@ -181,18 +182,24 @@ enum class SoilModel {
   kVanish,  ///< it is gone (the paper's model; the default)
   kFlow,    ///< it is pushed ahead of the blade and slides to its angle of repose
 };
-/// "vanish" or "flow".
-std::string_view to_string(SoilModel model);
-/// Inverse of to_string; nullopt for anything else.
-std::optional<SoilModel> parse_soil_model(std::string_view name);
+/// Its names (enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<SoilModel> kSoilModelNames[] = {
+    {SoilModel::kVanish, "vanish"},
+    {SoilModel::kFlow, "flow"},
+};
+constexpr std::span<const EnumName<SoilModel>> enum_names(SoilModel) { return kSoilModelNames; }
 
 /// What the grid's edge does to soil that reaches it.
 enum class SoilEdge {
   kWall,  ///< no soil leaves the terrain (the default)
   kOpen,  ///< soil sliding or pushed past the edge leaves it, and is counted
 };
-/// "wall" or "open".
-std::string_view to_string(SoilEdge edge);
+/// Its names (enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<SoilEdge> kSoilEdgeNames[] = {
+    {SoilEdge::kWall, "wall"},
+    {SoilEdge::kOpen, "open"},
+};
+constexpr std::span<const EnumName<SoilEdge>> enum_names(SoilEdge) { return kSoilEdgeNames; }
 
 /// The soil: its material and what happens to what the blade cuts (the
 /// scenario's `soil:` section); read-only during a run.
@@ -214,6 +221,13 @@ struct SoilFlowParams {
   std::int64_t max_pair_checks_per_step = 50000;
   /// The grid's edge: a wall, or open (bare ground beyond it at height 0).
   SoilEdge edge = SoilEdge::kWall;
+};
+
+/// The ranges of SoilFlowParams' own numbers (core/ranges.hpp): validate()
+/// checks them and the scenario reader reads `soil:` through them (the
+/// material's are material_ranges()).
+inline constexpr Range kSoilFlowRanges[] = {
+    {"max_pair_checks_per_step", 1000, 1e9, RangeEnds::kClosed, true},
 };
 
 /// Returns an empty string when params are valid, else a message naming the field.

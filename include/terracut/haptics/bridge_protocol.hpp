@@ -22,8 +22,11 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
+#include <span>
 #include <string_view>
 
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/math.hpp"
 #include "terracut/core/wire.hpp"
 
@@ -102,10 +105,25 @@ enum class Reject : std::uint8_t {
 static_assert(int(Reject::kBadChecksum) == int(wire::Frame::kBadChecksum) &&
                   int(Reject::kTruncated) == int(wire::Frame::kTruncated),
               "the framing reasons are wire::Frame's, in its order");
-inline constexpr std::size_t kRejectReasonCount = 10;  // including kNone
-/// "none", "truncated", "bad_length", "bad_magic", "bad_version",
-/// "bad_checksum", "bad_type", "duplicate", "reordered", "stale".
-std::string_view to_string(Reject reason);
+/// Its names (core/enum_names.hpp: to_string, parse_enum), in the enum's
+/// order: summary.json's rejected-packet counts are keyed by them.
+inline constexpr EnumName<Reject> kRejectNames[] = {
+    {Reject::kNone, "none"},
+    {Reject::kTruncated, "truncated"},
+    {Reject::kBadLength, "bad_length"},
+    {Reject::kBadMagic, "bad_magic"},
+    {Reject::kBadVersion, "bad_version"},
+    {Reject::kBadChecksum, "bad_checksum"},
+    {Reject::kBadType, "bad_type"},
+    {Reject::kDuplicate, "duplicate"},
+    {Reject::kReordered, "reordered"},
+    {Reject::kStale, "stale"},
+};
+constexpr std::span<const EnumName<Reject>> enum_names(Reject) { return kRejectNames; }
+using terracut::to_string;
+inline constexpr std::size_t kRejectReasonCount = std::size(kRejectNames);  // including kNone
+static_assert(std::size_t(kRejectNames[kRejectReasonCount - 1].value) + 1 == kRejectReasonCount,
+              "one name per reason, in the enum's order (RejectCounts is indexed by the value)");
 
 /// Checks a datagram's format (length, magic, version, CRC, type, payload
 /// size) and decodes it. Order of checks: length >= 4, magic, length >=

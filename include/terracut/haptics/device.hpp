@@ -82,6 +82,14 @@ class Device {
   /// Called once by the loop after the last tick.
   virtual void stop() noexcept {}
 
+  /// True while the device's user has paused it: only a virtual device has
+  /// a Pause (the viewer's). The real-time loop (HapticLoop::start) then
+  /// holds after the tick it is in, reads and writes nothing and costs no
+  /// CPU, until this is false again or a stop is requested; its clock
+  /// leaves the pause out. Called by the loop's thread between ticks. A real
+  /// device never pauses: a haptic loop must keep answering it.
+  virtual bool paused() noexcept { return false; }
+
   /// Counters for the summary (packets, rejections, hand energy, ...).
   virtual std::vector<DeviceStat> stats() const { return {}; }
 };

@@ -1,8 +1,9 @@
 // haptics.csv: one row per tick of a haptic loop (a LoopRecord), the columns
-// documented in docs/haptics.md.
+// documented in docs/haptics.md; written with io::CsvFile, terracut's one
+// CSV writer.
 #pragma once
 
-#include <iosfwd>
+#include <filesystem>
 #include <vector>
 
 #include "terracut/haptics/loop.hpp"
@@ -16,7 +17,9 @@ inline constexpr const char* kHapticsCsvColumns =
     "rate_limited,watchdog,ramping,nonfinite,bad_sample,silent,missed_deadline,period,compute,"
     "f_penetration,twist_torque,yaw_rate,fp_x,fp_y,fp_z";
 
-/// Writes records as haptics.csv text (kHapticsCsvColumns, then one row per record).
-void write_haptics_csv(std::ostream& out, const std::vector<LoopRecord>& records);
+/// Writes records as haptics.csv at path (kHapticsCsvColumns, then one row
+/// per record): numbers with %.9g, flags as 0 / 1. Throws InputError naming
+/// the file when it cannot be written.
+void write_haptics_csv(const std::filesystem::path& path, const std::vector<LoopRecord>& records);
 
 }  // namespace terracut::haptics

@@ -24,7 +24,9 @@
 //     (except the measured compute times). Tests and the `script` device use it.
 //   - start() / request_stop() / join(): on its own thread, paced by the
 //     Pacer (absolute deadlines, sleep then a short spin), with SCHED_FIFO
-//     and locked memory where permitted.
+//     and locked memory where permitted. A device its user paused (the
+//     viewer's virtual one: Device::paused) holds the thread between ticks,
+//     costing nothing, and the loop's time leaves the pause out.
 #pragma once
 
 #include <atomic>
@@ -120,6 +122,10 @@ struct LoopCounters {
 /// Percentiles of a per-tick time, microseconds (core/stats.hpp).
 using TimePercentiles = TimingStats;
 
+/// The range of a haptic loop's rate, Hz: narrower than a simulation's
+/// (kRateRange), since a device is paced and answered every tick.
+inline constexpr Range kLoopRateRange{"rate_hz", 10.0, 10000.0, RangeEnds::kClosed};
+
 /// The loop's parameters: the haptic settings, validated once, with their
 /// derived values computed once (the force model's workspace scale, loop
 /// rate and largest contact length) and the force model built once (its
@@ -127,16 +133,18 @@ using TimePercentiles = TimingStats;
 class LoopParams {
  public:
   /// settings: as parsed (any derived force fields are replaced); blade: the
-  /// scenario's blade (its length bounds the contact). Throws InputError
-  /// "haptics.FIELD ..." naming the bad field, including a ForceModel refusal
-  /// ("haptics.forces. ...").
-  LoopParams(const HapticSettings& settings, const BladeSpec& blade);
+  /// scenario's blade (its length bounds the contact); rate_hz: the loop's
+  /// rate, the simulation's (the scenario's rate_hz, or a program's
+  /// override), in kLoopRateRange. Throws InputError "haptics.FIELD ..."
+  /// naming the bad field, including a ForceModel refusal ("haptics.forces.
+  /// ..."), or "rate_hz ..." for a rate out of the loop's range.
+  LoopParams(const HapticSettings& settings, const BladeSpec& blade, double rate_hz);
 
   /// The settings with the derived force fields filled in.
   const HapticSettings& settings() const { return settings_; }
-  /// The loop rate, Hz (settings().rate_hz): the simulation the loop steps
-  /// must run at this rate.
-  double rate_hz() const { return settings_.rate_hz; }
+  /// The loop rate, Hz (kept once, as the force model's loop_rate_hz): the
+  /// simulation the loop steps must run at this rate.
+  double rate_hz() const { return settings_.forces.loop_rate_hz; }
   /// The force model (after the device check).
   const ForceModel& force_model() const { return model_; }
 
@@ -209,6 +217,9 @@ class HapticLoop {
   void request_stop() { stop_requested_.store(true, std::memory_order_relaxed); }
   /// Waits for the thread to end (it ends after options.ticks or a stop request).
   void join();
+  /// While the device is paused (Device::paused) the thread looks at it
+  /// again every this many seconds, and at a stop request.
+  static constexpr double kPausePoll_s = 0.005;
   /// True while the loop thread runs.
   bool running() const { return running_.load(std::memory_order_acquire); }
 

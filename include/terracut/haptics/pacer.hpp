@@ -168,6 +168,16 @@ class Pacer {
   /// start the schedule.
   Tick wait_next();
 
+  /// The caller holds its loop (a paused device, Device::paused): ends the
+  /// current tick as wait_next does (its compute time up to now), and waits
+  /// for no deadline until resume().
+  void hold();
+  /// After a hold: starts the next tick at once, the schedule re-anchored at
+  /// the present time. The gap is no period of the loop: the tick's period_s
+  /// is the nominal one, and no jitter, wake latency or missed deadline is
+  /// recorded for it.
+  Tick resume();
+
   /// The statistics so far.
   LoopStats stats() const;
   /// Clears the statistics; the schedule goes on.
@@ -175,9 +185,14 @@ class Pacer {
 
  private:
   PacerSettings settings_;
+  /// Records the current tick's compute time and counts it; returns the time
+  /// it ended.
+  double end_tick();
+
   std::shared_ptr<PacerClock> clock_;
   double period_s_ = 0.0;
   bool started_ = false;
+  bool held_ = false;          // between hold() and resume()
   double origin_s_ = 0.0;      // the schedule's t0
   Tick tick_{};                // the current tick
   double recorded_compute_s_ = -1.0;  // record_compute's value for the current tick, < 0 if none

@@ -29,6 +29,7 @@
 #include <string>
 #include <string_view>
 
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/forces.hpp"
 #include "terracut/core/math.hpp"
 #include "terracut/core/ranges.hpp"
@@ -36,16 +37,21 @@
 
 namespace terracut::haptics {
 
+using terracut::to_string;  // the enumerations' names (core/enum_names.hpp)
+
 /// Which device drives the tool.
 enum class DeviceKind {
   kScript,  ///< the tool follows the scenario's cut keyframes exactly
   kSim,     ///< a simulated operator hand pulled along the cut's path; feels the force
   kUdp,     ///< an external device process over the UDP bridge protocol
 };
-/// "script", "sim" or "udp".
-std::string_view to_string(DeviceKind kind);
-/// Inverse of to_string; nullopt for anything else.
-std::optional<DeviceKind> parse_device_kind(std::string_view name);
+/// Its names (core/enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<DeviceKind> kDeviceKindNames[] = {
+    {DeviceKind::kScript, "script"},
+    {DeviceKind::kSim, "sim"},
+    {DeviceKind::kUdp, "udp"},
+};
+constexpr std::span<const EnumName<DeviceKind>> enum_names(DeviceKind) { return kDeviceKindNames; }
 
 /// Mapping between the device's workspace and the world (see the file comment).
 struct WorkspaceMapping {
@@ -71,9 +77,12 @@ enum class SurfaceReference {
   /// cell), so use it to feel shapes, not while cutting deep.
   kTerrain,
 };
-/// "ground" or "terrain".
-std::string_view to_string(SurfaceReference reference);
-std::optional<SurfaceReference> parse_surface_reference(std::string_view name);
+/// Its names (core/enum_names.hpp: to_string, parse_enum).
+inline constexpr EnumName<SurfaceReference> kSurfaceReferenceNames[] = {
+    {SurfaceReference::kGround, "ground"},
+    {SurfaceReference::kTerrain, "terrain"},
+};
+constexpr std::span<const EnumName<SurfaceReference>> enum_names(SurfaceReference) { return kSurfaceReferenceNames; }
 
 /// The simulated operator hand of the `sim` device: a point mass held by the
 /// device, pulled by a spring-damper toward a target that moves along the
@@ -104,10 +113,8 @@ struct UdpSettings {
 
 /// Everything a haptic session needs besides the scenario's terrain and blade.
 struct HapticSettings {
-  /// Loop rate, Hz, finite, in [10, 10000]. Also the simulation's step rate
-  /// during the session and the rate of the passivity rule
-  /// (forces.loop_rate_hz is set from it).
-  double rate_hz = 1000.0;
+  // The loop's rate is the simulation's (the scenario's rate_hz, or a
+  // program's override): LoopParams takes it (haptics/loop.hpp).
   /// Device backend.
   DeviceKind device = DeviceKind::kSim;
   /// Name of the scenario cut whose keyframes the script and sim devices
@@ -125,13 +132,15 @@ struct HapticSettings {
   /// else the cut's first keyframe.
   std::optional<Vec3> tool_rotation_deg;
   /// Cut-off of the first-order low-pass on the backward-difference velocity,
-  /// Hz, finite, >= 0 and below rate_hz / 2; 0 disables the filter.
+  /// Hz, finite, >= 0 and below the loop's rate / 2 (LoopParams checks that);
+  /// 0 disables the filter.
   double velocity_cutoff_hz = 100.0;
   SurfaceReference surface_reference = SurfaceReference::kGround;
   /// The rendering of the physical force on the device, and the device's
   /// limits (core/forces.hpp). forces.workspace_scale and
-  /// forces.loop_rate_hz are derived (from workspace.scale and rate_hz) and
-  /// forces.max_contact_length_m from the blade length when the loop is built.
+  /// forces.loop_rate_hz are derived (from workspace.scale and the loop's
+  /// rate) and forces.max_contact_length_m from the blade length when the
+  /// loop is built.
   ForceModelParams forces{};
   /// Safety limits; safety.max_force_n must not exceed forces.device.max_force_n.
   SafetyParams safety{};
@@ -142,15 +151,16 @@ struct HapticSettings {
 /// Returns an empty string when the settings are valid, else a message that
 /// starts with the field's path (e.g. "workspace.scale must be ..."). Checks
 /// every field, including forces and safety (not the device-rendering check,
-/// which the ForceModel constructor makes).
+/// which the ForceModel constructor makes, nor the checks against the loop's
+/// rate, which LoopParams makes).
 std::string validate(const HapticSettings& s);
 /// The ranges of HapticSettings' own numbers, which validate() checks
 /// (core/ranges.hpp; forces and safety: force_ranges(), safety_ranges()).
 std::span<const Range> haptic_settings_ranges();
 
 /// The settings with the derived force fields filled in: forces.workspace_scale
-/// = workspace.scale, forces.loop_rate_hz = rate_hz and
+/// = workspace.scale, forces.loop_rate_hz = rate_hz (the loop's) and
 /// forces.max_contact_length_m = blade_length_m (> 0).
-HapticSettings with_derived_fields(HapticSettings settings, double blade_length_m);
+HapticSettings with_derived_fields(HapticSettings settings, double blade_length_m, double rate_hz);
 
 }  // namespace terracut::haptics

@@ -3,7 +3,6 @@
 // given keeps the default of HapticSettings. Full reference: docs/haptics.md.
 //
 //   haptics:
-//     rate_hz: 1000                  # loop rate, Hz, [10, 10000]
 //     device: sim                    # script | sim | udp
 //     cut: trench                    # cut followed by script/sim (default: first of the sequence)
 //     duration_s: 6                  # default: the cut's duration + settle_s (udp: 30)

@@ -5,14 +5,18 @@
 //   max_depth,cells_visited
 //
 // SI units (docs/scenario-format.md); numbers printed with %.9g, so the text
-// is the same on every run of the same scenario.
+// is the same on every run of the same scenario. CsvFile below is the one
+// CSV writer every file of terracut is written with.
 #pragma once
 
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <initializer_list>
+#include <span>
 #include <string>
+#include <string_view>
+#include <type_traits>
 
 #include "terracut/core/blade.hpp"
 #include "terracut/core/contact.hpp"
@@ -29,35 +33,65 @@ struct StepRecord {
   double removed_volume_m3 = 0.0;  ///< volume cut in this step, m^3
 };
 
-/// A CSV file written row by row through a large stdio buffer: the header
-/// at creation, then rows of numbers printed with %.9g (and text cells), so
-/// the text is the same on every run of the same scenario. Every error names
-/// the file ("PATH: cannot create: REASON", "PATH: write failed: REASON",
-/// InputError).
+/// A CSV file written row by row through a stdio buffer: the header at
+/// creation, then rows of cells, so the text is the same on every run of the
+/// same scenario. Every CSV file of terracut is one (contact.csv, force.csv,
+/// bodies.csv, haptics.csv, operator.csv, remote.csv). Every error names the
+/// file ("PATH: cannot create: REASON", "PATH: write failed: REASON",
+/// InputError). Writing a row allocates nothing.
 class CsvFile {
  public:
-  CsvFile(std::filesystem::path path, const std::string& header);
+  /// Creates (replaces) the file and writes header (the column names,
+  /// comma-separated, without the line's end).
+  CsvFile(std::filesystem::path path, std::string_view header);
   ~CsvFile();
   CsvFile(const CsvFile&) = delete;
   CsvFile& operator=(const CsvFile&) = delete;
 
-  /// One cell of a row: a number (%.9g) or a text (as is: no quoting, so
-  /// the caller gives text without commas, as cut names are).
-  struct Cell {
-    Cell(double v) : number(v) {}
-    Cell(const std::string& t) : text(&t) {}
-    double number = 0.0;
-    const std::string* text = nullptr;
+  /// One cell of a row: a double printed with %.9g, a whole number (any
+  /// integer or bool: 0 / 1), a number printed exactly (exact(): the shortest
+  /// text that reads back to the same double or float), or a text (as is: no
+  /// quoting, so the caller gives text without commas, as names are).
+  class Cell {
+   public:
+    Cell(double v) : kind_(Kind::kNumber), number_(v) {}
+    template <typename T>
+      requires std::is_integral_v<T>
+    Cell(T v) : kind_(Kind::kWhole), whole_(static_cast<long long>(v)) {}
+    Cell(const std::string& t) : kind_(Kind::kText), text_(t) {}
+    Cell(const char* t) : kind_(Kind::kText), text_(t) {}
+    static Cell exact(double v) { return Cell(Kind::kExactDouble, v); }
+    static Cell exact(float v) { return Cell(Kind::kExactFloat, v); }
+
+    /// Writes the cell's text into out (at least kMaxNumberChars for a
+    /// number); returns its end, or its text for a text cell.
+    std::string_view print(char* out) const noexcept;
+    static constexpr std::size_t kMaxNumberChars = 64;
+
+   private:
+    enum class Kind { kNumber, kWhole, kExactDouble, kExactFloat, kText };
+    Cell(Kind kind, double v) : kind_(kind), number_(v) {}
+    Kind kind_;
+    double number_ = 0.0;
+    long long whole_ = 0;
+    std::string_view text_;
   };
-  /// Appends one row.
-  void row(std::initializer_list<Cell> cells);
-  /// Flushes and closes.
+  /// Appends one row. Throws InputError "PATH: write failed: REASON".
+  void row(std::span<const Cell> cells);
+  void row(std::initializer_list<Cell> cells) { row(std::span(cells.begin(), cells.size())); }
+  /// Appends one row and never throws (a step listener's, in a real-time
+  /// tick): false when the write failed, which close() then reports.
+  bool try_row(std::initializer_list<Cell> cells) noexcept;
+  /// Flushes and closes; throws InputError "PATH: write failed: REASON"
+  /// when this or any try_row() failed.
   void close();
   const std::filesystem::path& path() const { return path_; }
 
  private:
+  bool put_row(std::span<const Cell> cells) noexcept;
   std::filesystem::path path_;
   std::FILE* file_ = nullptr;
+  int failed_errno_ = 0;  // the first failed try_row's errno, 0: none failed
 };
 
 /// Writes contact.csv row by row (a CsvFile).

@@ -94,7 +94,9 @@ struct Scenario {
 
   // --- Simulation ----------------------------------------------------------
   Representation representation = Representation::kSurface;
-  double rate_hz = 1000.0;  ///< fixed step rate, Hz, in (0, 1e6]
+  /// The one rate of every run of the scenario (SimParams::rate_hz): steps
+  /// per second, Hz, in (0, 1e6]; a haptic loop's too (in [10, 10000]).
+  double rate_hz = 1000.0;
   BladeSpec blade{};
 
   /// The cuts in the order listed; each has >= 1 keyframe with strictly
@@ -151,8 +153,8 @@ std::vector<std::string> parse_name_list(std::string_view text,
 GridSpec grid_spec(const Scenario& scenario);
 
 /// The simulation parameters of the scenario (grid, representation, blade)
-/// at its rate_hz, or at rate_hz when given (a haptic loop steps the
-/// simulation at its own rate, haptics.rate_hz).
+/// at its rate_hz, or at rate_hz when given (a program's override of the
+/// rate for its haptic loop, `terracut haptics --rate`).
 SimParams sim_params(const Scenario& scenario, std::optional<double> rate_hz = std::nullopt);
 
 /// The initial heights, rows x cols, row-major, metres: the generator sampled

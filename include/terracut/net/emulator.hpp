@@ -3,7 +3,8 @@
 // is developed on, so the conditions are made in-process, the same way for
 // the in-memory link of a single-process run and for the UDP (ENet) link of
 // a two-process run: the sender asks the emulator when (and whether) a
-// datagram arrives, and holds it until then.
+// datagram arrives, and holds it until then (net::EmulatedEndpoint,
+// emulated_link.hpp: a decorator in front of any transport).
 //
 // Per datagram, in this order (one seeded std::mt19937_64, so a run is
 // reproducible):
@@ -46,10 +47,21 @@ struct LinkConditions {
   double reorder = 0.0;          ///< probability a datagram is held back, [0, 1]
   double reorder_delay_s = 0.005;  ///< how long it is held back, s, [0, 10]
   /// Retransmission timeout of a lost reliable datagram, s, (0, 60];
-  /// nullopt: 2 x delay + 20 ms (a round trip and a margin).
+  /// nullopt: the round trip and kRetransmitMargin_s (retransmit_timeout_s).
   std::optional<double> retransmit_s;
   std::uint64_t seed = 1;  ///< RNG seed
 };
+
+/// What a retransmission costs beyond the round trip, s (ENet's own timeout
+/// adds about as much to its round-trip estimate).
+inline constexpr double kRetransmitMargin_s = 0.02;
+/// The retransmission timeout of a lost reliable datagram: c.retransmit_s
+/// when set, else round_trip_s + kRetransmitMargin_s. The one rule, for
+/// the emulator and for the buffers sized from it.
+double retransmit_timeout_s(const LinkConditions& c, double round_trip_s);
+/// The round trip these conditions make when the way back is alike: 2 x
+/// delay_s, s (what a station assumes until it has measured one).
+inline double emulated_round_trip_s(const LinkConditions& c) { return 2.0 * c.delay_s; }
 
 /// Empty when valid, else a message naming the field ("delay_s must be ...").
 std::string validate(const LinkConditions& c);
@@ -76,15 +88,19 @@ class LinkEmulator {
 
   const LinkConditions& conditions() const { return c_; }
   const EmulatorCounters& counters() const { return counters_; }
-  /// The retransmission timeout a lost reliable datagram costs, s.
-  double retransmit_s() const { return retransmit_s_; }
+  /// The retransmission timeout a lost reliable datagram costs, s: from the
+  /// measured round trip once there is one (set_round_trip_s), before that
+  /// from the configured delay (emulated_round_trip_s).
+  double retransmit_s() const { return retransmit_timeout_s(c_, round_trip_s_); }
+  /// The round trip the station measured, s (>= 0; a non-finite value is ignored).
+  void set_round_trip_s(double round_trip_s) noexcept;
 
  private:
   bool lose() noexcept;   // one loss draw (steps the Gilbert-Elliott chain)
   double uniform() noexcept;  // [0, 1)
 
   LinkConditions c_;
-  double retransmit_s_ = 0.0;
+  double round_trip_s_ = 0.0;
   std::mt19937_64 rng_;
   bool bad_ = false;
   double last_reliable_s_ = 0.0;

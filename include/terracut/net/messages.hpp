@@ -6,7 +6,7 @@
 //
 //   offset size type  field
 //   0      4    u32   magic = 0x4D4D4354 (the bytes "TCMM")
-//   4      2    u16   version = 1
+//   4      2    u16   version = 2
 //   6      2    u16   type (MessageType)
 //   8      4    u32   link: chosen for the pair of stations (a packet of another link is "foreign")
 //   12     4    u32   session: chosen by the sender at start (a new value = the station restarted)
@@ -27,11 +27,14 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <memory>
+#include <span>
 #include <string_view>
 #include <vector>
 
 #include "terracut/core/blade.hpp"
+#include "terracut/core/enum_names.hpp"
 #include "terracut/core/grid.hpp"
 #include "terracut/core/math.hpp"
 #include "terracut/core/wire.hpp"
@@ -39,11 +42,13 @@
 namespace terracut::net {
 
 inline constexpr std::uint32_t kMagic = 0x4D4D4354u;  // "TCMM" in memory order
-inline constexpr std::uint16_t kVersion = 1;
+/// 2: the command carries the operator's round trip, the measurement the
+/// commands the remote received (2026-12: measured, not configured).
+inline constexpr std::uint16_t kVersion = 2;
 inline constexpr std::size_t kHeaderSize = 40;
 inline constexpr std::size_t kCrcSize = 4;
 inline constexpr std::size_t kCommandPayloadSize = 72;
-inline constexpr std::size_t kMeasurementPayloadSize = 112;
+inline constexpr std::size_t kMeasurementPayloadSize = 120;
 inline constexpr std::size_t kPatchFixedSize = 32;  ///< before the compressed heights
 inline constexpr std::size_t kEstimatePayloadSize = 32;
 /// Largest patch, samples (2048 x 2048); a patch declaring more is refused.
@@ -70,19 +75,24 @@ struct Header {
 inline constexpr std::uint32_t kCommandLifted = 1u;  ///< the operator's tool was lifted (a jump, not a sweep)
 
 /// Tool command (72 bytes): t_s f64 at 40, position f64[3] at 48,
-/// orientation f64[4] (w, x, y, z) at 72, flags u32 at 104, reserved u32 at 108.
+/// orientation f64[4] (w, x, y, z) at 72, flags u32 at 104, round_trip_us
+/// u32 at 108.
 struct Command {
   double t_s = 0.0;  ///< operator loop time of the command, s
   BladePose pose{};  ///< commanded tool pose, world
   std::uint32_t flags = 0;
+  /// The round trip the operator measured (its recent largest), us; 0:
+  /// none yet. The remote's emulator and retransmissions use it.
+  std::uint32_t round_trip_us = 0;
 };
 
 /// Measurement flag bits.
 inline constexpr std::uint32_t kMeasurementHolding = 1u;  ///< link silent: the remote tool holds still
 
-/// What the remote measured (112 bytes): t_s f64 at 40, command_sequence
+/// What the remote measured (120 bytes): t_s f64 at 40, command_sequence
 /// u32 at 48, flags u32 at 52, position f64[3] at 56, orientation f64[4] at
-/// 80, force f64[3] at 112, contact_length f64 at 136, cut_depth f64 at 144.
+/// 80, force f64[3] at 112, contact_length f64 at 136, cut_depth f64 at 144,
+/// commands_received u32 at 152, reserved u32 at 156.
 struct Measurement {
   double t_s = 0.0;                    ///< remote loop time, s
   std::uint32_t command_sequence = 0;  ///< the newest command it follows
@@ -91,6 +101,10 @@ struct Measurement {
   Vec3 force_world_n{};         ///< measured force on the tool, world N
   double contact_length_m = 0;  ///< blade length in soil, m
   double cut_depth_m = 0;       ///< depth of cut, m
+  /// Commands of this operator session that reached the remote so far
+  /// (followed, or too old to follow): the operator's measure of its
+  /// command loss.
+  std::uint32_t commands_received = 0;
 };
 
 /// Heights of a rectangle (32 bytes + compressed data): t_s f64 at 40, c0,
@@ -132,11 +146,27 @@ enum class Reject : std::uint8_t {
   kReordered,    ///< older than the last accepted one
   kStale,        ///< newer sequence, older timestamp
 };
-inline constexpr std::size_t kRejectReasonCount = 12;  // including kNone
-/// "none", "truncated", "bad_length", "bad_magic", "bad_version",
-/// "bad_checksum", "bad_type", "foreign", "bad_payload", "duplicate",
-/// "reordered", "stale".
-std::string_view to_string(Reject reason);
+/// Its names (core/enum_names.hpp: to_string, parse_enum), in the enum's
+/// order: the link's rejected-datagram counts are keyed by them.
+inline constexpr EnumName<Reject> kRejectNames[] = {
+    {Reject::kNone, "none"},
+    {Reject::kTruncated, "truncated"},
+    {Reject::kBadLength, "bad_length"},
+    {Reject::kBadMagic, "bad_magic"},
+    {Reject::kBadVersion, "bad_version"},
+    {Reject::kBadChecksum, "bad_checksum"},
+    {Reject::kBadType, "bad_type"},
+    {Reject::kForeign, "foreign"},
+    {Reject::kBadPayload, "bad_payload"},
+    {Reject::kDuplicate, "duplicate"},
+    {Reject::kReordered, "reordered"},
+    {Reject::kStale, "stale"},
+};
+constexpr std::span<const EnumName<Reject>> enum_names(Reject) { return kRejectNames; }
+using terracut::to_string;
+inline constexpr std::size_t kRejectReasonCount = std::size(kRejectNames);  // including kNone
+static_assert(std::size_t(kRejectNames[kRejectReasonCount - 1].value) + 1 == kRejectReasonCount,
+              "one name per reason, in the enum's order (RejectCounts is indexed by the value)");
 
 static_assert(int(Reject::kBadChecksum) == int(wire::Frame::kBadChecksum) &&
                   int(Reject::kTruncated) == int(wire::Frame::kTruncated),

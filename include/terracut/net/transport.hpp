@@ -1,18 +1,18 @@
 // The transport between the two stations: an Endpoint sends datagrams on one
-// of two channels and receives what has arrived. Two carriers, one emulator
-// (emulator.hpp) at the sender of each:
+// of two channels and receives what has arrived. Two carriers:
 //   - MemoryLink: two endpoints in one process, for a single-process run and
 //     for tests; time is the stations' (simulated) time.
 //   - EnetEndpoint (enet_transport.hpp): UDP through ENet, one port, a
-//     reliable channel and an unreliable sequenced one; time is the wall clock.
+//     reliable channel and an unreliable sequenced one, authenticated and
+//     encrypted (secure.hpp); time is the wall clock.
+// The link emulator (emulated_link.hpp) is a decorator in front of either:
+// an Endpoint that wraps an Endpoint.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
-
-#include "terracut/net/emulator.hpp"
 
 namespace terracut::net {
 
@@ -101,18 +101,21 @@ class Endpoint {
   /// it for its working traffic, so that sending allocates nothing).
   /// The default does nothing (a carrier without a pool).
   virtual void reserve_in_flight(std::size_t /*datagrams*/, std::size_t /*bytes*/) {}
-  /// The emulator of this endpoint's sending direction.
-  virtual const LinkEmulator& emulator() const = 0;
+  /// The round trip the station measured, s: what a layer that needs the
+  /// delay uses instead of a configured one (the emulator's retransmission
+  /// timeout). The default does nothing.
+  virtual void note_round_trip_s(double /*round_trip_s*/) noexcept {}
 
  protected:
   TrafficCounters traffic_{};
 };
 
-/// Two endpoints joined in memory. a_to_b: the conditions of what a sends.
+/// Two endpoints joined in memory: what one sends, the other receives at its
+/// next receive(), in sending order (no delay, no loss: wrap each side in an
+/// EmulatedEndpoint for those).
 class MemoryLink {
  public:
-  /// Throws InputError naming the field of bad conditions.
-  MemoryLink(const LinkConditions& a_to_b, const LinkConditions& b_to_a);
+  MemoryLink();
   ~MemoryLink();
   Endpoint& a();
   Endpoint& b();

@@ -147,7 +147,8 @@ struct RunResult {
   /// What the user should know about the result (also summary.json's
   /// "warnings"): soil left steeper than its repose angle when the work
   /// cap stopped the relaxation short, cells too far from square for the
-  /// repose angle to hold in every direction (soil_warnings).
+  /// repose angle to hold in every direction (soil_warnings); a cut whose
+  /// blade never crosses the terrain (cut_warnings).
   std::vector<std::string> warnings;
   double wall_s = 0.0;               ///< wall-clock time of the simulation loop, seconds
 };
@@ -155,6 +156,13 @@ struct RunResult {
 /// Steps a batch run gives a cut at rate_hz: one at t = i / rate_hz (from
 /// the cut's start, Motion::sample) for i = 0..n, n = round(duration * rate_hz).
 std::int64_t cut_steps(const Motion& motion, double rate_hz);
+
+/// What a user should know about the scenario's cuts: each cut of the
+/// sequence whose blade edge, at every step (t = i / rate_hz), lies outside
+/// the terrain's X-Z extent seen from above, so that it cuts nothing (a
+/// keyframe written as an offset from the terrain's corner, a wrong sign).
+/// One readable line per such cut, naming it.
+std::vector<std::string> cut_warnings(const io::Scenario& scenario);
 
 /// What a user should know about a run's soil (kFlow; none with kVanish):
 /// cells still active at the end (the work cap stopped the relaxation

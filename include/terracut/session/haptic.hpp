@@ -37,18 +37,21 @@ namespace terracut::session {
 /// scenario's sequence, played as `terracut run` steps them (the tool
 /// lifted between them) by the script device; the sim hand, a hand that
 /// cannot jump between strokes, follows only the first. source: the name
-/// errors give. Throws InputError "SOURCE: haptics.cut: ..." when the cut
-/// named is not in the scenario or the scenario has none.
+/// errors give; rate_hz: the loop's rate, nullopt: the scenario's rate_hz.
+/// Throws InputError "SOURCE: haptics.cut: ..." when the cut named is not in
+/// the scenario or the scenario has none.
 haptics::DevicePath followed_path(const Scenario& scenario, const haptics::HapticSettings& settings,
-                                  const std::string& source);
+                                  const std::string& source,
+                                  std::optional<double> rate_hz = std::nullopt);
 
 /// The device of settings.device over the scenario (the one factory every
 /// program uses): script or sim along followed_path, or the UDP bridge at
-/// settings.udp (udp_port: the port to bind, 0 for any free one). Throws
-/// InputError as followed_path.
+/// settings.udp (udp_port: the port to bind, 0 for any free one); rate_hz
+/// as followed_path's. Throws InputError as followed_path.
 std::unique_ptr<haptics::Device> make_device(const Scenario& scenario,
                                              const haptics::HapticSettings& settings, int udp_port,
-                                             const std::string& source);
+                                             const std::string& source,
+                                             std::optional<double> rate_hz = std::nullopt);
 
 /// How a rig is built.
 struct RigOptions {
@@ -101,6 +104,9 @@ struct SessionOptions {
   std::optional<std::string> udp_address;  ///< overrides haptics.udp.address
   std::optional<int> udp_port;             ///< overrides haptics.udp.port (0: any free port)
   std::optional<double> duration_s;        ///< overrides haptics.duration_s, (0, 86400]
+  /// Overrides the scenario's rate_hz for the session's loop and its
+  /// simulation, Hz, in haptics::kLoopRateRange (`terracut haptics --rate`).
+  std::optional<double> rate_hz;
   /// nullopt: kFake for script, kReal for sim and udp. kFake with udp is refused.
   std::optional<ClockMode> clock;
   bool realtime = true;  ///< ask for SCHED_FIFO and locked memory (kReal)
@@ -147,8 +153,14 @@ class HapticSession {
   ClockMode clock() const { return clock_; }
   double duration_s() const { return duration_s_; }
   /// Warnings collected at build and after the run (rendering limited,
-  /// real-time refused, bad samples, missed deadlines, ...).
+  /// real-time refused, bad samples, missed deadlines, ...): summary.json's.
   std::vector<std::string> warnings() const;
+  /// What the device check changed at build (said once on SessionOptions::log
+  /// when the session is built).
+  const std::vector<std::string>& build_warnings() const { return build_warnings_; }
+  /// The warnings the run found (warnings() less build_warnings()): what a
+  /// program says at the end.
+  std::vector<std::string> run_warnings() const;
   /// summary.json's text.
   std::string summary_json() const;
 

@@ -35,7 +35,9 @@
 #include "terracut/core/wire.hpp"
 #include "terracut/core/stats.hpp"
 #include "terracut/haptics/device.hpp"
+#include "terracut/io/recording.hpp"
 #include "terracut/io/scenario.hpp"
+#include "terracut/net/emulated_link.hpp"
 #include "terracut/net/emulator.hpp"
 #include "terracut/net/messages.hpp"
 #include "terracut/net/transport.hpp"
@@ -61,7 +63,7 @@ struct RemoteRecord {
   double force_scale = 1.0;  ///< the estimate
   bool holding = false;      ///< link silent: holding still
   bool active = false;       ///< a command has arrived
-  double compute_s = 0.0;
+  double compute_s = 0.0;    ///< the whole tick (receiving, the loop, sensing, sending), s
 };
 
 /// One operator tick.
@@ -79,7 +81,10 @@ struct OperatorRecord {
   bool link_silent = false;
   double passivity_j = 0.0;      ///< energy into the hand over the last window, MMT, J
   double passivity_dfr_j = 0.0;  ///< the same for direct force reflection, J
-  double compute_s = 0.0;
+  double compute_s = 0.0;        ///< the whole tick (receiving, merging, the loop, sending), s
+  std::uint32_t command_sequence = 0;  ///< the command sent this tick
+  double round_trip_s = 0.0;   ///< newest measured round trip, s (0: none yet)
+  double command_loss = 0.0;   ///< commands the remote did not receive over about the last second, fraction
 };
 
 /// Counts of what a station received.
@@ -139,6 +144,15 @@ class RemoteStation {
   std::int64_t estimate_capped() const { return rls_capped_; }
   /// Packets sent that carried model updates (patches + estimates).
   std::int64_t update_packets() const { return counters_.patches + counters_.estimates; }
+  /// Commands of the current operator session that arrived (accepted, or
+  /// refused only as older than the newest: what each measurement reports
+  /// back), and those the accepted sequence numbers skipped.
+  std::int64_t commands_received() const { return commands_received_; }
+  std::int64_t commands_missed() const { return commands_.lost(); }
+  /// The round trip the operator measured and sent, s (0: none yet).
+  double round_trip_s() const { return round_trip_s_; }
+  /// When the newest command was accepted (station time), s.
+  double last_command_s() const { return last_command_s_; }
 
  private:
   void receive(double t_s);
@@ -156,6 +170,8 @@ class RemoteStation {
   std::vector<float> mirror_;  // what the operator was sent (starts as its initial heights)
   std::vector<float> sensed_;  // the sensed rectangle: soil, or a body's top over it
   wire::SequenceFilter commands_;
+  std::int64_t commands_received_ = 0;  // in the current operator session
+  double round_trip_s_ = 0.0;
   std::uint32_t command_sequence_ = 0;
   Vec3 commanded_m_{};
   bool has_command_ = false;
@@ -191,6 +207,10 @@ struct OperatorOptions {
   /// for a session without a set end (the viewer's, the live stations of
   /// `terracut mmt --role`, which stream them to a file).
   bool keep_records = true;
+  /// Measure the round trip on the wall clock (a station in real time: its
+  /// tick times may lag the wall clock's while it catches up); false: on the
+  /// station's time (simulated time, where the wall clock means nothing).
+  bool wall_clock = false;
 };
 
 class OperatorStation {
@@ -213,6 +233,27 @@ class OperatorStation {
   /// The newest measured round trip: from sending a command to receiving
   /// the first measurement of the remote following it, s; 0 before one.
   double rtt_s() const { return rtt_s_; }
+  /// The round trip a station must allow for: the largest measured over
+  /// the last one to two seconds; before the first, the configured delays
+  /// and jitters both ways. The protection window, the command's
+  /// round_trip_us and the emulator's retransmissions use it.
+  double round_trip_bound_s() const;
+  bool round_trip_measured() const { return rtt_known_; }
+  /// Commands sent; the newest command the remote followed and how many of
+  /// the commands up to it it received (both from its newest measurement).
+  std::int64_t commands_sent() const { return std::int64_t(seq_command_); }
+  std::int64_t commands_followed() const { return ack_known_ ? std::int64_t(ack_sequence_) + 1 : 0; }
+  std::int64_t commands_received_by_remote() const { return ack_received_; }
+  /// Fraction of the commands up to the newest followed one that the remote
+  /// did not receive: over the session, and over about the last second.
+  double command_loss() const;
+  double command_loss_recent() const { return loss_recent_; }
+  /// When the newest datagram was accepted (station time), and whether any was.
+  double last_heard_s() const { return last_heard_s_; }
+  bool heard() const { return heard_; }
+  /// Silences longer than timeout_s (the force faded), and the longest, s.
+  std::int64_t silences() const { return silences_; }
+  double longest_silence_s() const { return longest_silence_s_; }
   const StationCounters& counters() const { return counters_; }
   const HapticRig& rig() const { return *rig_; }
   const Simulation& simulation() const;
@@ -237,6 +278,9 @@ class OperatorStation {
   };
   void receive(double t_s);
   void merge(double t_s);
+  void measure_link(double t_s);
+  double round_trip_clock_s(double t_s) const;
+  double protection_s() const;
 
   MmtSettings settings_;
   net::Endpoint& link_;
@@ -245,7 +289,7 @@ class OperatorStation {
   std::unique_ptr<HapticRig> rig_;
   std::unique_ptr<ScaleCorrection> correction_;
   std::vector<float> stamp_s_;  // time each sample was last changed by the local tool
-  double protect_s_ = 0.0;
+  double protect_s_ = 0.0;      // a local cut this recent is not yet in what the remote sends
   // The blends in arrival order: [0, active_blends_) are merging, the rest
   // are kept (with their buffers) for the next patches.
   std::vector<Blend> blends_;
@@ -270,11 +314,25 @@ class OperatorStation {
   std::vector<OperatorRecord> records_;
   OperatorRecord last_{};
   OperatorOptions options_;
-  // When each command was sent, s, by sequence modulo the ring's size.
+  // When each command was sent (station time, or the wall clock's with
+  // OperatorOptions::wall_clock), s, by sequence modulo the ring's size.
   std::vector<double> command_sent_s_;
   std::uint32_t rtt_sequence_ = 0;  // the command the newest round trip is of
   double rtt_s_ = 0.0;
   bool rtt_known_ = false;
+  // The largest round trip of the current and the previous second.
+  double rtt_max_now_s_ = 0.0, rtt_max_before_s_ = 0.0, rtt_bucket_s_ = 0.0;
+  // The remote's newest report: the command it follows, the commands it received.
+  std::uint32_t ack_sequence_ = 0;
+  std::int64_t ack_received_ = 0;
+  bool ack_known_ = false;
+  // The report as it was at each of the last second's ticks (ring by tick).
+  std::vector<std::uint32_t> loss_sequence_;
+  std::vector<std::int64_t> loss_received_;
+  double loss_recent_ = 0.0;
+  std::int64_t silences_ = 0;
+  double longest_silence_s_ = 0.0;
+  bool was_silent_ = false;
   StationCounters counters_{};
   net::Inbox inbox_;
   net::Patch patch_;
@@ -295,10 +353,12 @@ struct MmtOverrides {
 /// naming the option.
 MmtSettings apply_overrides(MmtSettings s, const MmtOverrides& o);
 
-/// The figures of one run (summary.json's "results").
+/// The figures of one run (summary.json), the same for both stations in
+/// one process and for the report of two (write_two_process_report).
 struct MmtSummary {
   double duration_s = 0.0;
-  double rtt_s = 0.0;
+  double rtt_s = 0.0;           ///< emulated round trip (the configured delays)
+  double rtt_measured_s = 0.0;  ///< the operator's newest measured round trip
   double loss = 0.0;
   double deadband = 0.0;
   double force_rms_remote_n = 0.0;  ///< RMS of the remote's measured force
@@ -322,8 +382,24 @@ struct MmtSummary {
   std::int64_t estimate_samples = 0;
   std::int64_t estimate_outliers = 0;  ///< samples the estimate left out (remote's estimate_outliers)
   std::int64_t estimate_capped = 0;    ///< samples left out where the low-speed cap set the force
+  std::int64_t patches_merged = 0, estimates_applied = 0;  ///< by the operator
+  std::int64_t lost_to_remote = 0, lost_to_operator = 0;   ///< emulated losses
+  net::RejectCounts rejected_operator{}, rejected_remote{};
   TimingStats operator_compute{}, remote_compute{};
 };
+
+/// The figures of a session that its two stations' records give: the force
+/// errors, the remote's force, tracking, passivity, the factor applied at
+/// the end and the tick timing, into s. Each operator tick is compared with
+/// the remote's first tick that followed its command or a newer one (the
+/// same commanded motion, by command sequence: the measured delay, not a
+/// configured one), over the ticks where some force is felt or measured.
+void compare_records(const std::vector<OperatorRecord>& op, const std::vector<RemoteRecord>& rm,
+                     MmtSummary& s);
+
+/// "SCENARIO: mmt: the scenario has no mmt: section ...": the one refusal
+/// of every MMT entry point.
+std::string no_mmt_section(const Scenario& sc);
 
 /// Both stations in one process.
 class MmtRun {
@@ -348,7 +424,7 @@ class MmtRun {
   const MmtSettings& settings() const { return settings_; }
   OperatorStation& operator_station() { return *operator_; }
   RemoteStation& remote_station() { return *remote_; }
-  net::MemoryLink& link() { return *link_; }
+  net::EmulatedLink& link() { return *link_; }
   /// RMS of local - remote heights over the worked region, sampled every 50 ms: (t, rms).
   const std::vector<std::pair<double, double>>& terrain_error() const { return terrain_error_; }
 
@@ -357,7 +433,7 @@ class MmtRun {
   MmtSettings settings_;
   std::unique_ptr<Scenario> op_, remote_scn_;
   std::unique_ptr<haptics::Device> device_;
-  std::unique_ptr<net::MemoryLink> link_;
+  std::unique_ptr<net::EmulatedLink> link_;
   std::unique_ptr<OperatorStation> operator_;
   std::unique_ptr<RemoteStation> remote_;
   std::int64_t tick_ = 0, total_ticks_ = 0;
@@ -375,8 +451,9 @@ void write_remote_csv(const std::vector<RemoteRecord>& records, const std::files
 /// The same files written a tick at a time, for a live station whose
 /// records are not kept (an hour at 1 kHz is about 1.1 GB of them): the
 /// header on opening, a row per add(), buffered (a write to the file about
-/// every 400 rows). Throws InputError naming the file when it cannot be
-/// opened, and from add() or finish() when a write failed.
+/// every 400 rows; an io::CsvFile, the one CSV writer). Throws InputError
+/// naming the file when it cannot be created, and from add() or finish()
+/// when a write failed.
 class StationCsv {
  public:
   static StationCsv operator_csv(const std::filesystem::path& path);
@@ -391,14 +468,14 @@ class StationCsv {
 
  private:
   StationCsv(const std::filesystem::path& path, const char* header);
-  std::filesystem::path path_;
-  std::unique_ptr<char[]> buffer_;
-  std::unique_ptr<std::ofstream> out_;
+  std::unique_ptr<io::CsvFile> file_;
 };
 
 /// The operator's device of an mmt run: the scenario's script, sim or udp
-/// (bridge) device, haptics.device. Throws InputError (e.g. a port in use).
-std::unique_ptr<haptics::Device> make_operator_device(const Scenario& op);
+/// (bridge) device, haptics.device. repeat: the script device replays its
+/// cut over and over (its duration and half a second a round; a soak's
+/// hand). Throws InputError (e.g. a port in use, repeat with another device).
+std::unique_ptr<haptics::Device> make_operator_device(const Scenario& op, bool repeat = false);
 /// haptics.duration_s, else the operator's path plus settle_s (udp: 30 s), s.
 double operator_duration_s(const Scenario& op);
 

@@ -52,6 +52,11 @@ struct MmtSettings {
   double deadband = 0.0;
   /// Silence after which a station stops (remote holds, operator fades), s, (0, 60].
   double timeout_s = 0.2;
+  /// Two processes: silence after which the link is dead, s, (timeout_s,
+  /// 3600]: the operator ends its session with an error (exit code 4), and
+  /// the remote lets another operator open a session. A shorter silence
+  /// (a network drop) is survived: the operator reconnects and resumes.
+  double link_lost_s = 5.0;
   /// Identifies the pair of stations: packets of another link are "foreign".
   std::uint32_t link_id = 0x31504354u;
   /// Two-process mode: the remote listens here (IPv4); the operator connects.

@@ -32,8 +32,9 @@ std::string bodies_unavailable_message();
 
 /// How to build a world.
 struct WorldOptions {
-  /// The simulation's step rate, Hz; nullopt: the scenario's rate_hz. The
-  /// haptic loop gives its own (haptics.rate_hz).
+  /// The simulation's step rate, Hz; nullopt: the scenario's rate_hz (the
+  /// one rate). A haptic loop gives its own, LoopParams::rate_hz(): the
+  /// scenario's, or its program's override (`terracut haptics --rate`).
   std::optional<double> rate_hz;
   /// Where the bodies' per-step states go (bodies.csv); empty: not written.
   /// Only used when the scenario has bodies; the folder must exist.

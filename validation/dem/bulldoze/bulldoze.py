@@ -142,11 +142,11 @@ def make_bed(seed, smoke=False, force=False):
         "bulk_density_kg_per_m3": phi * dem.PARTICLE["density_kg_per_m3"],
         "density_box_m": box,
         "settling_ke_per_grain_j": settle,
-        "wall_s": wall,
+        "wall_s": wall, "cpu_s": dem.LAST_CPU_S,
     }
     dem.write_json(meta, info)
     if not smoke:
-        dem.log_cost("bulldoze_bed", "seed%d" % seed, wall, "%d grains" % len(x))
+        dem.log_cost("bulldoze_bed", "seed%d" % seed, wall, "%d grains; cpu %.0f s" % (len(x), dem.LAST_CPU_S))
     return info
 
 
@@ -216,6 +216,7 @@ def run_case(case, seed, smoke=False, force=False):
         "lowfile": os.path.join(wd, "lowering.txt"), "forcefile": os.path.join(wd, "force.txt"),
     })
     wall = dem.run_liggghts(os.path.join(HERE, "push.in"), v, wd, "push")
+    cpu = dem.LAST_CPU_S
     os.makedirs(outdir, exist_ok=True)
     # forces
     sr = binfo["restart_step"]
@@ -299,12 +300,15 @@ def run_case(case, seed, smoke=False, force=False):
         "timestep_s": dt, "rayleigh_check": dem.rayleigh_check(),
         "parameters": dem.parameters_json(),
         "wall_clock_s": wall,
+        "cpu_s": cpu,
+        "cost_note": "one LIGGGHTS process under nice -n 19 on a 2-core machine shared with C++ builds; "
+                     "wall-clock includes waiting for the CPU, cpu_s is the process's own CPU time",
     }
     info["metrics"] = window_metrics(info, outdir, grains)
     dem.write_json(os.path.join(outdir, "run.json"), info)
     if not smoke:
         dem.log_cost("bulldoze_run", "%s/seed%d" % (case, seed), wall,
-                     "%d grains, %d steps" % (binfo["particles"], s0 + 3 * nseg))
+                     "%d grains; %d steps; cpu %.0f s" % (binfo["particles"], s0 + 3 * nseg, cpu))
     return info
 
 
@@ -322,11 +326,13 @@ def window_metrics(info, outdir, grains):
     """Per 0.1 m push window: mean force, and at the window's end the pile
     ahead of the blade.  Pile region = cells with x >= tip line, plus, for a
     raked blade, the cells over the plate (between its rear top edge and the
-    tip, within the blade width).  pile_volume = sum over the region of
+    tip, within the blade width) whose surface lies above the plate, i.e.
+    the grains carried on the face (not the cut floor seen under the plate).  pile_volume = sum over the region of
     (h - h_initial) * cell^2 (net rise of the surface, bulk volume incl. pores);
     peak height = max over the region of h - H0 (H0 mean initial surface);
     pile_grain_volume = solid volume of grains in the region whose centre is
-    above H0."""
+    above H0, minus the same in the initial bed ahead of the tip line (the
+    undisturbed surface grains that already stick out above H0)."""
     cell = info["surfaces"]["cell_m"]
     ny, nx = info["surfaces"]["shape_rows_cols"]
     H0 = info["bed"]["initial_surface_mean_m"]
@@ -347,14 +353,21 @@ def window_metrics(info, outdir, grains):
         snap = info["surfaces"]["snapshots"]["p%d" % (k + 1)]
         h = np.load(os.path.join(outdir, snap["file"])).astype(float)
         xt = b["tip_line_at_push_start"]["x_m"] + hi
-        region = (X >= xt) | ((X >= xt + back) & (X < xt) & (np.abs(Y - yc) <= w / 2))
+        zt = b["tip_line_at_push_start"]["z_m"]
+        tana = math.tan(math.radians(b["rake_deg"])) if b["rake_deg"] < 89.999 else 0.0
+        over = (X >= xt + back) & (X < xt) & (np.abs(Y - yc) <= w / 2)
+        region = (X >= xt) | (over & (h > zt + (xt - X) * tana))
         vol = float(((h - h_init) * region).sum() * cell * cell)
         peak = float((h[region] - H0).max())
         g = grains["p%d" % (k + 1)]
         gx, gy, gz, gr = g["x"], g["y"], g["z"], g["radius"]
-        greg = (gx >= xt) | ((gx >= xt + back) & (gx < xt) & (np.abs(gy - yc) <= w / 2))
+        greg = (gx >= xt) | ((gx >= xt + back) & (gx < xt) & (np.abs(gy - yc) <= w / 2)
+                             & (gz > zt + (xt - gx) * tana))
         gsel = greg & (gz > H0)
-        gvol = float((4.0 / 3.0 * math.pi * gr[gsel] ** 3).sum())
+        gi = grains["init"]
+        gsel0 = (gi["x"] >= xt) & (gi["z"] > H0)   # the same count in the initial bed ahead of the tip
+        gvol = float((4.0 / 3.0 * math.pi * gr[gsel] ** 3).sum()
+                     - (4.0 / 3.0 * math.pi * gi["radius"][gsel0] ** 3).sum())
         out.append({"window_start_m": lo, "window_end_m": hi,
                     "fx_mean_n": float(force["fx_n"][sel].mean()),
                     "fy_mean_n": float(force["fy_n"][sel].mean()),
@@ -366,6 +379,18 @@ def window_metrics(info, outdir, grains):
                     "pile_peak_height_m": peak,
                     "swept_volume_m3": w * b["depth_m"] * hi})
     return out
+
+
+def recompute_metrics(case, seed):
+    """Recompute the window metrics of a finished run from its committed
+    files and the dumps still in work/ (after a change of definition)."""
+    outdir = os.path.join(RES, case, "seed%d" % seed)
+    info = json.load(open(os.path.join(outdir, "run.json")))
+    wd = _workdir("runs", case, "seed%d" % seed)
+    grains = {k: dem.read_dump(os.path.join(wd, k + ".dump")) for k in ("init", "p1", "p2", "p3")}
+    info["metrics"] = window_metrics(info, outdir, grains)
+    dem.write_json(os.path.join(outdir, "run.json"), info)
+    return info
 
 
 # ------------------------------------------------------------------- summary
@@ -399,13 +424,6 @@ def write_summary():
     path = os.path.join(RES, "summary.csv")
     os.makedirs(RES, exist_ok=True)
     with open(path, "w", newline="") as f:
-        f.write("# one row per case x seed x 0.1 m push window; rows with seed=mean/std are across seeds "
-                "(std: sample standard deviation, n_seeds rows). Forces: grains on blade, N, LIGGGHTS frame "
-                "(fx<0 resists the push). pile_volume_m3: net rise of the upper-envelope surface over the "
-                "initial one, summed over the region ahead of the tip line (plus over a raked plate), at the "
-                "window end. pile_grain_volume_m3: solid volume of grains there with centre above the mean "
-                "initial surface. pile_peak_height_m: max surface height there above the mean initial surface. "
-                "swept_volume_m3: blade width x depth x push at window end.\n")
         wr = csv.writer(f)
         wr.writerow(["case", "seed", "window_start_m", "window_end_m", "fx_mean_n", "fy_mean_n", "fz_mean_n",
                      "pile_volume_m3", "pile_grain_volume_m3", "pile_peak_height_m", "swept_volume_m3",

@@ -5,6 +5,7 @@ grid.  Python 3 with numpy/scipy only (/usr/bin/python3)."""
 
 import json
 import math
+import resource
 import os
 import re
 import subprocess
@@ -153,6 +154,14 @@ class LiggghtsError(RuntimeError):
     pass
 
 
+LAST_CPU_S = None   # CPU seconds (user+sys) of the last LIGGGHTS process
+
+
+def _child_cpu():
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
+
+
 def run_liggghts(script, variables, workdir, tag, timeout=None):
     """Run `nice -n 19 liggghts -in script -var ...` in workdir (one process,
     no MPI).  Returns wall-clock seconds.  Raises LiggghtsError when the exit
@@ -167,11 +176,14 @@ def run_liggghts(script, variables, workdir, tag, timeout=None):
         cmd += ["-var", k, _fmt(v)]
     with open(os.path.join(workdir, "cmd.%s" % tag), "w") as f:
         f.write(" ".join(cmd) + "\n")
+    global LAST_CPU_S
+    c0 = _child_cpu()
     t0 = time.time()
     with open(screen, "w") as out:
         proc = subprocess.run(cmd, cwd=workdir, stdout=out, stderr=subprocess.STDOUT,
                               timeout=timeout)
     wall = time.time() - t0
+    LAST_CPU_S = _child_cpu() - c0
     text = open(screen, errors="replace").read()
     if os.path.exists(log):
         text += open(log, errors="replace").read()
