@@ -84,6 +84,30 @@ def test_run_returns_the_soils_warnings(tmp_path):
     assert terracut.run(terracut.Scenario.from_dict(d), tmp_path / "square")["warnings"] == []
 
 
+def test_run_names_what_moved(tmp_path):
+    # With soil that flows the sum of the steps' cuts counts a pushed pile
+    # again at every step: the run also says what the blade cut from the
+    # ground, what it pushed and the soil no longer where it was, and the
+    # steps' columns hold the ground each step cut.
+    # A level layer 5 cm above the edge (a mound's flanks would slump
+    # where the blade never was, and count as moved).
+    d = small_exp1_dict()
+    d["terrain"] = dict(d["terrain"], generator="plane", plane={"height_m": 0.15})
+    d["soil"] = {"model": "flow", "repose_deg": 34}
+    scenario = terracut.Scenario.from_dict(d)
+    result = terracut.run(scenario, tmp_path / "run")
+    soil = result["soil"]
+    assert soil["net_moved_m3"] > 0
+    assert soil["net_moved_m3"] <= soil["cut_from_ground_m3"] + 1e-9
+    assert soil["cut_from_ground_m3"] <= result["removed_volume_m3"] + 1e-9
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    for key in ("cut_from_ground_m3", "displaced_volume_m3", "net_moved_m3"):
+        assert summary["soil"][key] == soil[key], key
+    columns = terracut.Simulation(scenario).run()
+    assert abs(columns["cut_from_ground"].sum() - soil["cut_from_ground_m3"]) <= 1e-9
+    assert abs(columns["displaced_volume"].sum() - soil["displaced_volume_m3"]) <= 1e-9
+
+
 def test_run_errors_name_the_output(tmp_path, exp1):
     blocker = tmp_path / "file"
     blocker.write_text("x")
