@@ -7,7 +7,9 @@ Reads DIR/contact.csv, DIR/height.npy, DIR/removed.npy and DIR/summary.json
 and writes one figure (default DIR/run.png) with:
   - the contact length over time, one colour per cut;
   - the blade centre's x, y, z over time;
-  - the cumulative removed volume over time;
+  - the cumulative volume the blade's edge cut over time (with soil that
+    flows, a pile cut and pushed again counts again: the title gives what
+    it cut from the ground, what it displaced and the net volume moved);
   - the final heights and the removed material as maps (X right, Z up, metres).
 
 Exit codes: 0 done; 2 bad arguments or input folder; 3 numpy or matplotlib missing.
@@ -92,8 +94,9 @@ def main(argv):
     ax_pose.grid(alpha=0.3)
     ax_pose.legend(fontsize=8)
 
+    soil = summary.get("soil")
     ax_volume.plot(t, np.cumsum(data["removed_volume"]), color="black", lw=1.2)
-    ax_volume.set_ylabel("removed volume (m$^3$)")
+    ax_volume.set_ylabel("cut by the edge, each pass (m$^3$)" if soil else "removed volume (m$^3$)")
     ax_volume.set_xlabel("time (s)")
     ax_volume.grid(alpha=0.3)
 
@@ -112,9 +115,17 @@ def main(argv):
 
     inputs = summary["inputs"]
     res = terrain["resolution"]
+    if soil and "cut_from_ground_m3" in soil:
+        # Soil that flows is not removed: say what the blade cut out of the
+        # ground, what it pushed (a pile pushed on counts at every step) and
+        # what is no longer where it was.
+        volumes = (f"cut from the ground {soil['cut_from_ground_m3']:.4g} m$^3$, displaced "
+                   f"{soil['displaced_volume_m3']:.4g} m$^3$ (each push counted), net moved "
+                   f"{soil['net_moved_m3']:.4g} m$^3$")
+    else:
+        volumes = f"removed {summary['removed_volume_m3']:.4g} m$^3$"
     fig.suptitle(f"{inputs['name']}: {res[0]}x{res[1]} {inputs['representation']}, "
-                 f"{inputs['rate_hz']:g} Hz, sequence ({', '.join(inputs['sequence'])}); "
-                 f"removed {summary['removed_volume_m3']:.4g} m$^3$")
+                 f"{inputs['rate_hz']:g} Hz, sequence ({', '.join(inputs['sequence'])});\n{volumes}")
     fig.tight_layout()
     try:
         fig.savefig(out, dpi=100)

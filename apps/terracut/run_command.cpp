@@ -99,7 +99,12 @@ Command add_run_command(CLI::App& app) {
       "                (mean and peak), the soil material, and per-step\n"
       "                timing percentiles (us; the only part that differs between runs);\n"
       "                with --realtime also \"realtime\": missed_deadlines, step_time and\n"
-      "                period_jitter {p50_us, p99_us, max_us, mean_us}\n"
+      "                period_jitter {p50_us, p99_us, max_us, mean_us}; with soil\n"
+      "                model flow also \"soil\": cut_from_ground_m3 (what the blade cut\n"
+      "                below the initial surface), displaced_volume_m3 (what it pushed,\n"
+      "                a pile pushed on counted at every step), net_moved_m3 (soil no\n"
+      "                longer where it was at the end); summary.json's removed volume\n"
+      "                is then every step's cut, the pushed pile counted again\n"
       "\n"
       "Progress is printed to stderr about once a second for runs longer than 2 s.\n"
       "Plot a run with: /usr/bin/python3 tools/plot_run.py DIR\n"
@@ -129,12 +134,22 @@ Command add_run_command(CLI::App& app) {
 
     if (!opt->quiet) {
       char line[512];
+      // With soil that flows the edge cuts a pushed pile again at every
+      // step, so the sum of the steps' cuts is not soil removed: name the
+      // ground cut, the soil pushed and the net soil moved instead.
+      char volumes[256];
+      if (result.soil)
+        std::snprintf(volumes, sizeof volumes,
+                      "cut from the ground %.6g m^3, displaced %.6g m^3 (each push counted), net moved %.6g m^3",
+                      result.soil->cut_from_ground_m3, result.soil->displaced_volume_m3,
+                      result.soil->net_moved_m3);
+      else
+        std::snprintf(volumes, sizeof volumes, "removed %.6g m^3", result.removed_volume_m3);
       std::snprintf(line, sizeof line,
-                    "%s: %lld steps, removed %.6g m^3 of %.6g m^3, conservation error %.3g m "
+                    "%s: %lld steps, %s of %.6g m^3, conservation error %.3g m "
                     "(per sample), %.3g m^3 (volume), p99 step %.1f us -> %s\n",
-                    scenario.base.name.c_str(), static_cast<long long>(result.steps),
-                    result.removed_volume_m3, result.initial_volume_m3,
-                    result.max_sample_error_m, result.volume_error_m3,
+                    scenario.base.name.c_str(), static_cast<long long>(result.steps), volumes,
+                    result.initial_volume_m3, result.max_sample_error_m, result.volume_error_m3,
                     result.step_timing.p99_us, opt->out.c_str());
       std::cout << line;
       if (result.realtime) {

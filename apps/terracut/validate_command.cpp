@@ -21,6 +21,7 @@
 
 #include "commands.hpp"
 #include "report_files.hpp"
+#include "soil_scenes.hpp"
 #include "validate_dem.hpp"
 #include "validate_soilbin.hpp"
 #include "terracut/core/simulation.hpp"
@@ -201,13 +202,7 @@ void flank_band(double repose_deg, double direction_deg, double& lo_deg, double&
 ConeResult run_cone(double repose_deg, const fs::path& dir) {
   const int n = kConeCells;
   const int centre = n / 2;
-  std::vector<float> column(std::size_t(n) * n, 0.0f);
-  for (int r = 0; r < n; ++r)
-    for (int c = 0; c < n; ++c)
-      if ((c - centre) * (c - centre) + (r - centre) * (r - centre) <=
-          kColumnRadiusCells * kColumnRadiusCells)
-        column[std::size_t(r) * n + c] = kColumnHeight_m;
-  HeightGrid g(grid_of_cells(n, n, kConeCell_m), column);
+  HeightGrid g(grid_of_cells(n, n, kConeCell_m), scenes::column(n, kColumnRadiusCells, kColumnHeight_m));
   ConeResult res;
   res.repose_deg = repose_deg;
   res.volume_before_m3 = g.volume_m3();
@@ -290,13 +285,7 @@ struct RampResult {
 // relaxed at repose 34 until nothing is active.
 RampResult run_ramp(const std::string& name, double initial_deg, bool diagonal) {
   const int n = kRampCells;
-  const double t = std::tan(rad(initial_deg));
-  std::vector<float> h(std::size_t(n) * n);
-  for (int r = 0; r < n; ++r)
-    for (int c = 0; c < n; ++c) {
-      const double along = diagonal ? (c + r) * kRampCell_m / std::sqrt(2.0) : c * kRampCell_m;
-      h[std::size_t(r) * n + c] = float(kRampBase_m + t * along);
-    }
+  const std::vector<float> h = scenes::ramp(n, kRampCell_m, kRampBase_m, initial_deg, diagonal);
   HeightGrid g(grid_of_cells(n, n, kRampCell_m), h);
   const double tallest = tallest_m(g);  // relaxing never raises the top
   RampResult res;
@@ -474,15 +463,11 @@ DozeResult run_doze(double width_m, const fs::path& dir) {
   // Room for the windrows beside the blade and for the pile ahead of it.
   res.cols = int(std::lround((width_m + 1.2) / kDozeCell_m));
   res.rows = int(std::lround((kDozeStart_z_m + kDozePush_m + 0.6) / kDozeCell_m));
-  res.x_centre_m = 0.5 * res.cols * kDozeCell_m;
-  SimParams p;
-  p.grid = grid_of_cells(res.cols, res.rows, kDozeCell_m);
-  p.blade.length_m = width_m;
-  p.soil = flow_params(kDozeRepose);
-  Simulation sim(p, std::vector<float>(std::size_t(res.cols) * res.rows, float(kDozeLayer_m)));
+  const scenes::Bulldoze scene{res.cols, res.rows, kDozeCell_m, width_m, kDozeLayer_m, kDozeDepth_m};
+  res.x_centre_m = scene.x_m();
+  Simulation sim(scene.params(flow_params(kDozeRepose)), scene.heights());
   const HeightGrid& g = sim.grid();
   const double initial = g.volume_m3();
-  const double edge_y = kDozeLayer_m - kDozeDepth_m;
   const int steps = int(std::lround(kDozePush_m / kDozeStepPush_m));
   const int sample_every = int(std::lround(kDozeSample_m * steps / kDozePush_m));
   std::int64_t updates = 0;
@@ -493,7 +478,7 @@ DozeResult run_doze(double width_m, const fs::path& dir) {
   for (int i = 0; i <= steps; ++i) {
     const double pushed = kDozePush_m * i / steps;
     const double z = kDozeStart_z_m + pushed;
-    const StepOutput& out = sim.step({{res.x_centre_m, edge_y, z}, Quat{}});
+    const StepOutput& out = sim.step(scene.pose(z));
     soil_s.push_back(out.timers.soil_s);
     step_s.push_back(out.timers.total_s);
     res.max_backlog = std::max(res.max_backlog, out.soil.backlog_cells);

@@ -32,7 +32,7 @@ class StepColumns {
     time_pose(o.t_s, o.pose, d);
     const double rest[kOwn] = {o.contact.length_m,        o.contact.section_area_m2,
                                o.contact.max_depth_m,     o.cut.removed_volume_m3,
-                               o.soil.displaced_volume_m3, o.listener_force_world_n.x,
+                               o.soil.displaced_volume_m3, o.soil.cut_from_ground_m3, o.listener_force_world_n.x,
                                o.listener_force_world_n.y, o.listener_force_world_n.z,
                                o.timers.total_s};
     std::copy(std::begin(rest), std::end(rest), d + kTimePose);
@@ -49,12 +49,12 @@ class StepColumns {
   py::dict dict() const { return columns_.dict(); }
 
  private:
-  static constexpr std::size_t kOwn = 9;
+  static constexpr std::size_t kOwn = 10;
   static constexpr std::size_t kMaxForce = 64;
   static std::vector<const char*> double_names() {
     std::vector<const char*> names = {"t", "x", "y", "z", "qw", "qx", "qy", "qz", "contact_length",
                                       "section_area", "max_depth", "removed_volume",
-                                      "displaced_volume", "listener_fx", "listener_fy",
+                                      "displaced_volume", "cut_from_ground", "listener_fx", "listener_fy",
                                       "listener_fz", "step_s"};
     for (const session::ForceColumn& c : session::force_columns()) names.push_back(c.name);
     return names;
@@ -248,9 +248,11 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("max_depth_m", [](const StepResult& r) { return r.out.contact.max_depth_m; },
                              "Largest depth of the edge below the surface, m.")
       .def_property_readonly("removed_volume_m3", [](const StepResult& r) { return r.out.cut.removed_volume_m3; },
-                             "Volume the step's sweep cut, m^3.")
+                             "Volume the step's sweep cut, m^3 (with soil flow: a pile cut again counts again).")
+      .def_property_readonly("cut_from_ground_m3", [](const StepResult& r) { return r.out.soil.cut_from_ground_m3; },
+                             "The part of the step's cut below the initial surface (soil flow), m^3.")
       .def_property_readonly("displaced_volume_m3", [](const StepResult& r) { return r.out.soil.displaced_volume_m3; },
-                             "Soil put down ahead of the blade (soil flow), m^3.")
+                             "Soil put down ahead of the blade (soil flow; a pile pushed on counts at every step), m^3.")
       .def_property_readonly("cells_visited", [](const StepResult& r) {
             return r.out.contact.cells_visited + r.out.cut.cells_visited;
           }, "Cells examined by the contact query and the cut.")
@@ -351,8 +353,10 @@ one thread at a time.)doc")
 pose: 7 numbers [x, y, z, qw, qx, qy, qz] (metres; unit quaternion) ->
 StepResult; or an (N, 7) array -> a dict of numpy columns, one row per step,
 stepped in one C++ loop without the GIL: step, t (s), x, y, z (m), qw..qz,
-contact_length (m), section_area (m^2), max_depth (m), removed_volume (m^3),
-displaced_volume (m^3), listener_fx..fz (N), step_s (s), cells_visited,
+contact_length (m), section_area (m^2), max_depth (m), removed_volume (m^3: with
+soil flow a pile cut again counts again), displaced_volume (m^3, a pile pushed
+on counts at every step), cut_from_ground (m^3, the cut below the initial
+surface), listener_fx..fz (N), step_s (s), cells_visited,
 substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
       .def("run", &run_sequence, py::arg("cuts") = py::none(),
            "Steps the scenario's sequence (or the given cuts: names or indices, or 'A,B,C') as `terracut "

@@ -55,9 +55,14 @@ def run(scenario, out_dir: Union[str, os.PathLike], realtime: bool = False) -> d
     per-cut figures ("cuts"), step timing ("step_timing", microseconds), and
     "records": contact.csv's columns as numpy arrays (t in s, cut index,
     x, y, z in m, qw..qz, contact_length m, removed_volume m^3,
-    section_area m^2, max_depth m). With soil that flows, "soil" (displaced
-    and left-over volumes, passes, final backlog) and "warnings": readable
-    lines, as summary.json's and `terracut run`'s (soil left steeper than its
+    section_area m^2, max_depth m; with soil that flows removed_volume
+    counts a pushed pile again at every step). With soil that flows, "soil"
+    (cut_from_ground_m3: the cut below the initial surface;
+    displaced_volume_m3: what the blade pushed, each push counted;
+    net_moved_m3: soil no longer where it was at the end; left_over_edge_m3,
+    passes, final_backlog_cells, capped_steps: steps the work cap stopped)
+    and "warnings": readable lines, as summary.json's and `terracut run`'s
+    (steps the work cap stopped, soil left steeper than its
     repose angle by the work cap, cells too far from square for the repose
     angle to hold in every direction); [] when there is nothing to say.
     The GIL is released during the run.

@@ -64,21 +64,48 @@ def test_terracut_run_writes_the_clis_files(cli, exp1, tmp_path):
 
 
 def test_run_returns_the_soils_warnings(tmp_path):
-    # Cells of 4:1 and a work cap too small for the cut: both named; the
-    # same run on square cells with the cap lifted has nothing to say.
+    # Cells of 4:1 and a work cap too small for the cut: the steps the cap
+    # stopped, the unsettled end and the cells all named; the same run on
+    # square cells with the cap lifted has nothing to say.
     d = small_exp1_dict()
     d["terrain"]["resolution"] = [40, 10]
     d["soil"] = {"model": "flow", "repose_deg": 34, "max_pair_checks_per_step": 1000}
     result = terracut.run(terracut.Scenario.from_dict(d), tmp_path / "oblong")
     warnings = result["warnings"]
-    assert len(warnings) == 2, warnings
-    assert "the relaxation was not done at the end" in warnings[0]
-    assert "let planes up to 40.9 degrees stand" in warnings[1]
+    assert len(warnings) == 3, warnings
+    assert "work cap" in warnings[0] and "stopped it in" in warnings[0]
+    assert result["soil"]["capped_steps"] > 0
+    assert "the relaxation was not done at the end" in warnings[1]
+    assert "let planes up to 40.9 degrees stand" in warnings[2]
     summary = json.loads((tmp_path / "oblong" / "summary.json").read_text())
     assert summary["warnings"] == warnings
     d["terrain"]["resolution"] = 20
     d["soil"]["max_pair_checks_per_step"] = 1000000000
     assert terracut.run(terracut.Scenario.from_dict(d), tmp_path / "square")["warnings"] == []
+
+
+def test_run_names_what_moved(tmp_path):
+    # With soil that flows the sum of the steps' cuts counts a pushed pile
+    # again at every step: the run also says what the blade cut from the
+    # ground, what it pushed and the soil no longer where it was, and the
+    # steps' columns hold the ground each step cut.
+    # A level layer 5 cm above the edge (a mound's flanks would slump
+    # where the blade never was, and count as moved).
+    d = small_exp1_dict()
+    d["terrain"] = dict(d["terrain"], generator="plane", plane={"height_m": 0.15})
+    d["soil"] = {"model": "flow", "repose_deg": 34}
+    scenario = terracut.Scenario.from_dict(d)
+    result = terracut.run(scenario, tmp_path / "run")
+    soil = result["soil"]
+    assert soil["net_moved_m3"] > 0
+    assert soil["net_moved_m3"] <= soil["cut_from_ground_m3"] + 1e-9
+    assert soil["cut_from_ground_m3"] <= result["removed_volume_m3"] + 1e-9
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    for key in ("cut_from_ground_m3", "displaced_volume_m3", "net_moved_m3"):
+        assert summary["soil"][key] == soil[key], key
+    columns = terracut.Simulation(scenario).run()
+    assert abs(columns["cut_from_ground"].sum() - soil["cut_from_ground_m3"]) <= 1e-9
+    assert abs(columns["displaced_volume"].sum() - soil["displaced_volume_m3"]) <= 1e-9
 
 
 def test_run_errors_name_the_output(tmp_path, exp1):

@@ -201,9 +201,15 @@ std::vector<std::string> cut_warnings(const io::Scenario& sc) {
 }
 
 std::vector<std::string> soil_warnings(const SoilFlowParams& soil, const GridSpec& grid,
-                                       std::int64_t final_backlog_cells) {
+                                       std::int64_t final_backlog_cells, std::int64_t capped_steps) {
   std::vector<std::string> w;
   if (soil.model != SoilModel::kFlow) return w;
+  if (capped_steps > 0)
+    w.push_back("soil: the relaxation's work cap (soil.max_pair_checks_per_step = " +
+                std::to_string(soil.max_pair_checks_per_step) + " neighbour visits a step) stopped it in " +
+                std::to_string(capped_steps) +
+                " steps; what it left for later steps can change a pushed pile (docs/soil.md, \"What the cap "
+                "defers\"): lift the cap for an offline run to compare");
   if (final_backlog_cells > 0)
     w.push_back("soil: the relaxation was not done at the end (a backlog of " + std::to_string(final_backlog_cells) +
                 " cells to examine and fluxes to apply): the work cap (soil.max_pair_checks_per_step = " +
@@ -309,12 +315,18 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
                      {"final", r.final_volume_m3},
                      {"left_over_edge", s.left_over_edge_m3},
                      {"error", r.volume_error_m3}}},
+                   // What the blade cut out of the ground, what it pushed
+                   // (a pile pushed on is counted at every step), and the
+                   // soil no longer where it was at the end.
+                   {"cut_from_ground_m3", s.cut_from_ground_m3},
                    {"displaced_volume_m3", s.displaced_volume_m3},
+                   {"net_moved_m3", s.net_moved_m3},
                    {"relaxation",
                     {{"passes", s.passes},
                      {"pair_checks", s.pair_checks},
                      {"max_backlog_cells", s.max_backlog_cells},
                      {"final_backlog_cells", s.final_backlog_cells},
+                     {"capped_steps", s.capped_steps},
                      {"max_pair_checks_per_step", sc.soil.max_pair_checks_per_step}}}};
     if (sc.blade.bucket.enabled())
       out["soil"]["bucket"] = {{"depth_m", sc.blade.bucket.depth_m},
@@ -460,10 +472,12 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
       if (listening) listeners_s.push_back(out.timers.listeners_s);
       if (flow) {
         soil.displaced_volume_m3 += out.soil.displaced_volume_m3;
+        soil.cut_from_ground_m3 += out.soil.cut_from_ground_m3;
         soil.left_over_edge_m3 += out.soil.left_over_edge_m3;
         soil.passes += out.soil.passes;
         soil.pair_checks += out.soil.pair_checks;
         soil.max_backlog_cells = std::max(soil.max_backlog_cells, out.soil.backlog_cells);
+        soil.capped_steps += out.soil.reached_cap ? 1 : 0;
         soil.bucket_in_m3 += out.soil.bucket_in_m3;
         soil.poured_m3 += out.soil.poured_m3;
         soil.max_bucket_load_m3 = std::max(soil.max_bucket_load_m3, out.soil.bucket_load_m3);
@@ -500,12 +514,15 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
   if (pacer) result.realtime = pacer->stats();
   if (flow) {
     soil.final_backlog_cells = sim.soil()->active_cells();
+    for (std::int64_t i = 0; i < grid.spec().sample_count(); ++i)
+      soil.net_moved_m3 += std::max(0.0, double(grid.initial()[i]) - double(grid.heights()[i]));
+    soil.net_moved_m3 *= grid.spec().cell_area_m2();
     soil.soil_timing = timing_stats(soil_s);
     result.soil = soil;
   }
   result.warnings = cut_warnings(sc);
   if (flow) {
-    const std::vector<std::string> soil_lines = soil_warnings(sc.soil, grid.spec(), soil.final_backlog_cells);
+    const std::vector<std::string> soil_lines = soil_warnings(sc.soil, grid.spec(), soil.final_backlog_cells, soil.capped_steps);
     result.warnings.insert(result.warnings.end(), soil_lines.begin(), soil_lines.end());
   }
 

@@ -19,6 +19,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/simulation.hpp"
+#include "soil_scenes.hpp"
 
 namespace terracut {
 namespace {
@@ -85,16 +86,9 @@ double flank_angle_deg(const HeightGrid& g, double cu, double cv, double dir_deg
   return std::atan((h80 - h20) / ((s20 - s80) * cell_m)) / kDeg;
 }
 
-// A column of sand (radius 15 cells, 0.4 m tall) on a bare floor.
-std::vector<float> column(int n, double radius_cells, float height_m) {
-  std::vector<float> h(std::size_t(n) * n, 0.0f);
-  const double c = 0.5 * (n - 1);
-  for (int r = 0; r < n; ++r)
-    for (int k = 0; k < n; ++k)
-      if ((k - c) * (k - c) + (r - c) * (r - c) <= radius_cells * radius_cells)
-        h[std::size_t(r) * n + k] = height_m;
-  return h;
-}
+// A column of sand on a bare floor (the scenes library's, as `terracut
+// validate` uses it).
+using scenes::column;
 
 TEST(IndexDivider, QuotientsEqualHardwareDivisionForEveryRowLength) {
   // Every row length up to 1100 and every 97th up to kMaxGridSide, at the
@@ -193,13 +187,7 @@ TEST(SoilFlow, ASlopeBelowTheReposeAngleNeverMoves) {
   const int n = 40;
   const double cell = 0.02;
   for (const bool diagonal : {false, true}) {
-    std::vector<float> h(std::size_t(n) * n);
-    const double slope = std::tan(30.0 * kDeg);
-    for (int r = 0; r < n; ++r)
-      for (int c = 0; c < n; ++c) {
-        const double along = diagonal ? (c + r) * cell / std::sqrt(2.0) : c * cell;
-        h[std::size_t(r) * n + c] = float(0.05 + slope * along);
-      }
+    const std::vector<float> h = scenes::ramp(n, cell, 0.05, 30.0, diagonal);
     HeightGrid g(grid_of_cells(n, n, cell), h);
     SoilFlow f(flow(34.0), g);
     EXPECT_EQ(f.active_cells(), 0) << diagonal;
@@ -356,17 +344,13 @@ struct Dozing {
   std::unique_ptr<Simulation> sim;
 
   explicit Dozing(SoilModel model) {
-    params.grid = grid_of_cells(200, 200, 0.01);
-    params.blade.length_m = 1.0;
-    params.soil = flow(34.0, 400000);
-    params.soil.model = model;
-    sim = std::make_unique<Simulation>(
-        params, std::vector<float>(std::size_t(200) * 200, float(layer_m)));
+    const scenes::Bulldoze scene{200, 200, 0.01, 1.0, layer_m, depth_m};
+    SoilFlowParams soil = flow(34.0, 400000);
+    soil.model = model;
+    params = scene.params(soil);
+    sim = std::make_unique<Simulation>(params, scene.heights());
     const int steps = int(std::lround(push_m / 0.0006));
-    for (int i = 0; i <= steps; ++i) {
-      const double z = start_z_m + push_m * i / steps;
-      sim->step({{1.0, layer_m - depth_m, z}, Quat{}});
-    }
+    for (int i = 0; i <= steps; ++i) sim->step(scene.pose(start_z_m + push_m * i / steps));
   }
   double edge_y() const { return layer_m - depth_m; }
   double blade_z() const { return start_z_m + push_m; }

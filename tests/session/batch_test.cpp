@@ -123,6 +123,10 @@ TEST(SoilWarnings, NameAnUnsettledEndAndCellsTooFarFromSquare) {
   GridSpec near = square;
   near.size_z_m = 0.105;
   EXPECT_TRUE(soil_warnings(soil, near, 0).empty());
+  // The work cap reached: the steps are counted and the cap named.
+  const std::vector<std::string> capped = soil_warnings(soil, square, 0, 3);
+  ASSERT_EQ(capped.size(), 1u);
+  EXPECT_NE(capped[0].find("stopped it in 3 steps"), std::string::npos) << capped[0];
   // With vanish there is no soil phase to warn about.
   soil.model = SoilModel::kVanish;
   EXPECT_TRUE(soil_warnings(soil, oblong, 17).empty());
@@ -262,9 +266,22 @@ TEST_F(RunTest, FlowingSoilIsConservedAndWrittenAsTakenAndDeposited) {
     if (deposited[i] > 0.0f) ++put;
   }
   EXPECT_GT(put, 5);
+  // The net soil moved is what the removed layer holds; the ground the blade
+  // cut is at least that (soil that slid back and was cut again counts
+  // again) and at most every step's cut (which counts the pushed soil again).
+  double removed_sum = 0.0;
+  for (const float r : removed) removed_sum += double(r);
+  const double cell_area = sc.base.size_x_m / cols * (sc.base.size_z_m / rows);
+  EXPECT_NEAR(result.soil->net_moved_m3, removed_sum * cell_area, 1e-6 * result.initial_volume_m3);
+  EXPECT_GE(result.soil->cut_from_ground_m3, result.soil->net_moved_m3 - 1e-9);
+  EXPECT_LE(result.soil->cut_from_ground_m3, result.removed_volume_m3 + 1e-9);
+  EXPECT_GT(result.soil->net_moved_m3, 0.0);
   EXPECT_TRUE(fs::exists(dir_ / "out" / "deposited.png"));
   const nlohmann::json j = nlohmann::json::parse(read_bytes(dir_ / "out" / "summary.json"));
   EXPECT_EQ(j["soil"]["model"], "flow");
+  EXPECT_EQ(j["soil"]["cut_from_ground_m3"].get<double>(), result.soil->cut_from_ground_m3);
+  EXPECT_EQ(j["soil"]["net_moved_m3"].get<double>(), result.soil->net_moved_m3);
+  EXPECT_EQ(j["soil"]["displaced_volume_m3"].get<double>(), result.soil->displaced_volume_m3);
   EXPECT_NEAR(j["soil"]["volume_m3"]["error"].get<double>(), 0.0, 1e-6 * result.initial_volume_m3);
   EXPECT_NEAR(j["conservation"]["volume_error_m3"].get<double>(), 0.0,
               1e-6 * result.initial_volume_m3);

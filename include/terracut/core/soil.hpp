@@ -89,6 +89,8 @@
 // slides or is pushed off the terrain, counted in left_over_edge_m3.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -148,6 +150,8 @@ class CellList {
   std::size_t capacity() const { return buf_.size() - 1; }
   bool empty() const { return size_ == 0; }
   void clear() { size_ = 0; }
+  /// Keeps the first n elements (n <= size()).
+  void truncate(std::size_t n) { size_ = std::min(size_, n); }
   void reserve(std::size_t n) {
     if (n + 1 > buf_.size()) buf_.resize(n + 1);
   }
@@ -232,10 +236,18 @@ std::string validate(const SoilFlowParams& params);
 /// What the soil phase did in one step.
 struct SoilStepResult {
   double displaced_volume_m3 = 0.0;  ///< cut soil put down ahead of the blade (soil pushed again counts again), m^3
+  /// The part of the step's cut that lay below the initial surface, m^3:
+  /// ground the blade cut, not pile it cut again (soil that slid back into
+  /// the cut and is cut again counts again).
+  double cut_from_ground_m3 = 0.0;
   int passes = 0;                    ///< relaxation passes run
   std::int64_t pair_checks = 0;      ///< work done, in neighbour visits (see max_pair_checks_per_step)
   std::int64_t moved_pairs = 0;      ///< pairs that exchanged soil
   std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
+  /// The relaxation stopped at the work cap (max_pair_checks_per_step) with
+  /// work left; the rest is carried over (a safety bound a normal push on
+  /// the documented cases does not reach: docs/soil.md).
+  bool reached_cap = false;
   double left_over_edge_m3 = 0.0;    ///< soil that left over an open edge, m^3
   double bucket_in_m3 = 0.0;         ///< cut soil the bucket took in this step, m^3
   double poured_m3 = 0.0;            ///< soil poured from the bucket's lip this step, m^3
@@ -368,8 +380,28 @@ class SoilFlow {
   float hull_under(std::uint32_t cell) const {
     return hull_under_[hull_slot(col_of(cell), row_of(cell))];
   }
+  /// Adds delta_m, a float rounding the writes lost (or, negative, gained),
+  /// back to a cell, never below the floor nor above the ceiling (a cell
+  /// already at the ceiling keeps it: the ulp is left out of the books
+  /// rather than clamped, and so deleted, by the Bullet heightfield).
+  void give_back(float& height_m, double delta_m) const {
+    height_m = float(std::clamp(double(height_m) + delta_m, 0.0, std::max(double(ceiling_m_), double(height_m))));
+  }
   void run_passes(HeightGrid& grid, SoilStepResult& out);
+  /// v rounded to a multiple of the relaxation's quantum, as a float: the
+  /// heights it writes and the amounts it moves, so that a cell's sum over
+  /// a pass is exact whatever the order of its sources (quantum_m_).
+  float quantized(double v) const { return float(quantum_m_ * std::nearbyint(v / quantum_m_)); }
+  /// Zeroes the fluxes [applied_, end) of source a that the blade, the hull
+  /// or a body now stands in the way of (the pass was examined in an
+  /// earlier step, against where they were then).
+  void drop_blocked_fluxes(std::uint32_t a, std::size_t end, const float* h);
   std::int64_t examine(std::uint32_t a, const float* h);
+  /// The fluxes of source a (height ha) down its steep directions dirs[0,
+  /// n) (the direction in the low byte, bit 8 set for one beyond an open
+  /// edge); returns their count.
+  std::int64_t fall_lines(std::uint32_t a, float ha, const float* h, const int* dirs, int n);
+  std::int64_t fall_visits_ = 0;  // cells the last examination's fall lines walked
   void finish_pass(HeightGrid& grid, SoilStepResult& out);
 
   SoilFlowParams params_;
@@ -385,7 +417,7 @@ class SoilFlow {
   double origin_x_ = 0.0;
   double origin_z_ = 0.0;
   detail::IndexDivider row_div_;  // cell index / cols_
-  // The 8 neighbours as index offsets and their repose limits (soil.cpp's kNeighbours order).
+  // The 8 neighbours as index offsets and their repose limits (soil_internal.hpp's kNeighbours order).
   std::int64_t offset_[8] = {};
   float limit8_[8] = {};
 
@@ -441,8 +473,14 @@ class SoilFlow {
   std::size_t applied_ = 0;
   std::vector<Source> sources_;
   std::size_t applied_sources_ = 0;
+  double quantum_m_ = 0.0;     // the relaxation's height quantum (quantized)
+  bool pass_spans_steps_ = false;  // the pass in progress was examined (in part) in an earlier step
   double pass_gained_m_ = 0.0;    // height the pass's writes gained by float rounding
-  std::uint32_t pass_highest_ = 0;  // the highest cell the pass raised or lowered
+  // The highest cells the pass lowered (all tied for highest, up to
+  // kMaxTiedHighest of them, and how many there were): they take its rounding.
+  static constexpr int kMaxTiedHighest = 8;
+  std::uint32_t pass_highest_[kMaxTiedHighest] = {};
+  int pass_highest_count_ = 0;
   float pass_highest_h_ = -1.0f;
   detail::CellList next_;    // cells to examine in the next pass (kQueued set)
   // The per-cell flags' byte: an enumeration, not std::uint8_t, because a

@@ -105,12 +105,15 @@ struct CutStats {
 
 /// What the soil phase did over a run (SoilModel::kFlow).
 struct SoilRunStats {
-  double displaced_volume_m3 = 0.0;  ///< cut soil put down ahead of the blade, m^3
+  double displaced_volume_m3 = 0.0;  ///< cut soil put down ahead of the blade, m^3 (soil pushed again counts again)
+  double cut_from_ground_m3 = 0.0;   ///< what the blade cut below the initial surface, m^3 (SoilStepResult::cut_from_ground_m3)
+  double net_moved_m3 = 0.0;         ///< at the end, soil no longer where it was: sum of max(initial - height, 0) x cell area, m^3
   double left_over_edge_m3 = 0.0;    ///< soil that left over an open edge, m^3
   std::int64_t passes = 0;           ///< relaxation passes
   std::int64_t pair_checks = 0;      ///< neighbour pairs examined
   std::int64_t max_backlog_cells = 0;  ///< largest number of cells carried to the next step
   std::int64_t final_backlog_cells = 0;  ///< cells still active at the end
+  std::int64_t capped_steps = 0;         ///< steps whose relaxation stopped at the work cap (SoilStepResult::reached_cap)
   double bucket_in_m3 = 0.0;          ///< cut soil the bucket took in, m^3 (0 without a bucket)
   double poured_m3 = 0.0;             ///< soil poured from the bucket, m^3
   double max_bucket_load_m3 = 0.0;    ///< largest load the bucket carried, m^3
@@ -163,11 +166,13 @@ std::vector<std::string> cut_warnings(const io::Scenario& scenario);
 
 /// What a user should know about a run's soil (kFlow; none with kVanish):
 /// cells still active at the end (the work cap stopped the relaxation
-/// short), and cells so far from square that planes steeper than on square
-/// cells stand (steepest_standing_slope_deg more than 0.5 degree above
-/// square cells'). One readable line each.
+/// short), steps whose relaxation the work cap stopped (capped_steps: what
+/// it deferred changes a pushed pile's history), and cells so far from
+/// square that planes steeper than on square cells stand
+/// (steepest_standing_slope_deg more than 0.5 degree above square cells').
+/// One readable line each.
 std::vector<std::string> soil_warnings(const SoilFlowParams& soil, const GridSpec& grid,
-                                       std::int64_t final_backlog_cells);
+                                       std::int64_t final_backlog_cells, std::int64_t capped_steps = 0);
 
 /// Runs the scenario's sequence and writes the outputs into options.out_dir.
 /// Throws terracut::InputError naming the file or folder when an output cannot

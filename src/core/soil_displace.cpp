@@ -1,0 +1,390 @@
+// Soil that flows, the displacement (soil.hpp): what the blade's edge cuts
+// is pushed ahead of it and put down where an avalanche down the face would
+// leave it; the blade marked as a wall for the relaxation.
+#include "terracut/core/soil.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "soil_internal.hpp"
+
+namespace terracut {
+
+using namespace soil_internal;
+
+void SoilFlow::before_cut(const HeightGrid& grid, const Segment& from, const Segment& to) {
+  // The bounding rectangle of the four endpoints, plus a cell.
+  const GridSpec& spec = grid.spec();
+  double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
+  for (const Vec3& p : {from.a, from.b, to.a, to.b}) {
+    const double u = to_cells(p.x, spec.origin_m.x, dx_), v = to_cells(p.z, spec.origin_m.z, dz_);
+    u0 = std::min(u0, u);
+    u1 = std::max(u1, u);
+    v0 = std::min(v0, v);
+    v1 = std::max(v1, v);
+  }
+  Rect r;
+  r.c0 = int(std::clamp(std::floor(u0) - 1.0, 0.0, double(cols_)));
+  r.c1 = int(std::clamp(std::floor(u1) + 2.0, 0.0, double(cols_)));
+  r.r0 = int(std::clamp(std::floor(v0) - 1.0, 0.0, double(rows_)));
+  r.r1 = int(std::clamp(std::floor(v1) + 2.0, 0.0, double(rows_)));
+  before_rect_ = r;
+  before_.resize(std::size_t(r.area()));
+  after_cut_.resize(std::size_t(r.area()));
+  const float* h = grid.heights();
+  std::size_t k = 0;
+  for (int row = r.r0; row < r.r1; ++row)
+    for (int c = r.c0; c < r.c1; ++c) before_[k++] = h[std::int64_t(row) * cols_ + c];
+}
+
+void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
+  // The cells whose centres lie within kBladeRadiusCells of the edge in
+  // plan: row by row, the columns where the row's line can meet that
+  // capsule (the part of the edge within the radius of the row, widened by
+  // the radius), each tested exactly.
+  const GridSpec& spec = grid.spec();
+  const double radius = kBladeRadiusCells * std::max(dx_, dz_);
+  const Vec3 d = edge.b - edge.a;
+  const double plan_length = std::hypot(d.x, d.z);
+  blade_ = {edge.a.x, edge.a.z, d.x, d.z, edge.a.y - spec.origin_m.y, d.y, plan_length > 0.0};
+  if (!blade_.present) return;
+  const double len2 = plan_length * plan_length;
+  blade_.len2 = d.x * d.x + d.z * d.z;
+  blade_.len = std::sqrt(blade_.len2);
+  const double half_num = 0.5 * (std::abs(d.z) * dx_ + std::abs(d.x) * dz_);
+  blade_.half = half_num / blade_.len;
+  // Where |nb| is certainly below or above half_num (relative rounding of
+  // the quotients ~1e-16; the margin 1e-12), |nb| / len < half is decided
+  // without dividing (blade_blocks).
+  blade_.half_lo = half_num * (1.0 - 1e-12);
+  blade_.half_hi = half_num * (1.0 + 1e-12);
+  const double zlo = std::min(edge.a.z, edge.b.z) - radius, zhi = std::max(edge.a.z, edge.b.z) + radius;
+  const int r0 = std::max(0, int(std::floor(to_cells(zlo, spec.origin_m.z, dz_) - 0.5)));
+  const int r1 = std::min(rows_ - 1, int(std::ceil(to_cells(zhi, spec.origin_m.z, dz_) - 0.5)));
+  for (int r = r0; r <= r1; ++r) {
+    const double z = spec.origin_m.z + (r + 0.5) * dz_;
+    // The edge's parameters where it is within the radius of this row's z.
+    double s0 = 0.0, s1 = 1.0;
+    if (std::abs(d.z) > 1e-12) {
+      const double sa = (z - radius - edge.a.z) / d.z, sb = (z + radius - edge.a.z) / d.z;
+      s0 = std::max(0.0, std::min(sa, sb));
+      s1 = std::min(1.0, std::max(sa, sb));
+      if (s0 > s1) continue;
+    } else if (std::abs(z - edge.a.z) > radius) {
+      continue;
+    }
+    const double xa = edge.a.x + d.x * s0, xb = edge.a.x + d.x * s1;
+    const int c0 = std::max(0, int(std::floor(to_cells(std::min(xa, xb) - radius, spec.origin_m.x, dx_) - 0.5)));
+    const int c1 = std::min(cols_ - 1, int(std::ceil(to_cells(std::max(xa, xb) + radius, spec.origin_m.x, dx_) - 0.5)));
+    for (int c = c0; c <= c1; ++c) {
+      const std::uint32_t i = std::uint32_t(std::int64_t(r) * cols_ + c);
+      const double x = spec.origin_m.x + (c + 0.5) * dx_;
+      const double s = std::clamp(((x - edge.a.x) * d.x + (z - edge.a.z) * d.z) / len2, 0.0, 1.0);
+      const double ex = x - (edge.a.x + d.x * s), ez = z - (edge.a.z + d.z * s);
+      if (ex * ex + ez * ez > radius * radius) continue;
+      set_flag(i, kNearBlade);
+      marked_.push_back(i);
+    }
+  }
+}
+
+void SoilFlow::clear_blade() {
+  for (std::uint32_t i : marked_) clear_flag(i, kNearBlade);
+  marked_.clear();
+  blade_.present = false;
+}
+
+void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to,
+                        double bucket_room_m3, SoilStepResult& out) {
+  const GridSpec& spec = grid.spec();
+  const double cell = std::max(dx_, dz_);
+  // The edge's horizontal normal, turned to the side it moved to.
+  const Vec3 e = to.b - to.a;
+  double nx = -e.z, nz = e.x;
+  const double plan_length = std::hypot(nx, nz);
+  const double mx = 0.5 * ((to.a.x + to.b.x) - (from.a.x + from.b.x));
+  const double mz = 0.5 * ((to.a.z + to.b.z) - (from.a.z + from.b.z));
+  if (plan_length > 1e-12) {
+    nx /= plan_length;
+    nz /= plan_length;
+  } else {
+    // An edge seen end-on: push along the motion, or along +X at rest.
+    const double m = std::hypot(mx, mz);
+    nx = m > 1e-12 ? mx / m : 1.0;
+    nz = m > 1e-12 ? mz / m : 0.0;
+  }
+  // One cell along the push (the longer cell side across it, so the roll
+  // never skips a cell).
+  const double step = std::min(dx_ / std::max(std::abs(nx), 1e-9), dz_ / std::max(std::abs(nz), 1e-9));
+  // The repose drop over one such cell.
+  const double limit_step = std::tan(params_.material.repose_deg * std::numbers::pi / 180.0) * step *
+                            std::hypot(nx, nz);
+  const double along_motion = nx * mx + nz * mz;
+  const bool moving = std::abs(along_motion) > 0.01 * cell;
+  if (moving && along_motion < 0.0) {
+    nx = -nx;
+    nz = -nz;
+  }
+
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  const Rect& r = before_rect_;
+  // What the cut took (exact in double: a difference of two floats) and
+  // what the displacement put down, measured as it writes, so that the
+  // rounding of the writes is given back at the end.
+  double taken = 0.0, put = 0.0;
+  std::int64_t last_put = -1;
+  const auto write = [&](std::int64_t cell, float value) {
+    dirty(std::uint32_t(cell));
+    put += double(value) - double(layers.height_m[cell]);
+    layers.height_m[cell] = value;
+    last_put = cell;
+  };
+  // Whether the centre of cell (c, r) lies behind the edge (on the side it
+  // came from, past the half cell its line passes through), within its
+  // length: the cut behind the blade, where no displaced soil may go.
+  const double edge_len2 = e.x * e.x + e.z * e.z;
+  const auto behind_blade = [&](int c, int r) {
+    if (!(edge_len2 > 0.0)) return false;
+    const double x = spec.origin_m.x + (c + 0.5) * dx_ - to.a.x, z = spec.origin_m.z + (r + 0.5) * dz_ - to.a.z;
+    const double t = (x * e.x + z * e.z) / edge_len2;
+    return t >= 0.0 && t <= 1.0 && x * nx + z * nz < -0.5 * cell;
+  };
+  // Puts `add` metres on `cell`, never above the ceiling (a Bullet
+  // heightfield's upper bound would clamp, and so delete, soil above it):
+  // what would rise above it goes to the nearest cells around with room,
+  // ring by ring, none under a body nor behind the blade.
+  const auto put_down = [&](std::int64_t cell, float add) {
+    float v = std::max(0.0f, layers.height_m[cell] + add);
+    float over = v > ceiling_m_ ? v - ceiling_m_ : 0.0f;
+    write(cell, v - over);
+    const int c0 = col_of(std::uint32_t(cell)), r0 = row_of(std::uint32_t(cell));
+    out.changed.include(c0, r0);
+    activate(std::uint32_t(cell));
+    for (int ring = 1; ring <= kMaxPushCells && over > 0.0f; ++ring)
+      for (int dr = -ring; dr <= ring && over > 0.0f; ++dr)
+        for (int dc = -ring; dc <= ring && over > 0.0f; dc += (dr == -ring || dr == ring) ? 1 : 2 * ring) {
+          const int c = c0 + dc, r = r0 + dr;
+          if (c < 0 || r < 0 || c >= cols_ || r >= rows_) continue;
+          const std::int64_t j = std::int64_t(r) * cols_ + c;
+          const float room = ceiling_m_ - layers.height_m[j];
+          if (obstacle_[j] != 0 || !(room > 0.0f) || behind_blade(c, r)) continue;
+          const float give = std::min(over, room);
+          // (h + (ceiling - h) may round an ulp above the ceiling.)
+          write(j, std::min(layers.height_m[j] + give, ceiling_m_));
+          over -= give;
+          out.changed.include(c, r);
+          activate(std::uint32_t(j));
+        }
+  };
+  // The share of each sample's cut that goes into the bucket: all of it
+  // while the bucket has room for the step's cut, else what fits.
+  double keep = 0.0;
+  if (bucket_room_m3 > 0.0) {
+    double cut = 0.0;
+    std::size_t j = 0;
+    for (int row = r.r0; row < r.r1; ++row)
+      for (int c = r.c0; c < r.c1; ++c, ++j) {
+        const float lost = before_[j] - layers.height_m[std::int64_t(row) * cols_ + c];
+        if (lost > 0.0f) cut += double(lost);
+      }
+    cut *= spec.cell_area_m2();
+    keep = cut > 0.0 ? std::min(1.0, bucket_room_m3 / cut) : 0.0;
+  }
+  // The heights the cut left, before any is written: soil put down on a cut
+  // sample not yet handled must not shrink what that sample's cut counts
+  // (else the books give back less than the cut took, and soil is lost).
+  std::size_t k = 0;
+  for (int row = r.r0; row < r.r1; ++row)
+    for (int c = r.c0; c < r.c1; ++c, ++k) after_cut_[k] = layers.height_m[std::int64_t(row) * cols_ + c];
+  k = 0;
+  for (int row = r.r0; row < r.r1; ++row)
+    for (int c = r.c0; c < r.c1; ++c, ++k) {
+      const std::int64_t i = std::int64_t(row) * cols_ + c;
+      const float cut = before_[k] - after_cut_[k];
+      if (!(cut > 0.0f)) continue;
+      // Ground: the part of the cut below the initial surface.
+      out.cut_from_ground_m3 +=
+          std::max(0.0, std::min(double(before_[k]), double(layers.initial_m[i])) - double(after_cut_[k])) *
+          spec.cell_area_m2();
+      dirty(std::uint32_t(i));
+      lowered(std::uint32_t(i), layers.height_m);  // its walls may now be too steep
+      const float kept = keep >= 1.0 ? cut : float(double(cut) * keep);
+      out.bucket_in_m3 += double(kept) * spec.cell_area_m2();
+      const float lost = cut - kept;  // what is displaced
+      if (!(lost > 0.0f)) continue;
+      taken += double(before_[k]) - double(after_cut_[k]) - double(kept);
+      // Straight ahead of the edge: the cell centre's distance to the edge's
+      // line along the normal, plus kDepositAheadCells. At rest, away from
+      // the line on the cell's own side.
+      const double x = spec.origin_m.x + (c + 0.5) * dx_;
+      const double z = spec.origin_m.z + (row + 0.5) * dz_;
+      const double s = (x - to.a.x) * nx + (z - to.a.z) * nz;
+      const double side = moving || s >= 0.0 ? 1.0 : -1.0;
+      const double go = side * (kDepositAheadCells * cell) - s;
+      // Beyond a wall, a target is its last cell; beyond an open edge, the
+      // soil leaves the terrain.
+      const auto beyond = [&](double along) {
+        const double u = to_cells(x + nx * along, spec.origin_m.x, dx_);
+        const double v = to_cells(z + nz * along, spec.origin_m.z, dz_);
+        return u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_;
+      };
+      const auto cell_at = [&](double along) {
+        const int tc = std::clamp(int(std::floor(to_cells(x + nx * along, spec.origin_m.x, dx_))),
+                                  0, cols_ - 1);
+        const int tr = std::clamp(int(std::floor(to_cells(z + nz * along, spec.origin_m.z, dz_))),
+                                  0, rows_ - 1);
+        return std::int64_t(tr) * cols_ + tc;
+      };
+      // The rest of the cut lands where an avalanche down the face ahead
+      // would leave it: the cells along the push from `from` (metres along
+      // the normal from this sample's centre), up to the first one above
+      // it, are filled to one line falling at the repose slope, the line as
+      // high as the volume `volume` (metres of height on one cell) needs.
+      // Cells beyond an open edge stand for the bare ground there (height
+      // 0): what fills them leaves the terrain. A wall or a body ends the
+      // run. Returns what found no cell (all of it when the first cell is
+      // a body's or the grid's end), for the caller to put down.
+      const auto fill_ahead = [&](double from, float volume) -> float {
+        std::int64_t cells[kMaxPushCells];
+        double reach[kMaxPushCells];  // the line's height at the first cell that just reaches this one
+        int count = 0;
+        double sum = 0.0, line = 0.0;
+        std::int64_t last = -1;
+        for (int m = 0; m < kMaxPushCells; ++m) {
+          const double along = from + side * m * step;
+          const bool off = params_.edge == SoilEdge::kOpen && beyond(along);
+          const std::int64_t u = off ? -1 : cell_at(along);
+          if (!off && (u == last || obstacle_[u] != 0)) break;  // against the grid's edge, or a body
+          const double b = (off ? 0.0 : double(layers.height_m[u])) + limit_step * m;
+          if (count > 0 && !(b < line)) break;  // at or above the line: nothing reaches it
+          cells[count] = u;
+          reach[count] = b;
+          sum += b;
+          ++count;
+          line = (double(volume) + sum) / count;
+          if (!off) last = u;
+        }
+        if (count == 0) return volume;
+        // A cell of the run above the final line (a hump) takes nothing:
+        // without it the line comes lower, until no more drop out.
+        for (int in = count;;) {
+          double s_in = 0.0;
+          int n_in = 0;
+          for (int j = 0; j < count; ++j)
+            if (reach[j] < line) s_in += reach[j], ++n_in;
+          if (n_in == in || n_in == 0) break;
+          in = n_in;
+          line = (double(volume) + s_in) / n_in;
+        }
+        for (int j = 0; j < count; ++j) {
+          const double add = line - reach[j];
+          if (!(add > 0.0)) continue;
+          if (cells[j] < 0) {
+            out.left_over_edge_m3 += add * spec.cell_area_m2();
+            taken -= add;
+          } else {
+            put_down(cells[j], float(add));
+          }
+        }
+        return 0.0f;
+      };
+      // The blade pushes what stands in front of it: along the push, the
+      // descending profile ahead (cells above the edge's height) moves on by
+      // one cell, the cut column's height taking the first cell's place, as
+      // a pile pushed by a blade does; what the shift does not account for
+      // (the cut layer itself) is put down just beyond the pile's toe. On
+      // flat ground nothing shifts and the cut soil is put down ahead.
+      const float edge_top = after_cut_[k];  // the cut column's new height
+      std::int64_t ray[kMaxPushCells];
+      int length = 0;
+      ray[length++] = cell_at(go);
+      float previous = before_[k];
+      // A bucket taking soil in does not push a pile.
+      if (kept == 0.0f && layers.height_m[ray[0]] < previous && !(layers.height_m[ray[0]] < edge_top) &&
+          !obstructed(std::uint32_t(ray[0]))) {
+        while (length < kMaxPushCells) {
+          const std::int64_t next = cell_at(go + side * length * step);
+          if (next == ray[length - 1]) break;  // against the grid's edge
+          const float here = layers.height_m[ray[length - 1]], ahead = layers.height_m[next];
+          if (!(ahead < here) || ahead < edge_top || obstructed(std::uint32_t(next))) break;
+          ray[length++] = next;
+        }
+        for (int j = 0; j < length; ++j) {
+          const std::int64_t cell_j = ray[j];
+          const float old = layers.height_m[cell_j];
+          write(cell_j, previous);
+          out.changed.include(col_of(std::uint32_t(cell_j)), row_of(std::uint32_t(cell_j)));
+          if (previous < old)
+            lowered(std::uint32_t(cell_j), layers.height_m);
+          else
+            activate(std::uint32_t(cell_j));
+          previous = old;
+        }
+      } else {
+        length = 0;  // nothing to push: the cut soil goes to the first cell ahead
+        previous = layers.height_m[ray[0]];
+      }
+      // What is left: the lost height less what the shift raised (which
+      // telescopes to the cut column's old height less the toe's old
+      // height). It extends the pile beyond its toe at the repose slope,
+      // cell by cell along the push; the rest of it stays on the last cell.
+      const float raised = length > 0 ? before_[k] - previous : 0.0f;
+      float rest = lost - raised;
+      out.displaced_volume_m3 += double(lost) * spec.cell_area_m2();
+      if (rest > 0.0f) rest = fill_ahead(go, rest);
+      std::int64_t t = length > 0 ? ray[length - 1] : ray[0];
+      float level = length > 0 ? layers.height_m[t] : before_[k];
+      // The last cell reached that is not under a rigid body (the cut
+      // column itself when the body stands right ahead).
+      std::int64_t free = length > 0 ? t : i;
+      for (int m = length > 0 ? length : 0; m < kMaxPushCells && rest > 0.0f; ++m) {
+        if (params_.edge == SoilEdge::kOpen && beyond(go + side * m * step)) {
+          // Pushed off the terrain: it is gone, and counted.
+          out.left_over_edge_m3 += double(rest) * spec.cell_area_m2();
+          taken -= double(rest);
+          rest = 0.0f;
+          break;
+        }
+        const std::int64_t u = cell_at(go + side * m * step);
+        if (u == t && m > 0) break;  // against the grid's edge
+        t = u;
+        if (obstacle_[u] != 0) break;  // never into, under or through a body
+        const float room = level - float(limit_step) - layers.height_m[u];
+        if (!(room > 0.0f)) {
+          if (m > 0 || length > 0) break;
+          continue;
+        }
+        free = u;
+        const float add = std::min(rest, room);
+        write(u, layers.height_m[u] + add);
+        rest -= add;
+        level = layers.height_m[u];
+        out.changed.include(col_of(std::uint32_t(u)), row_of(std::uint32_t(u)));
+        activate(std::uint32_t(u));
+      }
+      // What did not fit (or, by rounding, came out negative) is settled on
+      // the last cell reached, keeping the volume.
+      // Against a body with no free cell between it and the blade (the
+      // blade at or under it), it goes round the body: to the nearest cells
+      // beside it along the edge, half to each side when both are as near
+      // (so a mirrored scene gives the mirrored result).
+      std::int64_t t2 = -1;
+      if (obstacle_[t] != 0 && rest > 0.0f) {
+        t = free;
+        if (free == i) beside_body(grid, x + nx * go, z + nz * go, -nz, nx, t, t2);
+      }
+      const float half = t2 >= 0 ? 0.5f * rest : 0.0f;
+      for (const auto& [target, share] : {std::pair{t, rest - half}, std::pair{t2, half}}) {
+        if (target < 0 || share == 0.0f) continue;
+        put_down(target, share);
+      }
+    }
+  // Give back the rounding of the writes on the last cell written.
+  if (last_put >= 0 && put != taken) {
+    give_back(layers.height_m[last_put], taken - put);
+  }
+}
+
+}  // namespace terracut

@@ -1,0 +1,186 @@
+// Internal to the soil phase (soil.hpp), shared by its files, one per
+// phase: soil.cpp (parameters, construction, the step's order), soil_displace.cpp
+// (the blade's cut soil put down ahead, and the blade as a wall),
+// soil_relax.cpp (relaxation by fall lines), soil_bucket.cpp (the bucket's
+// hull, load and pour), soil_bodies.cpp (rigid bodies as obstacles). The
+// constants every phase reads, and the two members the displacement and the
+// relaxation both call on their hot paths (inline). Not part of the public API.
+#pragma once
+
+#include "terracut/core/soil.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include <bit>
+#include <cstdint>
+#include <vector>
+
+namespace terracut::soil_internal {
+/// Radius around the edge, in cells, of the cells whose pairs are tested
+/// against the blade (a pair is at most one diagonal long).
+inline constexpr double kBladeRadiusCells = 1.5;
+/// Distance beyond the edge's line, in cells, where displaced soil is put:
+/// the cell there is the first whose centre is clear of the blade (0.5 to
+/// 1.5 cells ahead), so that the push shifts the profile in front of the
+/// blade as a whole (at 1.5 it skipped the cell against the blade and left
+/// a dip there that drained the whole face).
+inline constexpr double kDepositAheadCells = 1.0;
+/// A slope moves only when it exceeds the repose limit of a cell pair by
+/// more than this fraction of the limit: 2 % of tan(repose), at most about
+/// 0.5 degree above the repose angle (34 degrees: 34.4). Smaller tolerances
+/// only lengthen the tail of a settling pile.
+inline constexpr double kToleranceOfLimit = 0.02;
+/// How far, in cells, the blade's ends move before the soil it held up is
+/// examined again.
+inline constexpr double kHeldMoveCells = 0.25;
+/// Longest run of cells the blade pushes ahead of it, per cut sample.
+inline constexpr int kMaxPushCells = 512;
+/// Longest fall line a source's soil slides down in one pass, cells (what
+/// lies beyond is reached in the next pass, from the line's end).
+inline constexpr int kMaxFallCells = 32;
+/// Rounds of the water fill after the first (each drops the cells that
+/// stand above the line); what a source would still give past them stays
+/// on it (a later pass moves it). Two settle nearly every source.
+inline constexpr int kMaxExtraRounds = 2;
+/// The most one examination can cost, in visits: its 8 neighbours, its
+/// fall lines, and their cells read again in each further round. The work
+/// cap admits a cell only with this much room left, so a step never passes
+/// it (and the minimum cap, 1000, leaves room for one).
+inline constexpr std::int64_t kMostExamineVisits = 8 + 8 * kMaxFallCells * (1 + kMaxExtraRounds);
+static_assert(kMostExamineVisits <= 1000);
+/// Fluxes a pass may hold per cell of the reserved active set.
+inline constexpr std::size_t kFluxesPerActiveCell = 32;
+/// The work cap's charge for a source's fall test (lowered): its 8
+/// neighbours read again.
+inline constexpr std::int64_t kFallTestVisits = 8;
+
+// The 8 neighbours: offsets and which limit applies (0 along X, 1 along Z, 2 diagonal).
+struct Neighbour {
+  int dc;
+  int dr;
+  int kind;
+};
+/// The cell index standing for the bare ground beyond an open edge.
+inline constexpr std::uint32_t kOutside = 0xffffffffu;
+
+inline constexpr Neighbour kNeighbours[8] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 1},  {0, -1, 1},
+                                             {1, 1, 2},  {-1, 1, 2}, {1, -1, 2}, {-1, -1, 2}};
+
+inline double to_cells(double v, double origin, double cell) { return (v - origin) / cell; }
+
+/// Writes every element of v's reserved storage once and empties it again:
+/// the pages are the process's from construction on, so the first tick to
+/// fill a list does not stop on page faults (a first touch of a few MiB of
+/// fresh pages costs the system a millisecond or more).
+template <typename T>
+void touch_reserved(std::vector<T>& v) {
+  v.resize(v.capacity());
+  v.clear();
+}
+
+#if defined(__SSE2__)
+/// The heights of an inner cell's 8 neighbours (p points at the cell; up is
+/// one row along +Z), in kNeighbours' order: n0 holds k = 0..3, n1 k = 4..7.
+inline void load_neighbours(const float* p, std::int64_t up, __m128& n0, __m128& n1) {
+  n0 = _mm_setr_ps(p[1], p[-1], p[up], p[-up]);
+  n1 = _mm_setr_ps(p[up + 1], p[up - 1], p[1 - up], p[-1 - up]);
+}
+
+/// Bit k set where lane k of (e0, e1) (k = 0..3, 4..7) is above tol.
+inline unsigned above_mask(__m128 e0, __m128 e1, float tol) {
+  const __m128 vt = _mm_set1_ps(tol);
+  return unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e0, vt))) | unsigned(_mm_movemask_ps(_mm_cmpgt_ps(e1, vt))) << 4;
+}
+#endif
+
+}  // namespace terracut::soil_internal
+
+namespace terracut {
+
+inline void SoilFlow::lowered(std::uint32_t cell, const float* h) {
+  // Only the pairs of this cell changed: a neighbour that now stands too
+  // steep above it is examined in the next pass (the same test as a pass's).
+  activate(cell);
+  const float hc = h[cell];
+  if (!(queued_[cell] & kEdge)) {
+    // All 8 tested without a branch each; the steep ones then activated.
+    unsigned steep = 0;
+#if defined(__SSE2__)
+    // As examine's: four pairs to an instruction, the same bits.
+    __m128 hb0, hb1;
+    soil_internal::load_neighbours(h + cell, offset_[2], hb0, hb1);
+    const __m128 vc = _mm_set1_ps(hc);
+    const __m128 e0 = _mm_sub_ps(_mm_sub_ps(hb0, vc), _mm_loadu_ps(limit8_));
+    const __m128 e1 = _mm_sub_ps(_mm_sub_ps(hb1, vc), _mm_loadu_ps(limit8_ + 4));
+    steep = soil_internal::above_mask(e0, e1, tolerance_m_);
+#else
+    for (int k = 0; k < 8; ++k)
+      steep |= unsigned(h[std::int64_t(cell) + offset_[k]] - hc - limit8_[k] > tolerance_m_) << k;
+#endif
+    for (; steep != 0; steep &= steep - 1)
+      activate(std::uint32_t(std::int64_t(cell) + offset_[std::countr_zero(steep)]));
+    return;
+  }
+  const int c = col_of(cell), r = row_of(cell);
+  for (int k = 0; k < 8; ++k) {
+    const int cb = c + soil_internal::kNeighbours[k].dc, rb = r + soil_internal::kNeighbours[k].dr;
+    if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_) continue;
+    const std::uint32_t b = std::uint32_t(std::int64_t(cell) + offset_[k]);
+    if (h[b] - hc - limit8_[k] > tolerance_m_) activate(b);
+  }
+}
+
+inline bool SoilFlow::blade_blocks(int hc, int hr, int lc, int lr, float top_m) const {
+  // Cell centres relative to the edge's first end, in plan.
+  const double xa = (double(hc) + 0.5) * dx_ + origin_x_ - blade_.ax;
+  const double za = (double(hr) + 0.5) * dz_ + origin_z_ - blade_.az;
+  const double xb = (double(lc) + 0.5) * dx_ + origin_x_ - blade_.ax;
+  const double zb = (double(lr) + 0.5) * dz_ + origin_z_ - blade_.az;
+  const double len2 = blade_.len2;
+  const double len = blade_.len;
+  // Signed distances to the edge's line (their numerators na, nb over
+  // len), and the half width of a cell across it (blade_.half): a cell
+  // closer than that is inside the blade (the edge passes through it).
+  // Most pairs lie on one side, outside the blade, and are told so without
+  // a division: the sign of na / len is na's, and a |n| away from the half
+  // width's numerator by more than rounding (blade_.half_lo, half_hi)
+  // compares as |n| / len would.
+  const double na = blade_.dx * za - blade_.dz * xa;
+  const double nb = blade_.dx * zb - blade_.dz * xb;
+  const double half = blade_.half;
+  const auto inside = [&](double n) {
+    const double q = std::abs(n);
+    return q < blade_.half_lo ? true : q > blade_.half_hi ? false : std::abs(n / len) < half;
+  };
+  const bool low_inside = inside(nb);
+  // A source inside the blade is on neither side: its soil stands against
+  // the blade (the cut takes it when the edge passes its centre), and the
+  // side a centre on or next to the edge's line falls on is a matter of
+  // rounding (a centre exactly on the line gave na = 0, counted on the
+  // negative side, and a pile stood against the blade collapsed into the
+  // cut behind it). It sheds nothing across or along the blade.
+  const bool high_inside = inside(na);
+  if (!low_inside && !high_inside && (na > 0.0) == (nb > 0.0)) return false;  // one side, outside the blade
+  // Where along the edge: at the low cell when it is inside the blade, at
+  // the source when it is, else where the pair's segment meets the line.
+  double px = xb, pz = zb;
+  if (!low_inside) {
+    if (high_inside) {
+      px = xa;
+      pz = za;
+    } else {
+      const double da = na / len, db = nb / len;
+      const double w = da / (da - db);
+      px = xa + (xb - xa) * w;
+      pz = za + (zb - za) * w;
+    }
+  }
+  const double t = (px * blade_.dx + pz * blade_.dz) / len2;
+  if (t < 0.0 || t > 1.0) return false;  // around an end of the blade
+  // The blade stops soil whose surface there is above its edge.
+  return double(top_m) > blade_.ay + blade_.dy * t;
+}
+
+}  // namespace terracut

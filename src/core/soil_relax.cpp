@@ -1,0 +1,413 @@
+// Soil that flows, the relaxation (soil.hpp, docs/soil.md "Relaxation:
+// fall lines"): steep cells' soil slides down their fall lines in Jacobi
+// passes, bounded per step by the work cap.
+#include "terracut/core/soil.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "soil_internal.hpp"
+
+namespace terracut {
+
+using namespace soil_internal;
+
+std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
+  // Cell a, if it stands steeper than the repose angle toward some
+  // neighbours, lets the soil above the repose line slide down its fall
+  // lines (fall_lines): its fluxes, from the heights frozen at the pass's
+  // start, are appended to the pass's list.
+  // One byte holds the cell's flags (border, near the blade, ...).
+  const std::uint8_t flags = queued_[a];
+  const float ha = h[a];
+  const float tol = tolerance_m_;
+  float excess[8];
+  // Bit k: neighbour k is lower by more than its limit and the tolerance;
+  // bit 8 + k: neighbour k lies beyond the grid's edge. The pairs are
+  // tested without a branch each (which of them is steep changes from
+  // cell to cell, so a branch per pair is mispredicted often).
+  unsigned steep = 0, outside = 0;
+  if (!(flags & kEdge)) {
+    // Inside the grid: all 8 neighbours exist.
+#if defined(__SSE2__)
+    // Four pairs to an instruction, in kNeighbours' order, with the same
+    // operations as the scalar form below (the same bits).
+    __m128 hb0, hb1;
+    load_neighbours(h + a, offset_[2], hb0, hb1);
+    const __m128 va = _mm_set1_ps(ha);
+    const __m128 e0 = _mm_sub_ps(_mm_sub_ps(va, hb0), _mm_loadu_ps(limit8_));
+    const __m128 e1 = _mm_sub_ps(_mm_sub_ps(va, hb1), _mm_loadu_ps(limit8_ + 4));
+    _mm_storeu_ps(excess, e0);
+    _mm_storeu_ps(excess + 4, e1);
+    steep = above_mask(e0, e1, tol);
+#else
+    for (int k = 0; k < 8; ++k) {
+      excess[k] = ha - h[std::int64_t(a) + offset_[k]] - limit8_[k];
+      steep |= unsigned(excess[k] > tol) << k;
+    }
+#endif
+  } else {
+    const int ca = col_of(a), ra = row_of(a);
+    for (int k = 0; k < 8; ++k) {
+      const int cb = ca + kNeighbours[k].dc, rb = ra + kNeighbours[k].dr;
+      if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_) {
+        // Beyond an open edge lies bare ground (height 0) that takes what
+        // slides onto it; a wall takes nothing.
+        outside |= 1u << k;
+        excess[k] = params_.edge == SoilEdge::kOpen ? ha - limit8_[k] : 0.0f;
+      } else {
+        excess[k] = ha - h[std::int64_t(a) + offset_[k]] - limit8_[k];
+      }
+      steep |= unsigned(excess[k] > tol) << k;
+    }
+  }
+  if (steep == 0) return 0;  // most examined cells cannot move
+  const bool blade = blade_.present && (flags & kNearBlade);
+  // The cell's column and row, for the blade's test only.
+  const int ca = blade ? col_of(a) : 0, ra = blade ? row_of(a) : 0;
+  const bool obstacles = !obstacles_.empty();
+  const bool hull = !hull_cells_.empty();
+  int dirs[8];
+  int n = 0;
+  for (unsigned bits = steep; bits != 0; bits &= bits - 1) {
+    const int k = std::countr_zero(bits);
+    if (!(outside & (1u << k))) {
+      const std::uint32_t b = std::uint32_t(std::int64_t(a) + offset_[k]);
+      if (blade || obstacles || hull) {
+        const std::uint8_t fb = queued_[b];
+        // The blade is a wall between the cells on its two sides, and soil
+        // does not flow into the cells it passes through. What it holds up
+        // is examined again once it has moved.
+        if (blade && (fb & kNearBlade) &&
+            blade_blocks(ca, ra, ca + kNeighbours[k].dc, ra + kNeighbours[k].dr, ha)) {
+          hold(a);
+          continue;
+        }
+        // Nor into a rigid body's footprint (soil under it may slide out).
+        if (obstacles && obstructed(b)) continue;
+        // Nor into a cell under the bucket's hull from higher than the hull's
+        // underside there (a flux never raises a cell above its source).
+        if ((fb & kHull) && ha > hull_under(b)) {
+          hold(a);
+          continue;
+        }
+      }
+    }
+    dirs[n++] = k | int((outside >> k) & 1u) << 8;
+  }
+  if (n == 0) return 0;
+  return fall_lines(a, ha, h, dirs, n);
+}
+
+std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, const int* dirs, int n) {
+  // The soil above the repose line through the source slides down its fall
+  // lines and comes to rest where the line meets the ground: along each
+  // steep direction k the cells from the neighbour on, as long as they
+  // stand below the source by more than the repose drop back to it (their
+  // reach, height + drop, under the source's height), up to the first that
+  // does not, the grid's edge, the blade, the hull's underside or a body.
+  // The source comes down to s and every cell of those runs whose reach is
+  // below s comes up to s less its drop:
+  // one line at the repose slope from the source down each fall line (the
+  // 1-D water fill of fill_ahead, from a point). s balances the volume:
+  // s = (h_a + sum of the reaches taken) / (1 + their count). The drop per
+  // cell is the pair's limit less the tolerance, so the lines it leaves
+  // stand a tolerance gentler than the threshold that moves them.
+  struct Line {
+    std::uint32_t cell[kMaxFallCells];
+    float reach[kMaxFallCells];
+    int length = 0;
+  };
+  // A reach marked as left out (a hump).
+  constexpr float kHump = std::numeric_limits<float>::infinity();
+  Line lines[8];
+  const float tol = tolerance_m_;
+  // A fall line from a cell far from the blade may still run into it.
+  const bool blade = blade_.present;
+  double total = ha;
+  int count = 1;
+  bool steep_below = false;
+  for (int j = 0; j < n; ++j) {
+    const int k = dirs[j] & 0xff;
+    const float drop = limit8_[k] - 0.25f * tol;
+    Line& line = lines[j];
+    if (dirs[j] >> 8) {
+      // Beyond an open edge: bare ground at height 0 that takes what comes.
+      line.cell[0] = kOutside;
+      line.reach[0] = drop;
+      line.length = 1;
+    } else {
+      std::uint32_t cur = std::uint32_t(std::int64_t(a) + offset_[k]);
+      for (int m = 1;; ++m) {
+        const float reach = h[cur] + drop * float(m);
+        if (!(reach < ha)) break;
+        line.cell[line.length] = cur;
+        line.reach[line.length++] = reach;
+        if (line.length == kMaxFallCells || (queued_[cur] & kEdge)) break;
+        const std::uint32_t next = std::uint32_t(std::int64_t(cur) + offset_[k]);
+        const std::uint8_t fn = queued_[next];
+        // A cell itself steeper than the threshold toward the next sheds
+        // in this pass too: the line ends on it (beyond it the frozen
+        // heights are not where the soil will rest, and two sources filling
+        // the same steep slope at once would flatten it).
+        if (m == 1 && h[cur] - h[next] - limit8_[k] > tol) steep_below = true;
+        if (!obstacles_.empty() && obstructed(next)) break;
+        if ((fn & kHull) && ha > hull_under(next)) break;
+        if (blade && (queued_[cur] & kNearBlade) && (fn & kNearBlade) &&
+            blade_blocks(col_of(cur), row_of(cur), col_of(next), row_of(next), ha))
+          break;
+        cur = next;
+      }
+    }
+    fall_visits_ += line.length;
+    for (int m = 0; m < line.length; ++m) total += line.reach[m];
+    count += line.length;
+  }
+  // A cell whose reach is at or above s stands above the final line (a
+  // hump) and takes nothing; without it s comes lower, until no more drop
+  // out (as in fill_ahead). s only comes down as cells drop out, and at
+  // least one cell stays (every reach is below h_a). Two or three rounds
+  // settle nearly every source; after 1 + kMaxExtraRounds a cell still at
+  // or above s gets nothing (its share would not be positive) and the
+  // source keeps that soil for a later pass.
+  double s = total / count;
+  for (int round = 0; round <= kMaxExtraRounds; ++round) {
+    bool changed = false;
+    const bool first = round == 0;
+    for (int j = 0; j < n; ++j) {
+      Line& line = lines[j];
+      if (!first) fall_visits_ += line.length;  // a further round reads every cell again
+      for (int m = 0; m < line.length; ++m)
+        if (line.reach[m] < kHump && double(line.reach[m]) >= s) {
+          total -= line.reach[m];
+          --count;
+          line.reach[m] = kHump;
+          changed = true;
+        }
+    }
+    s = total / count;
+    if (!changed) break;
+  }
+  std::uint32_t fluxes = 0;
+  for (int j = 0; j < n; ++j)
+    for (int m = 0; m < lines[j].length; ++m) {
+      if (!(lines[j].reach[m] < kHump)) continue;
+      const float give = quantized((steep_below ? 0.5 : 1.0) * (s - double(lines[j].reach[m])));
+      if (!(give > 0.0f)) continue;
+      fluxes_.push_back({lines[j].cell[m], give});
+      ++fluxes;
+    }
+  if (fluxes == 0) return 0;
+  sources_.push_back({a, fluxes, 1.0f});
+  return fluxes;
+}
+
+void SoilFlow::drop_blocked_fluxes(std::uint32_t a, std::size_t end, const float* h) {
+  const std::uint8_t fa = queued_[a];
+  const bool blade = blade_.present && (fa & kNearBlade);
+  if (!blade && hull_cells_.empty() && obstacles_.empty()) return;
+  const int ca = col_of(a), ra = row_of(a);
+  for (std::size_t j = applied_; j < end; ++j) {
+    Flux& f = fluxes_[j];
+    if (f.to == kOutside) continue;
+    const std::uint8_t fb = queued_[f.to];
+    const bool across = blade && (fb & kNearBlade) && blade_blocks(ca, ra, col_of(f.to), row_of(f.to), h[a]);
+    const bool into_hull = (fb & kHull) && h[a] > hull_under(f.to);
+    if (across || into_hull) hold(a);
+    if (across || into_hull || (!obstacles_.empty() && obstructed(f.to))) f.excess = 0.0f;
+  }
+}
+
+void SoilFlow::finish_pass(HeightGrid& grid, SoilStepResult& out) {
+  // The fluxes cancel exactly; the float heights do not quite: what the
+  // pass gained or lost by rounding was measured in double and is given
+  // back to the highest cell it changed, so no bias builds up over a run.
+  // When cells tie for highest (a mirror image would pick another of
+  // them), they share it, so a mirrored terrain gives it to the mirrored
+  // cells; more than kMaxTiedHighest, it waits for a later pass.
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  // The highest sources once the pass is applied (their final heights do
+  // not depend on the order they were applied in).
+  for (std::size_t j = 0; j < applied_sources_; ++j) {
+    const std::uint32_t a = sources_[j].cell;
+    const float now = layers.height_m[a];
+    if (now > pass_highest_h_) {
+      pass_highest_h_ = now;
+      pass_highest_[0] = a;
+      pass_highest_count_ = 1;
+    } else if (now == pass_highest_h_ && a != pass_highest_[0]) {
+      if (pass_highest_count_ < kMaxTiedHighest) pass_highest_[pass_highest_count_] = a;
+      ++pass_highest_count_;
+    }
+  }
+  if (pass_gained_m_ != 0.0 && pass_highest_h_ > 0.0f && pass_highest_count_ <= kMaxTiedHighest) {
+    // Shared equally by the cells tied for highest (the same set, mirrored,
+    // in a mirror image), in whole quanta (what is left under one waits for
+    // a later pass), never below the floor nor above the ceiling.
+    const double share = -pass_gained_m_ / pass_highest_count_;
+    for (int j = 0; j < pass_highest_count_; ++j) {
+      float& hh = layers.height_m[pass_highest_[j]];
+      const float old = hh;
+      hh = std::min(quantized(std::max(0.0, double(hh) + share)), std::max(ceiling_m_, old));
+      pass_gained_m_ += double(hh) - double(old);
+    }
+  }
+  pass_highest_h_ = -1.0f;
+  pass_highest_count_ = 0;
+  for (std::uint32_t cell : dirty_) clear_flag(cell, kDirty);
+  dirty_.clear();
+  active_.clear();
+  fluxes_.clear();
+  sources_.clear();
+  examined_ = applied_ = applied_sources_ = 0;
+  ++out.passes;
+}
+
+void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
+  const HeightGrid::EditLayers layers = grid.edit_layers();
+  float* h = layers.height_m;
+  const double cell_area = dx_ * dz_;
+  // The work of the step, in neighbour visits: 8 per cell examined, 1 per
+  // flux applied and 8 per source's fall test (its neighbours read again),
+  // so that a step's work tracks its time whether it examines or applies.
+  // It never passes the cap: a pass too large for what is left is carried on
+  // in the next step, where it stopped (its heights stay those it started
+  // from until all its cells are examined), so a collapse of any size is
+  // spread over ticks of bounded work.
+  const std::int64_t cap = params_.max_pair_checks_per_step;
+  std::int64_t work = 0;
+  // A pass left over from an earlier step was examined against the blade,
+  // hull and bodies of that step.
+  pass_spans_steps_ = !active_.empty();
+  // The rectangle of the cells that shed soil; the cells they shed to are
+  // their neighbours, so the changed rectangle is that plus a cell.
+  int changed_c0 = cols_, changed_c1 = -1, changed_r0 = rows_, changed_r1 = -1;
+  bool out_of_work = false;
+  while (!out_of_work) {
+    if (active_.empty()) {
+      // The next pass starts from the cells queued for it.
+      if (next_.empty()) break;
+      active_.swap(next_);
+      for (std::uint32_t a : active_) clear_flag(a, kQueued);
+      pass_spans_steps_ = false;
+    }
+    if (examined_ < active_.size()) {
+      // 8 visits per cell examined and one per cell of the fall lines it
+      // walks (fall_visits_), cell by cell while the cap leaves room for one
+      // more examination and a full fall line each way.
+      std::int64_t moved = 0;
+      // A pass whose fluxes would outgrow their list is split: the cells
+      // not examined yet go on to the next pass (a pass that large is a
+      // collapse of most of a reserved active set, or a grid's worth).
+      while (examined_ < active_.size() && work + kMostExamineVisits <= cap &&
+             fluxes_.size() + 8 * kMaxFallCells <= fluxes_.capacity()) {
+        fall_visits_ = 0;
+        moved += examine(active_[examined_++], h);
+        work += 8 + fall_visits_;
+      }
+      out.moved_pairs += moved;
+      if (examined_ < active_.size()) {
+        if (work + kMostExamineVisits <= cap) {
+          // Split: the rest of the list is examined in the next pass.
+          for (std::size_t j = examined_; j < active_.size(); ++j) activate(active_[j]);
+          active_.truncate(examined_);
+        } else {
+          out.reached_cap = true;
+          break;  // the rest in the next step
+        }
+      }
+    }
+    while (applied_sources_ < sources_.size()) {
+      // A source's fluxes are contiguous: applied together, then its fall
+      // tested against its neighbours.
+      const std::uint32_t a = sources_[applied_sources_].cell;
+      const std::size_t end = applied_ + sources_[applied_sources_].fluxes;
+      const float share = sources_[applied_sources_].share;
+      // No cell is dirty while dirty_ is empty (most passes: the cut marks
+      // cells only in a pass it interrupts), and then nothing is read for it.
+      const bool any_dirty = !dirty_.empty();
+      const bool stale = any_dirty && (queued_[a] & kDirty) != 0;
+      const std::int64_t cost = std::int64_t(end - applied_) + (stale ? 0 : kFallTestVisits);
+      if (work + cost > cap) {
+        out_of_work = true;
+        out.reached_cap = true;
+        break;
+      }
+      work += cost;
+      if (stale) {
+        applied_ = end;  // changed since it was examined: examined again
+        ++applied_sources_;
+        continue;
+      }
+      // A pass examined in an earlier step met the blade, the hull and the
+      // bodies where they were then; they have moved since. A flux that
+      // would now cross the blade, climb into the hull or enter a body is
+      // dropped (its source is held, and examined again).
+      if (pass_spans_steps_) drop_blocked_fluxes(a, end, h);
+      // Multiples of the quantum, summed exactly in double: the order of the
+      // source's fall lines (which a mirror image permutes) does not matter.
+      double total_d = 0.0;
+      for (std::size_t j = applied_; j < end; ++j)
+        if (!any_dirty || fluxes_[j].to == kOutside || !(queued_[fluxes_[j].to] & kDirty))
+          total_d += double(share * fluxes_[j].excess);
+      const float total = float(total_d);
+      // What the cell can give: never below the floor (the blade may have
+      // cut it since the pass was examined).
+      const float before = h[a];
+      const float scale = total > before ? before / total : 1.0f;
+      const float now = total > before ? 0.0f : quantized(double(before) - total_d);
+      h[a] = now;
+      // The grid's change in double: float rounding is what it gains.
+      double gained = double(now) - double(before);
+      const int ca = col_of(a), ra = row_of(a);
+      changed_c0 = std::min(changed_c0, ca);
+      changed_c1 = std::max(changed_c1, ca);
+      changed_r0 = std::min(changed_r0, ra);
+      changed_r1 = std::max(changed_r1, ra);
+      for (; applied_ < end; ++applied_) {
+        const Flux& f = fluxes_[applied_];
+        if (any_dirty && f.to != kOutside && (queued_[f.to] & kDirty)) continue;
+        const float give = (share * f.excess) * scale;
+        if (f.to == kOutside) {
+          out.left_over_edge_m3 += double(give) * cell_area;
+          gained += double(give);  // what left is no rounding gain
+          continue;
+        }
+        // Multiples of the quantum added to a multiple of it: exact, so a
+        // cell's sum does not depend on the order its sources were met in.
+        const float old = h[f.to], raised = quantized(double(old) + double(give));
+        h[f.to] = raised;
+        gained += double(raised) - double(old);
+        activate(f.to);
+        const int ct = col_of(f.to), rt = row_of(f.to);
+        changed_c0 = std::min(changed_c0, ct);
+        changed_c1 = std::max(changed_c1, ct);
+        changed_r0 = std::min(changed_r0, rt);
+        changed_r1 = std::max(changed_r1, rt);
+      }
+      pass_gained_m_ += gained;
+      ++applied_sources_;
+      lowered(a, h);
+    }
+    if (applied_sources_ < sources_.size()) break;
+    finish_pass(grid, out);
+  }
+  out.pair_checks += work;
+  if (changed_c1 >= 0) {
+    out.changed.include(std::max(changed_c0 - 1, 0), std::max(changed_r0 - 1, 0));
+    out.changed.include(std::min(changed_c1 + 1, cols_ - 1), std::min(changed_r1 + 1, rows_ - 1));
+  }
+  out.backlog_cells = active_cells();
+}
+
+SoilStepResult SoilFlow::relax(HeightGrid& grid) {
+  SoilStepResult out;
+  wake_held(nullptr);  // no blade now
+  clear_hull();        // nor a bucket
+  run_passes(grid, out);
+  return out;
+}
+
+}  // namespace terracut
