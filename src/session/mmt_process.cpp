@@ -17,6 +17,7 @@
 #include "terracut/core/format.hpp"
 #include "terracut/haptics/device_option.hpp"
 #include "terracut/io/image.hpp"
+#include "terracut/net/emulator.hpp"
 #include "terracut/session/world.hpp"
 
 namespace terracut::session {
@@ -339,8 +340,9 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
   // blend for the last updates to land (or --duration).
   const double path_s = operator_duration_s(op);
   auto run_length_s = [&] {
-    return o.overrides.duration_s.value_or(path_s + station.round_trip_bound_s() +
-                                           s.sense_period_s + s.blend_s + 0.3);
+    const double round_trip_s = station.round_trip_bound_s();
+    return o.overrides.duration_s.value_or(mmt_run_length_s(
+        s, path_s, round_trip_s, net::retransmit_timeout_s(s.to_operator, round_trip_s)));
   };
   if (o.log)
     *o.log << "terracut mmt: operator connected to " << address << ":" << port

@@ -162,14 +162,12 @@ MmtRun::MmtRun(const Scenario& op, const MmtOverrides& overrides) {
   operator_ = std::move(pair.operator_station);
   remote_ = std::move(pair.remote_station);
   rate_hz_ = operator_->rate_hz();
-  // After the path: a round trip, a sensing period and a blend for the last
-  // updates to land, and on a lossy link three retransmissions more.
+  // The run's length: the one rule (mmt_run_length_s), with the emulated
+  // round trip.
   const net::LinkConditions& back = settings_.to_operator;
-  const bool lossy = back.loss > 0.0 || back.burst.p_good_to_bad > 0.0;
-  const double retransmit_s = net::retransmit_timeout_s(back, net::emulated_round_trip_s(back));
-  const double duration = overrides.duration_s.value_or(
-      operator_duration_s(*op_) + settings_.to_remote.delay_s + back.delay_s +
-      settings_.sense_period_s + settings_.blend_s + 0.2 + (lossy ? 3.0 * retransmit_s : 0.0));
+  const double duration = overrides.duration_s.value_or(mmt_run_length_s(
+      settings_, operator_duration_s(*op_), settings_.to_remote.delay_s + back.delay_s,
+      net::retransmit_timeout_s(back, net::emulated_round_trip_s(back))));
   if (!(duration > 0.0) || duration > 3600.0)
     throw InputError(must_be("--duration", "in (0, 3600]", duration));
   total_ticks_ = std::max<std::int64_t>(1, std::llround(duration * rate_hz_));

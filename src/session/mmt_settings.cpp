@@ -190,6 +190,15 @@ std::string no_mmt_section(const Scenario& sc) {
          "docs/teleoperation.md)";
 }
 
+double mmt_run_length_s(const MmtSettings& settings, double path_s, double round_trip_s,
+                        double retransmit_s) {
+  const net::LinkConditions& back = settings.to_operator;
+  const bool lossy = back.loss > 0.0 || back.burst.p_good_to_bad > 0.0;
+  constexpr double kLandingMargin_s = 0.2;  // the last update's tick and a few more
+  return path_s + round_trip_s + settings.sense_period_s + settings.blend_s + kLandingMargin_s +
+         (lossy ? 3.0 * retransmit_s : 0.0);
+}
+
 Scenario load_remote_scenario(const Scenario& op) {
   if (!op.mmt) throw InputError(no_mmt_section(op));
   const MmtSettings& s = *op.mmt;

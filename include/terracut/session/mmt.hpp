@@ -455,6 +455,14 @@ void compare_records(const std::vector<OperatorRecord>& op, const std::vector<Re
 /// of every MMT entry point.
 std::string no_mmt_section(const Scenario& sc);
 
+/// How long an operator station runs when no --duration is given, s: its
+/// path (path_s), then a round trip (round_trip_s), a sensing period and a
+/// blend for the last updates to land, and on a lossy link back three
+/// retransmissions more (each retransmit_s). The one rule of the one-process
+/// run (the emulated round trip) and of the operator process (the measured).
+double mmt_run_length_s(const MmtSettings& settings, double path_s, double round_trip_s,
+                        double retransmit_s);
+
 /// The teleoperation pair of one process: the emulated link and both
 /// stations on it.
 struct StationPair {
