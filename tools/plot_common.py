@@ -15,6 +15,18 @@ def make_fail(script):
     return fail
 
 
+def save_figure(fig, out, fail, quiet, script):
+    """Writes fig to out (exit code 2 naming the file when it cannot) and
+    says so unless quiet."""
+    fig.tight_layout()
+    try:
+        fig.savefig(out, dpi=100)
+    except OSError as e:
+        fail(f"{out}: cannot write the figure: {e}")
+    if not quiet:
+        print(f"{script}: wrote {out}")
+
+
 def import_plotting(fail):
     """(numpy, matplotlib.pyplot) with the Agg backend; exit code 3 when missing."""
     try:

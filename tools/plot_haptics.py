@@ -19,7 +19,7 @@ import json
 import os
 import sys
 
-from plot_common import import_plotting, make_fail, parse_dir_args
+from plot_common import import_plotting, make_fail, parse_dir_args, save_figure
 
 fail = make_fail("plot_haptics.py")
 np, plt = import_plotting(fail)
@@ -128,13 +128,7 @@ def main(argv):
         f"period jitter p99 {timing['period_jitter']['p99']:.1f} us, compute p99 "
         f"{timing['compute']['p99']:.1f} us, {timing['missed_deadlines']} missed deadlines; "
         f"max device force {summary['forces']['max_device_force_n']:.3g} N", fontsize=11)
-    fig.tight_layout()
-    try:
-        fig.savefig(out, dpi=100)
-    except OSError as e:
-        fail(f"{out}: cannot write the figure: {e}")
-    if not quiet:
-        print(f"plot_haptics.py: wrote {out}")
+    save_figure(fig, out, fail, quiet, "plot_haptics.py")
     return 0
 
 

@@ -19,7 +19,7 @@ import json
 import os
 import sys
 
-from plot_common import import_plotting, make_fail, parse_dir_args
+from plot_common import import_plotting, make_fail, parse_dir_args, save_figure
 
 fail = make_fail("plot_run.py")
 np, plt = import_plotting(fail)
@@ -126,13 +126,7 @@ def main(argv):
         volumes = f"removed {summary['removed_volume_m3']:.4g} m$^3$"
     fig.suptitle(f"{inputs['name']}: {res[0]}x{res[1]} {inputs['representation']}, "
                  f"{inputs['rate_hz']:g} Hz, sequence ({', '.join(inputs['sequence'])});\n{volumes}")
-    fig.tight_layout()
-    try:
-        fig.savefig(out, dpi=100)
-    except OSError as e:
-        fail(f"{out}: cannot write the figure: {e}")
-    if not quiet:
-        print(f"plot_run.py: wrote {out}")
+    save_figure(fig, out, fail, quiet, "plot_run.py")
     return 0
 
 

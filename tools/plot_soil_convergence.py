@@ -19,7 +19,7 @@ Exit codes: 0 done; 2 bad arguments; 3 numpy, matplotlib or terracut missing.
 import os
 import sys
 
-from plot_common import import_plotting, make_fail
+from plot_common import import_plotting, make_fail, save_figure
 
 fail = make_fail("plot_soil_convergence.py")
 np, plt = import_plotting(fail)
@@ -115,13 +115,7 @@ def main(argv):
     across[0].set_ylabel("height above the layer (m)")
     fig.suptitle("1 m blade, 4 cm cut, 0.8 m push on 5 mm cells, then 0.2 s still: "
                  "the pile at the default work cap and with the cap lifted", fontsize=10)
-    fig.tight_layout()
-    try:
-        fig.savefig(out, dpi=100)
-    except OSError as e:
-        fail(f"{out}: cannot write the figure: {e}")
-    if not quiet:
-        print(f"plot_soil_convergence.py: wrote {out}")
+    save_figure(fig, out, fail, quiet, "plot_soil_convergence.py")
     return 0
 
 
