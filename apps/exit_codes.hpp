@@ -1,6 +1,8 @@
 // The exit codes of every terracut program (terracut, terracut-viewer,
-// terracut-device): one table, the same in each program's --help and in the
-// README ("Exit codes"). A program uses the codes that apply to it.
+// terracut-device): one table, printed by `terracut --help` (and the --help of
+// the subcommands that use codes past 2), terracut-viewer's and
+// terracut-device's, and in the README ("Exit codes"). A program uses the
+// codes that apply to it.
 #pragma once
 
 namespace terracut::apps {
