@@ -2,6 +2,8 @@
 """Driver of the terracut DEM reference data (LIGGGHTS-PUBLIC 3.8).
 
   run.py material --seeds 1 2 3          material tests -> results/material.json
+  run.py material ... --scheduler ADDR   the same, the tests side by side on a Dask cluster
+  run.py material ... --local-workers N  the same on a local Dask cluster of N processes
   run.py bed --seed 1                    pour the bulldozing bed of a seed (cached in work/)
   run.py bulldoze --case NAME --seed 1   one bulldozing run -> results/bulldoze/NAME/seed1/
   run.py bulldoze --case all --seed 1    every case of a seed
@@ -29,8 +31,54 @@ import material  # noqa: E402
 import bulldoze  # noqa: E402
 
 
+def _material_test_on_worker(here, test, smoke):
+    # Runs on a Dask worker (pickled by value from this script): the worker
+    # imports the material module from the same checkout, so a cluster's
+    # workers need this folder at the same path (a shared file system).
+    for sub in ("common", "material"):
+        path = os.path.join(here, sub)
+        if path not in sys.path:
+            sys.path.insert(0, path)
+    import material as m
+    return m.run_test(test, smoke)
+
+
+def dask_map_tests(client, smoke):
+    """A map_tests for material.run_all that runs each test as a task of the
+    Dask cluster behind client (the same kind of cluster terracut.sweep
+    uses), in the order given."""
+    def map_tests(tests):
+        futures = [client.submit(_material_test_on_worker, HERE, t, smoke, pure=False) for t in tests]
+        return client.gather(futures)
+    return map_tests
+
+
+def material_client(a):
+    """A dask.distributed Client for --scheduler ADDR or --local-workers N, or
+    None (the tests then run here, one after the other)."""
+    if not (a.scheduler or a.local_workers):
+        return None
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        sys.exit("run.py material: --scheduler/--local-workers need Dask's distributed "
+                 "(Debian: python3-distributed)")
+    if a.scheduler:
+        return Client(a.scheduler)
+    if a.local_workers < 1:
+        sys.exit("run.py material: --local-workers must be at least 1, got %d" % a.local_workers)
+    cluster = LocalCluster(n_workers=a.local_workers, threads_per_worker=1, processes=True,
+                           dashboard_address=None)
+    return Client(cluster)
+
+
 def cmd_material(a):
-    out = material.run_all(a.seeds)
+    client = material_client(a)
+    try:
+        out = material.run_all(a.seeds, map_tests=dask_map_tests(client, False) if client else None)
+    finally:
+        if client is not None:
+            client.close()
     for k in ("repose_deg", "bulk_density_kg_per_m3", "internal_friction_peak_deg",
               "internal_friction_residual_deg", "cohesion_pa", "soil_tool_friction_deg"):
         print(k, out[k], out[k + "_per_seed"])
@@ -107,8 +155,23 @@ def cmd_smoke(a):
     shutil.rmtree(sm, ignore_errors=True)
     shutil.rmtree(os.path.join(dem.WORK, "material", "smoke"), ignore_errors=True)
     print("LIGGGHTS", dem.liggghts_version())
-    material.run_all([1], smoke=True)
+    here = material.run_all([1], smoke=True)
     print("material scripts ok (%.1f s)" % (time.time() - t0))
+    # The same tests as tasks of a local Dask cluster give the same results.
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        print("Dask's distributed not installed: the material tests on a cluster are not checked")
+    else:
+        shutil.rmtree(os.path.join(dem.WORK, "material", "smoke"), ignore_errors=True)
+        with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                          dashboard_address=None) as cluster, Client(cluster) as client:
+            there = material.run_all([1], smoke=True, map_tests=dask_map_tests(client, True))
+        for k in ("repose_deg", "bulk_density_kg_per_m3", "internal_friction_peak_deg",
+                  "cohesion_pa", "soil_tool_friction_deg"):
+            a, b = here[k], there[k]
+            assert a == b or (a != a and b != b), (k, a, b)  # equal, or both NaN (too short a smoke)
+        print("material tests on a Dask cluster ok (%.1f s)" % (time.time() - t0))
     for c in ("vertical_w012_d050", "raked45_w012_d050"):
         info = bulldoze.run_case(c, 1, smoke=True)
         assert len(info["metrics"]) == 3
@@ -123,6 +186,9 @@ def main():
     sub = p.add_subparsers(dest="cmd", required=True)
     m = sub.add_parser("material")
     m.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    m.add_argument("--scheduler", help="a Dask scheduler's address: the tests run on its cluster")
+    m.add_argument("--local-workers", type=int, default=0,
+                   help="run the tests on a local Dask cluster of this many processes")
     m.set_defaults(fn=cmd_material)
     b = sub.add_parser("bed")
     b.add_argument("--seed", type=int, required=True)

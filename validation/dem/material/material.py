@@ -434,16 +434,54 @@ def mohr_coulomb(sig, tau):
     return math.degrees(math.atan(slope)), float(c)
 
 
-def run_all(seeds, smoke=False, outpath=None):
-    t0 = time.time()
-    rep, den, sh, st = {}, {}, {}, {}
+def tests_of(seeds, smoke=False):
+    """Every material test of the seeds, in order, as (kind, seed, normal
+    stress): the units of work a cluster can run side by side (each writes
+    its own work folder)."""
+    tests = []
     for s in seeds:
-        rep[s] = run_repose(s, smoke)
-        den[s] = run_density(s, smoke)
-        sh[s] = [run_shear_cell(s, sg, 1, smoke)
-                 for sg in (SMOKE["shear"] if smoke else SHEAR)["normal_stresses_pa"]]
-        st[s] = [run_soiltool(s, sg, smoke)
-                 for sg in (SMOKE["soiltool"] if smoke else SOILTOOL)["normal_stresses_pa"]]
+        tests.append(("repose", s, 0.0))
+        tests.append(("density", s, 0.0))
+        tests += [("shear", s, sg) for sg in (SMOKE["shear"] if smoke else SHEAR)["normal_stresses_pa"]]
+        tests += [("soiltool", s, sg) for sg in (SMOKE["soiltool"] if smoke else SOILTOOL)["normal_stresses_pa"]]
+    return tests
+
+
+def run_test(test, smoke=False):
+    """One material test (an item of tests_of): its result dict."""
+    kind, seed, sigma = test
+    if kind == "repose":
+        return run_repose(seed, smoke)
+    if kind == "density":
+        return run_density(seed, smoke)
+    if kind == "shear":
+        return run_shear_cell(seed, sigma, 1, smoke)
+    if kind == "soiltool":
+        return run_soiltool(seed, sigma, smoke)
+    raise ValueError("unknown material test %r" % (kind,))
+
+
+def run_all(seeds, smoke=False, outpath=None, map_tests=None):
+    """Every material test of the seeds, then material.json.  map_tests, when
+    given, runs a list of tests and returns their results in order (a Dask
+    cluster's map: run.py material --scheduler/--local-workers); else they
+    run here one after the other."""
+    t0 = time.time()
+    tests = tests_of(seeds, smoke)
+    results = map_tests(tests) if map_tests else [run_test(t, smoke) for t in tests]
+    if len(results) != len(tests):
+        raise RuntimeError("%d material tests gave %d results" % (len(tests), len(results)))
+    rep, den = {}, {}
+    sh, st = {s: [] for s in seeds}, {s: [] for s in seeds}
+    for (kind, seed, _), r in zip(tests, results):
+        if kind == "repose":
+            rep[seed] = r
+        elif kind == "density":
+            den[seed] = r
+        elif kind == "shear":
+            sh[seed].append(r)
+        else:
+            st[seed].append(r)
     return assemble(seeds, rep, den, sh, st, time.time() - t0, smoke, outpath)
 
 
