@@ -127,6 +127,7 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   const std::size_t active = std::min(n, std::max<std::size_t>(std::size_t(1) << 16, 4 * footprint));
   active_.reserve(active);
   next_.reserve(active);
+  candidates_.reserve(active);
   // A source's fall lines give up to 8 x kMaxFallCells fluxes, a handful as
   // a rule: a pass holds at most kFluxesPerActiveCell x active of them (a
   // larger one is split, examine's loop).

@@ -161,7 +161,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
     write(cell, v - over);
     const int c0 = col_of(std::uint32_t(cell)), r0 = row_of(std::uint32_t(cell));
     out.changed.include(c0, r0);
-    activate(std::uint32_t(cell));
+    candidate(std::uint32_t(cell), false);
     for (int ring = 1; ring <= kMaxPushCells && over > 0.0f; ++ring)
       for (int dr = -ring; dr <= ring && over > 0.0f; ++dr)
         for (int dc = -ring; dc <= ring && over > 0.0f; dc += (dr == -ring || dr == ring) ? 1 : 2 * ring) {
@@ -175,7 +175,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           write(j, std::min(layers.height_m[j] + give, ceiling_m_));
           over -= give;
           out.changed.include(c, r);
-          activate(std::uint32_t(j));
+          candidate(std::uint32_t(j), false);
         }
   };
   // The share of each sample's cut that goes into the bucket: all of it
@@ -209,7 +209,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           std::max(0.0, std::min(double(before_[k]), double(layers.initial_m[i])) - double(after_cut_[k])) *
           spec.cell_area_m2();
       dirty(std::uint32_t(i));
-      lowered(std::uint32_t(i), layers.height_m);  // its walls may now be too steep
+      candidate(std::uint32_t(i), true);  // its walls may now be too steep
       const float kept = keep >= 1.0 ? cut : float(double(cut) * keep);
       out.bucket_in_m3 += double(kept) * spec.cell_area_m2();
       const float lost = cut - kept;  // what is displaced
@@ -316,10 +316,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           const float old = layers.height_m[cell_j];
           write(cell_j, previous);
           out.changed.include(col_of(std::uint32_t(cell_j)), row_of(std::uint32_t(cell_j)));
-          if (previous < old)
-            lowered(std::uint32_t(cell_j), layers.height_m);
-          else
-            activate(std::uint32_t(cell_j));
+          candidate(std::uint32_t(cell_j), previous < old);
           previous = old;
         }
       } else {
@@ -362,7 +359,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
         rest -= add;
         level = layers.height_m[u];
         out.changed.include(col_of(std::uint32_t(u)), row_of(std::uint32_t(u)));
-        activate(std::uint32_t(u));
+        candidate(std::uint32_t(u), false);
       }
       // What did not fit (or, by rounding, came out negative) is settled on
       // the last cell reached, keeping the volume.
@@ -385,6 +382,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   if (last_put >= 0 && put != taken) {
     give_back(layers.height_m[last_put], taken - put);
   }
+  // Only the changed cells that now stand too steep (or lowered under a
+  // neighbour too steep above them) are examined: a pushed pile moves as
+  // a whole, and most of its cells keep their slopes.
+  settle_candidates(layers.height_m);
 }
 
 }  // namespace terracut

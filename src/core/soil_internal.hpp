@@ -99,10 +99,11 @@ inline unsigned above_mask(__m128 e0, __m128 e1, float tol) {
 
 namespace terracut {
 
-inline void SoilFlow::lowered(std::uint32_t cell, const float* h) {
+inline void SoilFlow::lowered(std::uint32_t cell, const float* h, bool self) {
   // Only the pairs of this cell changed: a neighbour that now stands too
-  // steep above it is examined in the next pass (the same test as a pass's).
-  activate(cell);
+  // steep above it is examined in the next pass (the same test as a pass's),
+  // and the cell itself (unless the caller has tested it: self false).
+  if (self) activate(cell);
   const float hc = h[cell];
   if (!(queued_[cell] & kEdge)) {
     // All 8 tested without a branch each; the steep ones then activated.

@@ -101,6 +101,50 @@ std::int64_t SoilFlow::examine(std::uint32_t a, const float* h) {
   return fall_lines(a, ha, h, dirs, n);
 }
 
+bool SoilFlow::steep_now(std::uint32_t a, const float* h) const {
+  const float ha = h[a];
+  const float tol = tolerance_m_;
+  if (!(queued_[a] & kEdge)) {
+    unsigned steep = 0;
+#if defined(__SSE2__)
+    __m128 hb0, hb1;
+    load_neighbours(h + a, offset_[2], hb0, hb1);
+    const __m128 va = _mm_set1_ps(ha);
+    const __m128 e0 = _mm_sub_ps(_mm_sub_ps(va, hb0), _mm_loadu_ps(limit8_));
+    const __m128 e1 = _mm_sub_ps(_mm_sub_ps(va, hb1), _mm_loadu_ps(limit8_ + 4));
+    steep = above_mask(e0, e1, tol);
+#else
+    for (int k = 0; k < 8; ++k) steep |= unsigned(ha - h[std::int64_t(a) + offset_[k]] - limit8_[k] > tol) << k;
+#endif
+    return steep != 0;
+  }
+  const int ca = col_of(a), ra = row_of(a);
+  for (int k = 0; k < 8; ++k) {
+    const int cb = ca + kNeighbours[k].dc, rb = ra + kNeighbours[k].dr;
+    float excess;
+    if (cb < 0 || rb < 0 || cb >= cols_ || rb >= rows_)
+      excess = params_.edge == SoilEdge::kOpen ? ha - limit8_[k] : 0.0f;
+    else
+      excess = ha - h[std::int64_t(a) + offset_[k]] - limit8_[k];
+    if (excess > tol) return true;
+  }
+  return false;
+}
+
+void SoilFlow::settle_candidates(const float* h) {
+  for (std::uint32_t cell : candidates_) {
+    const bool was_lowered = (queued_[cell] & kCandLowered) != 0;
+    clear_flag(cell, CellFlags(kCandidate | kCandLowered));
+    if (was_lowered) {
+      if (steep_now(cell, h)) activate(cell);
+      lowered(cell, h, false);
+    } else if (steep_now(cell, h)) {
+      activate(cell);
+    }
+  }
+  candidates_.clear();
+}
+
 std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, const int* dirs, int n) {
   // The soil above the repose line through the source slides down its fall
   // lines and comes to rest where the line meets the ground: along each
@@ -129,6 +173,9 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
   double total = ha;
   int count = 1;
   bool steep_below = false;
+  // The highest reach taken: when it is below s, no cell is a hump and
+  // the rounds below have nothing to drop (skipped: the same result).
+  float highest_reach = -std::numeric_limits<float>::infinity();
   for (int j = 0; j < n; ++j) {
     const int k = dirs[j] & 0xff;
     const float drop = limit8_[k] - 0.25f * tol;
@@ -162,7 +209,10 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
       }
     }
     fall_visits_ += line.length;
-    for (int m = 0; m < line.length; ++m) total += line.reach[m];
+    for (int m = 0; m < line.length; ++m) {
+      total += line.reach[m];
+      highest_reach = std::max(highest_reach, line.reach[m]);
+    }
     count += line.length;
   }
   // A cell whose reach is at or above s stands above the final line (a
@@ -173,7 +223,7 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
   // or above s gets nothing (its share would not be positive) and the
   // source keeps that soil for a later pass.
   double s = total / count;
-  for (int round = 0; round <= kMaxExtraRounds; ++round) {
+  for (int round = double(highest_reach) >= s ? 0 : kMaxExtraRounds + 1; round <= kMaxExtraRounds; ++round) {
     bool changed = false;
     const bool first = round == 0;
     for (int j = 0; j < n; ++j) {

@@ -346,7 +346,7 @@ class SoilFlow {
     queued_[cell] = CellFlags(f | kQueued);
     next_.push_if(cell, !(f & kQueued));
   }
-  void lowered(std::uint32_t cell, const float* h);
+  void lowered(std::uint32_t cell, const float* h, bool self = true);
   /// Marks cell a as held by the blade or the hull (examined again once
   /// they have moved), once.
   void hold(std::uint32_t a) {
@@ -364,6 +364,19 @@ class SoilFlow {
   int col_of(std::uint32_t i) const { return int(i - row_div_.quotient(i) * std::uint32_t(cols_)); }
   int row_of(std::uint32_t i) const { return int(row_div_.quotient(i)); }
   bool pending() const { return !active_.empty() || !next_.empty(); }
+  /// Queues a cell the displacement changed (was_lowered: its neighbours
+  /// may now stand too steep above it) for settle_candidates.
+  void candidate(std::uint32_t cell, bool was_lowered) {
+    const unsigned f = queued_[cell];
+    queued_[cell] = CellFlags(f | kCandidate | (was_lowered ? kCandLowered : 0));
+    candidates_.push_if(cell, !(f & kCandidate));
+  }
+  /// Queues the candidates that stand too steep toward a neighbour, and the
+  /// neighbours that stand too steep above a lowered one.
+  void settle_candidates(const float* h);
+  /// Whether cell a stands steeper than a pair's limit and the tolerance
+  /// toward some neighbour (examine's test, without the blade).
+  bool steep_now(std::uint32_t a, const float* h) const;
   void displace(HeightGrid& grid, const Segment& from, const Segment& to, double bucket_room_m3,
                 SoilStepResult& out);
   void beside_body(const HeightGrid& grid, double x, double z, double tx, double tz,
@@ -439,6 +452,8 @@ class SoilFlow {
   static constexpr std::uint8_t kHull = 8;    // under the bucket's hull (in hull_cells_)
   static constexpr std::uint8_t kNearBlade = 16;  // within reach of the step's blade (in marked_)
   static constexpr std::uint8_t kEdge = 32;   // on the grid's border (fewer than 8 neighbours); never cleared
+  static constexpr std::uint8_t kCandidate = 64;     // in candidates_
+  static constexpr std::uint8_t kCandLowered = 128;  // in candidates_, and lowered
   // A cell the cut, the displacement, the pour or an edit changed while a
   // pass was in progress: the pass's fluxes from or to it are dropped (they
   // came from heights it no longer has; it is examined again anyway).
@@ -483,6 +498,9 @@ class SoilFlow {
   int pass_highest_count_ = 0;
   float pass_highest_h_ = -1.0f;
   detail::CellList next_;    // cells to examine in the next pass (kQueued set)
+  // The cells the displacement changed in this step (kCandidate set):
+  // queued only where they stand too steep once it is done.
+  detail::CellList candidates_;
   // The per-cell flags' byte: an enumeration, not std::uint8_t, because a
   // store through a character type may alias any object, so each flag
   // written made the compiler reload the lists' ends and the pass's sums
