@@ -1303,8 +1303,10 @@ Command add_validate_command(CLI::App& app) {
   return [opt, dem_dir, soilbin_dir, only]() {
     const fs::path out(opt->out);
     create_output_folder(out);
-    for (const char* d : {"cone", "slope", "bulldozing", "conservation", "bucket"})
-      create_output_folder(out / d);
+    // The physical checks' folders, only when they run.
+    if (*only == "all" || *only == "soil")
+      for (const char* d : {"cone", "slope", "bulldozing", "conservation", "bucket"})
+        create_output_folder(out / d);
     const auto say = [&](const std::string& line) {
       if (!opt->quiet) std::cerr << "validate: " << line << "\n" << std::flush;
     };
