@@ -205,7 +205,11 @@ DemSection run_dem_section(const fs::path& results_dir, const fs::path& out_dir,
        << "terracut's relaxation uncapped): ";
     if (c.speedup_in_cpu_time)
       md << "the DEM " << fmt("%.0f", c.dem_cpu_s) << " s of CPU, terracut " << fmt("%.3f", c.terracut_cpu_s)
-         << " s of CPU";
+         << " s of CPU"
+         << (c.cpu_runs < c.seeds
+                 ? " (the " + std::to_string(c.cpu_runs) + " of " + std::to_string(c.seeds) +
+                       " runs whose DEM recorded its CPU time)"
+                 : std::string());
     else
       md << "the DEM " << fmt("%.0f", c.dem_wall_s) << " s of wall clock (its CPU time was not recorded), terracut "
          << fmt("%.3f", c.terracut_wall_s) << " s of wall clock on the same machine";

@@ -552,8 +552,10 @@ std::vector<CaseSummary> summarize(const std::vector<RunComparison>& runs, doubl
       ts.push_back(r->terracut_slope_n_per_m);
       dw.push_back(r->dem_wall_s);
       tw.push_back(r->terracut_wall_s);
-      dc.push_back(r->dem_cpu_s);
-      tc.push_back(r->terracut_cpu_s);
+      if (r->dem_cpu_s > 0.0) {  // only the runs whose DEM recorded its CPU time
+        dc.push_back(r->dem_cpu_s);
+        tc.push_back(r->terracut_cpu_s);
+      }
     }
     const Stats slope = stats_of(ds);
     c.dem_slope_n_per_m = slope.mean;
@@ -562,10 +564,10 @@ std::vector<CaseSummary> summarize(const std::vector<RunComparison>& runs, doubl
     c.slope_met = within(c.terracut_slope_n_per_m, slope, kSlopeTarget, c.slope_error);
     c.dem_wall_s = stats_of(dw).mean;
     c.terracut_wall_s = stats_of(tw).mean;
-    c.dem_cpu_s = stats_of(dc).mean;
-    c.terracut_cpu_s = stats_of(tc).mean;
-    c.speedup_in_cpu_time =
-        std::all_of(dc.begin(), dc.end(), [](double x) { return x > 0.0; }) && c.terracut_cpu_s > 0.0;
+    c.cpu_runs = int(dc.size());
+    c.dem_cpu_s = dc.empty() ? 0.0 : stats_of(dc).mean;
+    c.terracut_cpu_s = tc.empty() ? 0.0 : stats_of(tc).mean;
+    c.speedup_in_cpu_time = !dc.empty() && c.terracut_cpu_s > 0.0;
     c.speedup = c.speedup_in_cpu_time ? c.dem_cpu_s / c.terracut_cpu_s
                 : c.terracut_wall_s > 0.0 ? c.dem_wall_s / c.terracut_wall_s
                                           : 0.0;

@@ -229,6 +229,36 @@ TEST(Summarize, JudgesAgainstTheMeanOrTheSeedsScatter) {
   EXPECT_TRUE(s[0].speed_met);
 }
 
+// The speed-up is in CPU time over the runs whose DEM recorded its CPU time,
+// even when another run of the case did not (it is left out, not the case).
+TEST(Summarize, SpeedUpInCpuTimeOverTheRunsThatRecordedIt) {
+  RunComparison a, b, c;
+  for (RunComparison* r : {&a, &b, &c}) {
+    r->case_name = "vertical_w012_d050";
+    r->dem_wall_s = 1000.0;
+    r->terracut_wall_s = 1.0;
+    r->terracut_cpu_s = 0.5;
+  }
+  a.seed = 1;  // recorded no CPU time
+  b.seed = 2;
+  b.dem_cpu_s = 400.0;
+  c.seed = 3;
+  c.dem_cpu_s = 600.0;
+  c.terracut_cpu_s = 0.25;
+  const std::vector<CaseSummary> s = summarize({a, b, c}, 0.01);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_TRUE(s[0].speedup_in_cpu_time);
+  EXPECT_EQ(s[0].cpu_runs, 2);
+  // (400 + 600) / 2 over (0.5 + 0.25) / 2.
+  EXPECT_NEAR(s[0].speedup, 500.0 / 0.375, 1e-9);
+  // None recorded: wall time over every run.
+  b.dem_cpu_s = c.dem_cpu_s = 0.0;
+  const std::vector<CaseSummary> w = summarize({a, b, c}, 0.01);
+  EXPECT_FALSE(w[0].speedup_in_cpu_time);
+  EXPECT_EQ(w[0].cpu_runs, 0);
+  EXPECT_NEAR(w[0].speedup, 1000.0, 1e-9);
+}
+
 // ---- Files ----------------------------------------------------------------------
 
 class DemFiles : public ::testing::Test {

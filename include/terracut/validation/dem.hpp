@@ -185,10 +185,13 @@ struct CaseSummary {
   double dem_slope_n_per_m = 0.0, dem_slope_std_n_per_m = 0.0, terracut_slope_n_per_m = 0.0;
   double slope_error = 0.0;
   bool slope_met = false;
-  /// The speed-up in CPU time when every DEM run recorded it (a shared
-  /// machine's wall clock counts the time a process waits), else in wall time.
+  /// The speed-up in CPU time over the runs whose DEM recorded it (a shared
+  /// machine's wall clock counts the time a process waits; dem_cpu_s and
+  /// terracut_cpu_s are the means over those cpu_runs runs), else, when none
+  /// did, in wall time over every run.
   double dem_wall_s = 0.0, terracut_wall_s = 0.0, dem_cpu_s = 0.0, terracut_cpu_s = 0.0, speedup = 0.0;
   bool speedup_in_cpu_time = false;
+  int cpu_runs = 0;  ///< runs whose DEM recorded its CPU time
   bool speed_met = false;
 };
 
