@@ -520,8 +520,13 @@ void RemoteStation::tick(double t_s) {
   const std::int64_t steps_before = sim.step_count();
   const auto start = std::chrono::steady_clock::now();
   // The arm stalls while the force on it exceeds what it can push (the
-  // previous tick's physical force: a sensor's newest reading).
-  const bool stalled = length(loop.last().physical_force_world_n) > settings_.arm_force_limit_n;
+  // previous tick's physical force: a sensor's newest reading). With
+  // bodies the Bullet plate's servo holds the limit itself (it stops short,
+  // and the arm is placed where it stopped, below): holding here as well
+  // would drop its push to nothing every other tick.
+  const bool plate_limits = rig_->world().limited_arm().has_value();
+  const bool stalled = !plate_limits &&
+                       length(loop.last().physical_force_world_n) > settings_.arm_force_limit_n;
   device_->set_stalled(stalled);
   if (stalled) ++stalled_ticks_;
   choose_material();
