@@ -541,7 +541,12 @@ void RemoteStation::tick(double t_s) {
   BladePose arm_pose = r.tool;
   const std::optional<ArmState> arm = rig_->world().limited_arm();
   const bool arm_stalled = arm && stepped && arm->stalled;
-  if (arm && stepped) {
+  // Only where it stopped short: elsewhere the plate is at the pose to
+  // Bullet's float rounding, and the arm keeps its own (an arm that meets
+  // nothing runs exactly as without the limit).
+  if (arm && stepped &&
+      length(arm->pose.position_m - r.tool.position_m) >
+          1e-6 * std::max(1.0, length(r.tool.position_m))) {
     device_->place(arm->pose.position_m);
     arm_pose.position_m = arm->pose.position_m;
   }
