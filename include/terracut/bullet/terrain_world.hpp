@@ -4,7 +4,12 @@
 // btHeightfieldTerrainShape reading the HeightGrid's own heights() array in
 // place (no copy): cuts made by the Simulation are seen by Bullet at once and
 // the shape is never recreated. Loose rigid bodies (BodySpec: box, sphere,
-// cylinder) rest on it, and the blade is a kinematic plate that pushes them.
+// cylinder) rest on it, and the blade is a plate that pushes them:
+// kinematic (it goes where the blade goes), or, with the arm's force limit
+// (ToolPlateSpec::force_limit_n), a dynamic body driven to the blade pose
+// by a servo whose force is capped at the limit less the soil's force, so
+// that it stops short against a body it cannot move (docs/bullet.md, "The
+// arm's force limit").
 //
 // Placement (see docs/bullet.md): Bullet vertex (x, j) of the heightfield is
 // grid sample (c, r) = (x, j), at world
@@ -32,8 +37,10 @@
 // static in Bullet and touching nothing (the soil carries them; a buried
 // body that fell would sink through the heightfield, which is only a
 // surface), until the blade reaches one: the cut lowers the soil over its
-// footprint to its top, or the tool plate's box meets its box. Then it is
-// released: it becomes dynamic, and the soil it stood in (the samples under
+// footprint to its top, or the tool plate's box meets its box; with a
+// force-limited plate, until the plate pushes it harder than its break-out
+// force (break_out_resistance_n: the soil's passive earth pressure on it
+// and the friction under it). Then it is released: it becomes dynamic, and the soil it stood in (the samples under
 // its bounding box and one more all round, so that no terrain triangle cuts
 // into it) is lowered to its lowest point, where it rests; the plate then
 // meets it through Bullet. docs/bullet.md, "Buried bodies".
@@ -48,7 +55,7 @@
 //
 // The code has one room per model: src/bullet/terrain_world.cpp (the world,
 // its step, terrain edits, the tool plate), buried_bodies.cpp (holding and
-// releasing buried bodies), pile_pressure.cpp (the rings, the soil a body
+// releasing buried bodies, their break-out force), pile_pressure.cpp (the rings, the soil a body
 // sheds and the earth pressure; its parameters in pile_pressure.hpp).
 //
 // One step (step(out)) after each Simulation::step: terrain_changed(changed
