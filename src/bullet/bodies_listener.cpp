@@ -14,6 +14,14 @@ BodiesListener::BodiesListener(Simulation& sim, std::vector<BodySpec> bodies,
   // Soil that flows banks against the bodies and presses on them: the
   // simulation's soil material gives the pile's unit weight, and its angle
   // of repose is the loose pile's friction angle.
+  // The soil material holds buried bodies (their break-out force, with a
+  // force-limited tool plate).
+  {
+    const SoilMaterial& material = sim_.params().soil.material;
+    options_.world.break_out.unit_weight_n_per_m3 = material.unit_weight_n_per_m3;
+    options_.world.break_out.cohesion_pa = material.cohesion_pa;
+    options_.world.break_out.friction_angle_deg = material.internal_friction_deg;
+  }
   if (sim_.soil()) {
     const SoilMaterial& material = sim_.params().soil.material;
     options_.world.pile.enabled = true;

@@ -122,6 +122,17 @@ std::string validate(const TerrainWorldParams& p) {
     return must_be("tool.thickness_m", "in (0, 100]", p.tool.thickness_m);
   if (p.tool.enabled && !in_range(p.tool.friction, 0.0, 10.0))
     return must_be("tool.friction", "in [0, 10]", p.tool.friction);
+  if (!(std::isfinite(p.tool.force_limit_n) && p.tool.force_limit_n >= 0.0))
+    return must_be("tool.force_limit_n", "finite and >= 0 (0 = no limit)", p.tool.force_limit_n);
+  if (!(p.tool.mass_kg > 0.0 && p.tool.mass_kg <= 1e4))
+    return must_be("tool.mass_kg", "in (0, 10000]", p.tool.mass_kg);
+  if (!(std::isfinite(p.break_out.unit_weight_n_per_m3) && p.break_out.unit_weight_n_per_m3 > 0.0))
+    return must_be("break_out.unit_weight_n_per_m3", "finite and > 0",
+                   p.break_out.unit_weight_n_per_m3);
+  if (!(std::isfinite(p.break_out.cohesion_pa) && p.break_out.cohesion_pa >= 0.0))
+    return must_be("break_out.cohesion_pa", "finite and >= 0", p.break_out.cohesion_pa);
+  if (!in_range(p.break_out.friction_angle_deg, 0.0, 89.0))
+    return must_be("break_out.friction_angle_deg", "in [0, 89]", p.break_out.friction_angle_deg);
   if (std::string e = validate(p.pile); !e.empty()) return e;
   return {};
 }
@@ -233,8 +244,8 @@ TerrainWorld::TerrainWorld(const HeightGrid& grid, Simulation* owner, HeightGrid
     m.world.addRigidBody(m.floor_body.get());
   }
 
-  // The tool plate: kinematic, never sleeping; it has no contact response
-  // until its first pose is set.
+  // The tool plate: kinematic (no force limit) or dynamic (drive_tool),
+  // never sleeping; it has no contact response until its first pose is set.
   if (params_.tool.enabled) {
     m.tool_shape = std::make_unique<btBoxShape>(
         btVector3(btScalar(0.5 * blade.length_m), btScalar(0.5 * params_.tool.height_m),
@@ -245,14 +256,36 @@ TerrainWorld::TerrainWorld(const HeightGrid& grid, Simulation* owner, HeightGrid
     btTransform start;
     start.setIdentity();
     m.tool_motion = std::make_unique<btDefaultMotionState>(start);
-    btRigidBody::btRigidBodyConstructionInfo info(0, m.tool_motion.get(), m.tool_shape.get());
-    info.m_friction = btScalar(params_.tool.friction);
-    m.tool_body = std::make_unique<btRigidBody>(info);
-    m.tool_body->setCollisionFlags(m.tool_body->getCollisionFlags() |
-                                   btCollisionObject::CF_KINEMATIC_OBJECT |
-                                   btCollisionObject::CF_NO_CONTACT_RESPONSE);
-    m.tool_body->setActivationState(DISABLE_DEACTIVATION);
-    m.world.addRigidBody(m.tool_body.get());
+    if (!tool_limited()) {
+      btRigidBody::btRigidBodyConstructionInfo info(0, m.tool_motion.get(), m.tool_shape.get());
+      info.m_friction = btScalar(params_.tool.friction);
+      m.tool_body = std::make_unique<btRigidBody>(info);
+      m.tool_body->setCollisionFlags(m.tool_body->getCollisionFlags() |
+                                     btCollisionObject::CF_KINEMATIC_OBJECT |
+                                     btCollisionObject::CF_NO_CONTACT_RESPONSE);
+      m.tool_body->setActivationState(DISABLE_DEACTIVATION);
+      m.world.addRigidBody(m.tool_body.get());
+    } else {
+      // Dynamic, without gravity, its rotation fixed by the blade (the
+      // angular factor 0: contacts do not turn it); it meets the loose
+      // bodies and the held ones (their own group), not the terrain or the
+      // floor (it cuts through the soil, whose force is the soil model's).
+      const btScalar mass = btScalar(params_.tool.mass_kg);
+      btVector3 inertia(0, 0, 0);
+      m.tool_shape->calculateLocalInertia(mass, inertia);
+      btRigidBody::btRigidBodyConstructionInfo info(mass, m.tool_motion.get(), m.tool_shape.get(),
+                                                    inertia);
+      info.m_friction = btScalar(params_.tool.friction);
+      m.tool_body = std::make_unique<btRigidBody>(info);
+      m.tool_body->setFlags(m.tool_body->getFlags() | BT_DISABLE_WORLD_GRAVITY);
+      m.tool_body->setGravity(btVector3(0, 0, 0));
+      m.tool_body->setAngularFactor(btScalar(0));
+      m.tool_body->setCollisionFlags(m.tool_body->getCollisionFlags() |
+                                     btCollisionObject::CF_NO_CONTACT_RESPONSE);
+      m.tool_body->setActivationState(DISABLE_DEACTIVATION);
+      m.world.addRigidBody(m.tool_body.get(), detail::kToolGroup,
+                           btBroadphaseProxy::DefaultFilter | detail::kHeldGroup);
+    }
   }
 
   // Every body may touch the terrain, the floor, the plate and every other
@@ -295,9 +328,17 @@ TerrainWorld::TerrainWorld(const HeightGrid& grid, Simulation* owner, HeightGrid
     // static, in no pair with the terrain, the floor or the plate.
     const bool held = b.buried && b.mass_kg > 0.0;
     if (held) body->setMassProps(0, btVector3(0, 0, 0));
-    m.world.addRigidBody(body.get());
+    body->setUserIndex(int(m.bodies.size()));  // its index, for the plate's contacts
+    if (held && tool_limited()) {
+      // A force-limited plate presses on it (its break-out force).
+      m.world.addRigidBody(body.get(), btBroadphaseProxy::StaticFilter | detail::kHeldGroup,
+                           btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter);
+    } else {
+      m.world.addRigidBody(body.get());
+    }
     m.inertia.push_back(inertia);
     m.held.push_back(held ? 1 : 0);
+    m.breaking.push_back(0);
     obstacles_.reserve(specs_.size());
     // Its soil view holds the samples round the widest box the body can
     // have (its bounding sphere about its origin, with 5 cm for Bullet's
@@ -315,6 +356,7 @@ TerrainWorld::TerrainWorld(const HeightGrid& grid, Simulation* owner, HeightGrid
     m.body_shapes.push_back(std::move(shape));
     m.bodies.push_back(std::move(body));
   }
+  held_push_n_.assign(specs_.size(), Vec3{});
   refresh_views();  // what each body sees before the first edit
 }
 
@@ -323,6 +365,8 @@ TerrainWorld::~TerrainWorld() = default;
 void TerrainWorld::step(const StepOutput& out) {
   const double start = now_s();
   terrain_changed(out.changed);
+  // The soil's force on the tool (the listeners' part is added after them).
+  set_tool_load(out.force.total_n);
   set_tool_pose(out.pose);
   release_reached(out.changed);
   shed_rings();
@@ -469,6 +513,24 @@ void TerrainWorld::refresh_views() {
 void TerrainWorld::set_tool_pose(const BladePose& pose) {
   if (!params_.tool.enabled) return;
   Impl& m = *impl_;
+  if (tool_limited()) {
+    // The servo drives the plate towards the pose in advance() (drive_tool).
+    tool_target_ = pose;
+    tool_has_target_ = true;
+    if (tool_teleport_) {
+      const Vec3 centre =
+          pose.position_m + rotate(pose.orientation, {0.0, 0.5 * params_.tool.height_m, 0.0});
+      const btTransform t(to_bt(normalized(pose.orientation)), to_bt(centre));
+      m.tool_motion->setWorldTransform(t);
+      m.tool_body->setWorldTransform(t);
+      m.tool_body->setInterpolationWorldTransform(t);
+      m.tool_body->setLinearVelocity(btVector3(0, 0, 0));
+      m.tool_body->setCollisionFlags(m.tool_body->getCollisionFlags() &
+                                     ~btCollisionObject::CF_NO_CONTACT_RESPONSE);
+      tool_teleport_ = false;
+    }
+    return;
+  }
   const Vec3 centre = pose.position_m + rotate(pose.orientation, {0.0, 0.5 * params_.tool.height_m, 0.0});
   const btTransform t(to_bt(normalized(pose.orientation)), to_bt(centre));
   m.tool_motion->setWorldTransform(t);
@@ -482,9 +544,48 @@ void TerrainWorld::set_tool_pose(const BladePose& pose) {
   }
 }
 
+void TerrainWorld::drive_tool() {
+  Impl& m = *impl_;
+  btRigidBody& plate = *m.tool_body;
+  // Its rotation is the blade's; its velocity is what the servo's force,
+  // clamped to the limit less the soil's force, makes of the velocity it
+  // kept after the last step (contacts included), aiming at the blade pose
+  // in one step: dv = clamp(x_target - x) / dt - v, F dt / m).
+  const Quat q = normalized(tool_target_.orientation);
+  const Vec3 centre =
+      tool_target_.position_m + rotate(q, {0.0, 0.5 * params_.tool.height_m, 0.0});
+  btTransform t = plate.getWorldTransform();
+  t.setRotation(to_bt(q));
+  plate.setWorldTransform(t);
+  m.tool_motion->setWorldTransform(t);
+  const double budget_n = params_.tool.force_limit_n - tool_load_n_;
+  const Vec3 v = from_bt(plate.getLinearVelocity());
+  const Vec3 wanted = (centre - from_bt(t.getOrigin())) * (1.0 / dt_s_);
+  Vec3 dv = wanted - v;
+  bool stalled = false;
+  if (budget_n <= 0.0) {
+    // The soil alone holds the arm: it stops where it is.
+    dv = v * -1.0;
+    stalled = length(wanted) > 0.0;
+  } else {
+    const double most = budget_n * dt_s_ / params_.tool.mass_kg;
+    const double l = length(dv);
+    if (l > most) {
+      dv = dv * (most / l);
+      stalled = true;
+    }
+  }
+  plate.setLinearVelocity(to_bt(v + dv));
+  plate.setAngularVelocity(btVector3(0, 0, 0));
+  info_.tool_stalled = stalled;
+}
+
 void TerrainWorld::advance() {
   Impl& m = *impl_;
   const double start = now_s();
+  const bool limited = tool_limited() && tool_has_target_;
+  if (limited) drive_tool();
+  else info_.tool_stalled = false;
   // Exactly one internal step of dt (maxSubSteps = 0: no time accumulator, no
   // interpolation), so the world is a deterministic function of its inputs.
   m.world.stepSimulation(btScalar(dt_s_), 0, btScalar(dt_s_));
@@ -507,14 +608,22 @@ void TerrainWorld::advance() {
         if (pt.getAppliedImpulse() == btScalar(0) && pt.m_appliedImpulseLateral1 == btScalar(0) &&
             pt.m_appliedImpulseLateral2 == btScalar(0))
           continue;
-        impulse += sign * (pt.m_normalWorldOnB * pt.getAppliedImpulse() +
-                           pt.m_lateralFrictionDir1 * pt.m_appliedImpulseLateral1 +
-                           pt.m_lateralFrictionDir2 * pt.m_appliedImpulseLateral2);
+        const btVector3 j = sign * (pt.m_normalWorldOnB * pt.getAppliedImpulse() +
+                                    pt.m_lateralFrictionDir1 * pt.m_appliedImpulseLateral1 +
+                                    pt.m_lateralFrictionDir2 * pt.m_appliedImpulseLateral2);
+        impulse += j;
         ++points;
+        // The plate's push on a held body: the opposite of the body's on it.
+        if (limited) {
+          const int i = (tool_is_a ? pm->getBody1() : pm->getBody0())->getUserIndex();
+          if (i >= 0 && m.held[std::size_t(i)])
+            held_push_n_[std::size_t(i)] = held_push_n_[std::size_t(i)] - from_bt(j) * (1.0 / dt_s_);
+        }
       }
     }
   }
   info_.tool_force_n = from_bt(impulse) * (1.0 / dt_s_);
+  if (limited) judge_held_pushes();
   info_.tool_contact_points = points;
   info_.bodies_woken = pending_woken_;
   pending_woken_ = 0;
@@ -607,6 +716,13 @@ int TerrainWorld::raise_to_body_tops(const Rect& rect, std::span<float> out) con
       }
   }
   return raised;
+}
+
+BladePose TerrainWorld::tool_blade_pose() const {
+  if (!impl_->tool_body) return {};
+  const btTransform& t = impl_->tool_body->getWorldTransform();
+  const Quat q = from_bt(t.getRotation());
+  return {from_bt(t.getOrigin()) - rotate(q, {0.0, 0.5 * params_.tool.height_m, 0.0}), q};
 }
 
 BladePose TerrainWorld::tool_plate_pose() const {

@@ -28,6 +28,11 @@ inline btQuaternion to_bt(Quat q) {
 }
 inline Quat from_bt(const btQuaternion& q) { return {double(q.w()), double(q.x()), double(q.y()), double(q.z())}; }
 
+// Collision groups besides Bullet's own (btBroadphaseProxy's first six
+// bits): the force-limited tool plate, and the held bodies it presses on.
+inline constexpr int kToolGroup = 1 << 6;
+inline constexpr int kHeldGroup = 1 << 7;
+
 // Bullet's sequential-impulse solver with its scratch arrays reserved at
 // construction for the largest contact set the world is expected to reach,
 // so that the first contact of a new kind late in a run (the plate meeting a
@@ -71,6 +76,7 @@ struct TerrainWorld::Impl {
   std::vector<std::unique_ptr<btRigidBody>> bodies;
   std::vector<btVector3> inertia;  // per body, for a held one's release
   std::vector<char> held;          // per body: buried, not yet reached
+  std::vector<char> breaking;      // per held body: the plate's push exceeded its break-out force
 
   ~Impl() {
     for (auto& b : bodies) world.removeRigidBody(b.get());

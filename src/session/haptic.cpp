@@ -108,6 +108,7 @@ HapticRig::HapticRig(const Scenario& scenario, const LoopParams& params, Quat de
   WorldOptions wo;
   wo.rate_hz = params.rate_hz();
   wo.bodies_csv = options.bodies_csv;
+  wo.arm_force_limit_n = options.arm_force_limit_n;
   world_ = std::make_unique<World>(scenario, wo);
   LoopOptions lo = options.loop;
   lo.bodies = world_->bodies();

@@ -98,6 +98,8 @@ class FollowerDevice final : public haptics::Device {
   /// The arm's force limit reached: it does not move this tick (a stalled
   /// arm holds where it is while the load exceeds what it can push).
   void set_stalled(bool stalled) { stalled_ = stalled; }
+  /// The arm is where its force-limited plate stopped (World::limited_arm).
+  void place(const Vec3& position_m) { pose_.position_m = position_m; }
   const BladePose& pose() const { return pose_; }
 
   bool read(double, haptics::DeviceSample& out) noexcept override {
@@ -268,6 +270,8 @@ RemoteStation::RemoteStation(const Scenario& remote, const MmtSettings& settings
   RigOptions ro;
   ro.loop.record_capacity = 0;
   ro.loop.realtime = false;
+  // The arm's limit also limits the Bullet plate (1e7, the default: none).
+  ro.arm_force_limit_n = settings_.arm_force_limit_n < 1e7 ? settings_.arm_force_limit_n : 0.0;
   rig_ = std::make_unique<HapticRig>(remote, params, first_orientation(remote), *device_, ro);
   const HeightGrid& grid = rig_->world().simulation().grid();
   if (grid.cols() != operator_initial.cols() || grid.rows() != operator_initial.rows())
@@ -516,8 +520,13 @@ void RemoteStation::tick(double t_s) {
   const std::int64_t steps_before = sim.step_count();
   const auto start = std::chrono::steady_clock::now();
   // The arm stalls while the force on it exceeds what it can push (the
-  // previous tick's physical force: a sensor's newest reading).
-  const bool stalled = length(loop.last().physical_force_world_n) > settings_.arm_force_limit_n;
+  // previous tick's physical force: a sensor's newest reading). With
+  // bodies the Bullet plate's servo holds the limit itself (it stops short,
+  // and the arm is placed where it stopped, below): holding here as well
+  // would drop its push to nothing every other tick.
+  const bool plate_limits = rig_->world().limited_arm().has_value();
+  const bool stalled = !plate_limits &&
+                       length(loop.last().physical_force_world_n) > settings_.arm_force_limit_n;
   device_->set_stalled(stalled);
   if (stalled) ++stalled_ticks_;
   choose_material();
@@ -527,6 +536,21 @@ void RemoteStation::tick(double t_s) {
   previous_t_s_ = t_s;
   ticked_ = true;
   const bool stepped = sim.step_count() > steps_before;
+  // A force-limited plate stopped short against a body: the arm is where
+  // it is (the next tick moves on from there), and reports that pose.
+  BladePose arm_pose = r.tool;
+  const std::optional<ArmState> arm = rig_->world().limited_arm();
+  const bool arm_stalled = arm && stepped && arm->stalled;
+  // Only where it stopped short: elsewhere the plate is at the pose to
+  // Bullet's float rounding, and the arm keeps its own (an arm that meets
+  // nothing runs exactly as without the limit).
+  if (arm && stepped &&
+      length(arm->pose.position_m - r.tool.position_m) >
+          1e-6 * std::max(1.0, length(r.tool.position_m))) {
+    device_->place(arm->pose.position_m);
+    arm_pose.position_m = arm->pose.position_m;
+  }
+  if (arm_stalled && !stalled) ++stalled_ticks_;
   if (stepped) {
     include_rect(dirty_, sim.last().changed);
     include_rect(worked_, sim.last().changed);
@@ -537,7 +561,7 @@ void RemoteStation::tick(double t_s) {
     m.t_s = t_s;
     m.command_sequence = command_sequence_;
     m.flags = holding ? net::kMeasurementHolding : 0u;
-    m.pose = r.tool;
+    m.pose = arm_pose;
     // What a force sensor on the arm reads: the physical force.
     m.force_world_n = r.physical_force_world_n;
     m.contact_length_m = r.contact_length_m;
@@ -559,14 +583,14 @@ void RemoteStation::tick(double t_s) {
   rec.t_s = t_s;
   rec.command_sequence = command_sequence_;
   rec.commanded_m = commanded_m_;
-  rec.tool_m = r.tool.position_m;
+  rec.tool_m = arm_pose.position_m;
   rec.force_world_n = has_command_ ? r.physical_force_world_n : Vec3{};
   rec.contact_length_m = r.contact_length_m;
   rec.cut_depth_m = r.cut_depth_m;
   rec.estimate = estimate();
   rec.estimate_error = stepped ? estimate_error_ : -1.0;
   rec.in_changed_soil = in_changed_soil_;
-  rec.stalled = stalled;
+  rec.stalled = stalled || arm_stalled;
   rec.holding = holding;
   rec.active = has_command_;
   rec.compute_s = seconds_since(tick_start);  // the whole tick: what arrived, the loop, the estimate, what it sent

@@ -33,6 +33,7 @@ World::World(const Scenario& scenario, const WorldOptions& options) {
 #ifdef TERRACUT_HAVE_BULLET
   bullet::BodiesListenerOptions bo;
   bo.csv_path = options.bodies_csv;
+  bo.world.tool.force_limit_n = options.arm_force_limit_n;
   bodies_ = std::make_unique<bullet::BodiesListener>(*sim_, scenario.bodies, bo);
 #else
   throw InputError(bodies_unavailable_message());
@@ -57,6 +58,14 @@ void World::sense_heights(const Rect& rect, std::span<float> out) const {
 #ifdef TERRACUT_HAVE_BULLET
   if (bodies_) bodies_->world().raise_to_body_tops(rect, out);
 #endif
+}
+
+std::optional<ArmState> World::limited_arm() const {
+#ifdef TERRACUT_HAVE_BULLET
+  if (bodies_ && bodies_->world().tool_limited())
+    return ArmState{bodies_->world().tool_blade_pose(), bodies_->world().last().tool_stalled};
+#endif
+  return std::nullopt;
 }
 
 void World::finish() {

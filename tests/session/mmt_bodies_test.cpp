@@ -166,7 +166,11 @@ TEST(MmtBodies, HiddenRockIsHeldThenMetThenSeen) {
 #ifndef TERRACUT_HAVE_BULLET
   GTEST_SKIP() << "built without Bullet";
 #else
-  const Scenario sc = load_scenario(kScenarios / "mmt_hidden_rock.yaml");
+  // Without the scenario's arm limit: the plate shoves the rock up out of
+  // its pit and it lies still on the sand, where the camera sees it (with
+  // the limit it jams in its pit: TheRemoteArmStallsAgainstTheHiddenRock...).
+  Scenario sc = load_scenario(kScenarios / "mmt_hidden_rock.yaml");
+  sc.mmt->arm_force_limit_n = 1e7;
   MmtRun run(sc);
   const Vec3 start = remote_rock(run).position_m;
   // Held under the sand while the blade waits, plunges and cuts up to it:
@@ -212,6 +216,43 @@ TEST(MmtBodies, HiddenRockIsHeldThenMetThenSeen) {
       }
     }
   EXPECT_GT(seen, 60);
+#endif
+}
+
+TEST(MmtBodies, TheRemoteArmStallsAgainstTheHiddenRockAtItsLimit) {
+#ifndef TERRACUT_HAVE_BULLET
+  GTEST_SKIP() << "built without Bullet";
+#else
+  // mmt_hidden_rock with a 3 kN arm: the plate breaks the rock out of the
+  // sand (its break-out force, about 0.9 kN in this sand, is under the
+  // limit), pushes it into the far wall of its pit and stalls there. The
+  // remote's force (soil and rock) never exceeds the limit by more than
+  // the plate's momentum over a step at the arm's top speed.
+  Scenario sc = load_scenario(kScenarios / "mmt_hidden_rock.yaml");
+  const double limit = 3000.0;
+  sc.mmt->arm_force_limit_n = limit;  // the scenario's is 5 kN
+  MmtRun run(sc);
+  run.run();
+  const bullet::TerrainWorld& w =
+      run.remote_station().rig().world().bodies_listener()->world();
+  ASSERT_TRUE(w.tool_limited());
+  EXPECT_FALSE(remote_rock(run).held);
+  const double margin = w.params().tool.mass_kg * sc.mmt->follower_speed_m_per_s * 1000.0;
+  double peak = 0.0;
+  std::int64_t stalled = 0;
+  double behind = 0.0;
+  for (const RemoteRecord& r : run.remote_station().records()) {
+    peak = std::max(peak, length(r.force_world_n));
+    if (r.stalled) ++stalled;
+    behind = std::max(behind, length(r.commanded_m - r.tool_m));
+  }
+  EXPECT_LE(peak, limit + margin);
+  EXPECT_GT(peak, 0.5 * limit);  // it did push at its limit
+  EXPECT_GT(stalled, 100);
+  EXPECT_EQ(run.summary().stalled_ticks, stalled);
+  // Stalled, the arm fell behind the command (0.5 m/s) by more than its
+  // own servo's lag (1.5 m/s x 20 ms x ... : a few cm).
+  EXPECT_GT(behind, 0.1);
 #endif
 }
 

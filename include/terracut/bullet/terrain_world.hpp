@@ -4,7 +4,12 @@
 // btHeightfieldTerrainShape reading the HeightGrid's own heights() array in
 // place (no copy): cuts made by the Simulation are seen by Bullet at once and
 // the shape is never recreated. Loose rigid bodies (BodySpec: box, sphere,
-// cylinder) rest on it, and the blade is a kinematic plate that pushes them.
+// cylinder) rest on it, and the blade is a plate that pushes them:
+// kinematic (it goes where the blade goes), or, with the arm's force limit
+// (ToolPlateSpec::force_limit_n), a dynamic body driven to the blade pose
+// by a servo whose force is capped at the limit less the soil's force, so
+// that it stops short against a body it cannot move (docs/bullet.md, "The
+// arm's force limit").
 //
 // Placement (see docs/bullet.md): Bullet vertex (x, j) of the heightfield is
 // grid sample (c, r) = (x, j), at world
@@ -32,8 +37,10 @@
 // static in Bullet and touching nothing (the soil carries them; a buried
 // body that fell would sink through the heightfield, which is only a
 // surface), until the blade reaches one: the cut lowers the soil over its
-// footprint to its top, or the tool plate's box meets its box. Then it is
-// released: it becomes dynamic, and the soil it stood in (the samples under
+// footprint to its top, or the tool plate's box meets its box; with a
+// force-limited plate, until the plate pushes it harder than its break-out
+// force (break_out_resistance_n: the soil's passive earth pressure on it
+// and the friction under it). Then it is released: it becomes dynamic, and the soil it stood in (the samples under
 // its bounding box and one more all round, so that no terrain triangle cuts
 // into it) is lowered to its lowest point, where it rests; the plate then
 // meets it through Bullet. docs/bullet.md, "Buried bodies".
@@ -48,7 +55,7 @@
 //
 // The code has one room per model: src/bullet/terrain_world.cpp (the world,
 // its step, terrain edits, the tool plate), buried_bodies.cpp (holding and
-// releasing buried bodies), pile_pressure.cpp (the rings, the soil a body
+// releasing buried bodies, their break-out force), pile_pressure.cpp (the rings, the soil a body
 // sheds and the earth pressure; its parameters in pile_pressure.hpp).
 //
 // One step (step(out)) after each Simulation::step: terrain_changed(changed
@@ -85,7 +92,55 @@ struct ToolPlateSpec {
   double height_m = 0.1;       ///< extent above the edge along blade local +Y, metres, in (0, 100]
   double thickness_m = 0.02;   ///< extent along blade local Z, metres, in (0, 100]
   double friction = 0.5;       ///< Coulomb friction coefficient, [0, 10]
+  /// The arm's force limit, N: 0 = none (the plate is kinematic: it goes
+  /// where the blade goes, whatever it meets). > 0 (finite): the plate is a
+  /// dynamic body (gravity off, mass_kg, its rotation the blade's) driven
+  /// towards the blade pose by a servo whose force is clamped to this limit
+  /// less the soil's force on the tool (set_tool_load): against a body it
+  /// cannot move the plate stops short of the pose (the arm stalls), and
+  /// the bodies' force on it stays within the limit plus the plate's
+  /// momentum over a step (mass_kg x its speed / dt). With a limit, a
+  /// buried body is released by its break-out force (BreakOutSpec) instead
+  /// of the plate's first touch. docs/bullet.md, "The arm's force limit".
+  double force_limit_n = 0.0;
+  /// The plate's mass with a force limit, kg, in (0, 1e4]: the inertia the
+  /// bodies meet (the arm's moving mass at the tool).
+  double mass_kg = 5.0;
 };
+
+/// The soil that holds a buried body, for its break-out force (with a tool
+/// force limit): the simulation's soil material (BodiesListener sets it).
+struct BreakOutSpec {
+  double unit_weight_n_per_m3 = 16.25e3;  ///< gamma, N/m^3, finite, > 0
+  double cohesion_pa = 0.0;               ///< c, Pa, finite, >= 0
+  double friction_angle_deg = 30.0;       ///< phi, degrees, [0, 89]
+};
+
+/// A buried body's geometry against the soil, for break_out_resistance_n.
+struct BreakOutGeometry {
+  double width_m = 0.0;           ///< the face that pushes the soil, across the push, m
+  double top_depth_m = 0.0;       ///< that face's top below the soil surface beside it, m (>= 0)
+  double bottom_depth_m = 0.0;    ///< its bottom below the same surface, m (>= top_depth_m)
+  double footprint_m2 = 0.0;      ///< the body's plan area, m^2
+  double overburden_m = 0.0;      ///< soil over its top, m (>= 0)
+  double weight_n = 0.0;          ///< the body's weight, N
+  double down_push_n = 0.0;       ///< the tool's downward push on it, N (>= 0)
+};
+
+/// The soil's horizontal resistance to a buried body pushed out of it, N:
+/// Rankine's passive earth pressure on the face that pushes the soil,
+///   sigma_p(z) = K_p gamma z + 2 c sqrt(K_p),  K_p = tan^2(45 deg + phi / 2),
+/// integrated from the face's top depth z_t to its bottom depth z_b over its
+/// width w,
+///   P_p = w (K_p gamma (z_b^2 - z_t^2) / 2 + 2 c sqrt(K_p) (z_b - z_t)),
+/// plus the friction under its base of its weight, the soil over it and the
+/// tool's downward push, (W + gamma d A + F_down) tan(phi) (Rankine 1857;
+/// Terzaghi 1943, "Theoretical Soil Mechanics", ch. 2 and 4).
+double break_out_resistance_n(const BreakOutSpec& soil, const BreakOutGeometry& g);
+
+/// The soil's resistance to a buried body lifted out of it, N: its weight
+/// and the soil over it, W + gamma d A.
+double lift_out_resistance_n(const BreakOutSpec& soil, const BreakOutGeometry& g);
 
 /// Parameters of the Bullet world; validated at construction, read-only during a run.
 struct TerrainWorldParams {
@@ -129,6 +184,8 @@ struct TerrainWorldParams {
   bool cull_far_triangles = true;
   ToolPlateSpec tool{};
   PilePressureSpec pile{};
+  /// The soil that holds buried bodies (used with tool.force_limit_n > 0).
+  BreakOutSpec break_out{};
 };
 
 /// Returns an empty string when params are valid, else a message naming the field.
@@ -182,6 +239,15 @@ struct WorldStepInfo {
   /// The same pushes as vectors, summed over the bodies (horizontal: each
   /// along the inward normal of the face it presses on), newtons.
   Vec3 pile_thrust_n{};
+  /// With a tool force limit: the largest horizontal force of the plate on
+  /// a held body in the last step, N, and that body's break-out force
+  /// against it (break_out_resistance_n; 0 when no held body was touched).
+  /// A push above its break-out force releases the body before the next step.
+  double held_push_n = 0.0;
+  double held_resistance_n = 0.0;
+  /// With a tool force limit: the plate stopped short of the blade pose
+  /// (the servo's force reached the limit in the last step).
+  bool tool_stalled = false;
   double physics_s = 0.0;           ///< wall-clock time of Bullet's step, seconds
   double total_s = 0.0;             ///< wall-clock time of the whole step(), seconds
 };
@@ -228,6 +294,17 @@ class TerrainWorld {
   /// what it meets; the first pose, and the first after lift_tool(), places
   /// the plate without a velocity.
   void set_tool_pose(const BladePose& pose);
+  /// The soil's force on the tool this step, world N (Simulation's
+  /// out.force.total_n before the listeners; step(out) sets it): with a
+  /// force limit it counts against the limit, so the plate's servo has the
+  /// limit less its magnitude (none when the soil alone reaches the limit:
+  /// the plate holds, as the arm stalled in the soil would).
+  void set_tool_load(const Vec3& soil_force_n) { tool_load_n_ = length(soil_force_n); }
+  /// True when the plate is force-limited (params().tool.force_limit_n > 0).
+  bool tool_limited() const { return params_.tool.enabled && params_.tool.force_limit_n > 0.0; }
+  /// The blade pose the plate is at now (its edge; the pose last set when
+  /// the plate is kinematic): where a force-limited arm actually is.
+  BladePose tool_blade_pose() const;
   /// The next set_tool_pose jumps to its pose (use with Simulation::lift():
   /// between separate cuts the blade does not sweep through the air).
   void lift_tool() { tool_teleport_ = true; }
@@ -253,6 +330,13 @@ class TerrainWorld {
 
   /// Held bodies (buried, not yet reached by the blade).
   int held_count() const;
+  /// Held body i's geometry against the soil now for a push along the
+  /// horizontal direction `push` (world; its Y is ignored), and the tool's
+  /// downward push down_n: the face across the push (its bounding box's),
+  /// the soil beside that face (the mean height of the samples one cell out
+  /// of its footprint on the side the push goes), the soil over it (the
+  /// mean over its footprint).
+  BreakOutGeometry break_out_geometry(int i, Vec3 push, double down_n) const;
 
   int body_count() const { return int(specs_.size()); }
   const BodySpec& body_spec(int i) const { return specs_[std::size_t(i)]; }
@@ -309,6 +393,18 @@ class TerrainWorld {
   /// step's cut), before Bullet advances.
   void release_reached(const Rect& changed);
   void release(int i);
+  /// With a force limit: the plate's force on each held body in the last
+  /// step (world N), summed from the contacts in advance().
+  std::vector<Vec3> held_push_n_;
+  double tool_load_n_ = 0.0;
+  BladePose tool_target_{};   // the blade pose last set (force-limited plate)
+  bool tool_has_target_ = false;
+  /// Drives the force-limited plate towards tool_target_ for the next step.
+  void drive_tool();
+  /// After a step with a force-limited plate: each held body the plate
+  /// pushed harder than its break-out force is marked for release (in the
+  /// next step's release_reached), and info_.held_push_n is set.
+  void judge_held_pushes();
 
   // Piles against the bodies (pile_pressure.cpp).
   /// Applies the piles' earth pressure (params_.pile) to the dynamic bodies,

@@ -68,6 +68,8 @@ struct RigOptions {
   haptics::LoopOptions loop;
   /// bodies.csv of the world's bodies; empty: not written.
   std::filesystem::path bodies_csv;
+  /// The arm's force limit at the tool, N (WorldOptions::arm_force_limit_n); 0 = none.
+  double arm_force_limit_n = 0.0;
 };
 
 /// A haptic loop over a scenario's world.

@@ -39,6 +39,16 @@ struct WorldOptions {
   /// Where the bodies' per-step states go (bodies.csv); empty: not written.
   /// Only used when the scenario has bodies; the folder must exist.
   std::filesystem::path bodies_csv;
+  /// The arm's force limit at the tool, N (the remote's
+  /// mmt.remote.arm_force_limit_n); 0 = none. With bodies, the Bullet tool
+  /// plate becomes a force-limited servo (bullet::ToolPlateSpec::force_limit_n).
+  double arm_force_limit_n = 0.0;
+};
+
+/// Where a force-limited arm's plate is (World::limited_arm).
+struct ArmState {
+  BladePose pose{};      ///< the blade pose the plate is at after the last step
+  bool stalled = false;  ///< its servo's force reached the limit in the last step
 };
 
 class World {
@@ -67,6 +77,11 @@ class World {
   /// of a rigid body over the sample where that is higher (a buried body is
   /// under the soil until the blade reaches it). Allocation-free.
   void sense_heights(const Rect& rect, std::span<float> out) const;
+
+  /// With bodies and an arm force limit (WorldOptions::arm_force_limit_n):
+  /// where the force-limited plate is after the last step (it stops short
+  /// of the blade pose against a body it cannot move); nullopt otherwise.
+  std::optional<ArmState> limited_arm() const;
 
   /// After the run: flushes and closes the listeners' files (bodies.csv).
   /// Throws InputError naming a file that could not be written.
