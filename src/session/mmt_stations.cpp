@@ -490,7 +490,7 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
   Rect cand = dirty_;
   dirty_ = {};
   if (has_command_) include_rect(cand, window_around(device_->pose().position_m));
-  if (cand.empty()) return send_estimate(t_s);
+  if (cand.empty()) return;
   const HeightGrid& grid = simulation().grid();
   // What the camera sees: the soil, and the top of any body over it.
   sensed_.resize(std::size_t(cand.area()));
@@ -532,7 +532,6 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
       ++counters_.patches;
     }
   }
-  send_estimate(t_s);
 }
 
 // The estimate, when it changed (with the deadband: when it changes the
@@ -631,6 +630,9 @@ void RemoteStation::tick(double t_s) {
     sense(t_s, r);
     next_sense_s_ += settings_.sense_period_s;
   }
+  // The estimate the tick it changes (its refits come every fifth sample),
+  // not at the next sensing: up to a sensing period sooner.
+  if (has_command_) send_estimate(t_s);
   RemoteRecord rec;
   rec.t_s = t_s;
   rec.command_sequence = command_sequence_;
