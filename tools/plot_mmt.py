@@ -8,7 +8,8 @@ DIR/summary.json), or the report of a two-process session (`terracut mmt
 --report`), gives DIR/mmt.png, against the operator's time:
   - the horizontal physical force of the operator's local model (MMT), the
     remote's measured force for the same command (its first tick following
-    it, and its arm's lag later: what the operator should feel for the same
+    it, and its arm's lag later unless the operator's model moves as the
+    arm does, summary.json's aligned_after_s: what the operator should feel for the same
     motion), and the remote's force as it arrives (direct force
     reflection); the window of the "after 1 s of cutting" figures shaded;
   - the remote's estimate of its soil's cohesion and adhesion (kPa) with

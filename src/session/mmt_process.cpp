@@ -380,6 +380,7 @@ int run_operator_process(const Scenario& op, const ProcessOptions& o) {
   nlohmann::ordered_json j = station_json(station.counters(), *udp.endpoint, ran);
   j["role"] = "operator";
   j["rate_hz"] = station.rate_hz();
+  j["models_arm"] = s.models_arm;
   j["ended"] = {{"how", to_string(ended)}, {"t_s", ran}};
   j["link"] = link_json(s.to_remote);
   j["round_trip"] = {{"measured_s", station.rtt_s()},

@@ -374,8 +374,13 @@ MmtSummary write_two_process_report(const std::filesystem::path& operator_dir,
   s.rtt_s = number_at<double>(js_op, operator_dir, {"round_trip", "emulated_s"});
   s.rtt_measured_s = number_at<double>(js_op, operator_dir, {"round_trip", "measured_s"});
   s.loss = number_at<double>(js_op, operator_dir, {"link", "loss"});
+  // With the arm in the operator's model both blades move alike: no lag to
+  // align (a summary from before models_arm existed had none).
+  const bool models_arm = js_op.value("models_arm", false);
   compare_records(op, rm, number_at<double>(js_op, operator_dir, {"rate_hz"}),
-                  number_at<double>(js_rm, remote_dir, {"remote_arm", "follower_time_constant_s"}), s);
+                  models_arm ? 0.0
+                             : number_at<double>(js_rm, remote_dir, {"remote_arm", "follower_time_constant_s"}),
+                  s);
   // The terrain at the end: the local model against what the remote's camera
   // saw, over every sample either station worked.
   int rows_a = 0, cols_a = 0, rows_b = 0, cols_b = 0;

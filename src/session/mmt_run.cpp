@@ -226,8 +226,9 @@ MmtSummary MmtRun::summary() const {
   s.rtt_measured_s = operator_->rtt_s();
   s.loss = settings_.to_remote.loss;
   s.deadband = settings_.deadband;
+  // With the arm in the operator's model both blades move alike: no lag to align.
   compare_records(operator_->records(), remote_->records(), rate_hz_,
-                  settings_.follower_time_constant_s, s);
+                  settings_.models_arm ? 0.0 : settings_.follower_time_constant_s, s);
   for (const auto& [t, e] : terrain_error_) s.terrain_rms_max_m = std::max(s.terrain_rms_max_m, e);
   s.terrain_rms_final_m = terrain_error_.empty() ? 0.0 : terrain_error_.back().second;
   const double d = std::max(s.duration_s, 1e-9);

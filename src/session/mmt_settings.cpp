@@ -26,6 +26,7 @@ constexpr Range kRanges[] = {
     {"remote.sense_radius_m", 0.0, 100.0, RangeEnds::kOpenLow},
     {"remote.forgetting", 0.0, 1.0, RangeEnds::kOpenLow},
     {"remote.estimate_period_s", 1e-6, 1.0, RangeEnds::kClosed},
+    {"remote.estimate_resend_s", 0.0, 60.0, RangeEnds::kOpenLow},
     {"remote.arm_force_limit_n", 0.0, 1e7, RangeEnds::kOpenLow},
     {"remote.soil_change.z_below_m", -1e6, 1e6, RangeEnds::kClosed},
     {"link.seed", 0, 1e9, RangeEnds::kClosed, true},
@@ -69,6 +70,7 @@ std::string validate(const MmtSettings& s) {
   if (!(m = check("remote.sense_radius_m", s.sense_radius_m)).empty()) return m;
   if (!(m = check("remote.forgetting", s.forgetting)).empty()) return m;
   if (!(m = check("remote.estimate_period_s", s.estimate_period_s)).empty()) return m;
+  if (!(m = check("remote.estimate_resend_s", s.estimate_resend_s)).empty()) return m;
   if (!(m = check("remote.arm_force_limit_n", s.arm_force_limit_n)).empty()) return m;
   if (!(m = check("remote.soil_change.z_below_m", s.change_z_m)).empty()) return m;
   if (std::string p = net::validate(s.to_remote); !p.empty()) return "link." + p;
@@ -100,7 +102,8 @@ void MmtReader::read(const YAML::Node& value, const std::string& file) {
       top.section("remote", {"scenario", "soil", "follower_speed_m_per_s",
                              "follower_time_constant_s", "sense_period_s",
                              "sense_radius_m", "estimate", "forgetting",
-                             "estimate_period_s", "arm_force_limit_n", "soil_change"});
+                             "estimate_period_s", "estimate_resend_s", "arm_force_limit_n",
+                             "soil_change"});
   if (const auto f = remote.get("scenario")) {
     const std::filesystem::path p = f->text();
     s.remote_scenario = p.is_absolute() ? p : std::filesystem::path(file).parent_path() / p;
@@ -119,6 +122,7 @@ void MmtReader::read(const YAML::Node& value, const std::string& file) {
     change.get("z_below_m")->fail("soil_change needs soil: the soil beyond z_below_m");
   }
   remote.read_number("estimate_period_s", s.estimate_period_s);
+  remote.read_number("estimate_resend_s", s.estimate_resend_s);
   remote.read_number("arm_force_limit_n", s.arm_force_limit_n);
   remote.read_number("follower_speed_m_per_s", s.follower_speed_m_per_s);
   remote.read_number("follower_time_constant_s", s.follower_time_constant_s);
@@ -134,11 +138,12 @@ void MmtReader::read(const YAML::Node& value, const std::string& file) {
   s.to_operator.seed = s.to_remote.seed + 1;  // the two directions draw independently
 
   const yaml::Map op =
-      top.section("operator", {"blend_s", "max_update_step_n", "exclusion_m", "deadband"});
+      top.section("operator", {"blend_s", "max_update_step_n", "exclusion_m", "deadband", "models_arm"});
   op.read_number("blend_s", s.blend_s);
   op.read_number("max_update_step_n", s.max_update_step_n);
   op.read_number("exclusion_m", s.exclusion_m);
   op.read_number("deadband", s.deadband);
+  op.read_boolean("models_arm", s.models_arm);
   top.read_number("timeout_s", s.timeout_s);
   top.read_number("link_lost_s", s.link_lost_s);
   const yaml::Map udp = top.section("udp", {"address", "port"});

@@ -72,6 +72,19 @@ double predicted_horizontal_n(const SoilMaterial& m, const SoilSample& s) {
 
 }  // namespace
 
+namespace {
+
+// A first-order servo's tick (time constant tau: the step is the error x
+// dt / tau, gain = dt / tau), limited to the arm's speed (step_m per tick).
+Vec3 servo_step(Vec3 at, Vec3 target, double gain, double step_m) {
+  Vec3 d = (target - at) * gain;
+  const double l = length(d);
+  if (l > step_m) d = d * (step_m / l);
+  return at + d;
+}
+
+}  // namespace
+
 // ---------------------------------------------------------------------------
 // The remote's arm: follows the newest command as a first-order servo at a
 // limited speed (a real arm lags, and does not jump when a command is late).
@@ -108,12 +121,7 @@ class FollowerDevice final : public haptics::Device {
       workspace_.fill_sample(pose_, out);
       return true;
     }
-    // A first-order servo (time constant tau: the step is the error x dt /
-    // tau), limited to the arm's speed.
-    Vec3 d = (target_.position_m - pose_.position_m) * gain_;
-    const double l = length(d);
-    if (l > step_m_) d = d * (step_m_ / l);
-    pose_.position_m = pose_.position_m + d;
+    pose_.position_m = servo_step(pose_.position_m, target_.position_m, gain_, step_m_);
     pose_.orientation = target_.orientation;
     workspace_.fill_sample(pose_, out);
     return true;
@@ -127,6 +135,63 @@ class FollowerDevice final : public haptics::Device {
   BladePose pose_{}, target_{};
   bool has_pose_ = false;
   bool stalled_ = false;
+};
+
+// ---------------------------------------------------------------------------
+// The remote's arm in the operator's model (mmt.operator.models_arm): the
+// local tool follows the hand through the same servo as the remote's arm
+// follows the commands (FollowerDevice), so that the local blade makes the
+// motion the remote's will make, a one-way delay later, and the local force
+// is the one the remote will measure. The handle's own position stays in
+// the sample (what the device and the passivity observer see); the tool's
+// pose goes as the sample's world pose. The command sent is the hand's pose
+// (hand()), which the remote's arm follows.
+// ---------------------------------------------------------------------------
+
+class ArmModelDevice final : public haptics::Device {
+ public:
+  ArmModelDevice(haptics::Device& inner, const haptics::WorkspaceMapping& mapping,
+                 Quat orientation, double speed_m_per_s, double time_constant_s, double rate_hz)
+      : inner_(inner), workspace_(mapping), orientation_(orientation),
+        step_m_(speed_m_per_s / rate_hz),
+        gain_(std::min(1.0, 1.0 / (time_constant_s * rate_hz))) {}
+  std::string_view kind() const override { return inner_.kind(); }
+  void start(double t_s) override { inner_.start(t_s); }
+  bool read(double t_s, haptics::DeviceSample& out) noexcept override {
+    // The sample is the loop's, kept between ticks: its world pose is ours
+    // from the last tick unless the device gives one itself.
+    const haptics::DeviceSample kept = out;
+    out.has_world_pose = false;
+    if (!inner_.read(t_s, out)) {
+      out = kept;  // no sample: the loop keeps the one it had
+      return false;
+    }
+    hand_ = out.has_world_pose ? out.world_pose.position_m : workspace_.to_world(out.position_m);
+    // The first sample places the arm (the remote's starts at its first command).
+    tool_ = has_pose_ ? servo_step(tool_, hand_, gain_, step_m_) : hand_;
+    has_pose_ = true;
+    if (!out.has_world_pose) {
+      out.world_pose.orientation =
+          out.has_orientation ? workspace_.orientation_to_world(out.orientation) : orientation_;
+      out.has_world_pose = true;
+    }
+    out.world_pose.position_m = tool_;
+    return true;
+  }
+  void write(const haptics::DeviceCommand& c) noexcept override { inner_.write(c); }
+  void stop() noexcept override { inner_.stop(); }
+  std::vector<haptics::DeviceStat> stats() const override { return inner_.stats(); }
+  /// The hand's position, world (the newest sample's).
+  Vec3 hand() const { return hand_; }
+
+ private:
+  haptics::Device& inner_;
+  haptics::Workspace workspace_;
+  Quat orientation_;
+  double step_m_;
+  double gain_;
+  Vec3 hand_{}, tool_{};
+  bool has_pose_ = false;
 };
 
 // ---------------------------------------------------------------------------
@@ -179,8 +244,14 @@ class MaterialBlend {
   MaterialBlend(Simulation& sim, const haptics::HapticLoop& loop, double max_step_n)
       : sim_(sim), loop_(loop), max_step_n_(max_step_n), from_(sim.force_material()),
         to_(sim.force_material()) {}
-  /// A new estimate: the blend restarts from the material in use.
+  /// A new estimate: the blend restarts from the material in use. The
+  /// same one again (the remote's periodic resend) changes nothing.
   void set_target(const SoilMaterial& estimate) {
+    if (estimate.unit_weight_n_per_m3 == to_.unit_weight_n_per_m3 &&
+        estimate.cohesion_pa == to_.cohesion_pa && estimate.adhesion_pa == to_.adhesion_pa &&
+        estimate.internal_friction_deg == to_.internal_friction_deg &&
+        estimate.soil_tool_friction_deg == to_.soil_tool_friction_deg)
+      return;
     from_ = sim_.force_material();
     to_ = from_;
     to_.unit_weight_n_per_m3 = estimate.unit_weight_n_per_m3;
@@ -423,7 +494,7 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
   Rect cand = dirty_;
   dirty_ = {};
   if (has_command_) include_rect(cand, window_around(device_->pose().position_m));
-  if (cand.empty()) return send_estimate(t_s);
+  if (cand.empty()) return;
   const HeightGrid& grid = simulation().grid();
   // What the camera sees: the soil, and the top of any body over it.
   sensed_.resize(std::size_t(cand.area()));
@@ -465,11 +536,14 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
       ++counters_.patches;
     }
   }
-  send_estimate(t_s);
 }
 
 // The estimate, when it changed (with the deadband: when it changes the
-// horizontal force at the newest cut by more than the JND fraction).
+// horizontal force at the newest cut by more than the JND fraction), and
+// again when none has gone for estimate_resend_s. It is state, newest
+// wins: it goes unreliably, so a lost one holds back nothing behind it (on
+// the in-order reliable channel a lost estimate held the newer ones until
+// its retransmission, a round trip later), and the resend replaces it.
 void RemoteStation::send_estimate(double t_s) {
   const SoilEstimate& est = estimate();
   // The first samples of the first cut fit many materials that
@@ -489,7 +563,7 @@ void RemoteStation::send_estimate(double t_s) {
     for (int f = 0; f < kSoilFieldCount; ++f)
       send = send || field_value(m, SoilField(f)) != field_value(sent_, SoilField(f));
   }
-  if (!send) return;
+  if (!send && t_s - estimate_sent_s_ + 1e-9 < settings_.estimate_resend_s) return;
   net::Estimate e;
   e.t_s = t_s;
   e.material = m;
@@ -500,9 +574,10 @@ void RemoteStation::send_estimate(double t_s) {
   net::Header h{net::MessageType::kEstimate, settings_.link_id, session_, seq_estimate_++,
                 to_ns(t_s)};
   const std::size_t n = net::encode_estimate(h, e, out);
-  link_.send(net::Channel::kReliable, out, n, t_s);
+  link_.send(net::Channel::kUnreliable, out, n, t_s);
   sent_ = m;
   estimate_sent_ = true;
+  estimate_sent_s_ = t_s;
   ++counters_.estimates;
 }
 
@@ -579,6 +654,9 @@ void RemoteStation::tick(double t_s) {
     sense(t_s, r);
     next_sense_s_ += settings_.sense_period_s;
   }
+  // The estimate the tick it changes (its refits come every fifth sample),
+  // not at the next sensing: up to a sensing period sooner.
+  if (has_command_) send_estimate(t_s);
   RemoteRecord rec;
   rec.t_s = t_s;
   rec.command_sequence = command_sequence_;
@@ -607,7 +685,14 @@ OperatorStation::OperatorStation(const Scenario& op, const MmtSettings& settings
                                  std::uint32_t session, const OperatorOptions& options)
     : settings_(settings), link_(link), session_(session), options_(options) {
   const haptics::LoopParams params = loop_params(op);
-  guard_ = std::make_unique<LinkGuardDevice>(device);
+  haptics::Device* hand = &device;
+  if (settings_.models_arm) {
+    arm_ = std::make_unique<ArmModelDevice>(device, params.settings().workspace, first_orientation(op),
+                                            settings_.follower_speed_m_per_s,
+                                            settings_.follower_time_constant_s, params.rate_hz());
+    hand = arm_.get();
+  }
+  guard_ = std::make_unique<LinkGuardDevice>(*hand);
   RigOptions ro;
   ro.loop.record_capacity = 0;
   ro.loop.realtime = false;
@@ -901,10 +986,13 @@ void OperatorStation::tick(double t_s) {
     include_rect(worked_, c);
   }
 
-  // The command: where the operator's tool is.
+  // The command: where the operator's hand puts the tool (with the arm
+  // modelled, the hand's pose: the remote's arm follows it as the local
+  // tool did).
   net::Command cmd;
   cmd.t_s = t_s;
   cmd.pose = r.tool;
+  if (arm_) cmd.pose.position_m = arm_->hand();
   cmd.flags = (r.flags & haptics::kFlagReconnected) ? net::kCommandLifted : 0u;
   if (rtt_known_)
     cmd.round_trip_us = std::uint32_t(std::clamp(round_trip_bound_s() * 1e6, 1.0, 4e9));

@@ -73,6 +73,7 @@ bodies:
 mmt:
   remote: {follower_speed_m_per_s: 1.5, follower_time_constant_s: 0.02, sense_period_s: 0.05,
            sense_radius_m: 0.3, forgetting: 0.999, estimate_period_s: 0.01,
+           estimate_resend_s: 0.5,
            arm_force_limit_n: 5000, soil_change: {z_below_m: 0.0, soil: clay}}
   link: {delay_s: 0.05, jitter_s: 0.001, loss: 0.01, reorder: 0.01, reorder_delay_s: 0.005,
          retransmit_s: 0.2, seed: 3,

@@ -113,6 +113,7 @@ struct StationCounters {
 
 class FollowerDevice;
 class LinkGuardDevice;
+class ArmModelDevice;
 class MaterialBlend;
 
 /// What a remote station does beyond its settings.
@@ -202,6 +203,7 @@ class RemoteStation {
   std::int64_t ticks_ = 0;
   SoilMaterial sent_{};              // the material last sent
   bool estimate_sent_ = false;
+  double estimate_sent_s_ = 0.0;     // when the estimate last went
   SoilMaterial base_material_{}, changed_material_{};
   bool in_changed_soil_ = false;
   double estimate_error_ = -1.0;
@@ -311,6 +313,7 @@ class OperatorStation {
   MmtSettings settings_;
   net::Endpoint& link_;
   std::uint32_t session_;
+  std::unique_ptr<ArmModelDevice> arm_;  // the remote's arm in the local model (models_arm)
   std::unique_ptr<LinkGuardDevice> guard_;
   std::unique_ptr<HapticRig> rig_;
   std::unique_ptr<MaterialBlend> blend_;

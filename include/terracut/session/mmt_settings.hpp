@@ -46,6 +46,11 @@ struct MmtSettings {
   /// estimate_period_s, s, [loop period, 1]; the work on one sample is
   /// spread over the ticks to the next.
   double estimate_period_s = 0.01;
+  /// The estimate travels unreliably, newest wins (a lost one is not
+  /// waited for): besides every change it goes out again when none has gone
+  /// for estimate_resend_s, so that a lost one is replaced within that
+  /// time even when the deadband sends nothing new, s, (0, 60].
+  double estimate_resend_s = 0.5;
   /// The largest force the remote's arm exerts, N, (0, 1e7]: when the tool
   /// force on it exceeds this the arm stalls (holds its pose) instead of
   /// pushing on. 1e7: no limit.
@@ -65,6 +70,12 @@ struct MmtSettings {
   /// Perceptual deadband: send an update only when it changes the predicted
   /// force by more than this fraction, [0, 1); 0 sends every change.
   double deadband = 0.0;
+  /// The operator's local model moves its tool as the remote's arm moves
+  /// its own: the same first-order servo (follower_time_constant_s) and
+  /// speed limit (follower_speed_m_per_s) toward the hand, so that both
+  /// blades make the same motion (the command sent is the hand's pose).
+  /// false: the local tool is the hand.
+  bool models_arm = true;
   /// Silence after which a station stops (remote holds, operator fades), s, (0, 60].
   double timeout_s = 0.2;
   /// Two processes: silence after which the link is dead, s, (timeout_s,
