@@ -13,6 +13,9 @@
 //   side lines, each crossing computed once for the two cells it bounds.
 // - A row's samples are lowered as one span (SSE2, four at a time), with the
 //   same values HeightGrid::lower would write.
+// - Surface, a translation's band of rows near the columns' direction (a
+//   sample or none a row): walked along the columns instead, each column's
+//   run of rows found once; the same result, bit for bit.
 // - Spans are prefetched on big terrains, and so is the strip the blade will
 //   sweep next if it keeps its motion.
 #include "terracut/core/cut.hpp"
