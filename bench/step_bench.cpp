@@ -311,7 +311,7 @@ void register_all() {
   // normal across the middle of 4096^2, at several yaws, and a tilted blade
   // (rotated about its travel) against the same blade level.
   for (Representation rep : reps) {
-    for (double yaw : {0.0, 10.0, 30.0, 45.0, 60.0, 90.0}) {
+    for (double yaw : {0.0, 10.0, 15.0, 30.0, 37.0, 45.0, 53.0, 60.0, 75.0, 82.0, 89.0, 90.0}) {
       Case c{rep, 4096, kDirectionBladeFraction * 4096, yaw, false, 4000, 300, true};
       std::string name = std::string("direction/") + rep_name(rep) + "/yaw:" + std::to_string(int(yaw)) +
                          "/side:4096";

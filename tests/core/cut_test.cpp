@@ -325,6 +325,114 @@ TEST(Cut, AxisAndDiagonalTranslationsEqualBruteForce) {
   }
 }
 
+// A grid turned a quarter turn: sample (c, r) of the original is sample
+// (r, n - 1 - c) of the turned one, and a point (x, y, z) is (z, y, size - x)
+// (the grid's origin at 0, square). Exact for dyadic coordinates.
+std::vector<float> quarter_turn(const std::vector<float>& h, int n) {
+  std::vector<float> out(h.size());
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) out[size_t((n - 1 - c) * n + r)] = h[size_t(r * n + c)];
+  return out;
+}
+Vec3 quarter_turn(const Vec3& p, double size) { return {p.z, p.y, size - p.x}; }
+
+// The same cut at yaw theta and at theta + 90 degrees on the grid turned to
+// match lowers the same samples to the same heights, bit for bit. The
+// geometry is exact (cells of 1/64 m, the blade's ends, its run along the
+// grid and its step dyadic, the plane's slopes dyadic), so no rounding can
+// tell the two apart: a blade a few degrees off the rows (the row walk, long
+// spans) against the same blade a few degrees off the columns (the column
+// walk of the steep band), the closed boundary included (the edge passes
+// through sample centres). Several steps, the blade descending.
+TEST(Cut, QuarterTurnCutsTheSameSamples) {
+  const int n = 128;
+  const double size = 2.0, cell = size / n;  // 1/64 m
+  GridSpec s = test::square_spec(n, n, size, 1.0);
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<float> h(size_t(n) * n);
+  for (float& v : h) v = float(0.45 + 0.1 * unit(rng));
+  // The edge's run along x and z in cells (k:1 is a yaw of atan(1/k); 1:0
+  // along the rows), and the step along z in cells.
+  struct Run {
+    double dx, dz, step;
+  };
+  const Run runs[] = {{64, 8, 2.0}, {64, -8, 2.0}, {64, 4, 1.0}, {64, 2, 1.5}, {64, 0, 1.5}, {64, 16, 0.5}, {32, -1, 0.75}};
+  for (const Run& run : runs) {
+    for (Representation rep : {Representation::kSurface}) {
+      HeightGrid a(s, h), b(s, quarter_turn(h, n));
+      // From sample (20, 30)'s centre, under the material (at least 0.45 m)
+      // everywhere: rising 1/32 m along the edge, descending 1/128 m a step.
+      Vec3 p0{20.5 * cell, 0.40625, 30.5 * cell}, p1 = p0 + Vec3{run.dx * cell, 0.03125, run.dz * cell};
+      const Vec3 shift{0.0, -1.0 / 128.0, run.step * cell};
+      for (int k = 0; k < 12; ++k) {
+        const Segment from{p0, p1}, to{p0 + shift, p1 + shift};
+        const CutResult ra = cut_sweep(a, rep, from, to);
+        const CutResult rb = cut_sweep(b, rep, {quarter_turn(from.a, size), quarter_turn(from.b, size)},
+                                       {quarter_turn(to.a, size), quarter_turn(to.b, size)});
+        // The removed sums add the same drops, maybe in another order.
+        ASSERT_NEAR(ra.removed_volume_m3, rb.removed_volume_m3, 1e-12) << "run " << run.dx << ":" << run.dz << " k " << k;
+        ASSERT_EQ(ra.cells_visited, rb.cells_visited) << "run " << run.dx << ":" << run.dz << " k " << k;
+        p0 = to.a, p1 = to.b;
+      }
+      const std::vector<float> turned = quarter_turn(std::vector<float>(a.heights(), a.heights() + n * n), n);
+      int changed = 0;
+      for (int i = 0; i < n * n; ++i) {
+        ASSERT_EQ(turned[size_t(i)], b.heights()[i]) << "run " << run.dx << ":" << run.dz << " sample " << i;
+        changed += a.heights()[i] != h[size_t(i)];
+      }
+      // Every sample swept is lowered (the blade is under the material):
+      // the 12 steps' parallelogram, |dx| x 12 step cells, give or take
+      // its boundary (two samples a row at most, plus the ends).
+      const double area = std::abs(run.dx) * 12.0 * run.step, rows_crossed = std::abs(run.dz) + 12.0 * run.step;
+      EXPECT_NEAR(changed, area, 2.0 * rows_crossed + 2.0 * std::abs(run.dx) / std::max(1.0, std::abs(run.dz)) + 2.0)
+          << "run " << run.dx << ":" << run.dz;
+    }
+  }
+}
+
+// Blades within 15 degrees of the columns (the column walk's yaws and the
+// row walk's beyond them) moving along their normal a fraction of a cell per
+// step, both representations: the same cut as the brute force, and the
+// volume the cuts report is the volume the grid lost, at 48 yaws.
+TEST(Cut, SteepYawsEqualBruteForceAndConserveVolume) {
+  GridSpec s = test::square_spec(96, 96, 1.0, 1.0);
+  std::vector<float> h(size_t(s.sample_count()));
+  for (int r = 0; r < s.rows; ++r)
+    for (int c = 0; c < s.cols; ++c) h[size_t(r * s.cols + c)] = float(0.4 + 0.05 * std::sin(0.3 * c + 0.2 * r));
+  for (Representation rep : kBoth) {
+    for (int k = 0; k < 48; ++k) {
+      // 75 to 105 degrees and the same about 270, and a few in between.
+      const double yaw_deg = k < 20 ? 75.0 + 1.5 * k + 0.37 : k < 40 ? 255.0 + 1.5 * (k - 20) + 0.61 : 7.5 * (k - 40) + 1.3;
+      HeightGrid fast(s, h), slow(s, h);
+      const double volume0 = fast.volume_m3();
+      const Quat q = quat_from_axis_angle({0.0, 1.0, 0.0}, yaw_deg * std::numbers::pi / 180.0);
+      const Vec3 half = rotate(q, {0.35, 0.0, 0.0}), normal = rotate(q, {0.0, 0.0, 1.0});
+      Vec3 centre = Vec3{0.5, 0.39, 0.5} - normal * 0.1;
+      Segment from{centre - half, centre + half};
+      double removed = 0.0;
+      for (int step = 0; step < 40; ++step) {
+        const Vec3 shift = normal * (0.53 / 96.0) + Vec3{0.0, -0.0003, 0.0};
+        const Segment to{from.a + shift, from.b + shift};
+        const CutResult a = cut_sweep(fast, rep, from, to);
+        const CutResult b = cut_sweep_brute_force(slow, rep, from, to);
+        ASSERT_NEAR(a.removed_volume_m3, b.removed_volume_m3, 1e-7) << to_string(rep) << " yaw " << yaw_deg;
+        removed += a.removed_volume_m3;
+        from = to;
+      }
+      for (std::int64_t i = 0; i < s.sample_count(); ++i)
+        ASSERT_NEAR(fast.heights()[i], slow.heights()[i], kFloatTol) << to_string(rep) << " yaw " << yaw_deg << " sample " << i;
+      EXPECT_LE(fast.conservation_error_m(), 1e-6);
+      // Each drop is a float difference (rounded to half an ulp of 0.5 m at
+      // most, 3e-8 m) over a cell of 1/96^2 m^2; the blade lowers fewer
+      // than 96 x 40 samples.
+      EXPECT_GT(removed, 0.0) << to_string(rep) << " yaw " << yaw_deg;
+      EXPECT_NEAR(volume0 - fast.volume_m3(), removed, 96.0 * 40.0 * 3e-8 / (96.0 * 96.0))
+          << to_string(rep) << " yaw " << yaw_deg;
+    }
+  }
+}
+
 // The columns cut with the blade at rest is the paper's rule: each column the
 // line passes through is lowered until its top is at the line.
 TEST(Cut, ColumnsAtRestLowerToTheLine) {
