@@ -93,6 +93,7 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
     double highest = 0.5;
     for (std::int64_t i = 0; i < grid.spec().sample_count(); ++i) highest = std::max(highest, double(grid.heights()[i]));
     quantum_m_ = std::ldexp(1.0, std::ilogb(2.0 * highest) - 23);
+    inv_quantum_m_ = 1.0 / quantum_m_;
   }
   origin_x_ = spec.origin_m.x;
   origin_z_ = spec.origin_m.z;

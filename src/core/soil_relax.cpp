@@ -229,13 +229,18 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
     for (int j = 0; j < n; ++j) {
       Line& line = lines[j];
       if (!first) fall_visits_ += line.length;  // a further round reads every cell again
-      for (int m = 0; m < line.length; ++m)
-        if (line.reach[m] < kHump && double(line.reach[m]) >= s) {
-          total -= line.reach[m];
-          --count;
-          line.reach[m] = kHump;
-          changed = true;
-        }
+      // Without a branch per cell (which cells are humps is data, and a
+      // mispredicted branch cost more than the test): a cell that drops
+      // out takes its reach off the total (in the same order as before:
+      // subtracting 0 leaves a double as it is) and is marked.
+      for (int m = 0; m < line.length; ++m) {
+        const float r = line.reach[m];
+        const bool hump = (r < kHump) & (double(r) >= s);
+        total -= hump ? double(r) : 0.0;
+        count -= int(hump);
+        line.reach[m] = hump ? kHump : r;
+        changed |= hump;
+      }
     }
     s = total / count;
     if (!changed) break;

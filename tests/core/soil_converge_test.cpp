@@ -28,6 +28,9 @@ struct Pile {
   double ahead_m3 = 0.0;  // soil above the layer ahead of the blade, within its width
   double peak_m = 0.0;    // highest point above the layer there
   std::int64_t capped_steps = 0;
+  std::int64_t last_capped_step = -1;  // -1: the cap never stopped a step
+  std::int64_t last_step = 0;          // the hold's last
+  std::int64_t backlog_cells = 0;      // left queued by the last step
 };
 
 // A blade of width_m cutting 4 cm into a 20 cm layer of dry sand (repose
@@ -49,7 +52,10 @@ Pile push(double width_m, double cell_m, double speed_m_per_s, std::int64_t cap,
     const double s = std::min(1.0, double(i) / steps);
     const StepOutput& out = sim.step(scene.pose(z0 + travel * s));
     pile.capped_steps += out.soil.reached_cap ? 1 : 0;
+    if (out.soil.reached_cap) pile.last_capped_step = i;
+    pile.backlog_cells = out.soil.backlog_cells;
   }
+  pile.last_step = steps + std::lround(hold_s * 1000.0);
   const HeightGrid& g = sim.grid();
   const double blade_z = z0 + travel;
   for (int r = 0; r < rows; ++r)
@@ -93,8 +99,22 @@ TEST(SoilConvergence, APushAtOneMetreASecondOnFiveMillimetreCellsConvergesForThe
   // slopes), so the cap's work goes to the soil that moves: the 2 m blade's
   // pile at the default cap is the converged one within 5 % (+4.3 %; +8.2 %
   // when every cell the push changed was examined). The 1 m and 0.3 m
-  // blades do not meet it yet (+9.8 %, +43 %: docs/soil.md, "Not done yet").
+  // blades do not meet it yet (+9.8 %, +43 %: docs/soil.md, "Not done yet":
+  // a different settled pile, not a lag, TheCappedPushsPileIsSettledNotBehind).
   expect_converged(2.0, 0.005, 1.0);
+}
+
+TEST(SoilConvergence, TheCappedPushsPileIsSettledNotBehind) {
+  // Where the capped pile differs from the converged one (the 0.3 m blade
+  // at 1 m/s on 5 mm cells: +43 % ahead, docs/soil.md), it is not work the
+  // cap still owes: the cap stops steps only while the blade moves and
+  // shortly after, and by the end of the hold nothing is queued, so the
+  // capped run ends in a settled pile of its own (a longer hold changes
+  // nothing). The cap defers work; the difference is the path.
+  const Pile capped = push(0.3, 0.005, 1.0, SoilFlowParams{}.max_pair_checks_per_step);
+  EXPECT_GT(capped.capped_steps, 0);
+  EXPECT_LT(capped.last_capped_step, capped.last_step);
+  EXPECT_EQ(capped.backlog_cells, 0);
 }
 
 TEST(SoilConvergence, ACollapseSettlesInFarFewerPassesThanAPassAHalfExcess) {

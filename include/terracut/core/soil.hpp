@@ -404,7 +404,20 @@ class SoilFlow {
   /// v rounded to a multiple of the relaxation's quantum, as a float: the
   /// heights it writes and the amounts it moves, so that a cell's sum over
   /// a pass is exact whatever the order of its sources (quantum_m_).
-  float quantized(double v) const { return float(quantum_m_ * std::nearbyint(v / quantum_m_)); }
+  /// The quantum is a power of two, so v x its inverse is v / quantum to
+  /// the bit, and adding and taking away 1.5 x 2^52 rounds a double of
+  /// magnitude under 2^51 to the nearest integer, ties to even, as
+  /// nearbyint does in the default rounding mode: the same value without
+  /// the library call and the division (about 5 % of a capped step's time;
+  /// a negative v that rounds to zero gives +0 where nearbyint gave -0,
+  /// equal in every comparison and sum).
+  float quantized(double v) const {
+    const double q = v * inv_quantum_m_;
+    if (!(std::abs(q) < 0x1p51)) return float(quantum_m_ * std::nearbyint(q));
+    constexpr double kRound = 0x1.8p52;
+    // IEEE arithmetic: without -ffast-math no compiler folds (q + k) - k.
+    return float(quantum_m_ * ((q + kRound) - kRound));
+  }
   /// Zeroes the fluxes [applied_, end) of source a that the blade, the hull
   /// or a body now stands in the way of (the pass was examined in an
   /// earlier step, against where they were then).
@@ -489,6 +502,7 @@ class SoilFlow {
   std::vector<Source> sources_;
   std::size_t applied_sources_ = 0;
   double quantum_m_ = 0.0;     // the relaxation's height quantum (quantized)
+  double inv_quantum_m_ = 0.0;  // 1 / quantum_m_ (exact: a power of two)
   bool pass_spans_steps_ = false;  // the pass in progress was examined (in part) in an earlier step
   double pass_gained_m_ = 0.0;    // height the pass's writes gained by float rounding
   // The highest cells the pass lowered (all tied for highest, up to
