@@ -399,6 +399,8 @@ class TerrainWorld {
   double tool_load_n_ = 0.0;
   BladePose tool_target_{};   // the blade pose last set (force-limited plate)
   bool tool_has_target_ = false;
+  Vec3 tool_last_centre_{};   // the plate's target centre at the last drive_tool
+  bool tool_has_last_centre_ = false;
   /// Drives the force-limited plate towards tool_target_ for the next step.
   void drive_tool();
   /// After a step with a force-limited plate: each held body the plate
