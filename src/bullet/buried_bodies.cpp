@@ -112,9 +112,23 @@ void TerrainWorld::release_reached(const Rect& changed) {
   if (tool_limited()) {
     // The soil holds it until the plate's push exceeds its break-out
     // force (judge_held_pushes): neither a touch nor a cut to its top
-    // (still embedded to its full depth) releases it.
-    for (std::size_t i = 0; i < m.bodies.size(); ++i)
-      if (m.held[i] && m.breaking[i]) release(int(i));
+    // (still embedded to its full depth) releases it. A cut that took the
+    // soil under its centre down to its bottom (the blade passed under it,
+    // the plate below its box) does: nothing holds it, and it falls.
+    for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+      if (!m.held[i]) continue;
+      bool undermined = false;
+      if (!m.breaking[i]) {
+        btVector3 lo, hi;
+        m.bodies[i]->getAabb(lo, hi);
+        const Rect f = samples_under(lo, hi);
+        const int col = (f.c0 + f.c1 - 1) / 2, row = (f.r0 + f.r1 - 1) / 2;
+        undermined = !f.empty() && col >= changed.c0 && col < changed.c1 && row >= changed.r0 &&
+                     row < changed.r1 &&
+                     h[grid_.index(col, row)] <= float(double(lo.y()) - ground);
+      }
+      if (m.breaking[i] || undermined) release(int(i));
+    }
     return;
   }
   for (std::size_t i = 0; i < m.bodies.size(); ++i) {

@@ -528,6 +528,7 @@ void TerrainWorld::set_tool_pose(const BladePose& pose) {
       m.tool_body->setCollisionFlags(m.tool_body->getCollisionFlags() &
                                      ~btCollisionObject::CF_NO_CONTACT_RESPONSE);
       tool_teleport_ = false;
+      tool_has_last_centre_ = false;  // a jump to the pose is no motion of it
     }
     return;
   }
@@ -560,7 +561,26 @@ void TerrainWorld::drive_tool() {
   m.tool_motion->setWorldTransform(t);
   const double budget_n = params_.tool.force_limit_n - tool_load_n_;
   const Vec3 v = from_bt(plate.getLinearVelocity());
-  const Vec3 wanted = (centre - from_bt(t.getOrigin())) * (1.0 / dt_s_);
+  Vec3 wanted = (centre - from_bt(t.getOrigin())) * (1.0 / dt_s_);
+  // The pose's own velocity (0 after a jump to it).
+  const Vec3 u = tool_has_last_centre_ ? (centre - tool_last_centre_) * (1.0 / dt_s_) : Vec3{};
+  tool_last_centre_ = centre;
+  tool_has_last_centre_ = true;
+  if (budget_n > 0.0) {
+    // Brakes for the pose: the speed towards it relative to its own motion
+    // is at most what the servo's deceleration a = F / m stops within the
+    // distance left, c = -a dt / 2 + sqrt((a dt / 2)^2 + 2 a d). It binds
+    // only where that speed is over a dt, the most one step can change: the
+    // plate left behind (a stall let go), not while it follows the pose.
+    // Without it the one-step target arrives at full speed and swings past
+    // the pose by about the distance it made up, for most of a second.
+    const double a = budget_n / params_.tool.mass_kg;
+    const Vec3 rel = wanted - u;
+    const double r = length(rel);
+    const double h = 0.5 * a * dt_s_;
+    const double brake = -h + std::sqrt(h * h + 2.0 * a * r * dt_s_);
+    if (r > brake) wanted = u + rel * (brake / r);
+  }
   Vec3 dv = wanted - v;
   bool stalled = false;
   if (budget_n <= 0.0) {

@@ -124,6 +124,42 @@ TEST(ArmLimit, WithoutALimitTheKinematicPlateCrushesTheJam) {
   EXPECT_GT(peak, 10.0 * 1000.0);
 }
 
+// The arm held back (the soil alone at the limit: the plate stops where it
+// is) while the command runs 10 cm on at 0.5 m/s and stops; then the soil
+// lets go. The servo must brake for the pose it is driven to: with the
+// limit's 200 m/s^2 it reaches it and stays, as an arm would, instead of
+// arriving at 6 m/s and swinging 10 cm past it, back and forth for most of
+// a second (the one-step velocity target, clamped, never brakes in time).
+TEST(ArmLimit, ReleasedFromAStallThePlateBrakesOntoItsPose) {
+  const double limit = 1000.0;
+  Jam jam(limit);
+  TerrainWorld& w = jam.world;
+  w.set_tool_pose(edge_at(0.2, 0.8));  // over the block and the wall: it meets nothing
+  w.advance();
+  int i = 1;
+  w.set_tool_load({0.0, 0.0, 2.0 * limit});
+  for (; i <= 200; ++i) {
+    w.set_tool_pose(edge_at(0.2, 0.8 - 0.5 * std::min(i * kDt, 0.2)));
+    w.advance();
+  }
+  ASSERT_NEAR(w.tool_blade_pose().position_m.z, 0.8, 1e-6);  // held where it was
+  w.set_tool_load({});
+  double overshoot = 0.0;
+  int settled_at = -1;
+  for (; i <= 1200; ++i) {
+    w.set_tool_pose(edge_at(0.2, 0.7));
+    w.advance();
+    const double z = w.tool_blade_pose().position_m.z;
+    overshoot = std::max(overshoot, 0.7 - z);
+    if (std::fabs(z - 0.7) > 1e-3) settled_at = -1;
+    else if (settled_at < 0) settled_at = i;
+  }
+  // Braking from 200 m/s^2 the 10 cm take about 45 ms.
+  EXPECT_LT(overshoot, 1e-3);
+  ASSERT_GE(settled_at, 0);
+  EXPECT_LT((settled_at - 200) * kDt, 0.1);
+}
+
 // The break-out force by hand, for sand of gamma = 16 kN/m^3, phi = 30 deg
 // (K_p = tan^2 60 = 3 exactly), c = 0 and then 2 kPa: rock_buried.yaml's
 // block (0.3 x 0.2 x 0.25 m, 40 kg), top 2 cm under the surface, pushed

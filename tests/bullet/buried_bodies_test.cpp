@@ -86,6 +86,26 @@ TEST(BuriedBodies, AShallowCutOverItLeavesItHeld) {
              [&](int c, int r) { ASSERT_NEAR(sim.grid().height(c, r), 0.29, 1e-6); });
 }
 
+TEST(BuriedBodies, WithAForceLimitACutUnderItReleasesIt) {
+  // With the arm's force limit only the plate's push beyond the break-out
+  // force frees a buried body, and a cut to its top does not. But the blade
+  // 5 cm over the floor (the plate, 0.1 m high, passes under the box's
+  // bottom at 0.18) takes the soil under it away: nothing holds it then,
+  // and it must fall into the trench, not hang in the air.
+  Simulation sim(sand_params(), std::vector<float>(2500, 0.3f));
+  BodiesListenerOptions o;
+  o.world.tool.force_limit_n = 1e6;
+  BodiesListener bodies(sim, {buried_box()}, o);
+  const TerrainWorld& w = bodies.world();
+  ASSERT_TRUE(w.tool_limited());
+  sim.step(blade_at(0.05, 0.95));
+  for (int i = 1; i <= 1800; ++i) sim.step(blade_at(0.05, 0.95 - 0.0005 * i));
+  for (int i = 0; i < 500; ++i) sim.step(blade_at(0.05, 0.05));
+  EXPECT_EQ(w.held_count(), 0);
+  // It lies on the trench's floor (0.05), its centre 5 cm over it.
+  EXPECT_LT(w.body_state(0).position_m.y, 0.12);
+}
+
 TEST(BuriedBodies, ReleasedWhenThePlateReachesItThenPushedWithoutFlyingOut) {
   // rock_buried.yaml's block: 0.3 x 0.2 x 0.25 m, 40 kg, its top 2 cm under
   // the sand (centre y = 0.18), its back face at z = 0.725.

@@ -520,6 +520,38 @@ TEST(Mmt, BadPacketsOnBothStationsAreCountedNeverFatal) {
   EXPECT_GT(p.op.counters().accepted, 50);
 }
 
+// The estimate travels unreliably, newest wins: across the sequence's wrap
+// an estimate is newer, and one older than the newest accepted (reordered
+// on the way) is refused and counted, never applied.
+TEST(Mmt, AnOlderEstimateArrivingLateIsRefusedAcrossTheWrap) {
+  Scenario sc = load_scenario(kTrench);
+  sc.mmt->to_remote.delay_s = sc.mmt->to_operator.delay_s = 0.0;
+  sc.mmt->to_remote.jitter_s = sc.mmt->to_operator.jitter_s = 0.0;
+  sc.mmt->to_remote.loss = sc.mmt->to_operator.loss = 0.0;
+  Pair p(sc);
+  const std::uint32_t link = sc.mmt->link_id;
+  std::vector<std::uint8_t> e(net::kHeaderSize + net::kEstimatePayloadSize + net::kCrcSize);
+  auto send = [&](std::uint32_t seq, std::uint64_t t_ns, double unit_weight) {
+    net::Estimate est;
+    est.material.unit_weight_n_per_m3 = unit_weight;
+    est.samples = 20;
+    net::encode_estimate({net::MessageType::kEstimate, link, 7, seq, t_ns}, est, e.data());
+    p.link.b().send(net::Channel::kUnreliable, e.data(), e.size(), 0.0);
+  };
+  send(0xFFFFFFFEu, 1000, 17000.0);
+  send(1u, 3000, 18000.0);           // after the wrap: newer
+  send(0xFFFFFFFFu, 2000, 17500.0);  // sent between them, arrived last
+  p.op.tick(0.0);
+  EXPECT_EQ(p.op.counters().estimates, 2);
+  EXPECT_EQ(p.op.counters().rejected[net::Reject::kReordered], 1);
+  EXPECT_EQ(p.op.last_estimate().material.unit_weight_n_per_m3, 18000.0);
+  // The same estimate again (the remote's resend) is accepted and changes nothing.
+  send(2u, 4000, 18000.0);
+  p.op.tick(0.001);
+  EXPECT_EQ(p.op.counters().estimates, 3);
+  EXPECT_EQ(p.op.last_estimate().material.unit_weight_n_per_m3, 18000.0);
+}
+
 TEST(Mmt, SilentLinkStopsTheRemoteToolAndFadesTheOperatorsForce) {
   Scenario sc = load_scenario(kTrench);
   const double timeout = sc.mmt->timeout_s;

@@ -40,7 +40,8 @@
 // footprint to its top, or the tool plate's box meets its box; with a
 // force-limited plate, until the plate pushes it harder than its break-out
 // force (break_out_resistance_n: the soil's passive earth pressure on it
-// and the friction under it). Then it is released: it becomes dynamic, and the soil it stood in (the samples under
+// and the friction under it), or a cut takes the soil under its centre down
+// to its bottom. Then it is released: it becomes dynamic, and the soil it stood in (the samples under
 // its bounding box and one more all round, so that no terrain triangle cuts
 // into it) is lowered to its lowest point, where it rests; the plate then
 // meets it through Bullet. docs/bullet.md, "Buried bodies".
@@ -399,6 +400,8 @@ class TerrainWorld {
   double tool_load_n_ = 0.0;
   BladePose tool_target_{};   // the blade pose last set (force-limited plate)
   bool tool_has_target_ = false;
+  Vec3 tool_last_centre_{};   // the plate's target centre at the last drive_tool
+  bool tool_has_last_centre_ = false;
   /// Drives the force-limited plate towards tool_target_ for the next step.
   void drive_tool();
   /// After a step with a force-limited plate: each held body the plate
