@@ -22,7 +22,8 @@ double break_out_resistance_n(const BreakOutSpec& soil, const BreakOutGeometry& 
                                       2.0 * soil.cohesion_pa * root_kp * (zb - zt));
   const double normal = g.weight_n + soil.unit_weight_n_per_m3 * g.overburden_m * g.footprint_m2 +
                         g.down_push_n;
-  return passive + normal * std::tan(phi);
+  // The base slides on the soil under it: Mohr-Coulomb shear, c A + N tan phi.
+  return passive + soil.cohesion_pa * g.footprint_m2 + normal * std::tan(phi);
 }
 
 double lift_out_resistance_n(const BreakOutSpec& soil, const BreakOutGeometry& g) {

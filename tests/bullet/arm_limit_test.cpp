@@ -181,9 +181,10 @@ TEST(ArmLimit, BreakOutForceByHand) {
   // Base: (392.4 + 16000 x 0.02 x 0.075) x tan 30 = 416.4 x 0.577350 = 240.409 N.
   const double base = 416.4 / std::sqrt(3.0);
   EXPECT_NEAR(break_out_resistance_n(sand(0.0), block_geometry()), 345.6 + base, 1e-9);
-  // Cohesion adds 2 c sqrt(K_p) (z_b - z_t) w = 2 x 2000 x sqrt 3 x 0.2 x 0.3.
+  // Cohesion adds 2 c sqrt(K_p) (z_b - z_t) w = 2 x 2000 x sqrt 3 x 0.2 x 0.3
+  // on the face and c A = 2000 x 0.075 = 150 N under the base.
   EXPECT_NEAR(break_out_resistance_n(sand(2000.0), block_geometry()),
-              345.6 + base + 240.0 * std::sqrt(3.0), 1e-9);
+              345.6 + base + 240.0 * std::sqrt(3.0) + 150.0, 1e-9);
   // A downward push of 100 N adds its friction; lifting needs W + gamma d A.
   BreakOutGeometry pressed = block_geometry();
   pressed.down_push_n = 100.0;
