@@ -500,10 +500,26 @@ void TerrainWorld::see(SoilView& view, const Rect& seen) const {
     std::copy_n(h + grid_.index(seen.c0, row), seen.c1 - seen.c0, to);
 }
 
+Rect TerrainWorld::take_moved_rect() {
+  const Rect r = moved_rect_;
+  moved_rect_ = {};
+  return r;
+}
+
 void TerrainWorld::refresh_views() {
   for (std::size_t i = 0; i < views_.size(); ++i) {
     const btRigidBody& body = *impl_->bodies[i];
     if (body.isStaticObject() || !body.isActive()) continue;  // it did not move
+    {
+      btVector3 lo, hi;
+      body.getAabb(lo, hi);
+      const bool finite = std::isfinite(lo.x()) && std::isfinite(lo.z()) &&
+                          std::isfinite(hi.x()) && std::isfinite(hi.z());
+      const Rect f = finite ? samples_under(lo, hi) : Rect{};
+      if (!f.empty())
+        moved_rect_.include(Rect{std::max(f.c0 - 1, 0), std::max(f.r0 - 1, 0),
+                                 std::min(f.c1 + 1, grid_.cols()), std::min(f.r1 + 1, grid_.rows())});
+    }
     Rect reached{}, seen{};
     if (!view_region(int(i), reached, seen)) seen = {};
     if (!(seen == views_[i].region)) see(views_[i], seen);

@@ -494,6 +494,8 @@ void RemoteStation::sense(double t_s, const haptics::LoopRecord& r) {
   Rect cand = dirty_;
   dirty_ = {};
   if (has_command_) include_rect(cand, window_around(device_->pose().position_m));
+  // And where bodies moved: a rock the plate tipped over after it left.
+  include_rect(cand, rig_->world().take_moved_body_rect());
   if (cand.empty()) return;
   const HeightGrid& grid = simulation().grid();
   // What the camera sees: the soil, and the top of any body over it.

@@ -60,6 +60,13 @@ void World::sense_heights(const Rect& rect, std::span<float> out) const {
 #endif
 }
 
+Rect World::take_moved_body_rect() {
+#ifdef TERRACUT_HAVE_BULLET
+  if (bodies_) return bodies_->world().take_moved_rect();
+#endif
+  return {};
+}
+
 std::optional<ArmState> World::limited_arm() const {
 #ifdef TERRACUT_HAVE_BULLET
   if (bodies_ && bodies_->world().tool_limited())

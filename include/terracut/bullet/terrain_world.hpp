@@ -322,6 +322,12 @@ class TerrainWorld {
   /// body raised. Allocation-free; not during advance().
   int raise_to_body_tops(const Rect& rect, std::span<float> out) const;
 
+  /// The samples under the bodies that moved (awake, dynamic) in the steps
+  /// since the last call, and one more all round (empty: none moved):
+  /// where a camera's view of the bodies may have changed although no soil
+  /// did. Clears the record.
+  Rect take_moved_rect();
+
   /// Where soil that flows may not go for body i: the samples whose centres
   /// lie under its bounding box, and one more all round (clipped to the
   /// grid; empty when the body's box is not finite), with the box's lowest
@@ -390,6 +396,7 @@ class TerrainWorld {
   // Buried bodies (buried_bodies.cpp): Impl::held marks the held ones.
   int pending_released_ = 0;
   Rect pending_released_rect_{};
+  Rect moved_rect_{};  // take_moved_rect()
   /// Releases the held bodies the blade reached this step (changed: the
   /// step's cut), before Bullet advances.
   void release_reached(const Rect& changed);

@@ -78,6 +78,11 @@ class World {
   /// under the soil until the blade reaches it). Allocation-free.
   void sense_heights(const Rect& rect, std::span<float> out) const;
 
+  /// The samples under the bodies that moved since the last call (one more
+  /// all round; empty without bodies or when none moved): where the
+  /// camera's view may have changed although the soil did not.
+  Rect take_moved_body_rect();
+
   /// With bodies and an arm force limit (WorldOptions::arm_force_limit_n):
   /// where the force-limited plate is after the last step (it stops short
   /// of the blade pose against a body it cannot move); nullopt otherwise.
