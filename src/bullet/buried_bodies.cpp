@@ -57,8 +57,7 @@ BreakOutGeometry TerrainWorld::break_out_geometry(int i, Vec3 push, double down_
   // passes the box's half depth along it (the whole ring without a push).
   const double cx = 0.5 * double(lo.x() + hi.x()), cz = 0.5 * double(lo.z() + hi.z());
   const double half = 0.5 * (std::fabs(d.x) * sx + std::fabs(d.z) * sz);
-  const Rect ring{std::max(f.c0 - 1, 0), std::max(f.r0 - 1, 0), std::min(f.c1 + 1, grid_.cols()),
-                  std::min(f.r1 + 1, grid_.rows())};
+  const Rect ring = grown_by_one(f);
   double sum = 0.0, all = 0.0;
   int n = 0, n_all = 0;
   for (int row = ring.r0; row < ring.r1; ++row)
@@ -159,9 +158,7 @@ void TerrainWorld::release(int i) {
   // The soil it stood in: the samples under its box and one more all round
   // go down to its lowest point (lower() only lowers: a deeper cut stays),
   // so it rests on a level floor and no terrain triangle reaches into it.
-  Rect pit = samples_under(lo, hi);
-  pit = {std::max(pit.c0 - 1, 0), std::max(pit.r0 - 1, 0), std::min(pit.c1 + 1, grid_.cols()),
-         std::min(pit.r1 + 1, grid_.rows())};
+  const Rect pit = grown_by_one(samples_under(lo, hi));
   const float floor_h = float(double(lo.y()) - grid_.spec().origin_m.y);
   for (int row = pit.r0; row < pit.r1; ++row)
     for (int col = pit.c0; col < pit.c1; ++col) lower_sample(grid_.index(col, row), floor_h);

@@ -266,9 +266,6 @@ void TerrainWorld::apply_pile_pressure() {
   for (SoilView& view : views_) view.band_changed = false;
 }
 
-Rect TerrainWorld::pile_band(const SoilObstacle& o) const {
-  return {std::max(o.cells.c0 - 1, 0), std::max(o.cells.r0 - 1, 0),
-          std::min(o.cells.c1 + 1, grid_.cols()), std::min(o.cells.r1 + 1, grid_.rows())};
-}
+Rect TerrainWorld::pile_band(const SoilObstacle& o) const { return grown_by_one(o.cells); }
 
 }  // namespace terracut::bullet

@@ -516,9 +516,7 @@ void TerrainWorld::refresh_views() {
       const bool finite = std::isfinite(lo.x()) && std::isfinite(lo.z()) &&
                           std::isfinite(hi.x()) && std::isfinite(hi.z());
       const Rect f = finite ? samples_under(lo, hi) : Rect{};
-      if (!f.empty())
-        moved_rect_.include(Rect{std::max(f.c0 - 1, 0), std::max(f.r0 - 1, 0),
-                                 std::min(f.c1 + 1, grid_.cols()), std::min(f.r1 + 1, grid_.rows())});
+      if (!f.empty()) moved_rect_.include(grown_by_one(f));
     }
     Rect reached{}, seen{};
     if (!view_region(int(i), reached, seen)) seen = {};
@@ -529,14 +527,13 @@ void TerrainWorld::refresh_views() {
 void TerrainWorld::set_tool_pose(const BladePose& pose) {
   if (!params_.tool.enabled) return;
   Impl& m = *impl_;
+  const btTransform t(to_bt(normalized(pose.orientation)),
+                      to_bt(plate_centre(pose.position_m, pose.orientation)));
   if (tool_limited()) {
     // The servo drives the plate towards the pose in advance() (drive_tool).
     tool_target_ = pose;
     tool_has_target_ = true;
     if (tool_teleport_) {
-      const Vec3 centre =
-          pose.position_m + rotate(pose.orientation, {0.0, 0.5 * params_.tool.height_m, 0.0});
-      const btTransform t(to_bt(normalized(pose.orientation)), to_bt(centre));
       m.tool_motion->setWorldTransform(t);
       m.tool_body->setWorldTransform(t);
       m.tool_body->setInterpolationWorldTransform(t);
@@ -548,8 +545,6 @@ void TerrainWorld::set_tool_pose(const BladePose& pose) {
     }
     return;
   }
-  const Vec3 centre = pose.position_m + rotate(pose.orientation, {0.0, 0.5 * params_.tool.height_m, 0.0});
-  const btTransform t(to_bt(normalized(pose.orientation)), to_bt(centre));
   m.tool_motion->setWorldTransform(t);
   m.tool_body->setWorldTransform(t);
   if (tool_teleport_) {
@@ -569,8 +564,7 @@ void TerrainWorld::drive_tool() {
   // kept after the last step (contacts included), aiming at the blade pose
   // in one step: dv = clamp(x_target - x) / dt - v, F dt / m).
   const Quat q = normalized(tool_target_.orientation);
-  const Vec3 centre =
-      tool_target_.position_m + rotate(q, {0.0, 0.5 * params_.tool.height_m, 0.0});
+  const Vec3 centre = plate_centre(tool_target_.position_m, q);
   btTransform t = plate.getWorldTransform();
   t.setRotation(to_bt(q));
   plate.setWorldTransform(t);
@@ -752,6 +746,15 @@ int TerrainWorld::raise_to_body_tops(const Rect& rect, std::span<float> out) con
       }
   }
   return raised;
+}
+
+Vec3 TerrainWorld::plate_centre(const Vec3& edge, const Quat& q) const {
+  return edge + rotate(q, {0.0, 0.5 * params_.tool.height_m, 0.0});
+}
+
+Rect TerrainWorld::grown_by_one(const Rect& r) const {
+  return {std::max(r.c0 - 1, 0), std::max(r.r0 - 1, 0), std::min(r.c1 + 1, grid_.cols()),
+          std::min(r.r1 + 1, grid_.rows())};
 }
 
 BladePose TerrainWorld::tool_blade_pose() const {

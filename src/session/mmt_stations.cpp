@@ -74,6 +74,13 @@ double predicted_horizontal_n(const SoilMaterial& m, const SoilSample& s) {
 
 namespace {
 
+// The fields an estimate carries are the same in a and b (to the bit).
+bool same_estimated_fields(const SoilMaterial& a, const SoilMaterial& b) {
+  for (int f = 0; f < kSoilFieldCount; ++f)
+    if (field_value(a, SoilField(f)) != field_value(b, SoilField(f))) return false;
+  return true;
+}
+
 // A first-order servo's tick (time constant tau: the step is the error x
 // dt / tau, gain = dt / tau), limited to the arm's speed (step_m per tick).
 Vec3 servo_step(Vec3 at, Vec3 target, double gain, double step_m) {
@@ -247,11 +254,7 @@ class MaterialBlend {
   /// A new estimate: the blend restarts from the material in use. The
   /// same one again (the remote's periodic resend) changes nothing.
   void set_target(const SoilMaterial& estimate) {
-    if (estimate.unit_weight_n_per_m3 == to_.unit_weight_n_per_m3 &&
-        estimate.cohesion_pa == to_.cohesion_pa && estimate.adhesion_pa == to_.adhesion_pa &&
-        estimate.internal_friction_deg == to_.internal_friction_deg &&
-        estimate.soil_tool_friction_deg == to_.soil_tool_friction_deg)
-      return;
+    if (same_estimated_fields(estimate, to_)) return;
     from_ = sim_.force_material();
     to_ = from_;
     to_.unit_weight_n_per_m3 = estimate.unit_weight_n_per_m3;
@@ -344,6 +347,7 @@ RemoteStation::RemoteStation(const Scenario& remote, const MmtSettings& settings
   // The arm's limit also limits the Bullet plate (1e7, the default: none).
   ro.arm_force_limit_n = settings_.arm_force_limit_n < 1e7 ? settings_.arm_force_limit_n : 0.0;
   rig_ = std::make_unique<HapticRig>(remote, params, first_orientation(remote), *device_, ro);
+  plate_limits_ = rig_->world().limited_arm().has_value();
   const HeightGrid& grid = rig_->world().simulation().grid();
   if (grid.cols() != operator_initial.cols() || grid.rows() != operator_initial.rows())
     throw InputError("mmt.remote.scenario: the remote grid must have the operator's samples");
@@ -562,8 +566,7 @@ void RemoteStation::send_estimate(double t_s) {
              settings_.deadband * std::max(was, 1e-9);
     }
   } else if (!send) {
-    for (int f = 0; f < kSoilFieldCount; ++f)
-      send = send || field_value(m, SoilField(f)) != field_value(sent_, SoilField(f));
+    send = !same_estimated_fields(m, sent_);
   }
   if (!send && t_s - estimate_sent_s_ + 1e-9 < settings_.estimate_resend_s) return;
   net::Estimate e;
@@ -601,8 +604,7 @@ void RemoteStation::tick(double t_s) {
   // bodies the Bullet plate's servo holds the limit itself (it stops short,
   // and the arm is placed where it stopped, below): holding here as well
   // would drop its push to nothing every other tick.
-  const bool plate_limits = rig_->world().limited_arm().has_value();
-  const bool stalled = !plate_limits &&
+  const bool stalled = !plate_limits_ &&
                        length(loop.last().physical_force_world_n) > settings_.arm_force_limit_n;
   device_->set_stalled(stalled);
   if (stalled) ++stalled_ticks_;

@@ -40,7 +40,7 @@
 // footprint to its top, or the tool plate's box meets its box; with a
 // force-limited plate, until the plate pushes it harder than its break-out
 // force (break_out_resistance_n: the soil's passive earth pressure on it
-// and the friction under it), or a cut takes the soil under its centre down
+// and the shear under it), or a cut takes the soil under its centre down
 // to its bottom. Then it is released: it becomes dynamic, and the soil it stood in (the samples under
 // its bounding box and one more all round, so that no terrain triangle cuts
 // into it) is lowered to its lowest point, where it rests; the plate then
@@ -134,8 +134,9 @@ struct BreakOutGeometry {
 /// integrated from the face's top depth z_t to its bottom depth z_b over its
 /// width w,
 ///   P_p = w (K_p gamma (z_b^2 - z_t^2) / 2 + 2 c sqrt(K_p) (z_b - z_t)),
-/// plus the friction under its base of its weight, the soil over it and the
-/// tool's downward push, (W + gamma d A + F_down) tan(phi) (Rankine 1857;
+/// plus the shear under its base (Mohr-Coulomb on the soil it stands on:
+/// its plan area's cohesion and the friction of its weight, the soil over it
+/// and the tool's downward push), c A + (W + gamma d A + F_down) tan(phi) (Rankine 1857;
 /// Terzaghi 1943, "Theoretical Soil Mechanics", ch. 2 and 4).
 double break_out_resistance_n(const BreakOutSpec& soil, const BreakOutGeometry& g);
 
@@ -443,6 +444,11 @@ class TerrainWorld {
   // fields are pile_pressure.cpp's).
   /// The samples whose centres lie under a world box's X-Z extent (clipped).
   Rect samples_under(const btVector3& lo, const btVector3& hi) const;
+  /// r and one more sample all round, clipped to the grid.
+  Rect grown_by_one(const Rect& r) const;
+  /// The tool plate's centre for a blade edge at `edge` turned by q (the
+  /// plate stands tool.height_m above its edge, centred on it).
+  Vec3 plate_centre(const Vec3& edge, const Quat& q) const;
   /// What a dynamic body last saw of the soil round it: the samples whose
   /// triangles reach its box and two more all round (its pile band), and
   /// their heights. A reported change wakes the body (and drops its terrain

@@ -204,6 +204,7 @@ class RemoteStation {
   SoilMaterial sent_{};              // the material last sent
   bool estimate_sent_ = false;
   double estimate_sent_s_ = 0.0;     // when the estimate last went
+  bool plate_limits_ = false;        // a force-limited Bullet plate holds the arm's limit
   SoilMaterial base_material_{}, changed_material_{};
   bool in_changed_soil_ = false;
   double estimate_error_ = -1.0;
