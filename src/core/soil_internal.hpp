@@ -50,6 +50,12 @@ inline constexpr int kMaxExtraRounds = 2;
 /// it (and the minimum cap, 1000, leaves room for one).
 inline constexpr std::int64_t kMostExamineVisits = 8 + 8 * kMaxFallCells * (1 + kMaxExtraRounds);
 static_assert(kMostExamineVisits <= 1000);
+/// The window round each end of the blade that spill_round_ends builds
+/// in: this many cells each way from the tip.
+inline constexpr int kEndWindowCells = 48;
+/// Rounds of spill_round_ends' search for the cone's height (each finds the
+/// sets for the last height and solves the balance over them).
+inline constexpr int kEndRounds = 6;
 /// Fluxes a pass may hold per cell of the reserved active set.
 inline constexpr std::size_t kFluxesPerActiveCell = 32;
 /// The work cap's charge for a source's fall test (lowered): its 8

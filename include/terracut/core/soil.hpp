@@ -401,6 +401,13 @@ class SoilFlow {
     height_m = float(std::clamp(double(height_m) + delta_m, 0.0, std::max(double(ceiling_m_), double(height_m))));
   }
   void run_passes(HeightGrid& grid, SoilStepResult& out);
+  /// The soil above the repose cone through each end of the edge `to`
+  /// slides round it, down to the cells under the cone (soil_ends.cpp).
+  void spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepResult& out);
+  std::vector<std::uint8_t> ends_state_;  // spill_round_ends' window: per cell, 0 unseen, 1 donor, 2 receiver, 3 neither
+  std::vector<float> ends_key_;           // its cells' distances to the tip
+  std::vector<std::pair<double, int>> ends_keys_;
+  std::vector<std::int32_t> ends_queue_;
   /// v rounded to a multiple of the relaxation's quantum, as a float: the
   /// heights it writes and the amounts it moves, so that a cell's sum over
   /// a pass is exact whatever the order of its sources (quantum_m_).
