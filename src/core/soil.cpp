@@ -248,6 +248,8 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     run_passes(grid, out);
     clear_blade();
   }
+  out.pair_checks += ends_work_;  // (no pass ran)
+  ends_work_ = 0;
   out.backlog_cells = active_cells();
   return out;
 }

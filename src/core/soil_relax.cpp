@@ -332,7 +332,9 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   // from until all its cells are examined), so a collapse of any size is
   // spread over ticks of bounded work.
   const std::int64_t cap = params_.max_pair_checks_per_step;
-  std::int64_t work = 0;
+  // What the spill round the blade's ends spent this step counts too.
+  std::int64_t work = ends_work_;
+  ends_work_ = 0;
   // A pass left over from an earlier step was examined against the blade,
   // hull and bodies of that step.
   pass_spans_steps_ = !active_.empty();

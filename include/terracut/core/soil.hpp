@@ -404,8 +404,13 @@ class SoilFlow {
   /// The soil above the repose cone through each end of the edge `to`
   /// slides round it, down to the cells under the cone (soil_ends.cpp).
   void spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepResult& out);
-  std::vector<std::uint8_t> ends_state_;  // spill_round_ends' window: per cell, 0 unseen, 1 donor, 2 receiver, 3 neither
-  std::vector<float> ends_key_;           // its cells' distances to the tip
+  // spill_round_ends' window round a tip, per cell: where it lies, its
+  // distance to the tip, and donor / receiver in the round.
+  std::vector<std::uint8_t> ends_place_;
+  std::vector<float> ends_dist_;
+  std::vector<std::uint8_t> ends_state_;
+  double ends_s_[2] = {0.0, 0.0};  // each end's cone height at the last call
+  std::int64_t ends_work_ = 0;     // visits spill_round_ends spent this step (charged to the cap by run_passes)
   std::vector<std::pair<double, int>> ends_keys_;
   std::vector<std::int32_t> ends_queue_;
   /// v rounded to a multiple of the relaxation's quantum, as a float: the
