@@ -6,7 +6,6 @@
 #include "terracut/core/soil.hpp"
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -225,10 +224,9 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     if (mx * opening.x + mz * opening.z > 0.0) room = std::max(0.0, holds - load_m3_);
   }
   displace(grid, from, to, room, out);
-  {
-    static const bool ends = [] { const char* e = std::getenv("TERRACUT_ENDS"); return !e || e[0] != '0'; }();
-    if (ends && !blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0) spill_round_ends(grid, to, out);
-  }
+  // What the push left above the repose cone through an end of the blade
+  // goes round it now (the bucket's ends are its side plates: not yet).
+  if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0) spill_round_ends(grid, to, out);
   load_m3_ += out.bucket_in_m3;
   if (load_m3_ > holds && blade_spec_.bucket.enabled()) {
     pour(grid, to, load_m3_ - holds, out);
