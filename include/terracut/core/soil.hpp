@@ -57,6 +57,12 @@
 // collapse is spread over ticks of bounded work.
 // A step with nothing active costs microseconds: the blade is marked only when a pass runs.
 //
+// Each step that displaces soil, what stands above the repose cone through
+// an end of the blade's edge slides round that end at once (the soil's
+// spill into the trench's corner and the pile's hip, built rather than
+// relaxed over hundreds of passes; docs/soil.md "The spill round the
+// blade's ends"); its work counts against the same cap.
+//
 // A bucket (BladeSpec::bucket) takes what its lip cuts while it digs
 // forward (toward its opening), up to what it can hold in its present
 // orientation; the rest is displaced ahead as from a blade. What it holds is
