@@ -151,6 +151,18 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
     dirty_.reserve(footprint + hull);
   }
 
+  if (!blade.bucket.enabled()) {
+    // spill_round_ends' window round each end, and its sets (at most the
+    // window's cells).
+    const std::size_t window = std::size_t(2 * kEndWindowCells + 1) * std::size_t(2 * kEndWindowCells + 1);
+    ends_place_.assign(window, 0);
+    ends_dist_.assign(window, 0.0f);
+    ends_state_.assign(window, 0);
+    ends_keys_.reserve(window);
+    ends_queue_.reserve(window);
+    touch_reserved(ends_keys_);
+    touch_reserved(ends_queue_);
+  }
   for (auto* v : {&before_, &after_cut_}) touch_reserved(*v);
   for (auto* v : {&marked_, &held_, &dirty_, &hull_cells_}) touch_reserved(*v);
   touch_reserved(fluxes_);

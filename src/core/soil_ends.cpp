@@ -64,25 +64,37 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
   const double half = 0.5 * (std::abs(ez) * dx_ + std::abs(ex) * dz_) / len;
   const double slope = std::tan(params_.material.repose_deg * std::numbers::pi / 180.0);
   const double diag = std::hypot(dx_, dz_);
-  const double seed_reach = 1.5 * std::max(dx_, dz_);
   float* h = grid.edit_layers().height_m;
   constexpr int radius = kEndWindowCells;
   constexpr int side = 2 * radius + 1;
   constexpr std::uint8_t kUnknown = 0, kOff = 1, kPlus = 2, kMinus = 3;
   constexpr std::uint8_t kDonor = 1, kReceiver = 2;
-  ends_place_.resize(std::size_t(side) * side);
-  ends_dist_.resize(std::size_t(side) * side);
-  ends_state_.resize(std::size_t(side) * side);
+  // (Sized at construction: a 1 kHz tick allocates nothing.)
   for (int end = 0; end < 2; ++end) {
+    // The apex: the first cell past this end of the edge (its centre beyond
+    // the edge's span, outside the blade), through which every path round
+    // the end passes. Distances are counted from its centre along the
+    // 8-neighbour stencil's octagonal norm, so a cone in them stands at the
+    // repose limit of every pair of neighbours and no steeper, and a cell on
+    // one side and one on the other stand no further apart than their
+    // stencil path round the end allows. No such cell (the end at the
+    // grid's edge, in a body): no way round.
     const Vec3& tip = end == 0 ? to.a : to.b;
-    const int wc0 = int(std::floor(to_cells(tip.x, spec.origin_m.x, dx_))) - radius;
-    const int wr0 = int(std::floor(to_cells(tip.z, spec.origin_m.z, dz_))) - radius;
+    const double out_x = (end == 0 ? -ex : ex) / len, out_z = (end == 0 ? -ez : ez) / len;
+    int apex_c = -1, apex_r = -1;
+    for (double reach = 0.5; reach <= 2.0 && apex_c < 0; reach += 0.5) {
+      const double px = tip.x + out_x * reach * std::min(dx_, dz_), pz = tip.z + out_z * reach * std::min(dx_, dz_);
+      const int c = int(std::floor(to_cells(px, spec.origin_m.x, dx_))), r = int(std::floor(to_cells(pz, spec.origin_m.z, dz_)));
+      if (c < 0 || r < 0 || c >= cols_ || r >= rows_) break;
+      const double t = ((spec.origin_m.x + (c + 0.5) * dx_ - to.a.x) * ex + (spec.origin_m.z + (r + 0.5) * dz_ - to.a.z) * ez) / len2;
+      if (end == 0 ? t < 0.0 : t > 1.0) apex_c = c, apex_r = r;
+    }
+    if (apex_c < 0) continue;
+    const int wc0 = apex_c - radius, wr0 = apex_r - radius;
     std::fill(ends_place_.begin(), ends_place_.end(), kUnknown);
     // Where window cell w lies, found once a call: off (beyond the grid,
     // under a body, inside the blade, or nearer the other end) or on one
-    // side of the edge's line; its distance to the tip along the
-    // 8-neighbour stencil's octagonal norm (the cone it spans stands at the
-    // repose limit of every pair of cells, and no steeper).
+    // side of the edge's line; and its distance to the apex.
     const auto place = [&](int w) -> std::uint8_t {
       std::uint8_t& p = ends_place_[std::size_t(w)];
       if (p != kUnknown) return p;
@@ -94,8 +106,9 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
       if (end == 0 ? !(t < 0.5) : !(t > 0.5)) return p;
       const double n = (ex * (z - to.a.z) - ez * (x - to.a.x)) / len;
       if (std::abs(n) < half && t >= 0.0 && t <= 1.0) return p;
-      const double ux = std::abs(x - tip.x) / dx_, uz = std::abs(z - tip.z) / dz_;
-      ends_dist_[std::size_t(w)] = float(ux >= uz ? (ux - uz) * dx_ + uz * diag : (uz - ux) * dz_ + ux * diag);
+      const int uc = std::abs(w % side - radius), ur = std::abs(w / side - radius);
+      ends_dist_[std::size_t(w)] =
+          float(uc >= ur ? (uc - ur) * dx_ + ur * diag : (ur - uc) * dz_ + uc * diag);
       p = n > 0.0 ? kPlus : kMinus;
       return p;
     };
@@ -112,39 +125,24 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
       const double t = ((xa + (xb - xa) * u) * ex + (za + (zb - za) * u) * ez) / len2;
       return t >= 0.0 && t <= 1.0;
     };
-    // The seeds: the cells round the tip. The soil can go round only if
-    // they are one piece (the grid's edge or a body at the tip closes the
-    // way); the upper cone's height s lies between their heights less and
-    // more their cone's drop.
-    std::int32_t seeds[25];
+    // The seeds: the apex and its neighbours that soil can reach from it;
+    // the upper cone's height s lies between their heights less and more
+    // their cone's drop.
+    const int apex = radius * side + radius;
+    if (place(apex) == kOff) continue;
+    std::int32_t seeds[9];
     int n_seeds = 0;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (int lr = radius - 2; lr <= radius + 2; ++lr)
-      for (int lc = radius - 2; lc <= radius + 2; ++lc) {
-        const int w = lr * side + lc;
-        if (place(w) == kOff || ends_dist_[std::size_t(w)] > seed_reach) continue;
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc) {
+        const int w = apex + dr * side + dc;
+        if (place(w) == kOff || (w != apex && blocked(apex, w))) continue;
         seeds[n_seeds++] = w;
-        const double hw = h[std::int64_t(wr0 + lr) * cols_ + wc0 + lc], d = ends_dist_[std::size_t(w)];
+        const double hw = h[std::int64_t(wr0 + w / side) * cols_ + wc0 + w % side], d = ends_dist_[std::size_t(w)];
         lo = std::min(lo, hw + slope * d);
         hi = std::max(hi, hw - slope * d);
       }
-    if (n_seeds == 0 || !(hi > lo)) continue;  // the tip stands at rest
-    {
-      bool reached[25] = {true};
-      int stack[25], top = 0, count = 1;
-      stack[top++] = 0;
-      while (top > 0) {
-        const int p = stack[--top];
-        for (int q = 0; q < n_seeds; ++q) {
-          const int dc = seeds[q] % side - seeds[p] % side, dr = seeds[q] / side - seeds[p] / side;
-          if (reached[q] || std::abs(dc) > 1 || std::abs(dr) > 1 || blocked(seeds[p], seeds[q])) continue;
-          reached[q] = true;
-          stack[top++] = q;
-          ++count;
-        }
-      }
-      if (count != n_seeds) continue;
-    }
+    if (!(hi > lo)) continue;  // the end stands at rest
     // Rounds: the donors (above the upper cone through s, s + slope d) and
     // the receivers (below the lower one, s - slope d), each connected to
     // the seeds through its own kind; then s balancing what they give and
