@@ -204,7 +204,11 @@ TEST(HapticLoop, ScriptTrenchForcesFollowTheContact) {
         const double x = spec.origin_m.x + (col + 0.5) * spec.cell_x_m();
         if (std::abs(x) > 0.2 && std::abs(x) < 0.4) berm = std::max(berm, h(row, col));
       }
-      EXPECT_GT(berm, 0.3 + cell * tan_repose) << "z = " << z;
+      // (Half a cell's rise: the spill round the blade's ends is built at
+      // each step, docs/soil.md, and more of it lands in the trench's
+      // corner than the pass-by-pass spill put there: the windrows stand
+      // about 5 mm lower, 1.3 cm above the sand where the trench begins.)
+      EXPECT_GT(berm, 0.3 + 0.5 * cell * tan_repose) << "z = " << z;
     }
     for (int col = 0; col < spec.cols; ++col) {
       if (h(row, col) > top_h) {
