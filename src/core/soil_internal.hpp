@@ -51,7 +51,8 @@ inline constexpr int kMaxExtraRounds = 2;
 inline constexpr std::int64_t kMostExamineVisits = 8 + 8 * kMaxFallCells * (1 + kMaxExtraRounds);
 static_assert(kMostExamineVisits <= 1000);
 /// The window round each end of the blade that spill_round_ends builds
-/// in: this many cells each way from the tip.
+/// in: this many cells each way from the end's apex (24 cm on 5 mm cells;
+/// sets that reach its border stop there, and the passes do the rest).
 inline constexpr int kEndWindowCells = 48;
 /// Rounds of spill_round_ends' search for the cone's height (each finds the
 /// sets for the last height and solves the balance over them).

@@ -410,15 +410,16 @@ class SoilFlow {
   /// The soil above the repose cone through each end of the edge `to`
   /// slides round it, down to the cells under the cone (soil_ends.cpp).
   void spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepResult& out);
-  // spill_round_ends' window round a tip, per cell: where it lies, its
-  // distance to the tip, and donor / receiver in the round.
+  // spill_round_ends' window round an end's apex (the first cell past it),
+  // per cell: where it lies, its distance to the apex, and donor / receiver
+  // in the round; sized at construction.
   std::vector<std::uint8_t> ends_place_;
   std::vector<float> ends_dist_;
   std::vector<std::uint8_t> ends_state_;
   double ends_s_[2] = {0.0, 0.0};  // each end's cone height at the last call
   std::int64_t ends_work_ = 0;     // visits spill_round_ends spent this step (charged to the cap by run_passes)
-  std::vector<std::pair<double, int>> ends_keys_;
-  std::vector<std::int32_t> ends_queue_;
+  std::vector<std::pair<double, int>> ends_keys_;  // the round's donors' and receivers' cone keys
+  std::vector<std::int32_t> ends_queue_;           // the round's sets, window cells in the order found
   /// v rounded to a multiple of the relaxation's quantum, as a float: the
   /// heights it writes and the amounts it moves, so that a cell's sum over
   /// a pass is exact whatever the order of its sources (quantum_m_).
