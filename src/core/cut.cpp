@@ -1169,6 +1169,28 @@ bool setup_oblique_columns(const GridFrame& f, const Parallelogram& p, ColumnsOb
   return true;
 }
 
+/// Rows ahead of the columns band whose cells are asked for, where the band
+/// is steep (its bounds moving at most kColumnWalkMaxSlope columns a row).
+/// There a row's cells are one cache line, the next row's 4 * cols bytes
+/// further; on a power-of-two side those lines share few L1 and L2 sets, so
+/// the column the band walks does not stay in the caches from one step to
+/// the next, and each row waited on L3 for its load (59 % of the yaw-90
+/// columns cut in a profile). Measured on the direction benchmark's
+/// geometry (4096^2, columns cut): yaw 90 71.7 -> 53.0 us with 8 rows, 53.9
+/// with 16, 54.2 with 32 (to L2); yaw 82 48.3 -> 46.6 us; yaw 45 (not
+/// steep) 42.8 -> 43.2 us, so it is left out there.
+constexpr int kBandAheadRows = 8;
+
+/// A hint to fetch the cache line at p for writing, into L1 (no effect on
+/// results; prefetches never fault).
+inline void prefetch_write(const float* p) {
+#if defined(__GNUC__)
+  __builtin_prefetch(p, 1, 3);
+#else
+  (void)p;
+#endif
+}
+
 /// Rows of the columns band spanning about this many cells or more are
 /// lowered four cells at a time (SSE2); narrower ones cell by cell.
 constexpr double kWideRowCells = 4.0;
@@ -1287,6 +1309,7 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
   const double row_cells = std::abs(hi_u + (double(band_r0) - hi_r) * hi_k - (lo_u + (double(band_r0) - lo_r) * lo_k)) +
                            std::max(std::abs(lo_k), std::abs(hi_k)) + 1.0;
   const bool wide_rows = row_cells >= kWideRowCells;
+  const bool steep = std::abs(lo_k) <= kColumnWalkMaxSlope && std::abs(hi_k) <= kColumnWalkMaxSlope;
   for (int r = band_r0; r <= band_r1; ++r) {
     const double va = double(r), vb = double(r) + 1.0;  // inside [vmin, vmax]
     const double u_lo_b = lo_u + (vb - lo_r) * lo_k, u_hi_b = hi_u + (vb - hi_r) * hi_k;
@@ -1310,6 +1333,10 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
     const int c_hi = floor_clamped(umax, -1, f.cols - 1);
     if (c_lo > c_hi) continue;
     float* const cells = height + grid.index(0, r);
+    if (steep && r + kBandAheadRows <= band_r1) {
+      const int c_ahead = std::clamp(c_lo + int(kBandAheadRows * lo_k), 0, f.cols - 1);
+      prefetch_write(cells + std::int64_t(kBandAheadRows) * f.cols + c_ahead);
+    }
     RowChange change;
     change.visited = c_hi - c_lo + 1;
 #if defined(__SSE2__) && defined(__GNUC__)
