@@ -77,21 +77,12 @@ inline void lower_one(const HeightGrid::EditLayers& layers, std::int64_t row, in
 /// unchanged), and a drop of +0 leaves the sum's bits as they are: the
 /// values of lower_one, bit for bit.
 inline void lower_one_unbranched(float* row, int c, float t, RowChange& change) {
-#if defined(__SSE2__)
-  const __m128 told = _mm_load_ss(row + c);
-  const __m128 th = _mm_max_ss(_mm_set_ss(t), _mm_setzero_ps());
-  const __m128 tnow = _mm_min_ss(th, told);
-  _mm_store_ss(row + c, tnow);
-  const float old = _mm_cvtss_f32(told), now = _mm_cvtss_f32(tnow);
-  const int lowered = _mm_comilt_ss(tnow, told);
-#else
   const float h = t > 0.0f ? t : 0.0f;
   const float old = row[c];
   const float now = h < old ? h : old;
   row[c] = now;
-  const bool lowered = now < old;
-#endif
   change.removed_m += double(old - now);
+  const bool lowered = now < old;
   change.first = lowered && change.first < 0 ? c : change.first;
   change.last = lowered ? c : change.last;
 }
@@ -1191,10 +1182,6 @@ inline void prefetch_write(const float* p) {
 #endif
 }
 
-/// Rows of the columns band spanning about this many cells or more are
-/// lowered four cells at a time (SSE2); narrower ones cell by cell.
-constexpr double kWideRowCells = 4.0;
-
 void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsOblique& w, CutBook& book) {
   CutBook rows;  // a local, so that its fields stay in registers
   const HeightGrid::EditLayers layers = grid.edit_layers();
@@ -1304,11 +1291,6 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
   y_lo_a = corner_y(u_lo_a, double(band_r0));
   y_hi_a = corner_y(u_hi_a, double(band_r0));
   float* const height = layers.height_m;
-  // Cells a row of the band spans, about: its section's width, the bounds'
-  // shift over the row, and a cell for the ends.
-  const double row_cells = std::abs(hi_u + (double(band_r0) - hi_r) * hi_k - (lo_u + (double(band_r0) - lo_r) * lo_k)) +
-                           std::max(std::abs(lo_k), std::abs(hi_k)) + 1.0;
-  const bool wide_rows = row_cells >= kWideRowCells;
   const bool steep = std::abs(lo_k) <= kColumnWalkMaxSlope && std::abs(hi_k) <= kColumnWalkMaxSlope;
   for (int r = band_r0; r <= band_r1; ++r) {
     const double va = double(r), vb = double(r) + 1.0;  // inside [vmin, vmax]
@@ -1339,60 +1321,6 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
     }
     RowChange change;
     change.visited = c_hi - c_lo + 1;
-#if defined(__SSE2__) && defined(__GNUC__)
-    if (wide_rows && c_lo + 4 * ((c_hi - c_lo) / 4) + 3 < f.cols) {
-      const __m128d va2 = _mm_set1_pd(va), vb2 = _mm_set1_pd(vb);
-      const __m128d cv2 = _mm_set1_pd(chain_v), cu2 = _mm_set1_pd(chain_u), ck2 = _mm_set1_pd(chain_k);
-      const __m128d y02 = _mm_set1_pd(y0), gu2 = _mm_set1_pd(gu), gv2 = _mm_set1_pd(gv);
-      const __m128d us2 = _mm_set1_pd(u_star), ym2 = _mm_set1_pd(y_min), one2 = _mm_set1_pd(1.0);
-      // chord_min at U for both lanes: the same operations in the same order.
-      auto chord2 = [&](__m128d U) {
-        const __m128d chain_at = _mm_add_pd(cv2, _mm_mul_pd(_mm_sub_pd(U, cu2), ck2));
-        const __m128d v = low_end ? _mm_max_pd(chain_at, va2) : _mm_min_pd(chain_at, vb2);
-        return _mm_add_pd(_mm_add_pd(y02, _mm_mul_pd(gu2, U)), _mm_mul_pd(gv2, v));
-      };
-      // The cell's lowest point: u_star < c ? left : c + 1 < u_star ? right : y_min.
-      auto lowest2 = [&](__m128d cd, __m128d left, __m128d right) {
-        const __m128d is_left = _mm_cmplt_pd(us2, cd), is_right = _mm_cmplt_pd(_mm_add_pd(cd, one2), us2);
-        const __m128d inner = _mm_or_pd(_mm_and_pd(is_right, right), _mm_andnot_pd(is_right, ym2));
-        return _mm_or_pd(_mm_and_pd(is_left, left), _mm_andnot_pd(is_left, inner));
-      };
-      const __m128 zero = _mm_setzero_ps();
-      for (int cw = c_lo; cw <= c_hi; cw += 4) {
-        const int n = std::min(4, c_hi - cw + 1);
-        const __m128d k01 = _mm_set_pd(double(cw) + 1.0, double(cw));
-        const __m128d k23 = _mm_set_pd(double(cw) + 3.0, double(cw) + 2.0);
-        const __m128d k45 = _mm_set_pd(double(cw) + 5.0, double(cw) + 4.0);
-        const __m128d ch01 = chord2(k01), ch23 = chord2(k23), ch4 = chord2(k45);
-        const __m128d ch12 = _mm_shuffle_pd(ch01, ch23, 1), ch34 = _mm_shuffle_pd(ch23, ch4, 1);
-        const __m128d low01 = lowest2(k01, ch01, ch12), low23 = lowest2(k23, ch23, ch34);
-        const __m128 t = _mm_movelh_ps(_mm_cvtpd_ps(low01), _mm_cvtpd_ps(low23));
-        // lower_one on each of the n cells, the other lanes stored back as they were.
-        const __m128 old = _mm_loadu_ps(cells + cw);
-        const __m128 lowered = _mm_min_ps(_mm_max_ps(t, zero), old);
-        static const std::int32_t kLanes[8] = {-1, -1, -1, -1, 0, 0, 0, 0};
-        const __m128 in = _mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(kLanes + 4 - n)));
-        const __m128 now = _mm_or_ps(_mm_and_ps(in, lowered), _mm_andnot_ps(in, old));
-        _mm_storeu_ps(cells + cw, now);
-        const int bits = _mm_movemask_ps(_mm_cmplt_ps(now, old));
-        // The drops summed in cell order, +0 where unchanged (as lower_one_unbranched).
-        const __m128 drop = _mm_sub_ps(old, now);
-        const __m128d d01 = _mm_cvtps_pd(drop), d23 = _mm_cvtps_pd(_mm_movehl_ps(drop, drop));
-        double sum = change.removed_m;
-        sum += _mm_cvtsd_f64(d01);
-        sum += _mm_cvtsd_f64(_mm_unpackhi_pd(d01, d01));
-        sum += _mm_cvtsd_f64(d23);
-        sum += _mm_cvtsd_f64(_mm_unpackhi_pd(d23, d23));
-        change.removed_m = sum;
-        if (bits != 0) {
-          if (change.first < 0) change.first = cw + __builtin_ctz(unsigned(bits));
-          change.last = cw + 31 - __builtin_clz(unsigned(bits));
-        }
-      }
-      rows.add(r, change);
-      continue;
-    }
-#endif
     double left = chord_min(double(c_lo));
     for (int c = c_lo; c <= c_hi; ++c) {
       const double cd = double(c);
