@@ -217,14 +217,21 @@ inline void prefetch_l2(const float* p) {
 
 /// Columns ahead of the surface's fast walk along the columns (z-major) whose
 /// nodes it asks for, column by column, besides the chunks' prefetch. A
-/// blade within a few degrees of the columns reads one or two cache lines a
+/// blade within 45 degrees of the columns reads one or two cache lines a
 /// row, 4 * cols bytes apart; on a power-of-two side those lines fall into
-/// few L1 and L2 sets, so the lines the chunk's prefetch brought in evicted
-/// one another before they were read, and each row waited on L3. Measured
-/// (direction benchmark's geometry, 4096^2, surface contact): yaw 90 22.5
-/// -> 18.0 us, yaw 82 12.3 -> 10.0 us, yaw 45 unchanged; the same in the
-/// columns walk made yaw 90 slower (14.3 -> 16 us) and is not done.
+/// few L1 and L2 sets, so the lines a chunk's prefetch brought in evicted
+/// one another before they were read, and rows waited on L3. Measured on the
+/// direction benchmark (`terracut_bench --benchmark_filter=direction/`,
+/// 4096^2, surface contact p50): yaw 53 12.6 -> 9.5 us, 60 14.0 -> 10.0,
+/// 75 13.8 -> 9.8, 82 13.7 -> 9.2, 89 25.4 -> 15.9, 90 24.2 -> 15.5; 8, 12
+/// and 16 columns ahead measured within a microsecond of 24.
 constexpr int kAheadRows = 24;
+
+/// The same for the columns' fast walk: 8 columns ahead, into L1. Measured on
+/// the direction benchmark (4096^2, columns contact): yaw 53 10.1 -> 8.3 us,
+/// 60 10.2 -> 8.1, 75 13.3 -> 8.0, 82 11.4 -> 8.3, 89 15.5 -> 14.7, 90 13.8
+/// -> 14.7 (24 columns ahead to L2: 8.0 to 8.8 us at 53 to 82).
+constexpr int kAheadCellRows = 8;
 
 /// Columns per chunk of the fast walks. Pieces that enter or leave material
 /// are queued (at most four per column) and added after each chunk, so the
@@ -280,6 +287,7 @@ std::int64_t columns_full(const float* h, const Line& l, int p_first, int p_end,
   const float* cell = h + p_first * sp + std::int64_t(Q) * sq;
   Pending pending[kMaxPending];
   std::int64_t visited = 0;
+  const bool rows_apart = sp != 1;  // along the columns (z-major): see kAheadCellRows
   prefetch_columns(h, l, p_first, std::min(p_end, p_first + kChunkColumns), q_in);
   for (int chunk = p_first; chunk < p_end; chunk += kChunkColumns) {
     int chunk_end = std::min(p_end, chunk + kChunkColumns);
@@ -298,6 +306,10 @@ std::int64_t columns_full(const float* h, const Line& l, int p_first, int p_end,
     constexpr bool pairs = kPairs;
 #endif
     for (int P = chunk; P < chunk_end; ++P) {
+      if (rows_apart && P + kAheadCellRows + 1 < p_end) {
+        prefetch(cell + kAheadCellRows * sp);
+        prefetch(cell + (kAheadCellRows + 1) * sp);
+      }
 #if defined(__SSE2__)
       // Two one-cell columns at once, in SSE2 lanes (the same arithmetic as
       // the one-cell branch below, per lane).

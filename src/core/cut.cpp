@@ -1166,10 +1166,11 @@ bool setup_oblique_columns(const GridFrame& f, const Parallelogram& p, ColumnsOb
 /// further; on a power-of-two side those lines share few L1 and L2 sets, so
 /// the column the band walks does not stay in the caches from one step to
 /// the next, and each row waited on L3 for its load (59 % of the yaw-90
-/// columns cut in a profile). Measured on the direction benchmark's
-/// geometry (4096^2, columns cut): yaw 90 71.7 -> 53.0 us with 8 rows, 53.9
-/// with 16, 54.2 with 32 (to L2); yaw 82 48.3 -> 46.6 us; yaw 45 (not
-/// steep) 42.8 -> 43.2 us, so it is left out there.
+/// columns cut in a profile). Measured on the direction benchmark
+/// (`terracut_bench --benchmark_filter=direction/`, 4096^2, columns cut
+/// p50): yaw 89 58.7 -> 46.1 us, 90 65.8 -> 50.6 us; in a loop of contact
+/// and cut alone, 16 and 32 rows ahead (to L2) were within 1.2 us of 8, and
+/// at yaw 45 (not steep) it gained nothing (42.8 -> 43.2 us).
 constexpr int kBandAheadRows = 8;
 
 /// A hint to fetch the cache line at p for writing, into L1 (no effect on
