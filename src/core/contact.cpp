@@ -227,10 +227,13 @@ inline void prefetch_l2(const float* p) {
 /// and 16 columns ahead measured within a microsecond of 24.
 constexpr int kAheadRows = 24;
 
-/// The same for the columns' fast walk: 8 columns ahead, into L1. Measured on
-/// the direction benchmark (4096^2, columns contact): yaw 53 10.1 -> 8.3 us,
-/// 60 10.2 -> 8.1, 75 13.3 -> 8.0, 82 11.4 -> 8.3, 89 15.5 -> 14.7, 90 13.8
-/// -> 14.7 (24 columns ahead to L2: 8.0 to 8.8 us at 53 to 82).
+/// The same for the columns' fast walk: 8 columns ahead, into L1, where the
+/// edge is off the columns by more than 1 in 64. Measured on the direction
+/// benchmark (4096^2, columns contact p50): yaw 53 10.6 -> 8.2 us, 60 10.7
+/// -> 8.0, 75 11.4 -> 7.8, 82 11.0 -> 8.1, 89 14.7 -> 15.2 (24 columns
+/// ahead to L2: 8.0 to 8.8 us at 53 to 82). At yaw 90 (an edge along the
+/// columns, where the chunks' prefetch finds every line) it took 13.4 to
+/// 16.1-17.2 us, hence the limit.
 constexpr int kAheadCellRows = 8;
 
 /// Columns per chunk of the fast walks. Pieces that enter or leave material
@@ -287,7 +290,9 @@ std::int64_t columns_full(const float* h, const Line& l, int p_first, int p_end,
   const float* cell = h + p_first * sp + std::int64_t(Q) * sq;
   Pending pending[kMaxPending];
   std::int64_t visited = 0;
-  const bool rows_apart = sp != 1;  // along the columns (z-major): see kAheadCellRows
+  // Along the columns (z-major), the edge off them by more than 1 in 64: see
+  // kAheadCellRows.
+  const bool rows_apart = sp != 1 && std::abs(r) > 1.0 / 64.0;
   prefetch_columns(h, l, p_first, std::min(p_end, p_first + kChunkColumns), q_in);
   for (int chunk = p_first; chunk < p_end; chunk += kChunkColumns) {
     int chunk_end = std::min(p_end, chunk + kChunkColumns);
