@@ -222,18 +222,19 @@ inline void prefetch_l2(const float* p) {
 /// few L1 and L2 sets, so the lines a chunk's prefetch brought in evicted
 /// one another before they were read, and rows waited on L3. Measured on the
 /// direction benchmark (`terracut_bench --benchmark_filter=direction/`,
-/// 4096^2, surface contact p50): yaw 53 12.6 -> 9.5 us, 60 14.0 -> 10.0,
-/// 75 13.8 -> 9.8, 82 13.7 -> 9.2, 89 25.4 -> 15.9, 90 24.2 -> 15.5; 8, 12
-/// and 16 columns ahead measured within a microsecond of 24.
+/// 4096^2, surface contact p50, docs/bench/direction.md): yaw 53 12.4 ->
+/// 9.3 us, 60 13.5 -> 9.9, 75 13.5 -> 9.9, 82 13.0 -> 9.0, 89 24.1 -> 16.0,
+/// 90 23.5 -> 15.5; 8, 12 and 16 columns ahead measured within a
+/// microsecond of 24.
 constexpr int kAheadRows = 24;
 
 /// The same for the columns' fast walk: 8 columns ahead, into L1, where the
 /// edge is off the columns by more than 1 in 64. Measured on the direction
-/// benchmark (4096^2, columns contact p50): yaw 53 10.6 -> 8.2 us, 60 10.7
-/// -> 8.0, 75 11.4 -> 7.8, 82 11.0 -> 8.1, 89 14.7 -> 15.2 (24 columns
+/// benchmark (4096^2, columns contact p50): yaw 53 10.7 -> 8.1 us, 60 10.7
+/// -> 7.9, 75 11.4 -> 7.8, 82 10.8 -> 8.1, 89 14.6 -> 15.5 (24 columns
 /// ahead to L2: 8.0 to 8.8 us at 53 to 82). At yaw 90 (an edge along the
 /// columns, where the chunks' prefetch finds every line) it took 13.4 to
-/// 16.1-17.2 us, hence the limit.
+/// 16.1-17.2 us, hence the limit (13.6 -> 14.1 us with it).
 constexpr int kAheadCellRows = 8;
 
 /// Columns per chunk of the fast walks. Pieces that enter or leave material

@@ -1169,7 +1169,7 @@ bool setup_oblique_columns(const GridFrame& f, const Parallelogram& p, ColumnsOb
 /// the next, and each row waited on L3 for its load (59 % of the yaw-90
 /// columns cut in a profile). Measured on the direction benchmark
 /// (`terracut_bench --benchmark_filter=direction/`, 4096^2, columns cut
-/// p50): yaw 89 58.7 -> 46.1 us, 90 65.8 -> 50.6 us; in a loop of contact
+/// p50): yaw 89 57.7 -> 45.7 us, 90 64.9 -> 50.4 us; in a loop of contact
 /// and cut alone, 16 and 32 rows ahead (to L2) were within 1.2 us of 8, and
 /// at yaw 45 (not steep) it gained nothing (42.8 -> 43.2 us).
 constexpr int kBandAheadRows = 8;
