@@ -206,6 +206,37 @@ struct Pending {
   double s0, s1, d0, d1;
 };
 
+/// A hint to fetch the cache line at p into L2 (and not L1).
+inline void prefetch_l2(const float* p) {
+#if defined(__GNUC__)
+  __builtin_prefetch(p, 0, 2);
+#else
+  (void)p;
+#endif
+}
+
+/// Columns ahead of the surface's fast walk along the columns (z-major) whose
+/// nodes it asks for, column by column, besides the chunks' prefetch. A
+/// blade within 45 degrees of the columns reads one or two cache lines a
+/// row, 4 * cols bytes apart; on a power-of-two side those lines fall into
+/// few L1 and L2 sets, so the lines a chunk's prefetch brought in evicted
+/// one another before they were read, and rows waited on L3. Measured on the
+/// direction benchmark (`terracut_bench --benchmark_filter=direction/`,
+/// 4096^2, surface contact p50, docs/bench/direction.md): yaw 53 12.4 ->
+/// 9.3 us, 60 13.5 -> 9.9, 75 13.5 -> 9.9, 82 13.0 -> 9.0, 89 24.1 -> 16.0,
+/// 90 23.5 -> 15.5; 8, 12 and 16 columns ahead measured within a
+/// microsecond of 24.
+constexpr int kAheadRows = 24;
+
+/// The same for the columns' fast walk: 8 columns ahead, into L1, where the
+/// edge is off the columns by more than 1 in 64. Measured on the direction
+/// benchmark (4096^2, columns contact p50): yaw 53 10.7 -> 8.1 us, 60 10.7
+/// -> 7.9, 75 11.4 -> 7.8, 82 10.8 -> 8.1, 89 14.6 -> 15.5 (24 columns
+/// ahead to L2: 8.0 to 8.8 us at 53 to 82). At yaw 90 (an edge along the
+/// columns, where the chunks' prefetch finds every line) it took 13.4 to
+/// 16.1-17.2 us, hence the limit (13.6 -> 14.1 us with it).
+constexpr int kAheadCellRows = 8;
+
 /// Columns per chunk of the fast walks. Pieces that enter or leave material
 /// are queued (at most four per column) and added after each chunk, so the
 /// walks' loops make no calls and keep their sums in registers (every SSE
@@ -260,6 +291,9 @@ std::int64_t columns_full(const float* h, const Line& l, int p_first, int p_end,
   const float* cell = h + p_first * sp + std::int64_t(Q) * sq;
   Pending pending[kMaxPending];
   std::int64_t visited = 0;
+  // Along the columns (z-major), the edge off them by more than 1 in 64: see
+  // kAheadCellRows.
+  const bool rows_apart = sp != 1 && std::abs(r) > 1.0 / 64.0;
   prefetch_columns(h, l, p_first, std::min(p_end, p_first + kChunkColumns), q_in);
   for (int chunk = p_first; chunk < p_end; chunk += kChunkColumns) {
     int chunk_end = std::min(p_end, chunk + kChunkColumns);
@@ -278,6 +312,10 @@ std::int64_t columns_full(const float* h, const Line& l, int p_first, int p_end,
     constexpr bool pairs = kPairs;
 #endif
     for (int P = chunk; P < chunk_end; ++P) {
+      if (rows_apart && P + kAheadCellRows + 1 < p_end) {
+        prefetch(cell + kAheadCellRows * sp);
+        prefetch(cell + (kAheadCellRows + 1) * sp);
+      }
 #if defined(__SSE2__)
       // Two one-cell columns at once, in SSE2 lanes (the same arithmetic as
       // the one-cell branch below, per lane).
@@ -489,6 +527,9 @@ std::int64_t surface_columns(const float* h, const Line& l, int p_first, int p_e
   // Columns wholly in material are summed in a-units (each is 1 / dp long).
   Pending pending[kMaxPending];
   std::int64_t visited = 0;
+  // Walking along the columns (z-major), each column's nodes are a row
+  // apart: see kAheadRows.
+  const bool rows_apart = sp != 1;
   prefetch_columns(h, l, p_first, std::min(p_end, p_first + kChunkColumns), q_in);
   for (int chunk = p_first; chunk < p_end; chunk += kChunkColumns) {
     int chunk_end = std::min(p_end, chunk + kChunkColumns);
@@ -514,6 +555,10 @@ std::int64_t surface_columns(const float* h, const Line& l, int p_first, int p_e
     constexpr bool pairs = kPairs;
 #endif
     for (int P = chunk; P < chunk_end; ++P) {
+      if (rows_apart && P + kAheadRows + 1 < p_end) {
+        prefetch_l2(base + kAheadRows * sp);
+        prefetch_l2(base + (kAheadRows + 1) * sp);
+      }
 #if defined(__SSE2__)
       // Two one-square columns at once, in SSE2 lanes: the common case of a
       // blade inside material whose edge crosses no minor line for a while.
