@@ -152,16 +152,6 @@ inline std::int64_t traverse(const Line& l, double s_lo, double s_hi, int pmin, 
   return visited;
 }
 
-/// A hint to fetch the cache line at p (no effect on results; prefetches
-/// never fault).
-inline void prefetch(const float* p) {
-#if defined(__GNUC__)
-  __builtin_prefetch(p);
-#else
-  (void)p;
-#endif
-}
-
 /// Prefetches the nodes (rows Q and Q + 1) of columns [P0, P1) of the line
 /// l, given the minor coordinate q_at_P0 at column P0: one hint per cache
 /// line along a row (x-major) or per column (z-major). On a terrain larger
@@ -174,10 +164,10 @@ inline void prefetch_columns(const float* h, const Line& l, int P0, int P1, doub
   for (int P = P0; P < P1; P += stride) {
     int Q = std::clamp(int(q_at_P0 + r * (P - P0)), 1, l.nq - 3);
     const float* node = h + P * l.sp + std::int64_t(Q) * l.sq;
-    prefetch(node - l.sq);
-    prefetch(node);
-    prefetch(node + l.sq);
-    prefetch(node + 2 * l.sq);
+    detail::prefetch<>(node - l.sq);
+    detail::prefetch<>(node);
+    detail::prefetch<>(node + l.sq);
+    detail::prefetch<>(node + 2 * l.sq);
   }
 }
 
@@ -205,15 +195,6 @@ std::int64_t columns_general(const float* h, const Line& l, double sa, double sb
 struct Pending {
   double s0, s1, d0, d1;
 };
-
-/// A hint to fetch the cache line at p into L2 (and not L1).
-inline void prefetch_l2(const float* p) {
-#if defined(__GNUC__)
-  __builtin_prefetch(p, 0, 2);
-#else
-  (void)p;
-#endif
-}
 
 /// Columns ahead of the surface's fast walk along the columns (z-major) whose
 /// nodes it asks for, column by column, besides the chunks' prefetch. A
@@ -313,8 +294,8 @@ std::int64_t columns_full(const float* h, const Line& l, int p_first, int p_end,
 #endif
     for (int P = chunk; P < chunk_end; ++P) {
       if (rows_apart && P + kAheadCellRows + 1 < p_end) {
-        prefetch(cell + kAheadCellRows * sp);
-        prefetch(cell + (kAheadCellRows + 1) * sp);
+        detail::prefetch<>(cell + kAheadCellRows * sp);
+        detail::prefetch<>(cell + (kAheadCellRows + 1) * sp);
       }
 #if defined(__SSE2__)
       // Two one-cell columns at once, in SSE2 lanes (the same arithmetic as
@@ -556,8 +537,8 @@ std::int64_t surface_columns(const float* h, const Line& l, int p_first, int p_e
 #endif
     for (int P = chunk; P < chunk_end; ++P) {
       if (rows_apart && P + kAheadRows + 1 < p_end) {
-        prefetch_l2(base + kAheadRows * sp);
-        prefetch_l2(base + (kAheadRows + 1) * sp);
+        detail::prefetch<false, 2>(base + kAheadRows * sp);
+        detail::prefetch<false, 2>(base + (kAheadRows + 1) * sp);
       }
 #if defined(__SSE2__)
       // Two one-square columns at once, in SSE2 lanes: the common case of a

@@ -183,16 +183,6 @@ constexpr int kPrimeSamples = 1024;
 /// Spans up to this many samples are lowered by a plain inline loop.
 constexpr int kSmallSpan = 8;
 
-/// A hint to fetch the cache line at p (no effect on results; prefetches
-/// never fault).
-inline void prefetch(const float* p) {
-#if defined(__GNUC__)
-  __builtin_prefetch(p, 0, 2);
-#else
-  (void)p;
-#endif
-}
-
 /// Lowers samples c in [c_lo, c_hi] of row r to the targets that
 /// fill(c, n, t) writes for samples c .. c + n - 1 (metres above the ground,
 /// float; +inf leaves a sample as it is), kBatch at a time, and returns the
@@ -217,7 +207,7 @@ inline RowChange lower_row(HeightGrid& grid, int r, int c_lo, int c_hi, Fill&& f
   // Ask for the row's first cache lines at once, so that on a terrain
   // larger than the caches their misses overlap instead of queueing one
   // after the other (the hardware prefetcher takes long rows from there).
-  for (int c = c_lo; c <= std::min(c_hi, c_lo + kPrimeSamples - 1); c += 16) prefetch(height + c);
+  for (int c = c_lo; c <= std::min(c_hi, c_lo + kPrimeSamples - 1); c += 16) detail::prefetch<false, 2>(height + c);
   float t[kBatch];
   for (int c = c_lo; c <= c_hi; c += kBatch) {
     int n = std::min(kBatch, c_hi - c + 1);
@@ -237,7 +227,7 @@ inline RowChange lower_row_targets(HeightGrid& grid, int r, int c_lo, int c_hi, 
   const std::int64_t row = grid.index(0, r) + c_lo;
   float* height = grid.edit_layers().height_m + row;
   int n = c_hi - c_lo + 1;
-  for (int k = 0; k < std::min(n, kPrimeSamples); k += 16) prefetch(height + k);
+  for (int k = 0; k < std::min(n, kPrimeSamples); k += 16) detail::prefetch<false, 2>(height + k);
   SpanResult span = lower_span(height, targets, n);
   RowChange change;
   change.visited = n;
@@ -1174,16 +1164,6 @@ bool setup_oblique_columns(const GridFrame& f, const Parallelogram& p, ColumnsOb
 /// at yaw 45 (not steep) it gained nothing (42.8 -> 43.2 us).
 constexpr int kBandAheadRows = 8;
 
-/// A hint to fetch the cache line at p for writing, into L1 (no effect on
-/// results; prefetches never fault).
-inline void prefetch_write(const float* p) {
-#if defined(__GNUC__)
-  __builtin_prefetch(p, 1, 3);
-#else
-  (void)p;
-#endif
-}
-
 void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsOblique& w, CutBook& book) {
   CutBook rows;  // a local, so that its fields stay in registers
   const HeightGrid::EditLayers layers = grid.edit_layers();
@@ -1322,7 +1302,7 @@ void cut_oblique_columns(HeightGrid& grid, const GridFrame& f, const ColumnsObli
       float* const cells = height + grid.index(0, r);
       if (decltype(steep)::value && r + kBandAheadRows <= band_r1) {
         const int c_ahead = std::clamp(c_lo + int(kBandAheadRows * lo_k), 0, f.cols - 1);
-        prefetch_write(cells + std::int64_t(kBandAheadRows) * f.cols + c_ahead);
+        detail::prefetch<true, 3>(cells + std::int64_t(kBandAheadRows) * f.cols + c_ahead);
       }
       RowChange change;
       change.visited = c_hi - c_lo + 1;
@@ -1367,7 +1347,7 @@ void prefetch_next_sweep(const HeightGrid& grid, const GridFrame& f, const Segme
     double t = double(k) / points;
     int c = floor_clamped(ua + t * (ub - ua), 0, f.cols - 1);
     int r = floor_clamped(va + t * (vb - va), 0, f.rows - 1);
-    prefetch(height + grid.index(c, r));
+    detail::prefetch<false, 2>(height + grid.index(c, r));
   }
 }
 

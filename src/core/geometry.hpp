@@ -223,4 +223,16 @@ inline int sweep_triangles_above_floor(const Segment& from, const Segment& to, d
   return n;
 }
 
+/// A hint to fetch the cache line at p, for reading or (kWrite) writing,
+/// with GCC's temporal locality (3: into every cache level, 2: not into L1).
+/// No effect on results: prefetches never fault.
+template <bool kWrite = false, int kLocality = 3>
+inline void prefetch(const float* p) {
+#if defined(__GNUC__)
+  __builtin_prefetch(p, kWrite ? 1 : 0, kLocality);
+#else
+  (void)p;
+#endif
+}
+
 }  // namespace terracut::detail

@@ -83,10 +83,13 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
     const double out_x = (end == 0 ? -ex : ex) / len, out_z = (end == 0 ? -ez : ez) / len;
     int apex_c = -1, apex_r = -1;
     for (double reach = 0.5; reach <= 2.0 && apex_c < 0; reach += 0.5) {
-      const double px = tip.x + out_x * reach * std::min(dx_, dz_), pz = tip.z + out_z * reach * std::min(dx_, dz_);
-      const int c = int(std::floor(to_cells(px, spec.origin_m.x, dx_))), r = int(std::floor(to_cells(pz, spec.origin_m.z, dz_)));
+      const double step = reach * std::min(dx_, dz_);
+      const double px = tip.x + out_x * step, pz = tip.z + out_z * step;
+      const int c = int(std::floor(to_cells(px, spec.origin_m.x, dx_)));
+      const int r = int(std::floor(to_cells(pz, spec.origin_m.z, dz_)));
       if (c < 0 || r < 0 || c >= cols_ || r >= rows_) break;
-      const double t = ((spec.origin_m.x + (c + 0.5) * dx_ - to.a.x) * ex + (spec.origin_m.z + (r + 0.5) * dz_ - to.a.z) * ez) / len2;
+      const double cx = spec.origin_m.x + (c + 0.5) * dx_ - to.a.x, cz = spec.origin_m.z + (r + 0.5) * dz_ - to.a.z;
+      const double t = (cx * ex + cz * ez) / len2;
       if (end == 0 ? t < 0.0 : t > 1.0) apex_c = c, apex_r = r;
     }
     if (apex_c < 0) continue;
@@ -206,8 +209,9 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
       const std::int64_t i = std::int64_t(r) * cols_ + c;
       const double d = ends_dist_[std::size_t(w)];
       const float old = h[i];
-      const float now = ends_state_[std::size_t(w)] == kDonor ? std::min(old, quantized(std::max(0.0, s + slope * d)))
-                                                              : std::max(old, std::min(quantized(s - slope * d), ceiling_m_));
+      const float now = ends_state_[std::size_t(w)] == kDonor
+                            ? std::min(old, quantized(std::max(0.0, s + slope * d)))
+                            : std::max(old, std::min(quantized(s - slope * d), ceiling_m_));
       if (now == old) continue;
       gained += double(now) - double(old);
       dirty(std::uint32_t(i));
