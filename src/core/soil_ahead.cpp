@@ -50,8 +50,7 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
     const Vec3 p = lerp(edge.a, edge.b, (i + 0.5) / n);
     // The depth at the lookahead, below the undisturbed surface.
     const Vec3 q = p + u * lookahead_m;
-    const double now = surface_height_m(grid, representation, q.x, q.z);
-    const double before = surface_height_m(spec, grid.initial(), representation, q.x, q.z);
+    const auto [now, before] = surface_heights_m(spec, grid.heights(), grid.initial(), representation, q.x, q.z);
     const double depth = ground + std::min(now, before) - p.y;
     if (!(depth > 0.0)) continue;
     sum_d += depth;
@@ -63,8 +62,8 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
     double pile = 0.0;
     for (int k = 0; k < reach_points; ++k) {
       const Vec3 r = q + u * (reach_m * (k + 0.5) / reach_points);
-      pile += std::max(0.0, surface_height_m(grid, representation, r.x, r.z) -
-                                surface_height_m(spec, grid.initial(), representation, r.x, r.z));
+      const auto [now_r, before_r] = surface_heights_m(spec, grid.heights(), grid.initial(), representation, r.x, r.z);
+      pile += std::max(0.0, now_r - before_r);
     }
     // Weighted by the part's depth: the surcharge acts on q d w.
     sum_pile_d += depth * pile / reach_points;

@@ -5,6 +5,8 @@
 // from the same function.
 #pragma once
 
+#include <utility>
+
 #include "terracut/core/contact.hpp"
 #include "terracut/core/grid.hpp"
 
@@ -22,6 +24,12 @@ double surface_height_m(const HeightGrid& grid, Representation representation, d
 /// e.g. a viewer's frame) laid out as spec says.
 double surface_height_m(const GridSpec& spec, const float* heights_m,
                         Representation representation, double x, double z) noexcept;
+
+/// The same over two layers laid out as spec says (e.g. the grid's heights
+/// and its initial ones) at one point, found once: each of the pair is
+/// surface_height_m over that layer, bit for bit.
+std::pair<double, double> surface_heights_m(const GridSpec& spec, const float* first_m, const float* second_m,
+                                            Representation representation, double x, double z) noexcept;
 
 /// World Y of the terrain surface at (x, z): origin_m.y + surface_height_m.
 double surface_y_m(const HeightGrid& grid, Representation representation, double x,
