@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 #include "soil_internal.hpp"
 
@@ -69,7 +70,13 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
   constexpr int side = 2 * radius + 1;
   constexpr std::uint8_t kUnknown = 0, kOff = 1, kPlus = 2, kMinus = 3;
   constexpr std::uint8_t kDonor = 1, kReceiver = 2;
-  // (Sized at construction: a 1 kHz tick allocates nothing.)
+  // Cell (c, r)'s centre relative to the edge's first end, in plan.
+  const auto centre = [&](int c, int r) {
+    return std::pair{spec.origin_m.x + (c + 0.5) * dx_ - to.a.x, spec.origin_m.z + (r + 0.5) * dz_ - to.a.z};
+  };
+  // (The window's scratch is sized at construction, and its states are all
+  // 0 between calls: a 1 kHz tick allocates nothing and clears only the
+  // cells it marked.)
   for (int end = 0; end < 2; ++end) {
     // The apex: the first cell past this end of the edge (its centre beyond
     // the edge's span, outside the blade), through which every path round
@@ -88,7 +95,7 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
       const int c = int(std::floor(to_cells(px, spec.origin_m.x, dx_)));
       const int r = int(std::floor(to_cells(pz, spec.origin_m.z, dz_)));
       if (c < 0 || r < 0 || c >= cols_ || r >= rows_) break;
-      const double cx = spec.origin_m.x + (c + 0.5) * dx_ - to.a.x, cz = spec.origin_m.z + (r + 0.5) * dz_ - to.a.z;
+      const auto [cx, cz] = centre(c, r);
       const double t = (cx * ex + cz * ez) / len2;
       if (end == 0 ? t < 0.0 : t > 1.0) apex_c = c, apex_r = r;
     }
@@ -104,10 +111,10 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
       const int c = wc0 + w % side, r = wr0 + w / side;
       p = kOff;
       if (c < 0 || r < 0 || c >= cols_ || r >= rows_ || obstacle_[std::int64_t(r) * cols_ + c] != 0) return p;
-      const double x = spec.origin_m.x + (c + 0.5) * dx_, z = spec.origin_m.z + (r + 0.5) * dz_;
-      const double t = ((x - to.a.x) * ex + (z - to.a.z) * ez) / len2;
+      const auto [x, z] = centre(c, r);
+      const double t = (x * ex + z * ez) / len2;
       if (end == 0 ? !(t < 0.5) : !(t > 0.5)) return p;
-      const double n = (ex * (z - to.a.z) - ez * (x - to.a.x)) / len;
+      const double n = (ex * z - ez * x) / len;
       if (std::abs(n) < half && t >= 0.0 && t <= 1.0) return p;
       const int uc = std::abs(w % side - radius), ur = std::abs(w / side - radius);
       ends_dist_[std::size_t(w)] =
@@ -119,10 +126,8 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
     // (their centres on its two sides, the crossing within its span).
     const auto blocked = [&](int v, int w) {
       if (place(v) == place(w)) return false;
-      const double xa = (wc0 + v % side + 0.5) * dx_ + spec.origin_m.x - to.a.x;
-      const double za = (wr0 + v / side + 0.5) * dz_ + spec.origin_m.z - to.a.z;
-      const double xb = (wc0 + w % side + 0.5) * dx_ + spec.origin_m.x - to.a.x;
-      const double zb = (wr0 + w / side + 0.5) * dz_ + spec.origin_m.z - to.a.z;
+      const auto [xa, za] = centre(wc0 + v % side, wr0 + v / side);
+      const auto [xb, zb] = centre(wc0 + w % side, wr0 + w / side);
       const double na = ex * za - ez * xa, nb = ex * zb - ez * xb;
       const double u = na / (na - nb);
       const double t = ((xa + (xb - xa) * u) * ex + (za + (zb - za) * u) * ez) / len2;
@@ -155,9 +160,13 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
     // The search starts where this end's cone stood at the last call (the
     // tip moves a cell or less between calls), else halfway.
     double s = ends_s_[end] > lo && ends_s_[end] < hi ? ends_s_[end] : 0.5 * (lo + hi);
-    for (int round = 0; round < kEndRounds; ++round) {
-      std::fill(ends_state_.begin(), ends_state_.end(), std::uint8_t(0));
+    // Only the cells of a round's sets carry a state: they are cleared.
+    const auto clear_sets = [&] {
+      for (const std::int32_t w : queue) ends_state_[std::size_t(w)] = 0;
       queue.clear();
+    };
+    for (int round = 0; round < kEndRounds; ++round) {
+      clear_sets();
       keys.clear();
       // The round's visits (8 a cell of the sets: its neighbours) stay
       // within what the work cap leaves: past it the sets stop growing (the
@@ -221,6 +230,7 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
       out.changed.include(c, r);
     }
     if (last >= 0 && gained != 0.0) give_back(h[last], -gained);
+    clear_sets();
   }
   settle_candidates(h);
 }
