@@ -16,7 +16,8 @@ namespace {
 // The number of parts an edge is read at.
 int edge_parts(const GridSpec& spec, const Segment& edge) {
   const double cell = std::min(spec.cell_x_m(), spec.cell_z_m());
-  return std::clamp(static_cast<int>(std::ceil(length(edge.b - edge.a) / cell)), 2, 64);
+  // (Clamped in double: a finite edge may be far longer than INT_MAX cells.)
+  return static_cast<int>(std::clamp(std::ceil(length(edge.b - edge.a) / cell), 2.0, 64.0));
 }
 
 // The depth and length of a uniform cut equivalent to the parts' depths d_i
@@ -58,7 +59,7 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
     // The pile over the wedge: soil above the initial surface ahead.
     if (!(wedge_per_depth > 0.0)) continue;
     const double reach_m = wedge_per_depth * depth;
-    const int reach_points = std::clamp(static_cast<int>(std::ceil(reach_m / cell)), 1, 64);
+    const int reach_points = static_cast<int>(std::clamp(std::ceil(reach_m / cell), 1.0, 64.0));
     double pile = 0.0;
     for (int k = 0; k < reach_points; ++k) {
       const Vec3 r = q + u * (reach_m * (k + 0.5) / reach_points);

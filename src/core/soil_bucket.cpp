@@ -63,7 +63,9 @@ void SoilFlow::pour(HeightGrid& grid, const Segment& lip, double volume_m3, Soil
   // put on the cell under it (or, beyond an open edge, counted as gone).
   const GridSpec& spec = grid.spec();
   const double span = std::hypot(lip.b.x - lip.a.x, lip.b.z - lip.a.z);
-  const int points = 1 + int(std::ceil(span / (0.5 * std::min(dx_, dz_))));
+  // (At most 4 (cols + rows) points: a lip longer than the grid's diagonal,
+  // valid input, is spread more coarsely rather than overflowing the count.)
+  const int points = 1 + ceil_within(span / (0.5 * std::min(dx_, dz_)), 0, 4 * (cols_ + rows_));
   const double share_m = volume_m3 / points / spec.cell_area_m2();
   const HeightGrid::EditLayers layers = grid.edit_layers();
   double put = 0.0, wanted = 0.0;
@@ -76,7 +78,7 @@ void SoilFlow::pour(HeightGrid& grid, const Segment& lip, double volume_m3, Soil
       out.left_over_edge_m3 += share_m * spec.cell_area_m2();
       continue;
     }
-    const int c = std::clamp(int(std::floor(u)), 0, cols_ - 1), r = std::clamp(int(std::floor(v)), 0, rows_ - 1);
+    const int c = floor_within(u, 0, cols_ - 1), r = floor_within(v, 0, rows_ - 1);
     const std::int64_t i = std::int64_t(r) * cols_ + c;
     dirty(std::uint32_t(i));
     const float now = float(double(layers.height_m[i]) + share_m);

@@ -61,8 +61,8 @@ void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
   blade_.half_lo = half_num * (1.0 - 1e-12);
   blade_.half_hi = half_num * (1.0 + 1e-12);
   const double zlo = std::min(edge.a.z, edge.b.z) - radius, zhi = std::max(edge.a.z, edge.b.z) + radius;
-  const int r0 = std::max(0, int(std::floor(to_cells(zlo, spec.origin_m.z, dz_) - 0.5)));
-  const int r1 = std::min(rows_ - 1, int(std::ceil(to_cells(zhi, spec.origin_m.z, dz_) - 0.5)));
+  const int r0 = floor_within(to_cells(zlo, spec.origin_m.z, dz_) - 0.5, 0, rows_);
+  const int r1 = ceil_within(to_cells(zhi, spec.origin_m.z, dz_) - 0.5, -1, rows_ - 1);
   for (int r = r0; r <= r1; ++r) {
     const double z = spec.origin_m.z + (r + 0.5) * dz_;
     // The edge's parameters where it is within the radius of this row's z.
@@ -76,8 +76,8 @@ void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
       continue;
     }
     const double xa = edge.a.x + d.x * s0, xb = edge.a.x + d.x * s1;
-    const int c0 = std::max(0, int(std::floor(to_cells(std::min(xa, xb) - radius, spec.origin_m.x, dx_) - 0.5)));
-    const int c1 = std::min(cols_ - 1, int(std::ceil(to_cells(std::max(xa, xb) + radius, spec.origin_m.x, dx_) - 0.5)));
+    const int c0 = floor_within(to_cells(std::min(xa, xb) - radius, spec.origin_m.x, dx_) - 0.5, 0, cols_);
+    const int c1 = ceil_within(to_cells(std::max(xa, xb) + radius, spec.origin_m.x, dx_) - 0.5, -1, cols_ - 1);
     for (int c = c0; c <= c1; ++c) {
       const std::uint32_t i = std::uint32_t(std::int64_t(r) * cols_ + c);
       const double x = spec.origin_m.x + (c + 0.5) * dx_;
@@ -231,10 +231,8 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
         return u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_;
       };
       const auto cell_at = [&](double along) {
-        const int tc = std::clamp(int(std::floor(to_cells(x + nx * along, spec.origin_m.x, dx_))),
-                                  0, cols_ - 1);
-        const int tr = std::clamp(int(std::floor(to_cells(z + nz * along, spec.origin_m.z, dz_))),
-                                  0, rows_ - 1);
+        const int tc = floor_within(to_cells(x + nx * along, spec.origin_m.x, dx_), 0, cols_ - 1);
+        const int tr = floor_within(to_cells(z + nz * along, spec.origin_m.z, dz_), 0, rows_ - 1);
         return std::int64_t(tr) * cols_ + tc;
       };
       // The rest of the cut lands where an avalanche down the face ahead

@@ -92,8 +92,8 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
     for (double reach = 0.5; reach <= 2.0 && apex_c < 0; reach += 0.5) {
       const double step = reach * std::min(dx_, dz_);
       const double px = tip.x + out_x * step, pz = tip.z + out_z * step;
-      const int c = int(std::floor(to_cells(px, spec.origin_m.x, dx_)));
-      const int r = int(std::floor(to_cells(pz, spec.origin_m.z, dz_)));
+      const int c = floor_within(to_cells(px, spec.origin_m.x, dx_), -1, cols_);
+      const int r = floor_within(to_cells(pz, spec.origin_m.z, dz_), -1, rows_);
       if (c < 0 || r < 0 || c >= cols_ || r >= rows_) break;
       const auto [cx, cz] = centre(c, r);
       const double t = (cx * ex + cz * ez) / len2;

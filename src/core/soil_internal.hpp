@@ -14,6 +14,7 @@
 #endif
 
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -76,6 +77,19 @@ inline constexpr Neighbour kNeighbours[8] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 1}, 
                                              {1, 1, 2},  {-1, 1, 2}, {1, -1, 2}, {-1, -1, 2}};
 
 inline double to_cells(double v, double origin, double cell) { return (v - origin) / cell; }
+
+/// floor(v) as an int within [lo, hi]: clamped in double first, so that a
+/// point far off the grid (a blade kilometres long is valid input) never
+/// overflows the conversion. NaN gives lo.
+inline int floor_within(double v, int lo, int hi) {
+  const double f = std::floor(v);
+  return f >= double(hi) ? hi : f >= double(lo) ? int(f) : lo;
+}
+/// The same for ceil(v).
+inline int ceil_within(double v, int lo, int hi) {
+  const double f = std::ceil(v);
+  return f >= double(hi) ? hi : f >= double(lo) ? int(f) : lo;
+}
 
 /// Writes every element of v's reserved storage once and empties it again:
 /// the pages are the process's from construction on, so the first tick to
