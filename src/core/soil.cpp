@@ -238,7 +238,7 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   displace(grid, from, to, room, out);
   // What the push left above the repose cone through an end of the blade
   // goes round it now (the bucket's ends are its side plates: not yet).
-  if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0) spill_round_ends(grid, to, out);
+  if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0) spill_round_ends(grid, from, to, out);
   load_m3_ += out.bucket_in_m3;
   if (load_m3_ > holds && blade_spec_.bucket.enabled()) {
     pour(grid, to, load_m3_ - holds, out);

@@ -54,7 +54,7 @@ double balance(std::vector<std::pair<double, int>>& keys) {
 
 }  // namespace
 
-void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepResult& out) {
+void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& from, const Segment& to, SoilStepResult& out) {
   const GridSpec& spec = grid.spec();
   const double ex = to.b.x - to.a.x, ez = to.b.z - to.a.z;
   const double len2 = ex * ex + ez * ez;
@@ -63,12 +63,23 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
   // Half a cell's width across the edge's line: a centre closer than that
   // is inside the blade (as blade_blocks has it).
   const double half = 0.5 * (std::abs(ez) * dx_ + std::abs(ex) * dz_) / len;
+  // The side the edge came from, by the sign of the motion across its line
+  // (none when it moved along the line or stood still, as displace has
+  // it): the cells inside the blade on that side are behind it, cut, and
+  // take what comes round the ends as the trench behind them does. Those
+  // ahead hold the pile against the blade and take nothing here.
+  const double mx = 0.5 * ((to.a.x + to.b.x) - (from.a.x + from.b.x));
+  const double mz = 0.5 * ((to.a.z + to.b.z) - (from.a.z + from.b.z));
+  const double across = (ex * mz - ez * mx) / len;
+  const double behind = std::abs(across) > 0.01 * std::max(dx_, dz_) ? -across : 0.0;
   const double slope = std::tan(params_.material.repose_deg * std::numbers::pi / 180.0);
   const double diag = std::hypot(dx_, dz_);
   float* h = grid.edit_layers().height_m;
   constexpr int radius = kEndWindowCells;
   constexpr int side = 2 * radius + 1;
-  constexpr std::uint8_t kUnknown = 0, kOff = 1, kPlus = 2, kMinus = 3;
+  // A cell's place: off, or its side of the edge's line, with kInside when
+  // the edge passes through it (behind the blade: a receiver only).
+  constexpr std::uint8_t kUnknown = 0, kOff = 1, kPlus = 2, kMinus = 3, kSide = 3, kInside = 4;
   constexpr std::uint8_t kDonor = 1, kReceiver = 2;
   // Cell (c, r)'s centre relative to the edge's first end, in plan.
   const auto centre = [&](int c, int r) {
@@ -103,8 +114,8 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
     const int wc0 = apex_c - radius, wr0 = apex_r - radius;
     std::fill(ends_place_.begin(), ends_place_.end(), kUnknown);
     // Where window cell w lies, found once a call: off (beyond the grid,
-    // under a body, inside the blade, or nearer the other end) or on one
-    // side of the edge's line; and its distance to the apex.
+    // under a body, inside the blade ahead of it, or nearer the other end)
+    // or on one side of the edge's line; and its distance to the apex.
     const auto place = [&](int w) -> std::uint8_t {
       std::uint8_t& p = ends_place_[std::size_t(w)];
       if (p != kUnknown) return p;
@@ -115,17 +126,19 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
       const double t = (x * ex + z * ez) / len2;
       if (end == 0 ? !(t < 0.5) : !(t > 0.5)) return p;
       const double n = (ex * z - ez * x) / len;
-      if (std::abs(n) < half && t >= 0.0 && t <= 1.0) return p;
+      const bool inside = std::abs(n) < half && t >= 0.0 && t <= 1.0;
+      // A centre on the line itself is the row the edge cuts now: behind.
+      if (inside && !(behind != 0.0 && n * behind >= 0.0)) return p;
       const int uc = std::abs(w % side - radius), ur = std::abs(w / side - radius);
       ends_dist_[std::size_t(w)] =
           float(uc >= ur ? (uc - ur) * dx_ + ur * diag : (ur - uc) * dz_ + uc * diag);
-      p = n > 0.0 ? kPlus : kMinus;
+      p = inside ? std::uint8_t((behind > 0.0 ? kPlus : kMinus) | kInside) : n > 0.0 ? kPlus : kMinus;
       return p;
     };
     // Whether the edge stands between two neighbouring cells in the window
     // (their centres on its two sides, the crossing within its span).
     const auto blocked = [&](int v, int w) {
-      if (place(v) == place(w)) return false;
+      if ((place(v) & kSide) == (place(w) & kSide)) return false;
       const auto [xa, za] = centre(wc0 + v % side, wr0 + v / side);
       const auto [xb, zb] = centre(wc0 + w % side, wr0 + w / side);
       const double na = ex * za - ez * xa, nb = ex * zb - ez * xb;
@@ -174,6 +187,7 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepRes
       const std::int64_t room = params_.max_pair_checks_per_step - ends_work_;
       const auto admit = [&](int w, std::uint8_t kind) {
         if (std::int64_t(queue.size() + 1) * 8 > room) return;
+        if (kind == kDonor && (place(w) & kInside)) return;  // held against the blade
         const double hw = h[std::int64_t(wr0 + w / side) * cols_ + wc0 + w % side];
         const double d = ends_dist_[std::size_t(w)];
         if (kind == kDonor ? hw - slope * d > s : hw + slope * d < s) {

@@ -408,8 +408,10 @@ class SoilFlow {
   }
   void run_passes(HeightGrid& grid, SoilStepResult& out);
   /// The soil above the repose cone through each end of the edge `to`
-  /// slides round it, down to the cells under the cone (soil_ends.cpp).
-  void spill_round_ends(HeightGrid& grid, const Segment& to, SoilStepResult& out);
+  /// slides round it, down to the cells under the cone, those the edge has
+  /// just cut behind it included (soil_ends.cpp); `from` is where the edge
+  /// was, for which side is behind.
+  void spill_round_ends(HeightGrid& grid, const Segment& from, const Segment& to, SoilStepResult& out);
   // spill_round_ends' window round an end's apex (the first cell past it),
   // per cell: where it lies, its distance to the apex, and donor / receiver
   // in the round; sized at construction.
