@@ -68,15 +68,20 @@ inline void lower_one(const HeightGrid::EditLayers& layers, std::int64_t row, in
   change.last = c;
 }
 
-/// lower_one for sample c of row (the row's first sample) without a branch
-/// on the data, for the columns band: its rows hold two to four cells,
-/// lowered or not in a pattern that shifts from row to row, and there a
-/// mispredicted branch waited for the sample's load from memory before the
-/// walk went on. (Where nearly every sample is lowered, as in the surface
+/// lower_one for sample c of row (the row's first sample) written without
+/// an if on the data, for the columns band: its rows hold two to four
+/// cells, lowered or not in a pattern that shifts from row to row, and there
+/// a mispredicted branch waited for the sample's load from memory before
+/// the walk went on. (Where nearly every sample is lowered, as in the surface
 /// walks, the branch predicts well and this form measured no faster.) The
-/// minimum keeps the old bits where the target is not lower (stored back
-/// unchanged), and a drop of +0 leaves the sum's bits as they are: the
-/// values of lower_one, bit for bit.
+/// source has no branch, but GCC 12 at -O3 still compiles the float
+/// comparisons into conditional jumps (`g++ -O3 -S` of this function in a
+/// loop, 2026-12-05: three data-dependent jumps, one cmov); a form with
+/// SSE minss / maxss and no jump measured 2 to 5 us slower in the
+/// benchmark at yaw 30 to 82 (docs/performance.md, "Every direction,
+/// seventh look"). The minimum keeps the old bits where
+/// the target is not lower (stored back unchanged), and a drop of +0
+/// leaves the sum's bits as they are: the values of lower_one, bit for bit.
 inline void lower_one_unbranched(float* row, int c, float t, RowChange& change) {
   const float h = t > 0.0f ? t : 0.0f;
   const float old = row[c];
