@@ -472,6 +472,28 @@ TEST_F(CliTest, ValidateWritesItsOutputsAndEveryCheckPasses) {
   EXPECT_EQ(slurp(out / "checks.csv").find("FAIL"), std::string::npos);
 }
 
+// With figures: every picture the report shows is drawn (the DEM section's
+// surface maps were linked but not drawn by the full run until 2026-12-05).
+TEST_F(CliTest, ValidateDrawsEveryFigureItsReportShows) {
+  const Result probe = exec({"/usr/bin/python3", "-c", "import numpy, matplotlib"});
+  if (probe.code != 0) GTEST_SKIP() << "/usr/bin/python3 with numpy and matplotlib not available";
+  const fs::path out = dir_ / "val";
+  const Result r = terracut({"validate", "--out", out.string(), "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string report = slurp(out / "report.md");
+  int shown = 0;
+  for (std::size_t at = report.find("]("); at != std::string::npos; at = report.find("](", at + 2)) {
+    const std::size_t end = report.find(')', at);
+    ASSERT_NE(end, std::string::npos);
+    const std::string name = report.substr(at + 2, end - at - 2);
+    if (name.size() < 4 || name.substr(name.size() - 4) != ".png") continue;
+    ++shown;
+    ASSERT_TRUE(fs::exists(out / name)) << name << " is shown in report.md but not drawn";
+    EXPECT_EQ(slurp(out / name).substr(1, 3), "PNG") << name;
+  }
+  EXPECT_GE(shown, 5);  // cone, slope, bulldozing, conservation, bucket at least
+}
+
 // Calibration from material tests (docs/validation.md, "Calibration"): the
 // fitted fields with their uncertainties on stdout, calibration.json and a
 // soil.yaml that a scenario takes as its soil: section.
