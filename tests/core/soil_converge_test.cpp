@@ -35,19 +35,30 @@ struct Pile {
   double volume_change = 0.0;          // the grid's volume at the end / at the start - 1
 };
 
-// A blade of width_m cutting 4 cm into a 20 cm layer of dry sand (repose
-// 34) on cells of cell_m, pushed 0.8 m along +Z at speed, then held still
-// for hold_s (the relaxation goes on).
-Pile push(double width_m, double cell_m, double speed_m_per_s, std::int64_t cap, double hold_s = 0.2) {
-  const double travel = 0.8, depth = 0.04, layer = 0.2;
-  const int cols = int(std::lround((width_m + 1.6) / cell_m)), rows = int(std::lround((travel + 1.4) / cell_m));
-  const scenes::Bulldoze scene{cols, rows, cell_m, width_m, layer, depth};
+// The pushes' scene: a blade of width_m cutting 4 cm into a 20 cm layer on
+// cells of cell_m, room for travel_m along +Z from z = 0.4 m.
+constexpr double kLayer = 0.2, kStartZ = 0.4;
+scenes::Bulldoze push_scene(double width_m, double cell_m, double travel_m) {
+  return {int(std::lround((width_m + 1.6) / cell_m)), int(std::lround((travel_m + 1.4) / cell_m)), cell_m, width_m,
+          kLayer, 0.04};
+}
+// Its simulation: soil that flows, dry sand (repose 34), at the work cap.
+Simulation push_simulation(const scenes::Bulldoze& scene, std::int64_t cap) {
   SoilFlowParams soil;
   soil.model = SoilModel::kFlow;
   soil.material.repose_deg = 34.0;
   soil.max_pair_checks_per_step = cap;
-  Simulation sim(scene.params(soil), scene.heights());
-  const double x = scene.x_m(), z0 = 0.4;
+  return Simulation(scene.params(soil), scene.heights());
+}
+
+// That blade pushed 0.8 m at speed, then held still for hold_s (the
+// relaxation goes on).
+Pile push(double width_m, double cell_m, double speed_m_per_s, std::int64_t cap, double hold_s = 0.2) {
+  const double travel = 0.8, layer = kLayer;
+  const scenes::Bulldoze scene = push_scene(width_m, cell_m, travel);
+  const int cols = scene.cols, rows = scene.rows;
+  Simulation sim = push_simulation(scene, cap);
+  const double x = scene.x_m(), z0 = kStartZ;
   const int steps = int(std::lround(travel / speed_m_per_s * 1000.0));
   const double volume = sim.grid().volume_m3();
   Pile pile;
@@ -118,15 +129,11 @@ TEST(SoilConvergence, APushAtOneMetreASecondOnFiveMillimetreCellsConvergesForEve
 // longer holds. From the push's first 0.1 m on (before it the trench's back
 // wall, where the blade went in, stands in it).
 double steepest_behind_the_blade(double width_m, double cell_m, double speed_m_per_s) {
-  const double travel = 0.3, depth = 0.04, layer = 0.2;
-  const int cols = int(std::lround((width_m + 1.6) / cell_m)), rows = int(std::lround((travel + 1.4) / cell_m));
-  const scenes::Bulldoze scene{cols, rows, cell_m, width_m, layer, depth};
-  SoilFlowParams soil;
-  soil.model = SoilModel::kFlow;
-  soil.material.repose_deg = 34.0;
-  soil.max_pair_checks_per_step = kLifted;
-  Simulation sim(scene.params(soil), scene.heights());
-  const double x = scene.x_m(), z0 = 0.4, limit = std::tan(34.0 * kDeg) * cell_m;
+  const double travel = 0.3;
+  const scenes::Bulldoze scene = push_scene(width_m, cell_m, travel);
+  const int cols = scene.cols, rows = scene.rows;
+  Simulation sim = push_simulation(scene, kLifted);
+  const double x = scene.x_m(), z0 = kStartZ, limit = std::tan(34.0 * kDeg) * cell_m;
   const int steps = int(std::lround(travel / speed_m_per_s * 1000.0));
   double steepest = -1.0;
   for (int i = 0; i <= steps; ++i) {
