@@ -162,58 +162,68 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
   struct Line {
     std::uint32_t cell[kMaxFallCells];
     float reach[kMaxFallCells];
-    int length = 0;
+    int length = 0;  // the cells walked
+    int live = 0;    // of them, the first `live` (compacted) are not humps
   };
-  // A reach marked as left out (a hump).
-  constexpr float kHump = std::numeric_limits<float>::infinity();
   Line lines[8];
   const float tol = tolerance_m_;
   // A fall line from a cell far from the blade may still run into it.
   const bool blade = blade_.present;
   double total = ha;
   int count = 1;
+  int walked = 0;  // the cells of all the lines, for the visits of a further round
   bool steep_below = false;
   // The highest reach taken: when it is below s, no cell is a hump and
   // the rounds below have nothing to drop (skipped: the same result).
   float highest_reach = -std::numeric_limits<float>::infinity();
+  const bool obstacles = !obstacles_.empty();
   for (int j = 0; j < n; ++j) {
     const int k = dirs[j] & 0xff;
     const float drop = limit8_[k] - 0.25f * tol;
     Line& line = lines[j];
+    // The line's length in a local: a store to the cells (unsigned) may
+    // alias the struct's int, and kept the length in memory.
+    int len = 0;
     if (dirs[j] >> 8) {
       // Beyond an open edge: bare ground at height 0 that takes what comes.
       line.cell[0] = kOutside;
       line.reach[0] = drop;
-      line.length = 1;
+      len = 1;
     } else {
-      std::uint32_t cur = std::uint32_t(std::int64_t(a) + offset_[k]);
+      const std::int64_t step = offset_[k];
+      std::uint32_t cur = std::uint32_t(std::int64_t(a) + step);
+      std::uint8_t fc = queued_[cur];
       for (int m = 1;; ++m) {
         const float reach = h[cur] + drop * float(m);
         if (!(reach < ha)) break;
-        line.cell[line.length] = cur;
-        line.reach[line.length++] = reach;
-        if (line.length == kMaxFallCells || (queued_[cur] & kEdge)) break;
-        const std::uint32_t next = std::uint32_t(std::int64_t(cur) + offset_[k]);
+        line.cell[len] = cur;
+        line.reach[len++] = reach;
+        if (len == kMaxFallCells || (fc & kEdge)) break;
+        const std::uint32_t next = std::uint32_t(std::int64_t(cur) + step);
         const std::uint8_t fn = queued_[next];
         // A cell itself steeper than the threshold toward the next sheds
         // in this pass too: the line ends on it (beyond it the frozen
         // heights are not where the soil will rest, and two sources filling
         // the same steep slope at once would flatten it).
         if (m == 1 && h[cur] - h[next] - limit8_[k] > tol) steep_below = true;
-        if (!obstacles_.empty() && obstructed(next)) break;
+        if (obstacles && obstructed(next)) break;
         if ((fn & kHull) && ha > hull_under(next)) break;
-        if (blade && (queued_[cur] & kNearBlade) && (fn & kNearBlade) &&
+        if (blade && (fc & kNearBlade) && (fn & kNearBlade) &&
             blade_blocks(col_of(cur), row_of(cur), col_of(next), row_of(next), ha))
           break;
         cur = next;
+        fc = fn;
       }
     }
-    fall_visits_ += line.length;
-    for (int m = 0; m < line.length; ++m) {
+    line.length = len;
+    fall_visits_ += len;
+    for (int m = 0; m < len; ++m) {
       total += line.reach[m];
       highest_reach = std::max(highest_reach, line.reach[m]);
     }
-    count += line.length;
+    line.live = len;
+    count += len;
+    walked += len;
   }
   // A cell whose reach is at or above s stands above the final line (a
   // hump) and takes nothing; without it s comes lower, until no more drop
@@ -224,31 +234,50 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
   // source keeps that soil for a later pass.
   double s = total / count;
   for (int round = double(highest_reach) >= s ? 0 : kMaxExtraRounds + 1; round <= kMaxExtraRounds; ++round) {
+    // A further round reads every walked cell again (the work counts them
+    // all, humps included, as when humps were marked in place).
+    if (round > 0) fall_visits_ += walked;
+    // A float r is at or above s exactly when it is at or above the least
+    // float at or above s: the test in float, the same answers.
+    float at_least = float(s);
+    if (double(at_least) < s) at_least = std::nextafter(at_least, std::numeric_limits<float>::infinity());
     bool changed = false;
-    const bool first = round == 0;
+    float highest_left = -std::numeric_limits<float>::infinity();
     for (int j = 0; j < n; ++j) {
       Line& line = lines[j];
-      if (!first) fall_visits_ += line.length;  // a further round reads every cell again
       // Without a branch per cell (which cells are humps is data, and a
       // mispredicted branch cost more than the test): a cell that drops
-      // out takes its reach off the total (in the same order as before:
-      // subtracting 0 leaves a double as it is) and is marked.
-      for (int m = 0; m < line.length; ++m) {
+      // out takes its reach off the total (in the lines' order, as before:
+      // subtracting 0 leaves a double as it is), and the cells left are
+      // moved up in their order, so later rounds and the fluxes read only
+      // them. (Listing the humps and taking them off after the loop, a
+      // shorter chain of subtractions, measured slower.)
+      int kept = 0;
+      for (int m = 0; m < line.live; ++m) {
         const float r = line.reach[m];
-        const bool hump = (r < kHump) & (double(r) >= s);
+        const bool hump = r >= at_least;
         total -= hump ? double(r) : 0.0;
         count -= int(hump);
-        line.reach[m] = hump ? kHump : r;
         changed |= hump;
+        line.reach[kept] = r;
+        line.cell[kept] = line.cell[m];
+        highest_left = hump ? highest_left : std::max(highest_left, r);
+        kept += int(!hump);
       }
+      line.live = kept;
     }
     s = total / count;
     if (!changed) break;
+    // Every cell left below the new s: a further round would drop none and
+    // end the rounds. Its visits are counted; it is not run.
+    if (round < kMaxExtraRounds && !(double(highest_left) >= s)) {
+      fall_visits_ += walked;
+      break;
+    }
   }
   std::uint32_t fluxes = 0;
   for (int j = 0; j < n; ++j)
-    for (int m = 0; m < lines[j].length; ++m) {
-      if (!(lines[j].reach[m] < kHump)) continue;
+    for (int m = 0; m < lines[j].live; ++m) {
       const float give = quantized((steep_below ? 0.5 : 1.0) * (s - double(lines[j].reach[m])));
       if (!(give > 0.0f)) continue;
       fluxes_.push_back({lines[j].cell[m], give});
