@@ -250,10 +250,16 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     mark_hull(grid, to, orientation);
     shoulder(grid, out);
   }
-  wake_held(&to);
+  // Where this step's cut or the last one's passed cell centres, cells the
+  // blade held may now lie behind it (the trench's, blade_blocks: a centre
+  // the edge stood on when it cut it is behind it from the next step on):
+  // all are examined again.
+  const bool cut_now = out.displaced_volume_m3 > 0.0 || out.bucket_in_m3 > 0.0;
+  wake_held(cut_now || cut_last_step_ ? nullptr : &to);
+  cut_last_step_ = cut_now;
   // The blade's wall matters only to a pass: marked only when one runs.
   if (pending()) {
-    mark_blade(grid, to);
+    mark_blade(grid, from, to);
     if (held_.empty()) held_edge_ = to, held_heel_ = hull_heel_;  // where the blade and hull hold what the passes find held
     run_passes(grid, out);
     clear_blade();

@@ -39,7 +39,7 @@ void SoilFlow::before_cut(const HeightGrid& grid, const Segment& from, const Seg
     for (int c = r.c0; c < r.c1; ++c) before_[k++] = h[std::int64_t(row) * cols_ + c];
 }
 
-void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
+void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& from, const Segment& edge) {
   // The cells whose centres lie within kBladeRadiusCells of the edge in
   // plan: row by row, the columns where the row's line can meet that
   // capsule (the part of the edge within the radius of the row, widened by
@@ -60,6 +60,13 @@ void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& edge) {
   // without dividing (blade_blocks).
   blade_.half_lo = half_num * (1.0 - 1e-12);
   blade_.half_hi = half_num * (1.0 + 1e-12);
+  // Each end's motion across the line in the step (any motion counts).
+  const auto across = [&](const Vec3& was, const Vec3& is) {
+    const double n = d.x * (is.z - was.z) - d.z * (is.x - was.x);
+    return std::abs(n) > 1e-9 * half_num ? n : 0.0;
+  };
+  blade_.across_a = across(from.a, edge.a);
+  blade_.across_b = across(from.b, edge.b);
   const double zlo = std::min(edge.a.z, edge.b.z) - radius, zhi = std::max(edge.a.z, edge.b.z) + radius;
   const int r0 = floor_within(to_cells(zlo, spec.origin_m.z, dz_) - 0.5, 0, rows_);
   const int r1 = ceil_within(to_cells(zhi, spec.origin_m.z, dz_) - 0.5, -1, rows_ - 1);

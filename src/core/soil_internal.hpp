@@ -176,15 +176,40 @@ inline bool SoilFlow::blade_blocks(int hc, int hr, int lc, int lr, float top_m) 
     const double q = std::abs(n);
     return q < blade_.half_lo ? true : q > blade_.half_hi ? false : std::abs(n / len) < half;
   };
-  const bool low_inside = inside(nb);
+  bool low_inside = inside(nb);
   // A source inside the blade is on neither side: its soil stands against
   // the blade (the cut takes it when the edge passes its centre), and the
   // side a centre on or next to the edge's line falls on is a matter of
   // rounding (a centre exactly on the line gave na = 0, counted on the
   // negative side, and a pile stood against the blade collapsed into the
   // cut behind it). It sheds nothing across or along the blade.
-  const bool high_inside = inside(na);
-  if (!low_inside && !high_inside && (na > 0.0) == (nb > 0.0)) return false;  // one side, outside the blade
+  bool high_inside = inside(na);
+  // Except a cell inside the blade whose centre the edge has passed (on the
+  // side it came from, by more than rounding): cut, it lies behind the
+  // plate and is the trench's, a cell of that side. A centre on the line
+  // (within rounding) takes soil from that side (the edge stands on it as it
+  // cuts it) but sheds nothing: it may hold soil the cut has not taken yet
+  // (a blade at 45 degrees stands on the centres it has not cut).
+  bool a_side = na > 0.0, b_side = nb > 0.0;
+  if (low_inside || high_inside) {
+    const double margin = 1e-9 * blade_.half_lo;
+    const auto along = [&](double x, double z) { return std::clamp((x * blade_.dx + z * blade_.dz) / len2, 0.0, 1.0); };
+    const auto behind_sign = [&](double t) { return -((1.0 - t) * blade_.across_a + t * blade_.across_b); };
+    if (low_inside) {
+      const double t = along(xb, zb), b = behind_sign(t);
+      if (nb * b > 0.0 && std::abs(nb) > margin) {
+        low_inside = false;
+      } else if (b != 0.0 && std::abs(nb) <= margin) {
+        low_inside = false;
+        b_side = b > 0.0;  // on the line: on the side the edge came from
+      }
+    }
+    if (high_inside) {
+      const double t = along(xa, za), b = behind_sign(t);
+      if (na * b > 0.0 && std::abs(na) > margin) high_inside = false, a_side = b > 0.0;
+    }
+  }
+  if (!low_inside && !high_inside && a_side == b_side) return false;  // one side, outside the blade
   // Where along the edge: at the low cell when it is inside the blade, at
   // the source when it is, else where the pair's segment meets the line.
   double px = xb, pz = zb;

@@ -361,7 +361,7 @@ class SoilFlow {
     held_.push_back(a);
   }
   void wake_held(const Segment* edge);
-  void mark_blade(const HeightGrid& grid, const Segment& edge);
+  void mark_blade(const HeightGrid& grid, const Segment& from, const Segment& edge);
   void clear_blade();
   /// Whether the blade stops soil at height top_m flowing from cell
   /// (hc, hr) to its neighbour (lc, lr).
@@ -419,6 +419,7 @@ class SoilFlow {
   std::vector<float> ends_dist_;
   std::vector<std::uint8_t> ends_state_;
   double ends_s_[2] = {0.0, 0.0};  // each end's cone height at the last call
+  bool cut_last_step_ = false;     // the last after_cut displaced or took in soil
   std::int64_t ends_work_ = 0;     // visits spill_round_ends spent this step (charged to the cap by run_passes)
   std::vector<std::pair<double, int>> ends_keys_;  // the round's donors' and receivers' cone keys
   std::vector<std::int32_t> ends_queue_;           // the round's sets, window cells in the order found
@@ -476,6 +477,10 @@ class SoilFlow {
     double ax = 0.0, az = 0.0, dx = 0.0, dz = 0.0, ay = 0.0, dy = 0.0;
     bool present = false;
     double len2 = 0.0, len = 0.0, half = 0.0, half_lo = 0.0, half_hi = 0.0;
+    // Each end's motion in the step across the edge's line (as n's
+    // numerator, dx z - dz x), 0 when it did not cross it: the side the edge
+    // came from is the other one.
+    double across_a = 0.0, across_b = 0.0;
   };
   BladeLine blade_{};
 
