@@ -231,9 +231,8 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     // It takes soil in only while its lip leads: moving toward its opening
     // (the blade frame's -Z, in plan).
     const Vec3 opening = rotate(orientation, {0.0, 0.0, -1.0});
-    const double mx = 0.5 * ((to.a.x + to.b.x) - (from.a.x + from.b.x));
-    const double mz = 0.5 * ((to.a.z + to.b.z) - (from.a.z + from.b.z));
-    if (mx * opening.x + mz * opening.z > 0.0) room = std::max(0.0, holds - load_m3_);
+    const PlanMotion m = midpoint_motion(from, to);
+    if (m.x * opening.x + m.z * opening.z > 0.0) room = std::max(0.0, holds - load_m3_);
   }
   displace(grid, from, to, room, out);
   // What the push left above the repose cone through an end of the blade

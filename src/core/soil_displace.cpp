@@ -111,8 +111,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   const Vec3 e = to.b - to.a;
   double nx = -e.z, nz = e.x;
   const double plan_length = std::hypot(nx, nz);
-  const double mx = 0.5 * ((to.a.x + to.b.x) - (from.a.x + from.b.x));
-  const double mz = 0.5 * ((to.a.z + to.b.z) - (from.a.z + from.b.z));
+  const auto [mx, mz] = midpoint_motion(from, to);
   if (plan_length > 1e-12) {
     nx /= plan_length;
     nz /= plan_length;

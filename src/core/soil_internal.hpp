@@ -78,6 +78,16 @@ inline constexpr Neighbour kNeighbours[8] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 1}, 
 
 inline double to_cells(double v, double origin, double cell) { return (v - origin) / cell; }
 
+/// How far the edge's midpoint moved in plan over a step, from `from` to
+/// `to`: {x, z}, metres (the bucket's lip, the displacement's push and the
+/// spill's side the edge came from all read it).
+struct PlanMotion {
+  double x, z;
+};
+inline PlanMotion midpoint_motion(const Segment& from, const Segment& to) {
+  return {0.5 * ((to.a.x + to.b.x) - (from.a.x + from.b.x)), 0.5 * ((to.a.z + to.b.z) - (from.a.z + from.b.z))};
+}
+
 /// floor(v) as an int within [lo, hi]: clamped in double first, so that a
 /// point far off the grid (a blade kilometres long is valid input) never
 /// overflows the conversion. NaN gives lo.
@@ -197,16 +207,14 @@ inline bool SoilFlow::blade_blocks(int hc, int hr, int lc, int lr, float top_m) 
     const auto behind_sign = [&](double t) { return -((1.0 - t) * blade_.across_a + t * blade_.across_b); };
     if (low_inside) {
       const double t = along(xb, zb), b = behind_sign(t);
-      if (nb * b > 0.0 && std::abs(nb) > margin) {
+      if (b != 0.0 && (std::abs(nb) <= margin || nb * b > 0.0)) {
         low_inside = false;
-      } else if (b != 0.0 && std::abs(nb) <= margin) {
-        low_inside = false;
-        b_side = b > 0.0;  // on the line: on the side the edge came from
+        b_side = b > 0.0;  // on the line, or past it: on the side the edge came from
       }
     }
     if (high_inside) {
       const double t = along(xa, za), b = behind_sign(t);
-      if (na * b > 0.0 && std::abs(na) > margin) high_inside = false, a_side = b > 0.0;
+      if (na * b > 0.0 && std::abs(na) > margin) high_inside = false;  // na's sign is b's
     }
   }
   if (!low_inside && !high_inside && a_side == b_side) return false;  // one side, outside the blade

@@ -162,8 +162,7 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
   struct Line {
     std::uint32_t cell[kMaxFallCells];
     float reach[kMaxFallCells];
-    int length = 0;  // the cells walked
-    int live = 0;    // of them, the first `live` (compacted) are not humps
+    int live = 0;  // the cells walked; after a round, the first `live` (compacted) are not humps
   };
   Line lines[8];
   const float tol = tolerance_m_;
@@ -215,7 +214,6 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
         fc = fn;
       }
     }
-    line.length = len;
     fall_visits_ += len;
     for (int m = 0; m < len; ++m) {
       total += line.reach[m];
