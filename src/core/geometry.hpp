@@ -119,6 +119,85 @@ inline double surface_in_square(double h00, double h10, double h01, double h11, 
   return h11 + (1.0 - a) * (h01 - h11) + (1.0 - b) * (h10 - h11);
 }
 
+/// Where a point falls among the samples, found once for any layer laid out
+/// as spec says: outside the terrain (height 0), a column's sample, or a
+/// square of the triangulated surface (the split surface_in_square uses)
+/// with the point's place in it. The terrain surface query (surface.hpp)
+/// and the soil ahead of the edge (soil_ahead.cpp) read through it.
+struct SurfacePoint {
+  SurfacePoint() = default;
+  bool outside = true;
+  bool columns = false;
+  bool lower = false;       // kSurface: the point lies in the square's lower triangle
+  std::int64_t sample = 0;  // kColumns: the cell's sample; kSurface: the square's first node
+  std::int64_t right = 0;   // kSurface: the offset of the square's next node along X
+  std::int64_t up = 0;      // and along Z (0 where the grid is one sample wide)
+  double a = 0.0, b = 0.0;  // kSurface: the point's offsets in the square
+
+  /// At world (x, z).
+  SurfacePoint(const GridSpec& spec, Representation representation, double x, double z)
+      : SurfacePoint(spec.cols, spec.rows, representation, (x - spec.origin_m.x) / spec.cell_x_m(),
+                     (z - spec.origin_m.z) / spec.cell_z_m()) {}
+
+  /// At continuous cell coordinates (u, v) (cell (c, r) covers [c, c+1) x
+  /// [r, r+1)) of a grid of cols x rows samples.
+  SurfacePoint(int cols, int rows, Representation representation, double u, double v) {
+    if (!(u >= 0.0 && u <= cols && v >= 0.0 && v <= rows)) return;
+    outside = false;
+    if (representation == Representation::kColumns) {
+      columns = true;
+      const int c = std::min(int(u), cols - 1), r = std::min(int(v), rows - 1);
+      sample = std::int64_t(r) * cols + c;
+      return;
+    }
+    // Node coordinates (sample (c, r) at integer (c, r)), clamped to the
+    // outer samples: the half-cell border is flat.
+    const double us = std::clamp(u - 0.5, 0.0, double(cols - 1));
+    const double vs = std::clamp(v - 0.5, 0.0, double(rows - 1));
+    const int i = std::clamp(int(us), 0, std::max(cols - 2, 0));
+    const int j = std::clamp(int(vs), 0, std::max(rows - 2, 0));
+    a = us - i;
+    b = vs - j;
+    lower = a + b <= 1.0;
+    // (i + 1 and j + 1 are within the grid unless it is one sample wide,
+    // where the next node is the node itself, as clamped_height gives.)
+    sample = std::int64_t(j) * cols + i;
+    right = i + 1 < cols ? 1 : 0;
+    up = j + 1 < rows ? std::int64_t(cols) : 0;
+  }
+
+  /// On the triangulated surface at (u, v) known to lie where no clamp
+  /// applies (u in [0.5, cols - 0.5), v in [0.5, rows - 0.5)): the same
+  /// square and offsets as the constructor above, without its tests.
+  static SurfacePoint interior(int cols, double u, double v) {
+    SurfacePoint p;
+    const double us = u - 0.5, vs = v - 0.5;
+    const int i = int(us), j = int(vs);
+    p.outside = false;
+    p.a = us - i;
+    p.b = vs - j;
+    p.lower = p.a + p.b <= 1.0;
+    p.sample = std::int64_t(j) * cols + i;
+    p.right = 1;
+    p.up = cols;
+    return p;
+  }
+
+  /// The surface's height over the layer h at the point, metres above the
+  /// ground level.
+  double height(const float* h) const {
+    if (outside) return 0.0;
+    if (columns) return h[sample];
+    const float* s = h + sample;
+    const double h00 = s[0], h10 = s[right], h01 = s[up], h11 = s[up + right];
+    // Both triangles' planes, then the one the point is in (surface_in_square's
+    // arithmetic).
+    const double in_lower = h00 + a * (h10 - h00) + b * (h01 - h00);
+    const double in_upper = h11 + (1.0 - a) * (h01 - h11) + (1.0 - b) * (h10 - h11);
+    return lower ? in_lower : in_upper;
+  }
+};
+
 /// Height of sample (c, r) with indices clamped to the grid (the surface's
 /// flat extension over the half-cell border).
 inline double clamped_height(const float* h, int cols, int rows, int c, int r) {

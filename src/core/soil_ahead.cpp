@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "terracut/core/surface.hpp"
+#include "geometry.hpp"
 
 namespace terracut {
 
@@ -46,6 +47,8 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
   const double cell = std::min(spec.cell_x_m(), spec.cell_z_m());
   const int n = edge_parts(spec, edge);
   const double ground = spec.origin_m.y;
+  const float* now_m = grid.heights();
+  const float* initial_m = grid.initial();
   double sum_d = 0.0, sum_d2 = 0.0, sum_pile_d = 0.0;
   for (int i = 0; i < n; ++i) {
     const Vec3 p = lerp(edge.a, edge.b, (i + 0.5) / n);
@@ -60,11 +63,25 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
     if (!(wedge_per_depth > 0.0)) continue;
     const double reach_m = wedge_per_depth * depth;
     const int reach_points = static_cast<int>(std::clamp(std::ceil(reach_m / cell), 1.0, 64.0));
+    // The points q + u reach (k + 1/2) / reach_points, walked in cell
+    // coordinates (the same points to rounding, without two divisions each).
+    const double qu = (q.x - spec.origin_m.x) / spec.cell_x_m(), qv = (q.z - spec.origin_m.z) / spec.cell_z_m();
+    const double spacing = reach_m / reach_points;
+    const double du = u.x * spacing / spec.cell_x_m(), dv = u.z * spacing / spec.cell_z_m();
+    // Whether every point lies where the surface needs no clamp (the walk
+    // is straight: its ends decide, with a margin for their rounding).
+    const auto clear = [&](double t) {
+      const double pu = qu + du * t, pv = qv + dv * t;
+      return pu >= 0.5 + 1e-6 && pu < spec.cols - 0.5 - 1e-6 && pv >= 0.5 + 1e-6 && pv < spec.rows - 0.5 - 1e-6;
+    };
+    const bool interior = representation == Representation::kSurface && clear(0.5) && clear(reach_points - 0.5);
     double pile = 0.0;
     for (int k = 0; k < reach_points; ++k) {
-      const Vec3 r = q + u * (reach_m * (k + 0.5) / reach_points);
-      const auto [now_r, before_r] = surface_heights_m(spec, grid.heights(), grid.initial(), representation, r.x, r.z);
-      pile += std::max(0.0, now_r - before_r);
+      const double t = k + 0.5;
+      const double pu = qu + du * t, pv = qv + dv * t;
+      const detail::SurfacePoint r = interior ? detail::SurfacePoint::interior(spec.cols, pu, pv)
+                                              : detail::SurfacePoint(spec.cols, spec.rows, representation, pu, pv);
+      pile += std::max(0.0, r.height(now_m) - r.height(initial_m));
     }
     // Weighted by the part's depth: the surcharge acts on q d w.
     sum_pile_d += depth * pile / reach_points;
