@@ -46,6 +46,12 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
   const GridSpec& spec = grid.spec();
   const double cell = std::min(spec.cell_x_m(), spec.cell_z_m());
   const int n = edge_parts(spec, edge);
+  // The parts' length in plan: the wedge is read as finely along the
+  // motion as across it (one point a cell, or a part's length where the
+  // parts are longer: on a 1 m edge of 64 parts over 5 mm cells, 15.6 mm).
+  // Finer along than across buys no accuracy (the coarser spacing sets the
+  // quadrature's error) and cost two thirds of the step's force there.
+  const double part_m = std::hypot(edge.b.x - edge.a.x, edge.b.z - edge.a.z) / n;
   const double ground = spec.origin_m.y;
   const float* now_m = grid.heights();
   const float* initial_m = grid.initial();
@@ -62,7 +68,7 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
     // The pile over the wedge: soil above the initial surface ahead.
     if (!(wedge_per_depth > 0.0)) continue;
     const double reach_m = wedge_per_depth * depth;
-    const int reach_points = static_cast<int>(std::clamp(std::ceil(reach_m / cell), 1.0, 64.0));
+    const int reach_points = static_cast<int>(std::clamp(std::ceil(reach_m / std::max(cell, part_m)), 1.0, 64.0));
     // The points q + u reach (k + 1/2) / reach_points, walked in cell
     // coordinates (the same points to rounding, without two divisions each).
     const double qu = (q.x - spec.origin_m.x) / spec.cell_x_m(), qv = (q.z - spec.origin_m.z) / spec.cell_z_m();

@@ -60,8 +60,9 @@ inline constexpr double kWedgeLengthPerDepth = 2.0;
 
 /// The depth, width and pile ahead of the edge (see SoilAhead); at each part
 /// of the edge the pile is averaged over up to 64 points along the motion
-/// from the lookahead to wedge_per_depth x that part's depth beyond it (no
-/// pile read with wedge_per_depth 0). A motion without a horizontal part or
+/// from the lookahead to wedge_per_depth x that part's depth beyond it, one
+/// a cell or one a part's length in plan where that is longer (no pile read
+/// with wedge_per_depth 0). A motion without a horizontal part or
 /// a non-finite input gives zeros. Allocates nothing.
 SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, const Segment& edge,
                      Vec3 velocity_m_per_s, double lookahead_m,
