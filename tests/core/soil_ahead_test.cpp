@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -89,6 +90,50 @@ TEST(CutDepth, APileAheadIsNotDepthButSurchargeHeight) {
   EXPECT_NEAR(surface_y_m(g, Representation::kSurface, 0.5, 0.4 + look) - 0.15, 0.15, 1e-6);
   // No horizontal motion: nothing ahead.
   EXPECT_EQ(soil_ahead(g, Representation::kSurface, edge, {0.0, -1.0, 0.0}, look).depth_m, 0.0);
+}
+
+// The pile over the wedge is a mean along the motion, read at points one
+// spacing h apart, h = max(cell, the part's length): on a pile falling
+// linearly ahead the midpoint rule is exact, and where the pile ends inside
+// the wedge (a kink of slope k) it is off by at most k h^2 / 8 over the
+// wedge's length L, plus the surface's interpolation across that kink (at
+// most k cell / 4 at the one point in the kink's cell, so k cell h / (4 L)
+// on the mean). Edges of 0.3 m (parts of one 5 mm cell) and 2 m (64 parts
+// of 31 mm) on 5 mm cells.
+TEST(CutDepth, ThePileIsTheMeanOverTheWedgeWithinItsSamplingError) {
+  const double cell = 0.005, layer = 0.2, edge_y = 0.15, edge_z = 0.4, k = 0.6;
+  const int cols = 600, rows = 200;
+  const auto pushed = [&](double top_m) {
+    // The pile above the layer ahead of the edge's line: top_m at the line,
+    // falling at k ahead, none behind.
+    HeightGrid g(grid_of_cells(cols, rows, cell), std::vector<float>(std::size_t(cols) * rows, float(layer)));
+    std::vector<float> h(std::size_t(cols) * rows, float(layer));
+    for (int r = 0; r < rows; ++r) {
+      const double z = (r + 0.5) * cell;
+      const float pile = z >= edge_z ? float(std::max(0.0, top_m - k * (z - edge_z))) : 0.0f;
+      for (int c = 0; c < cols; ++c) h[std::size_t(r) * cols + c] = float(layer) + pile;
+    }
+    g.set_heights({0, 0, cols, rows}, h.data());
+    return g;
+  };
+  const double look = depth_lookahead_m(grid_of_cells(cols, rows, cell));
+  const double depth = layer - edge_y, reach = kWedgeLengthPerDepth * depth;
+  for (const double length_m : {0.3, 2.0}) {
+    const Segment edge{{1.5 - 0.5 * length_m, edge_y, edge_z}, {1.5 + 0.5 * length_m, edge_y, edge_z}};
+    const int parts = int(std::min(64.0, std::ceil(length_m / cell)));
+    const double h = std::max(cell, length_m / parts);
+    // Linear over the whole wedge: the mean is the pile at its middle.
+    const HeightGrid linear = pushed(0.2);
+    const SoilAhead a = soil_ahead(linear, Representation::kSurface, edge, {0.0, 0.0, 1.0}, look);
+    EXPECT_NEAR(a.depth_m, depth, 1e-6) << length_m;
+    EXPECT_NEAR(a.pile_m, 0.2 - k * (look + 0.5 * reach), 1e-6) << length_m;
+    // Ending inside the wedge, at t = top / k - look past its start.
+    const double top = 0.05, at_start = top - k * look;
+    const double exact = at_start * at_start / (2.0 * k) / reach;
+    const HeightGrid kinked = pushed(top);
+    const SoilAhead b = soil_ahead(kinked, Representation::kSurface, edge, {0.0, 0.0, 1.0}, look);
+    EXPECT_NEAR(b.pile_m, exact, k * h * h / (8.0 * reach) + k * cell * h / (4.0 * reach) + 1e-6) << length_m;
+  }
 }
 
 TEST(Embedment, TheDepthIsReadBesideTheEdgeNotInItsOwnTrench) {
