@@ -189,12 +189,7 @@ struct SurfacePoint {
     if (outside) return 0.0;
     if (columns) return h[sample];
     const float* s = h + sample;
-    const double h00 = s[0], h10 = s[right], h01 = s[up], h11 = s[up + right];
-    // Both triangles' planes, then the one the point is in (surface_in_square's
-    // arithmetic).
-    const double in_lower = h00 + a * (h10 - h00) + b * (h01 - h00);
-    const double in_upper = h11 + (1.0 - a) * (h01 - h11) + (1.0 - b) * (h10 - h11);
-    return lower ? in_lower : in_upper;
+    return surface_in_square(s[0], s[right], s[up], s[up + right], a, b, lower);
   }
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "terracut/core/surface.hpp"
 #include "geometry.hpp"
@@ -13,6 +14,8 @@ double depth_lookahead_m(const GridSpec& spec) {
 }
 
 namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // The number of parts an edge is read at.
 int edge_parts(const GridSpec& spec, const Segment& edge) {
@@ -33,6 +36,41 @@ void equivalent_cut(double sum_d, double sum_d2, double part, double& depth_m, d
   length_m = part * sum_d * sum_d / sum_d2;
 }
 
+// Points start + t step (world x, z; t from t0 to t1) read in cell
+// coordinates: no two divisions a point, and where every point of the walk
+// lies inside the grid's outer half cells (the walk is straight, so its
+// ends decide, with a margin for their rounding) the surface's clamps are
+// skipped.
+class Walk {
+ public:
+  Walk(const GridSpec& spec, Representation representation, double x, double z, double step_x, double step_z,
+       double t0, double t1)
+      : cols_(spec.cols),
+        rows_(spec.rows),
+        representation_(representation),
+        u0_((x - spec.origin_m.x) / spec.cell_x_m()),
+        v0_((z - spec.origin_m.z) / spec.cell_z_m()),
+        du_(step_x / spec.cell_x_m()),
+        dv_(step_z / spec.cell_z_m()) {
+    interior_ = representation == Representation::kSurface && clear(t0) && clear(t1);
+  }
+  detail::SurfacePoint at(double t) const {
+    const double u = u0_ + du_ * t, v = v0_ + dv_ * t;
+    return interior_ ? detail::SurfacePoint::interior(cols_, u, v)
+                     : detail::SurfacePoint(cols_, rows_, representation_, u, v);
+  }
+
+ private:
+  bool clear(double t) const {
+    const double u = u0_ + du_ * t, v = v0_ + dv_ * t;
+    return u >= 0.5 + 1e-6 && u < cols_ - 0.5 - 1e-6 && v >= 0.5 + 1e-6 && v < rows_ - 0.5 - 1e-6;
+  }
+  int cols_, rows_;
+  Representation representation_;
+  double u0_, v0_, du_, dv_;
+  bool interior_ = false;
+};
+
 }  // namespace
 
 SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, const Segment& edge,
@@ -46,51 +84,59 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
   const GridSpec& spec = grid.spec();
   const double cell = std::min(spec.cell_x_m(), spec.cell_z_m());
   const int n = edge_parts(spec, edge);
-  // The parts' length in plan: the wedge is read as finely along the
-  // motion as across it (one point a cell, or a part's length where the
-  // parts are longer: on a 1 m edge of 64 parts over 5 mm cells, 15.6 mm).
-  // Finer along than across buys no accuracy (the coarser spacing sets the
-  // quadrature's error) and cost two thirds of the step's force there.
+  // The parts' length in plan, the spacing of the wedge's points along the
+  // motion where it is longer than a cell (see the pile below).
   const double part_m = std::hypot(edge.b.x - edge.a.x, edge.b.z - edge.a.z) / n;
   const double ground = spec.origin_m.y;
   const float* now_m = grid.heights();
   const float* initial_m = grid.initial();
   double sum_d = 0.0, sum_d2 = 0.0, sum_pile_d = 0.0;
+  // The parts' centres, one lookahead ahead.
+  const Vec3 e = edge.b - edge.a;
+  const Walk ahead(spec, representation, edge.a.x + u.x * lookahead_m, edge.a.z + u.z * lookahead_m, e.x / n, e.z / n,
+                   0.5, n - 0.5);
   for (int i = 0; i < n; ++i) {
     const Vec3 p = lerp(edge.a, edge.b, (i + 0.5) / n);
     // The depth at the lookahead, below the undisturbed surface.
     const Vec3 q = p + u * lookahead_m;
-    const auto [now, before] = surface_heights_m(spec, grid.heights(), grid.initial(), representation, q.x, q.z);
-    const double depth = ground + std::min(now, before) - p.y;
+    const detail::SurfacePoint at_q = ahead.at(i + 0.5);
+    const double depth = ground + std::min(at_q.height(now_m), at_q.height(initial_m)) - p.y;
     if (!(depth > 0.0)) continue;
     sum_d += depth;
     sum_d2 += depth * depth;
     // The pile over the wedge: soil above the initial surface ahead.
     if (!(wedge_per_depth > 0.0)) continue;
     const double reach_m = wedge_per_depth * depth;
-    const int reach_points = static_cast<int>(std::clamp(std::ceil(reach_m / std::max(cell, part_m)), 1.0, 64.0));
-    // The points q + u reach (k + 1/2) / reach_points, walked in cell
-    // coordinates (the same points to rounding, without two divisions each).
-    const double qu = (q.x - spec.origin_m.x) / spec.cell_x_m(), qv = (q.z - spec.origin_m.z) / spec.cell_z_m();
-    const double spacing = reach_m / reach_points;
-    const double du = u.x * spacing / spec.cell_x_m(), dv = u.z * spacing / spec.cell_z_m();
-    // Whether every point lies where the surface needs no clamp (the walk
-    // is straight: its ends decide, with a margin for their rounding).
-    const auto clear = [&](double t) {
-      const double pu = qu + du * t, pv = qv + dv * t;
-      return pu >= 0.5 + 1e-6 && pu < spec.cols - 0.5 - 1e-6 && pv >= 0.5 + 1e-6 && pv < spec.rows - 0.5 - 1e-6;
+    if (!(reach_m < kInfinity)) continue;  // (an overflowing depth x wedge: no pile read)
+    // The mean over the wedge by the midpoint rule on intervals of one
+    // spacing h from the lookahead on, the last one what is left of the
+    // reach (weighted by its length): the points stay where they are as the
+    // depth changes and the last interval grows from nothing, so the pile
+    // read is continuous in the depth (a count of evenly spread points,
+    // ceil(reach / h), moved them all when it changed by one: a step of up
+    // to 4 % of the pile on a 2 m edge over 5 mm cells). h is one cell, or
+    // the part's length where that is longer (the wedge read as finely
+    // along the motion as the edge is along itself: on a 1 m edge of 64
+    // parts over 5 mm cells, 15.6 mm, 7 points a part where one a cell took
+    // two thirds of the step's force; the force moved by at most 0.1 % over
+    // the soil benchmark's push, docs/forces.md), and at least 1/64 of the
+    // reach.
+    const double h = std::max({cell, part_m < kInfinity ? part_m : cell, reach_m / 64.0});
+    const int whole = static_cast<int>(std::clamp(std::floor(reach_m / h), 0.0, 64.0));
+    const double rest_m = std::max(0.0, reach_m - whole * h);
+    const double last_t = rest_m > 0.0 ? whole * h + 0.5 * rest_m : (whole - 0.5) * h;
+    const Walk wedge(spec, representation, q.x, q.z, u.x, u.z, std::min(0.5 * h, last_t), last_t);
+    const auto pile_at = [&](double t) {
+      const detail::SurfacePoint r = wedge.at(t);
+      return std::max(0.0, r.height(now_m) - r.height(initial_m));
     };
-    const bool interior = representation == Representation::kSurface && clear(0.5) && clear(reach_points - 0.5);
     double pile = 0.0;
-    for (int k = 0; k < reach_points; ++k) {
-      const double t = k + 0.5;
-      const double pu = qu + du * t, pv = qv + dv * t;
-      const detail::SurfacePoint r = interior ? detail::SurfacePoint::interior(spec.cols, pu, pv)
-                                              : detail::SurfacePoint(spec.cols, spec.rows, representation, pu, pv);
-      pile += std::max(0.0, r.height(now_m) - r.height(initial_m));
-    }
+    for (int k = 0; k < whole; ++k) pile += pile_at((k + 0.5) * h);
+    pile *= h;
+    if (rest_m > 0.0) pile += rest_m * pile_at(whole * h + 0.5 * rest_m);
+    pile /= reach_m;
     // Weighted by the part's depth: the surcharge acts on q d w.
-    sum_pile_d += depth * pile / reach_points;
+    sum_pile_d += depth * pile;
   }
   equivalent_cut(sum_d, sum_d2, length(edge.b - edge.a) / n, out.depth_m, out.width_m);
   if (sum_d > 0.0) out.pile_m = sum_pile_d / sum_d;
@@ -118,13 +164,19 @@ Embedment embedment(const HeightGrid& grid, Representation representation, const
     sides[3] = {0.0, 0.0, -lookahead_m};
     side_count = 4;
   }
-  const int n = edge_parts(grid.spec(), edge);
+  const GridSpec& spec = grid.spec();
+  const int n = edge_parts(spec, edge);
+  // The parts' centres, on each side.
+  const Walk beside_walk[4] = {
+      Walk(spec, representation, edge.a.x + sides[0].x, edge.a.z + sides[0].z, e.x / n, e.z / n, 0.5, n - 0.5),
+      Walk(spec, representation, edge.a.x + sides[1].x, edge.a.z + sides[1].z, e.x / n, e.z / n, 0.5, n - 0.5),
+      Walk(spec, representation, edge.a.x + sides[2].x, edge.a.z + sides[2].z, e.x / n, e.z / n, 0.5, n - 0.5),
+      Walk(spec, representation, edge.a.x + sides[3].x, edge.a.z + sides[3].z, e.x / n, e.z / n, 0.5, n - 0.5)};
   double sum_d = 0.0, sum_d2 = 0.0;
   for (int i = 0; i < n; ++i) {
     const Vec3 p = lerp(edge.a, edge.b, (i + 0.5) / n);
     double beside = 0.0;
-    for (int k = 0; k < side_count; ++k)
-      beside += surface_y_m(grid, representation, p.x + sides[k].x, p.z + sides[k].z);
+    for (int k = 0; k < side_count; ++k) beside += spec.origin_m.y + beside_walk[k].at(i + 0.5).height(grid.heights());
     const double depth = beside / side_count - p.y;
     if (depth > 0.0) {
       sum_d += depth;

@@ -136,6 +136,117 @@ TEST(CutDepth, ThePileIsTheMeanOverTheWedgeWithinItsSamplingError) {
   }
 }
 
+// The pile read does not jump as the depth changes: lowering a 2 m edge
+// over 5 mm cells (64 parts of 31 mm, the wedge read every 31 mm) through
+// a pile that ends inside the wedge, the reading changes between depths
+// 0.01 mm apart by no more than the mean over a wedge of length L can:
+// |dM/dL| <= (f(L) + M) / L for the exact mean, plus (h k / 2) / L for the
+// last interval's midpoint moving along the pile's slope k, with L = 2 d.
+// (A count of evenly spread points, ceil(L / h), moved every point when it
+// changed: steps of up to 4 % of the pile.)
+TEST(CutDepth, ThePileIsContinuousInTheDepth) {
+  const double cell = 0.005, layer = 0.2, edge_z = 0.4, k = 0.6, top = 0.03;
+  const int cols = 600, rows = 200;
+  HeightGrid g(grid_of_cells(cols, rows, cell), std::vector<float>(std::size_t(cols) * rows, float(layer)));
+  std::vector<float> h(std::size_t(cols) * rows, float(layer));
+  for (int r = 0; r < rows; ++r) {
+    const double z = (r + 0.5) * cell;
+    const float pile = z >= edge_z ? float(std::max(0.0, top - k * (z - edge_z))) : 0.0f;
+    for (int c = 0; c < cols; ++c) h[std::size_t(r) * cols + c] = float(layer) + pile;
+  }
+  g.set_heights({0, 0, cols, rows}, h.data());
+  const double look = depth_lookahead_m(g.spec());
+  const double spacing = 2.0 / 64.0, step = 1e-5;
+  double previous = -1.0;
+  int changed = 0;
+  for (double depth = 0.02; depth <= 0.06; depth += step) {
+    const double y = layer - depth;
+    const SoilAhead a = soil_ahead(g, Representation::kSurface, {{0.5, y, edge_z}, {2.5, y, edge_z}}, {0.0, 0.0, 1.0}, look);
+    if (previous >= 0.0) {
+      const double reach = kWedgeLengthPerDepth * depth;
+      const double bound = kWedgeLengthPerDepth * step * (2.0 * top + 0.5 * spacing * k) / reach;
+      EXPECT_LE(std::abs(a.pile_m - previous), bound + 1e-9) << "depth " << depth;
+      changed += a.pile_m != previous ? 1 : 0;
+    }
+    previous = a.pile_m;
+  }
+  EXPECT_GT(changed, 1000);  // the pile read does change with the depth
+}
+
+// The wedge's points walked in cell coordinates (with the clamps skipped
+// where the walk lies inside the grid) read what the surface query reads at
+// the same world points: against surface_heights_m at q + u t, with the
+// same intervals, where the wedge runs off the grid, on both
+// representations, on a grid one sample wide, and across a yawed motion.
+TEST(CutDepth, ThePileReadsWhatTheSurfaceQueryReadsAtTheSamePoints) {
+  const auto reference = [](const HeightGrid& g, Representation rep, const Segment& edge, Vec3 v, double look) {
+    const GridSpec& spec = g.spec();
+    const double cell = std::min(spec.cell_x_m(), spec.cell_z_m());
+    const int n = int(std::clamp(std::ceil(length(edge.b - edge.a) / cell), 2.0, 64.0));
+    const double part = std::hypot(edge.b.x - edge.a.x, edge.b.z - edge.a.z) / n;
+    const double speed = std::hypot(v.x, v.z);
+    const Vec3 u{v.x / speed, 0.0, v.z / speed};
+    double sum_d = 0.0, sum_pile_d = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const Vec3 p = lerp(edge.a, edge.b, (i + 0.5) / n);
+      const Vec3 q = p + u * look;
+      const auto [now, before] = surface_heights_m(spec, g.heights(), g.initial(), rep, q.x, q.z);
+      const double depth = spec.origin_m.y + std::min(now, before) - p.y;
+      if (!(depth > 0.0)) continue;
+      const double reach = kWedgeLengthPerDepth * depth;
+      const double h = std::max({cell, part, reach / 64.0});
+      const int whole = int(std::floor(reach / h));
+      const double rest = reach - whole * h;
+      const auto pile_at = [&](double t) {
+        const Vec3 r = q + u * t;
+        const auto [a, b] = surface_heights_m(spec, g.heights(), g.initial(), rep, r.x, r.z);
+        return std::max(0.0, a - b);
+      };
+      double pile = 0.0;
+      for (int k = 0; k < whole; ++k) pile += h * pile_at((k + 0.5) * h);
+      if (rest > 0.0) pile += rest * pile_at(whole * h + 0.5 * rest);
+      sum_d += depth;
+      sum_pile_d += depth * pile / reach;
+    }
+    return sum_d > 0.0 ? sum_pile_d / sum_d : 0.0;
+  };
+  // A bumpy pile on a 0.2 m layer (heights from a formula), the cut 5 cm.
+  const auto terrain = [](int cols, int rows, double cell) {
+    HeightGrid g(grid_of_cells(cols, rows, cell), std::vector<float>(std::size_t(cols) * rows, 0.2f));
+    std::vector<float> h(std::size_t(cols) * rows);
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c)
+        h[std::size_t(r) * cols + c] = float(0.2 + 0.03 * (1.0 + std::sin(0.7 * c + 1.3 * r)) * (r > rows / 3 ? 1.0 : 0.0));
+    g.set_heights({0, 0, cols, rows}, h.data());
+    return g;
+  };
+  struct Case {
+    int cols, rows;
+    double cell;
+    Segment edge;
+    Vec3 v;
+  };
+  const Case cases[] = {
+      {100, 60, 0.01, {{0.2, 0.15, 0.45}, {0.8, 0.15, 0.45}}, {0.0, 0.0, 1.0}},   // the wedge runs off the far side
+      {100, 60, 0.01, {{0.2, 0.15, 0.3}, {0.8, 0.15, 0.3}}, {0.0, 0.0, 1.0}},     // inside the grid
+      {100, 60, 0.01, {{0.3, 0.15, 0.25}, {0.7, 0.15, 0.35}}, {-0.3, 0.0, 1.0}},  // yawed, oblique motion
+      {1, 200, 0.005, {{0.0, 0.15, 0.4}, {0.005, 0.15, 0.4}}, {0.0, 0.0, 1.0}},   // one sample wide
+      {100, 60, 0.01, {{0.2, 0.15, 0.3}, {0.8, 0.15, 0.3}}, {0.0, 0.0, -1.0}},    // backwards, into the bare layer
+  };
+  for (const Case& c : cases) {
+    const HeightGrid g = terrain(c.cols, c.rows, c.cell);
+    const double look = depth_lookahead_m(g.spec());
+    for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
+      const double expected = reference(g, rep, c.edge, c.v, look);
+      const SoilAhead a = soil_ahead(g, rep, c.edge, c.v, look);
+      EXPECT_NEAR(a.pile_m, expected, 1e-12) << c.cols << " x " << c.rows << ", " << int(rep);
+      if (c.v.z > 0.0) {
+        EXPECT_GT(expected, 0.0);  // the cases read a pile
+      }
+    }
+  }
+}
+
 TEST(Embedment, TheDepthIsReadBesideTheEdgeNotInItsOwnTrench) {
   // A 0.2 m layer with a one-cell trench cut down to 0.12 m along row 40
   // (z in [0.40, 0.41)), where a horizontal edge along X sits at y = 0.12.

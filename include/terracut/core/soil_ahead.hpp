@@ -59,10 +59,13 @@ struct SoilAhead {
 inline constexpr double kWedgeLengthPerDepth = 2.0;
 
 /// The depth, width and pile ahead of the edge (see SoilAhead); at each part
-/// of the edge the pile is averaged over up to 64 points along the motion
-/// from the lookahead to wedge_per_depth x that part's depth beyond it, one
-/// a cell or one a part's length in plan where that is longer (no pile read
-/// with wedge_per_depth 0). A motion without a horizontal part or
+/// of the edge the pile is averaged along the motion from the lookahead to
+/// wedge_per_depth x that part's depth beyond it, by the midpoint rule on
+/// intervals of one cell, or of the part's length in plan where that is
+/// longer, or of 1/64 of the reach where that is longer still, the last
+/// interval what is left of the reach (so the reading is continuous in the
+/// depth); no pile read with wedge_per_depth 0, nor where the reach
+/// overflows. A motion without a horizontal part or
 /// a non-finite input gives zeros. Allocates nothing.
 SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, const Segment& edge,
                      Vec3 velocity_m_per_s, double lookahead_m,
