@@ -118,7 +118,7 @@ SoilAhead soil_ahead(const HeightGrid& grid, Representation representation, cons
     // the part's length where that is longer (the wedge read as finely
     // along the motion as the edge is along itself: on a 1 m edge of 64
     // parts over 5 mm cells, 15.6 mm, 7 points a part where one a cell took
-    // two thirds of the step's force; the force moved by at most 0.1 % over
+    // two thirds of the step's force; the force moved by at most 0.13 % over
     // the soil benchmark's push, docs/forces.md), and at least 1/64 of the
     // reach.
     const double h = std::max({cell, part_m < kInfinity ? part_m : cell, reach_m / 64.0});
