@@ -14,6 +14,24 @@
 namespace terracut {
 namespace {
 
+// A 0.2 m layer of 5 mm cells (600 x 200) with a pile above it ahead of
+// the line z = 0.4 m: top_m at the line, falling at slope k ahead, none
+// behind (the pile a blade along X pushes there).
+constexpr double kPileCell = 0.005, kPileLayer = 0.2, kPileLine = 0.4;
+constexpr int kPileCols = 600, kPileRows = 200;
+HeightGrid pile_ahead(double top_m, double k) {
+  HeightGrid g(grid_of_cells(kPileCols, kPileRows, kPileCell),
+               std::vector<float>(std::size_t(kPileCols) * kPileRows, float(kPileLayer)));
+  std::vector<float> h(std::size_t(kPileCols) * kPileRows);
+  for (int r = 0; r < kPileRows; ++r) {
+    const double z = (r + 0.5) * kPileCell;
+    const float pile = z >= kPileLine ? float(std::max(0.0, top_m - k * (z - kPileLine))) : 0.0f;
+    for (int c = 0; c < kPileCols; ++c) h[std::size_t(r) * kPileCols + c] = float(kPileLayer) + pile;
+  }
+  g.set_heights({0, 0, kPileCols, kPileRows}, h.data());
+  return g;
+}
+
 TEST(CutDepth, WithoutAPileTheDepthIsTheDepthAhead) {
   HeightGrid g(grid_of_cells(100, 100, 0.01), std::vector<float>(100 * 100, 0.2f));
   const Segment edge{{0.3, 0.15, 0.4}, {0.7, 0.15, 0.4}};
@@ -101,22 +119,9 @@ TEST(CutDepth, APileAheadIsNotDepthButSurchargeHeight) {
 // on the mean). Edges of 0.3 m (parts of one 5 mm cell) and 2 m (64 parts
 // of 31 mm) on 5 mm cells.
 TEST(CutDepth, ThePileIsTheMeanOverTheWedgeWithinItsSamplingError) {
-  const double cell = 0.005, layer = 0.2, edge_y = 0.15, edge_z = 0.4, k = 0.6;
-  const int cols = 600, rows = 200;
-  const auto pushed = [&](double top_m) {
-    // The pile above the layer ahead of the edge's line: top_m at the line,
-    // falling at k ahead, none behind.
-    HeightGrid g(grid_of_cells(cols, rows, cell), std::vector<float>(std::size_t(cols) * rows, float(layer)));
-    std::vector<float> h(std::size_t(cols) * rows, float(layer));
-    for (int r = 0; r < rows; ++r) {
-      const double z = (r + 0.5) * cell;
-      const float pile = z >= edge_z ? float(std::max(0.0, top_m - k * (z - edge_z))) : 0.0f;
-      for (int c = 0; c < cols; ++c) h[std::size_t(r) * cols + c] = float(layer) + pile;
-    }
-    g.set_heights({0, 0, cols, rows}, h.data());
-    return g;
-  };
-  const double look = depth_lookahead_m(grid_of_cells(cols, rows, cell));
+  const double cell = kPileCell, layer = kPileLayer, edge_y = 0.15, edge_z = kPileLine, k = 0.6;
+  const auto pushed = [&](double top_m) { return pile_ahead(top_m, k); };
+  const double look = depth_lookahead_m(grid_of_cells(kPileCols, kPileRows, cell));
   const double depth = layer - edge_y, reach = kWedgeLengthPerDepth * depth;
   for (const double length_m : {0.3, 2.0}) {
     const Segment edge{{1.5 - 0.5 * length_m, edge_y, edge_z}, {1.5 + 0.5 * length_m, edge_y, edge_z}};
@@ -145,16 +150,8 @@ TEST(CutDepth, ThePileIsTheMeanOverTheWedgeWithinItsSamplingError) {
 // (A count of evenly spread points, ceil(L / h), moved every point when it
 // changed: steps of up to 4 % of the pile.)
 TEST(CutDepth, ThePileIsContinuousInTheDepth) {
-  const double cell = 0.005, layer = 0.2, edge_z = 0.4, k = 0.6, top = 0.03;
-  const int cols = 600, rows = 200;
-  HeightGrid g(grid_of_cells(cols, rows, cell), std::vector<float>(std::size_t(cols) * rows, float(layer)));
-  std::vector<float> h(std::size_t(cols) * rows, float(layer));
-  for (int r = 0; r < rows; ++r) {
-    const double z = (r + 0.5) * cell;
-    const float pile = z >= edge_z ? float(std::max(0.0, top - k * (z - edge_z))) : 0.0f;
-    for (int c = 0; c < cols; ++c) h[std::size_t(r) * cols + c] = float(layer) + pile;
-  }
-  g.set_heights({0, 0, cols, rows}, h.data());
+  const double layer = kPileLayer, edge_z = kPileLine, k = 0.6, top = 0.03;
+  const HeightGrid g = pile_ahead(top, k);
   const double look = depth_lookahead_m(g.spec());
   const double spacing = 2.0 / 64.0, step = 1e-5;
   double previous = -1.0;
