@@ -377,6 +377,7 @@ def main(argv):
         plot_validate_dem.profiles(out_dir)
         plot_validate_dem.piles(out_dir)
         plot_validate_dem.maps(out_dir)  # the report shows soil_dem_maps.png too
+        plot_validate_dem.sections(out_dir)
     return 0
 
 

@@ -18,6 +18,11 @@ profiles.csv and cases.csv) and receives:
   soil_dem_maps.png      per case (its first seed), the surface's change after
                          the whole push seen from above: the DEM's, terracut's,
                          and their difference (DIR/dem/maps/*.npy)
+  soil_dem_sections.png  per case, the surface's change across the push after
+                         it, averaged over a band along the push: ahead of the
+                         blade's tip (the pile's width and height) and behind
+                         it (the trench and the windrows); the DEM's mean and
+                         range over its seeds, terracut's mean, the blade's span
 
 Exit codes: 0 done; 2 bad arguments or input folder; 3 numpy or matplotlib missing.
 Needs Debian's python3-numpy and python3-matplotlib.
@@ -156,6 +161,63 @@ def maps(out_dir):
     FILES.save(fig, out_dir, "soil_dem_maps.png", "terracut against a DEM: the surface after the push, from above")
 
 
+# The DEM cases' geometry (validation/dem/README.md): the surface grids'
+# cell, the blade's centre across the bed and its tip at the push's end.
+DEM_CELL_M = 0.005
+DEM_CENTRE_Y_M = 0.25
+DEM_TIP_END_X_M = 0.45
+
+
+def sections(out_dir):
+    folder = os.path.join(out_dir, "dem", "maps")
+    if not os.path.isdir(folder):
+        return
+    stems = sorted(f[: -len("_initial.npy")] for f in os.listdir(folder) if f.endswith("_initial.npy"))
+    by_case = {}
+    for stem in stems:
+        by_case.setdefault(stem.rsplit("_seed", 1)[0], []).append(stem)
+    if not by_case:
+        return
+    # Bands along the push (x, m): 0.1 m ahead of the tip, and 0.05 to
+    # 0.25 m behind it (clear of the blade and of the push's start).
+    bands = (("ahead of the tip: x from 0.45 to 0.55 m", DEM_TIP_END_X_M, DEM_TIP_END_X_M + 0.10),
+             ("behind the tip: x from 0.20 to 0.40 m", DEM_TIP_END_X_M - 0.25, DEM_TIP_END_X_M - 0.05))
+    fig, axes = plt.subplots(len(by_case), 2, figsize=(12.8, 3.4 * len(by_case)), squeeze=False)
+    for row, (case, case_stems) in zip(axes, sorted(by_case.items())):
+        # The blade's width from the case's name (..._w012_...: 0.12 m).
+        width = next((int(part[1:]) / 100.0 for part in case.split("_") if part[:1] == "w" and part[1:].isdigit()), None)
+        for ax, (title, x0, x1) in zip(row, bands):
+            dem, tc = [], []
+            for stem in case_stems:
+                init = np.load(os.path.join(folder, stem + "_initial.npy"))
+                c0, c1 = int(round(x0 / DEM_CELL_M)), int(round(x1 / DEM_CELL_M))
+                c0, c1 = max(c0, 0), min(c1, init.shape[1])
+                if c1 <= c0:
+                    continue
+                for source, out in (("_dem.npy", dem), ("_terracut.npy", tc)):
+                    change = np.load(os.path.join(folder, stem + source)) - init
+                    out.append(change[:, c0:c1].mean(axis=1))
+            if not dem:
+                ax.axis("off")
+                continue
+            y = (np.arange(len(dem[0])) + 0.5) * DEM_CELL_M
+            dem, tc = np.array(dem) * 1e3, np.array(tc) * 1e3
+            ax.fill_between(y, dem.min(axis=0), dem.max(axis=0), color="black", alpha=0.15, label="DEM, range over the seeds")
+            ax.plot(y, dem.mean(axis=0), color="black", label=f"DEM, mean of {len(dem)} seeds")
+            ax.plot(y, tc.mean(axis=0), "--", color="tab:red", label="terracut, mean over the same beds")
+            if width is not None:
+                ax.axvspan(DEM_CENTRE_Y_M - 0.5 * width, DEM_CENTRE_Y_M + 0.5 * width, color="tab:blue", alpha=0.08,
+                           label="the blade's span")
+            ax.axhline(0.0, color="0.5", lw=0.6)
+            ax.set_title(f"{case}: {title}", fontsize=9)
+            ax.set_xlabel("y across the push (m)")
+            ax.set_ylabel("change of the surface (mm)")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7)
+    FILES.save(fig, out_dir, "soil_dem_sections.png",
+               "terracut against a DEM: the surface across the push, ahead of the blade and behind it")
+
+
 def main(argv):
     out_dir, FILES.quiet = parse_folder_args(argv, __doc__)
     if not os.path.isfile(os.path.join(out_dir, "dem", "cases.csv")):
@@ -164,6 +226,7 @@ def main(argv):
     profiles(out_dir)
     piles(out_dir)
     maps(out_dir)
+    sections(out_dir)
     return 0
 
 

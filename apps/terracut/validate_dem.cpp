@@ -228,9 +228,11 @@ DemSection run_dem_section(const fs::path& results_dir, const fs::path& out_dir,
   }
   md << "Targets met: " << section.met << " of " << section.targets << ". Figures: `soil_dem_force.png` "
         "(force against the distance pushed), `soil_dem_profiles.png` (the centre line), "
-        "`soil_dem_piles.png` (the soil ahead of the blade), `soil_dem_maps.png` (the surfaces after the push).\n\n"
+        "`soil_dem_piles.png` (the soil ahead of the blade), `soil_dem_maps.png` (the surfaces after the push), "
+        "`soil_dem_sections.png` (the surfaces across the push, ahead of the blade and behind it).\n\n"
      << "![force against distance pushed](soil_dem_force.png)\n\n![centre lines](soil_dem_profiles.png)\n\n"
-        "![the soil ahead of the blade](soil_dem_piles.png)\n\n![the surfaces after the push](soil_dem_maps.png)\n";
+        "![the soil ahead of the blade](soil_dem_piles.png)\n\n![the surfaces after the push](soil_dem_maps.png)\n\n"
+        "![the surfaces across the push](soil_dem_sections.png)\n";
   section.markdown = md.str();
   return section;
 }
