@@ -132,19 +132,30 @@ def piles(out_dir):
     FILES.save(fig, out_dir, "soil_dem_piles.png", "terracut against a DEM: the soil ahead of the blade")
 
 
-def maps(out_dir):
+# The DEM cases' geometry (validation/dem/README.md): the surface grids'
+# cell, the blade's centre across the bed and its tip at the push's end.
+DEM_CELL_M = 0.005
+DEM_CENTRE_Y_M = 0.25
+DEM_TIP_END_X_M = 0.45
+
+
+def map_stems(out_dir):
+    """The surfaces' folder and, per case, its runs' file stems (CASE_seedN), sorted."""
     folder = os.path.join(out_dir, "dem", "maps")
-    if not os.path.isdir(folder):
-        return
-    stems = sorted({f[: -len("_initial.npy")] for f in os.listdir(folder) if f.endswith("_initial.npy")})
-    firsts = {}
-    for stem in stems:
-        case = stem.rsplit("_seed", 1)[0]
-        firsts.setdefault(case, stem)
+    by_case = {}
+    if os.path.isdir(folder):
+        for stem in sorted(f[: -len("_initial.npy")] for f in os.listdir(folder) if f.endswith("_initial.npy")):
+            by_case.setdefault(stem.rsplit("_seed", 1)[0], []).append(stem)
+    return folder, by_case
+
+
+def maps(out_dir):
+    folder, by_case = map_stems(out_dir)
+    firsts = {case: stems[0] for case, stems in by_case.items()}
     if not firsts:
         return
     fig, axes = plt.subplots(len(firsts), 3, figsize=(15, 3.3 * len(firsts)), squeeze=False)
-    cell = 0.005  # m, the DEM's surface grid (validation/dem/README.md)
+    cell = DEM_CELL_M
     for row, (case, stem) in zip(axes, sorted(firsts.items())):
         init = np.load(os.path.join(folder, stem + "_initial.npy"))
         dem = np.load(os.path.join(folder, stem + "_dem.npy")) - init
@@ -161,21 +172,8 @@ def maps(out_dir):
     FILES.save(fig, out_dir, "soil_dem_maps.png", "terracut against a DEM: the surface after the push, from above")
 
 
-# The DEM cases' geometry (validation/dem/README.md): the surface grids'
-# cell, the blade's centre across the bed and its tip at the push's end.
-DEM_CELL_M = 0.005
-DEM_CENTRE_Y_M = 0.25
-DEM_TIP_END_X_M = 0.45
-
-
 def sections(out_dir):
-    folder = os.path.join(out_dir, "dem", "maps")
-    if not os.path.isdir(folder):
-        return
-    stems = sorted(f[: -len("_initial.npy")] for f in os.listdir(folder) if f.endswith("_initial.npy"))
-    by_case = {}
-    for stem in stems:
-        by_case.setdefault(stem.rsplit("_seed", 1)[0], []).append(stem)
+    folder, by_case = map_stems(out_dir)
     if not by_case:
         return
     # Bands along the push (x, m): 0.1 m ahead of the tip, and 0.05 to
@@ -186,20 +184,20 @@ def sections(out_dir):
     for row, (case, case_stems) in zip(axes, sorted(by_case.items())):
         # The blade's width from the case's name (..._w012_...: 0.12 m).
         width = next((int(part[1:]) / 100.0 for part in case.split("_") if part[:1] == "w" and part[1:].isdigit()), None)
+        # Each run's change of the surface, DEM's and terracut's.
+        changes = []
+        for stem in case_stems:
+            init = np.load(os.path.join(folder, stem + "_initial.npy"))
+            changes.append(tuple(np.load(os.path.join(folder, stem + source)) - init
+                                 for source in ("_dem.npy", "_terracut.npy")))
         for ax, (title, x0, x1) in zip(row, bands):
-            dem, tc = [], []
-            for stem in case_stems:
-                init = np.load(os.path.join(folder, stem + "_initial.npy"))
-                c0, c1 = int(round(x0 / DEM_CELL_M)), int(round(x1 / DEM_CELL_M))
-                c0, c1 = max(c0, 0), min(c1, init.shape[1])
-                if c1 <= c0:
-                    continue
-                for source, out in (("_dem.npy", dem), ("_terracut.npy", tc)):
-                    change = np.load(os.path.join(folder, stem + source)) - init
-                    out.append(change[:, c0:c1].mean(axis=1))
-            if not dem:
+            c0 = max(int(round(x0 / DEM_CELL_M)), 0)
+            c1 = min(int(round(x1 / DEM_CELL_M)), changes[0][0].shape[1])
+            if c1 <= c0:
                 ax.axis("off")
                 continue
+            dem = [d[:, c0:c1].mean(axis=1) for d, _ in changes]
+            tc = [t[:, c0:c1].mean(axis=1) for _, t in changes]
             y = (np.arange(len(dem[0])) + 0.5) * DEM_CELL_M
             dem, tc = np.array(dem) * 1e3, np.array(tc) * 1e3
             ax.fill_between(y, dem.min(axis=0), dem.max(axis=0), color="black", alpha=0.15, label="DEM, range over the seeds")

@@ -166,18 +166,17 @@ Embedment embedment(const HeightGrid& grid, Representation representation, const
   }
   const GridSpec& spec = grid.spec();
   const int n = edge_parts(spec, edge);
-  // The parts' centres, on each side.
-  const Walk beside_walk[4] = {
-      Walk(spec, representation, edge.a.x + sides[0].x, edge.a.z + sides[0].z, e.x / n, e.z / n, 0.5, n - 0.5),
-      Walk(spec, representation, edge.a.x + sides[1].x, edge.a.z + sides[1].z, e.x / n, e.z / n, 0.5, n - 0.5),
-      Walk(spec, representation, edge.a.x + sides[2].x, edge.a.z + sides[2].z, e.x / n, e.z / n, 0.5, n - 0.5),
-      Walk(spec, representation, edge.a.x + sides[3].x, edge.a.z + sides[3].z, e.x / n, e.z / n, 0.5, n - 0.5)};
+  // The surface beside each part's centre, summed over the sides (n <= 64).
+  double beside[64] = {};
+  for (int k = 0; k < side_count; ++k) {
+    const Walk walk(spec, representation, edge.a.x + sides[k].x, edge.a.z + sides[k].z, e.x / n, e.z / n, 0.5,
+                    n - 0.5);
+    for (int i = 0; i < n; ++i) beside[i] += spec.origin_m.y + walk.at(i + 0.5).height(grid.heights());
+  }
   double sum_d = 0.0, sum_d2 = 0.0;
   for (int i = 0; i < n; ++i) {
     const Vec3 p = lerp(edge.a, edge.b, (i + 0.5) / n);
-    double beside = 0.0;
-    for (int k = 0; k < side_count; ++k) beside += spec.origin_m.y + beside_walk[k].at(i + 0.5).height(grid.heights());
-    const double depth = beside / side_count - p.y;
+    const double depth = beside[i] / side_count - p.y;
     if (depth > 0.0) {
       sum_d += depth;
       sum_d2 += depth * depth;
