@@ -63,6 +63,9 @@ inline constexpr std::size_t kFluxesPerActiveCell = 32;
 /// The work cap's charge for a source's fall test (lowered): its 8
 /// neighbours read again.
 inline constexpr std::int64_t kFallTestVisits = 8;
+/// The most an examination's fluxes cost to apply: one visit a flux (8 fall
+/// lines of kMaxFallCells cells) and its source's fall test.
+inline constexpr std::int64_t kMostExamineFluxVisits = 8 * kMaxFallCells + kFallTestVisits;
 
 // The 8 neighbours: offsets and which limit applies (0 along X, 1 along Z, 2 diagonal).
 struct Neighbour {

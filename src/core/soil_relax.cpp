@@ -286,10 +286,11 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
   return fluxes;
 }
 
-void SoilFlow::drop_blocked_fluxes(std::uint32_t a, std::size_t end, const float* h) {
+std::int64_t SoilFlow::drop_blocked_fluxes(std::uint32_t a, std::size_t end, const float* h) {
   const std::uint8_t fa = queued_[a];
   const bool blade = blade_.present && (fa & kNearBlade);
-  if (!blade && hull_cells_.empty() && obstacles_.empty()) return;
+  if (!blade && hull_cells_.empty() && obstacles_.empty()) return 0;
+  std::int64_t dropped = 0;
   const int ca = col_of(a), ra = row_of(a);
   for (std::size_t j = applied_; j < end; ++j) {
     Flux& f = fluxes_[j];
@@ -298,8 +299,12 @@ void SoilFlow::drop_blocked_fluxes(std::uint32_t a, std::size_t end, const float
     const bool across = blade && (fb & kNearBlade) && blade_blocks(ca, ra, col_of(f.to), row_of(f.to), h[a]);
     const bool into_hull = (fb & kHull) && h[a] > hull_under(f.to);
     if (across || into_hull) hold(a);
-    if (across || into_hull || (!obstacles_.empty() && obstructed(f.to))) f.excess = 0.0f;
+    if ((across || into_hull || (!obstacles_.empty() && obstructed(f.to))) && f.excess != 0.0f) {
+      f.excess = 0.0f;
+      ++dropped;
+    }
   }
+  return dropped;
 }
 
 void SoilFlow::finish_pass(HeightGrid& grid, SoilStepResult& out) {
@@ -358,7 +363,20 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   // in the next step, where it stopped (its heights stay those it started
   // from until all its cells are examined), so a collapse of any size is
   // spread over ticks of bounded work.
+  // With a tool in the soil the next step displaces soil again, and the
+  // fluxes of a pass carried over would be dropped wherever it did (they
+  // came from heights those cells no longer have). So there the cap splits
+  // the pass instead: examination stops while the work left leaves room to
+  // apply every flux found, those are applied in this step, and the cells
+  // not examined wait for the next pass (a smaller Jacobi pass, not the
+  // same bits as the whole one). No pass with fluxes then spans steps. The
+  // room kept is the most one examination and its fluxes can cost (1040
+  // visits); a cap under four times that (from 1000, the least allowed, to
+  // 4159) would spend too much of itself on room and carries the pass over
+  // as without a tool.
   const std::int64_t cap = params_.max_pair_checks_per_step;
+  const bool split_at_cap =
+      (blade_.present || !hull_cells_.empty()) && cap >= 4 * (kMostExamineVisits + kMostExamineFluxVisits);
   // What the spill round the blade's ends spent this step counts too.
   std::int64_t work = ends_work_;
   ends_work_ = 0;
@@ -385,16 +403,26 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       // A pass whose fluxes would outgrow their list is split: the cells
       // not examined yet go on to the next pass (a pass that large is a
       // collapse of most of a reserved active set, or a grid's worth).
-      while (examined_ < active_.size() && work + kMostExamineVisits <= cap &&
-             fluxes_.size() + 8 * kMaxFallCells <= fluxes_.capacity()) {
+      // Splitting at the cap, the room kept is what applying the fluxes
+      // found so far and those of one more examination would cost.
+      auto room = [&] {
+        const std::int64_t to_apply = split_at_cap ? std::int64_t(fluxes_.size() - applied_) +
+                                                         kFallTestVisits * std::int64_t(sources_.size() - applied_sources_) +
+                                                         kMostExamineFluxVisits
+                                                   : 0;
+        return work + to_apply + kMostExamineVisits <= cap;
+      };
+      while (examined_ < active_.size() && room() && fluxes_.size() + 8 * kMaxFallCells <= fluxes_.capacity()) {
         fall_visits_ = 0;
         moved += examine(active_[examined_++], h);
         work += 8 + fall_visits_;
       }
       out.moved_pairs += moved;
       if (examined_ < active_.size()) {
-        if (work + kMostExamineVisits <= cap) {
+        const bool split_for_room = split_at_cap && examined_ > 0 && !room();
+        if (split_for_room || (examined_ > 0 && room())) {
           // Split: the rest of the list is examined in the next pass.
+          if (split_for_room) out.reached_cap = true;
           for (std::size_t j = examined_; j < active_.size(); ++j) activate(active_[j]);
           active_.truncate(examined_);
         } else {
@@ -421,6 +449,7 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       }
       work += cost;
       if (stale) {
+        out.stale_fluxes += std::int64_t(end - applied_);
         applied_ = end;  // changed since it was examined: examined again
         ++applied_sources_;
         continue;
@@ -429,7 +458,7 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       // bodies where they were then; they have moved since. A flux that
       // would now cross the blade, climb into the hull or enter a body is
       // dropped (its source is held, and examined again).
-      if (pass_spans_steps_) drop_blocked_fluxes(a, end, h);
+      if (pass_spans_steps_) out.stale_fluxes += drop_blocked_fluxes(a, end, h);
       // Multiples of the quantum, summed exactly in double: the order of the
       // source's fall lines (which a mirror image permutes) does not matter.
       double total_d = 0.0;
@@ -452,7 +481,10 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       changed_r1 = std::max(changed_r1, ra);
       for (; applied_ < end; ++applied_) {
         const Flux& f = fluxes_[applied_];
-        if (any_dirty && f.to != kOutside && (queued_[f.to] & kDirty)) continue;
+        if (any_dirty && f.to != kOutside && (queued_[f.to] & kDirty)) {
+          ++out.stale_fluxes;
+          continue;
+        }
         const float give = (share * f.excess) * scale;
         if (f.to == kOutside) {
           out.left_over_edge_m3 += double(give) * cell_area;

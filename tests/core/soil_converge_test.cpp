@@ -32,6 +32,7 @@ struct Pile {
   std::int64_t last_capped_step = -1;  // -1: the cap never stopped a step
   std::int64_t last_step = 0;          // the hold's last
   std::int64_t backlog_cells = 0;      // left queued by the last step
+  std::int64_t stale_fluxes = 0;       // fluxes found in one step and dropped in a later one
   double volume_change = 0.0;          // the grid's volume at the end / at the start - 1
 };
 
@@ -68,6 +69,7 @@ Pile push(double width_m, double cell_m, double speed_m_per_s, std::int64_t cap,
     pile.capped_steps += out.soil.reached_cap ? 1 : 0;
     if (out.soil.reached_cap) pile.last_capped_step = i;
     pile.backlog_cells = out.soil.backlog_cells;
+    pile.stale_fluxes += out.soil.stale_fluxes;
   }
   pile.last_step = steps + std::lround(hold_s * 1000.0);
   const HeightGrid& g = sim.grid();
@@ -187,6 +189,36 @@ TEST(SoilConvergence, TheCappedPushsPileIsSettledNotBehind) {
   EXPECT_GT(capped.capped_steps, 0);
   EXPECT_LT(capped.last_capped_step, capped.last_step);
   EXPECT_EQ(capped.backlog_cells, 0);
+}
+
+TEST(SoilConvergence, ACappedPushSpendsNoWorkOnFluxesItsNextStepSpoils) {
+  // With the blade in the soil every step displaces soil, so a pass whose
+  // fluxes the cap carried into the next step would find cells changed
+  // under them and drop those fluxes, work paid for twice. The cap splits
+  // the pass instead: what was examined is applied in its step. The 0.3 m
+  // blade at 1 m/s on 5 mm cells, where the cap stops most steps (the code
+  // that carried passes over dropped fluxes on the push's capped steps).
+  const Pile capped = push(0.3, 0.005, 1.0, SoilFlowParams{}.max_pair_checks_per_step);
+  EXPECT_GT(capped.capped_steps, 100);
+  EXPECT_EQ(capped.stale_fluxes, 0);
+}
+
+TEST(SoilConvergence, TheLeastCapsStillMoveSoilWithTheBladeIn) {
+  // Splitting a pass at the cap keeps room to apply what was examined (up
+  // to 1040 visits for one cell), from a cap of 4160 on; at the least cap
+  // allowed, 1000, and on either side of 4160, the relaxation must still
+  // move soil while the blade pushes, and never pass the cap.
+  for (const std::int64_t cap : {std::int64_t(1000), std::int64_t(4159), std::int64_t(4160), std::int64_t(5000)}) {
+    const scenes::Bulldoze scene = push_scene(0.3, 0.01, 0.1);
+    Simulation sim = push_simulation(scene, cap);
+    std::int64_t moved = 0;
+    for (int i = 0; i <= 200; ++i) {
+      const StepOutput& out = sim.step(scene.pose(kStartZ + 0.1 * std::min(1.0, i / 100.0)));
+      EXPECT_LE(out.soil.pair_checks, cap) << "cap " << cap << ", step " << i;
+      moved += out.soil.moved_pairs;
+    }
+    EXPECT_GT(moved, 1000) << "cap " << cap;
+  }
 }
 
 TEST(SoilConvergence, ACollapseSettlesInFarFewerPassesThanAPassAHalfExcess) {

@@ -254,6 +254,11 @@ struct SoilStepResult {
   /// work left; the rest is carried over (a safety bound a normal push on
   /// the documented cases does not reach: docs/soil.md).
   bool reached_cap = false;
+  /// Fluxes examined in an earlier step and dropped in this one because a
+  /// cell they join changed (or the tool moved into their way) meanwhile:
+  /// work the cap paid for nothing. None with a tool in the soil, where the
+  /// cap splits a pass rather than carry its fluxes over.
+  std::int64_t stale_fluxes = 0;
   double left_over_edge_m3 = 0.0;    ///< soil that left over an open edge, m^3
   double bucket_in_m3 = 0.0;         ///< cut soil the bucket took in this step, m^3
   double poured_m3 = 0.0;            ///< soil poured from the bucket's lip this step, m^3
@@ -442,8 +447,8 @@ class SoilFlow {
   }
   /// Zeroes the fluxes [applied_, end) of source a that the blade, the hull
   /// or a body now stands in the way of (the pass was examined in an
-  /// earlier step, against where they were then).
-  void drop_blocked_fluxes(std::uint32_t a, std::size_t end, const float* h);
+  /// earlier step, against where they were then); returns how many.
+  std::int64_t drop_blocked_fluxes(std::uint32_t a, std::size_t end, const float* h);
   std::int64_t examine(std::uint32_t a, const float* h);
   /// The fluxes of source a (height ha) down its steep directions dirs[0,
   /// n) (the direction in the low byte, bit 8 set for one beyond an open
@@ -495,9 +500,11 @@ class SoilFlow {
   static constexpr std::uint8_t kCandLowered = 128;  // in candidates_, and lowered
   // A cell the cut, the displacement, the pour or an edit changed while a
   // pass was in progress: the pass's fluxes from or to it are dropped (they
-  // came from heights it no longer has; it is examined again anyway).
+  // came from heights it no longer has; it is examined again anyway). A
+  // pass none of whose cells was examined yet has no fluxes: it reads the
+  // new heights.
   void dirty(std::uint32_t cell) {
-    if (active_.empty() || (queued_[cell] & kDirty)) return;
+    if (examined_ == 0 || (queued_[cell] & kDirty)) return;
     set_flag(cell, kDirty);
     dirty_.push_back(cell);
   }
