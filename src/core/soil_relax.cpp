@@ -188,6 +188,8 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
       line.cell[0] = kOutside;
       line.reach[0] = drop;
       len = 1;
+      total += drop;
+      highest_reach = std::max(highest_reach, drop);
     } else {
       const std::int64_t step = offset_[k];
       std::uint32_t cur = std::uint32_t(std::int64_t(a) + step);
@@ -195,6 +197,9 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
       for (int m = 1;; ++m) {
         const float reach = h[cur] + drop * float(m);
         if (!(reach < ha)) break;
+        // Summed as walked: the same order as a loop over the line after.
+        total += reach;
+        highest_reach = std::max(highest_reach, reach);
         line.cell[len] = cur;
         line.reach[len++] = reach;
         if (len == kMaxFallCells || (fc & kEdge)) break;
@@ -215,10 +220,6 @@ std::int64_t SoilFlow::fall_lines(std::uint32_t a, float ha, const float* h, con
       }
     }
     fall_visits_ += len;
-    for (int m = 0; m < len; ++m) {
-      total += line.reach[m];
-      highest_reach = std::max(highest_reach, line.reach[m]);
-    }
     line.live = len;
     count += len;
     walked += len;
