@@ -252,9 +252,9 @@ struct SoilStepResult {
   std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
   /// The relaxation stopped at the work cap (max_pair_checks_per_step) with
   /// work left; the rest is done in later steps. A push on 1 cm cells
-  /// reaches it on a few percent of its steps, one on 5 mm cells on most
-  /// (docs/soil.md, "Not done yet"); the pile the capped run leaves is then
-  /// within about 2 % of the converged one.
+  /// reaches it on up to a tenth of its steps, one on 5 mm cells on most
+  /// (docs/soil.md, "A capped pass split, not carried over"); the pile the
+  /// capped run leaves is then within about 2 % of the converged one.
   bool reached_cap = false;
   /// Fluxes examined in an earlier step and dropped in this one because a
   /// cell they join changed (or the tool moved into their way) meanwhile:
