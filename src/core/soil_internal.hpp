@@ -66,6 +66,11 @@ inline constexpr std::int64_t kFallTestVisits = 8;
 /// The most an examination's fluxes cost to apply: one visit a flux (8 fall
 /// lines of kMaxFallCells cells) and its source's fall test.
 inline constexpr std::int64_t kMostExamineFluxVisits = 8 * kMaxFallCells + kFallTestVisits;
+/// The least cap at which a pass is split at the cap with a tool in the soil
+/// (run_passes): four times the room one examination and its fluxes keep
+/// (4160 visits); under it the pass is carried over.
+inline constexpr std::int64_t kLeastSplitCap = 4 * (kMostExamineVisits + kMostExamineFluxVisits);
+static_assert(kLeastSplitCap == 4160, "the docs and tests/core/soil_converge_test.cpp quote 4160");
 
 // The 8 neighbours: offsets and which limit applies (0 along X, 1 along Z, 2 diagonal).
 struct Neighbour {

@@ -370,14 +370,11 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   // the pass instead: examination stops while the work left leaves room to
   // apply every flux found, those are applied in this step, and the cells
   // not examined wait for the next pass (a smaller Jacobi pass, not the
-  // same bits as the whole one). No pass with fluxes then spans steps. The
-  // room kept is the most one examination and its fluxes can cost (1040
-  // visits); a cap under four times that (from 1000, the least allowed, to
-  // 4159) would spend too much of itself on room and carries the pass over
-  // as without a tool.
+  // same bits as the whole one). No pass with fluxes then spans steps. A
+  // cap under kLeastSplitCap would spend too much of itself on that room
+  // and carries the pass over as without a tool.
   const std::int64_t cap = params_.max_pair_checks_per_step;
-  const bool split_at_cap =
-      (blade_.present || !hull_cells_.empty()) && cap >= 4 * (kMostExamineVisits + kMostExamineFluxVisits);
+  const bool split_at_cap = (blade_.present || !hull_cells_.empty()) && cap >= kLeastSplitCap;
   // What the spill round the blade's ends spent this step counts too.
   std::int64_t work = ends_work_;
   ends_work_ = 0;
@@ -420,10 +417,10 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       }
       out.moved_pairs += moved;
       if (examined_ < active_.size()) {
-        const bool split_for_room = split_at_cap && examined_ > 0 && !room();
-        if (split_for_room || (examined_ > 0 && room())) {
+        const bool fits = room();
+        if (examined_ > 0 && (fits || split_at_cap)) {
           // Split: the rest of the list is examined in the next pass.
-          if (split_for_room) out.reached_cap = true;
+          if (!fits) out.reached_cap = true;
           for (std::size_t j = examined_; j < active_.size(); ++j) activate(active_[j]);
           active_.truncate(examined_);
         } else {
