@@ -162,6 +162,10 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
     ends_queue_.reserve(window);
     touch_reserved(ends_keys_);
     touch_reserved(ends_queue_);
+    // The settle's window: the blade's square, the spill's windows
+    // round its ends, the pile ahead and the margin.
+    const double side = reach_cells + 2.0 * (kEndWindowCells + kSettlePileCells + kSettleMarginCells);
+    reserve_settle(std::size_t(std::min(double(n), side * side)));
   }
   for (auto* v : {&before_, &after_cut_}) touch_reserved(*v);
   for (auto* v : {&marked_, &held_, &dirty_, &hull_cells_}) touch_reserved(*v);
@@ -212,6 +216,7 @@ void SoilFlow::wake_held(const Segment* edge) {
 
 void SoilFlow::wake(const Rect& rect) {
   if (rect.empty()) return;
+  settle_abort();  // heights written by another hand
   const int c0 = std::max(rect.c0 - 1, 0), c1 = std::min(rect.c1 + 1, cols_);
   const int r0 = std::max(rect.r0 - 1, 0), r1 = std::min(rect.r1 + 1, rows_);
   for (int r = r0; r < r1; ++r)
@@ -225,6 +230,13 @@ void SoilFlow::wake(const Rect& rect) {
 SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const Segment& to,
                                    const Quat& orientation) {
   SoilStepResult out;
+  // What before_cut's share of a settle did.
+  out.settle_visits = settle_early_visits_;
+  if (!settle_changed_.empty()) {
+    out.changed = settle_changed_;
+    settle_changed_ = Rect{};
+  }
+  settle_early_visits_ = 0;
   double room = 0.0, holds = 0.0;
   if (blade_spec_.bucket.enabled()) {
     holds = bucket_retained_m3(blade_spec_, orientation, params_.material.repose_deg);
@@ -238,6 +250,23 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   // What the push left above the repose cone through an end of the blade
   // goes round it now (the bucket's ends are its side plates: not yet).
   if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0) spill_round_ends(grid, from, to, out);
+  // What they left steeper than the stencil allows settles in one
+  // construction (soil_settle.cpp), spread over as many steps as the work
+  // cap asks while the passes wait. A step that displaces soil while one is
+  // still under way lets it go on without the cells it wrote, and another
+  // follows it, over both steps' cells, before the passes run.
+  if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0) {
+    if (settle_phase_ == SettlePhase::kIdle) {
+      settle_start(grid, from, to, out.changed);
+    } else {
+      if (!settle_again_) settle_next_rect_ = settle_rect_;
+      settle_next_rect_.include(out.changed.c0, out.changed.r0);
+      settle_next_rect_.include(out.changed.c1 - 1, out.changed.r1 - 1);
+      settle_next_from_ = from;
+      settle_next_to_ = to;
+      settle_again_ = true;
+    }
+  }
   load_m3_ += out.bucket_in_m3;
   if (load_m3_ > holds && blade_spec_.bucket.enabled()) {
     pour(grid, to, load_m3_ - holds, out);
@@ -256,8 +285,15 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   const bool cut_now = out.displaced_volume_m3 > 0.0 || out.bucket_in_m3 > 0.0;
   wake_held(cut_now || cut_last_step_ ? nullptr : &to);
   cut_last_step_ = cut_now;
+  if (settle_phase_ != SettlePhase::kIdle) {
+    const std::int64_t done = settle_continue(grid, out.changed, params_.max_pair_checks_per_step - ends_work_);
+    out.settle_visits += done;
+    ends_work_ += done;
+  }
   // The blade's wall matters only to a pass: marked only when one runs.
-  if (pending()) {
+  if (settle_phase_ != SettlePhase::kIdle) {
+    out.reached_cap = true;  // the settle goes on in the next step
+  } else if (pending()) {
     mark_blade(grid, from, to);
     if (held_.empty()) held_edge_ = to, held_heel_ = hull_heel_;  // where the blade and hull hold what the passes find held
     run_passes(grid, out);

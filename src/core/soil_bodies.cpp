@@ -32,6 +32,7 @@ void SoilFlow::set_obstacles(std::span<const SoilObstacle> obstacles) noexcept {
     }
     if (same && k == obstacles_.size()) return;
   }
+  settle_abort();  // a settle under way found its walls with the old bodies
   // Clear the old ones; the soil banked against them may now slide on, so
   // the cells along their sides (inside and out) are examined again.
   for (const SoilObstacle& o : obstacles_) {

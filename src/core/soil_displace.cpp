@@ -14,7 +14,16 @@ namespace terracut {
 
 using namespace soil_internal;
 
-void SoilFlow::before_cut(const HeightGrid& grid, const Segment& from, const Segment& to) {
+void SoilFlow::before_cut(HeightGrid& grid, const Segment& from, const Segment& to) {
+  // A settle under way goes on before the cut changes any height (its
+  // surfaces were found from the heights before it); the step's passes wait
+  // for it.
+  settle_changed_ = Rect{};
+  settle_early_visits_ = 0;
+  if (settle_phase_ != SettlePhase::kIdle) {
+    settle_early_visits_ = settle_continue(grid, settle_changed_, params_.max_pair_checks_per_step);
+    ends_work_ += settle_early_visits_;
+  }
   // The bounding rectangle of the four endpoints, plus a cell.
   const GridSpec& spec = grid.spec();
   double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
@@ -143,6 +152,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   std::int64_t last_put = -1;
   const auto write = [&](std::int64_t cell, float value) {
     dirty(std::uint32_t(cell));
+    settle_exclude(cell);
     put += double(value) - double(layers.height_m[cell]);
     layers.height_m[cell] = value;
     last_put = cell;
@@ -215,6 +225,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           std::max(0.0, std::min(double(before_[k]), double(layers.initial_m[i])) - double(after_cut_[k])) *
           spec.cell_area_m2();
       dirty(std::uint32_t(i));
+      settle_exclude(i);
       candidate(std::uint32_t(i), true);  // its walls may now be too steep
       const float kept = keep >= 1.0 ? cut : float(double(cut) * keep);
       out.bucket_in_m3 += double(kept) * spec.cell_area_m2();

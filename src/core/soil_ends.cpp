@@ -238,6 +238,7 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& from, const Seg
       if (now == old) continue;
       gained += double(now) - double(old);
       dirty(std::uint32_t(i));
+      settle_exclude(i);
       h[i] = now;
       last = i;
       candidate(std::uint32_t(i), now < old);

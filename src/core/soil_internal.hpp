@@ -58,6 +58,16 @@ inline constexpr int kEndWindowCells = 48;
 /// Rounds of spill_round_ends' search for the cone's height (each finds the
 /// sets for the last height and solves the balance over them).
 inline constexpr int kEndRounds = 6;
+/// The settle's window (soil_settle.cpp): the cells the step changed and
+/// this many more round them.
+inline constexpr int kSettleMarginCells = 16;
+/// Its buckets of keys, each an axis pair's limit wide: heights up to this
+/// many limits apart (6.9 m on 5 mm cells at 34 degrees); what lies beyond
+/// is left to the passes.
+inline constexpr std::size_t kSettleBuckets = 4096;
+/// Rows of pile ahead of the blade that the settle's scratch is sized for, beside the blade's square and the spill's windows round its ends
+/// (a larger window is left to the passes).
+inline constexpr int kSettlePileCells = 64;
 /// Fluxes a pass may hold per cell of the reserved active set.
 inline constexpr std::size_t kFluxesPerActiveCell = 32;
 /// The work cap's charge for a source's fall test (lowered): its 8

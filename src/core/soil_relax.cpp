@@ -520,6 +520,18 @@ SoilStepResult SoilFlow::relax(HeightGrid& grid) {
   SoilStepResult out;
   wake_held(nullptr);  // no blade now
   clear_hull();        // nor a bucket
+  if (settle_phase_ != SettlePhase::kIdle) {
+    // A settle under way goes on first; the passes wait for it.
+    out.settle_visits = settle_continue(grid, out.changed, params_.max_pair_checks_per_step);
+    ends_work_ += out.settle_visits;
+    if (settle_phase_ != SettlePhase::kIdle) {
+      out.pair_checks = ends_work_;
+      ends_work_ = 0;
+      out.reached_cap = true;
+      out.backlog_cells = active_cells();
+      return out;
+    }
+  }
   run_passes(grid, out);
   return out;
 }

@@ -248,13 +248,19 @@ struct SoilStepResult {
   double cut_from_ground_m3 = 0.0;
   int passes = 0;                    ///< relaxation passes run
   std::int64_t pair_checks = 0;      ///< work done, in neighbour visits (see max_pair_checks_per_step)
+  /// The part of pair_checks the settle of the displaced pile did (docs/soil.md
+  /// "The displaced pile settled at once"), in neighbour visits.
+  std::int64_t settle_visits = 0;
   std::int64_t moved_pairs = 0;      ///< pairs that exchanged soil
   std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
   /// The relaxation stopped at the work cap (max_pair_checks_per_step) with
-  /// work left; the rest is done in later steps. A push on 1 cm cells
-  /// reaches it on up to a tenth of its steps, one on 5 mm cells on most
-  /// (docs/soil.md, "A capped pass split, not carried over"); the pile the
-  /// capped run leaves is then within about 2 % of the converged one.
+  /// work left, the settle of the displaced pile or the passes; the rest is
+  /// done in later steps. A push on 1 cm cells reaches it on about 1 % of
+  /// its steps, one on 5 mm cells on 15 to 40 % (the settle of a displacing
+  /// step spread over the steps after it); the pile the capped run leaves
+  /// is then within 3.6 % of the soil ahead, and a cell's rise at the peak,
+  /// of the converged one (docs/soil.md, "The displaced pile settled at
+  /// once").
   bool reached_cap = false;
   /// Fluxes examined in an earlier step and dropped in this one because a
   /// cell they join changed (or the tool moved into their way) meanwhile:
@@ -315,7 +321,7 @@ class SoilFlow {
   /// Before the cut of a step: remembers the heights under the region the
   /// edge may sweep from `from` to `to` (their bounding rectangle plus a
   /// cell), so that the cut's change of each sample is known afterwards.
-  void before_cut(const HeightGrid& grid, const Segment& from, const Segment& to);
+  void before_cut(HeightGrid& grid, const Segment& from, const Segment& to);
 
   /// After the cut: displacement of what was cut ahead of the edge `to`
   /// (moving from `from`) or into the bucket, the bucket's pour at its
@@ -430,6 +436,58 @@ class SoilFlow {
   std::int64_t ends_work_ = 0;     // visits spill_round_ends spent this step (charged to the cap by run_passes)
   std::vector<std::pair<double, int>> ends_keys_;  // the round's donors' and receivers' cone keys
   std::vector<std::int32_t> ends_queue_;           // the round's sets, window cells in the order found
+  /// What the displacement and the spill left steeper than a pair's limit
+  /// settles, each connected patch to a stable surface of its own volume
+  /// (soil_settle.cpp, docs/soil.md "The displaced pile settled at once"):
+  /// settle_start sets it up over the window round `changed`, replacing
+  /// one under way; settle_continue does up to `budget` visits of it and
+  /// returns them (it is done when settle_phase_ is back to kIdle; the
+  /// passes wait for it); settle_abort drops it (heights another writer
+  /// changed).
+  void settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed);
+  std::int64_t settle_continue(HeightGrid& grid, Rect& changed, std::int64_t budget);
+  void settle_abort();
+  /// Another writer changed `cell` while a settle is under way: the cell
+  /// takes no part in its patches (each still keeps its own volume, from
+  /// its cells' heights; the passes see to the rest).
+  void settle_exclude(std::int64_t cell) {
+    if (settle_phase_ == SettlePhase::kIdle) return;
+    const int lc = col_of(std::uint32_t(cell)) - settle_wc0_, lr = row_of(std::uint32_t(cell)) - settle_wr0_;
+    if (lc < 0 || lr < 0 || lc >= settle_ww_ || lr >= settle_wh_) return;
+    settle_done_[std::size_t(lr) * std::size_t(settle_ww_) + std::size_t(lc)] |= kSettleExcluded;
+  }
+  static constexpr std::uint8_t kSettleExcluded = 8;  // (also "in a patch": either way not open)
+  /// Sizes the settle's scratch for a window of this many cells.
+  void reserve_settle(std::size_t window_cells);
+  enum class SettlePhase : std::uint8_t { kIdle, kSeed, kLow, kHigh, kPatches };
+  SettlePhase settle_phase_ = SettlePhase::kIdle;
+  // A step displaced soil while a settle was under way: another follows it
+  // (over the union of the windows), before the passes.
+  bool settle_again_ = false;
+  Rect settle_next_rect_{};
+  Segment settle_next_from_{}, settle_next_to_{};
+  // The settle's window (first column and row, columns, rows); where it is
+  // in its phase (the list index of the seeding and the patches; the
+  // spread's current bucket, the buckets used and the lowest key).
+  Rect settle_rect_{};  // the cells it was started for (the window less its margin)
+  int settle_wc0_ = 0, settle_wr0_ = 0, settle_ww_ = 0, settle_wh_ = 0;
+  std::size_t settle_q_ = 0, settle_b_ = 0, settle_used_ = 0;
+  float settle_kmin_ = 0.0f;
+  // What before_cut's share of the settle changed and did, for after_cut's
+  // result.
+  Rect settle_changed_{};
+  std::int64_t settle_early_visits_ = 0;
+  // Its scratch, per window cell: its state bits, the low and high
+  // surfaces; per row, the columns the blade walls off; the cells changed,
+  // a patch, its widths, the seeds, and the buckets' lists (entries: cell,
+  // next; heads per bucket).
+  std::vector<std::uint8_t> settle_done_;
+  std::vector<float> settle_low_, settle_high_, settle_widths_;
+  std::vector<int> settle_row_lo_, settle_row_hi_;
+  std::vector<std::int32_t> settle_cells_, settle_patch_;
+  std::vector<std::pair<float, std::int32_t>> settle_seeds_[2];
+  std::vector<std::pair<std::int32_t, std::int32_t>> settle_entries_;
+  std::vector<std::int32_t> settle_heads_;
   /// v rounded to a multiple of the relaxation's quantum, as a float: the
   /// heights it writes and the amounts it moves, so that a cell's sum over
   /// a pass is exact whatever the order of its sources (quantum_m_).

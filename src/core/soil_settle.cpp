@@ -1,0 +1,377 @@
+// Soil that flows, the displaced pile settled in one construction (soil.hpp,
+// docs/soil.md "The displaced pile settled at once"): what the displacement
+// and the spill round the blade's ends left steeper than the stencil allows
+// is brought, in each connected patch, to a stable surface that keeps the
+// patch's volume, rather than by hundreds of relaxation passes.
+#include "terracut/core/soil.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "soil_internal.hpp"
+
+namespace terracut {
+
+using namespace soil_internal;
+
+namespace {
+
+/// The delta >= 0 with sum over w of (w - delta)+ = excess, for widths
+/// w > 0 whose sum is at least excess: a selection in expected linear time
+/// (the widths are reordered).
+double level_below(std::vector<float>& w, double excess) {
+  double acc_sum = 0.0;  // the widths known to lie above delta, and their count
+  std::int64_t acc_n = 0;
+  std::size_t lo = 0, hi = w.size();  // the widths not placed yet
+  while (lo < hi) {
+    // The middle of three as the pivot; the widths above it to the front.
+    const float a = w[lo], b = w[lo + (hi - lo) / 2], c = w[hi - 1];
+    const float p = std::max(std::min(a, b), std::min(std::max(a, b), c));
+    std::size_t m = lo;
+    double sum_above = 0.0;
+    for (std::size_t j = lo; j < hi; ++j)
+      if (w[j] > p) {
+        sum_above += double(w[j]);
+        std::swap(w[j], w[m++]);
+      }
+    const std::int64_t n_above = std::int64_t(m - lo);
+    if ((acc_sum + sum_above) - double(p) * double(acc_n + n_above) > excess) {
+      hi = m;  // delta above p: those at or below it take nothing
+    } else {
+      // delta at or below p: those above it, and those equal, take their share.
+      std::size_t e = m;
+      for (std::size_t j = m; j < hi; ++j)
+        if (w[j] == p) std::swap(w[j], w[e++]);
+      acc_sum += sum_above + double(p) * double(e - m);
+      acc_n += n_above + std::int64_t(e - m);
+      lo = e;
+    }
+  }
+  return acc_n > 0 ? std::max((acc_sum - excess) / double(acc_n), 0.0) : 0.0;
+}
+
+}  // namespace
+
+void SoilFlow::reserve_settle(std::size_t window_cells) {
+  settle_done_.assign(window_cells, 0);
+  settle_low_.assign(window_cells, 0.0f);
+  settle_high_.assign(window_cells, 0.0f);
+  settle_row_lo_.assign(std::size_t(rows_), 0);
+  settle_row_hi_.assign(std::size_t(rows_), 0);
+  settle_cells_.reserve(window_cells);
+  settle_patch_.reserve(window_cells);
+  settle_widths_.reserve(window_cells);
+  settle_seeds_[0].reserve(window_cells);
+  settle_seeds_[1].reserve(window_cells);
+  settle_entries_.reserve(2 * window_cells);
+  settle_heads_.assign(kSettleBuckets, -1);
+  touch_reserved(settle_cells_);
+  touch_reserved(settle_patch_);
+  touch_reserved(settle_widths_);
+  touch_reserved(settle_seeds_[0]);
+  touch_reserved(settle_seeds_[1]);
+  touch_reserved(settle_entries_);
+}
+
+void SoilFlow::settle_abort() {
+  settle_again_ = false;
+  if (settle_phase_ == SettlePhase::kIdle) return;
+  // The buckets' lists still holding entries are emptied.
+  std::fill(settle_heads_.begin(), settle_heads_.end(), -1);
+  settle_phase_ = SettlePhase::kIdle;
+}
+
+void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed) {
+  if (settle_phase_ != SettlePhase::kIdle) settle_abort();
+  if (changed.empty() || settle_low_.empty()) return;
+  // The window: the cells the step changed and a margin round them. One
+  // larger than the scratch reserved at construction is left to the passes.
+  const int wc0 = std::max(0, changed.c0 - kSettleMarginCells), wc1 = std::min(cols_, changed.c1 + kSettleMarginCells);
+  const int wr0 = std::max(0, changed.r0 - kSettleMarginCells), wr1 = std::min(rows_, changed.r1 + kSettleMarginCells);
+  const int ww = wc1 - wc0, wh = wr1 - wr0;
+  if (ww < 3 || wh < 3 || std::size_t(ww) * std::size_t(wh) > settle_low_.size()) return;
+  settle_rect_ = changed;
+  settle_wc0_ = wc0;
+  settle_wr0_ = wr0;
+  settle_ww_ = ww;
+  settle_wh_ = wh;
+  const std::size_t size = std::size_t(ww) * std::size_t(wh);
+  const GridSpec& spec = grid.spec();
+  const float* h = grid.heights();
+  // The window's heights, twice: the low and the high surfaces start as
+  // them. (Window cell l = lr * ww + lc is cell (wc0 + lc, wr0 + lr).)
+  for (int lr = 0; lr < wh; ++lr) {
+    const float* row = h + std::int64_t(wr0 + lr) * cols_ + wc0;
+    std::copy(row, row + ww, settle_low_.data() + std::size_t(lr) * std::size_t(ww));
+    std::copy(row, row + ww, settle_high_.data() + std::size_t(lr) * std::size_t(ww));
+  }
+  std::fill(settle_done_.begin(), settle_done_.begin() + std::ptrdiff_t(size), std::uint8_t(0));
+  // The blade's wall: a cell inside the blade, or behind it within its span
+  // (on the side the edge came from, as spill_round_ends has it), is not
+  // part of the pile's surface; nor is a cell under a body. Per row of the
+  // window, the columns [row_lo, row_hi) the blade walls off: the centres
+  // within its span (0 <= t <= 1) and on its side of the line n > -half
+  // (n < half, or both, by the side it came from) form one interval.
+  const double ex = to.b.x - to.a.x, ez = to.b.z - to.a.z;
+  const double len2 = ex * ex + ez * ez;
+  const double len = std::sqrt(len2);
+  const double half = len > 0.0 ? 0.5 * (std::abs(ez) * dx_ + std::abs(ex) * dz_) / len : 0.0;
+  const PlanMotion motion = midpoint_motion(from, to);
+  const double across = len > 0.0 ? (ex * motion.z - ez * motion.x) / len : 0.0;
+  const double behind = std::abs(across) > 0.01 * std::max(dx_, dz_) ? -across : 0.0;
+  const double ox = spec.origin_m.x - to.a.x;
+  for (int lr = 0; lr < wh; ++lr) {
+    int& lo_c = settle_row_lo_[std::size_t(lr)];
+    int& hi_c = settle_row_hi_[std::size_t(lr)];
+    lo_c = hi_c = 0;
+    if (!(len2 > 0.0)) continue;
+    const double z = spec.origin_m.z + (wr0 + lr + 0.5) * dz_ - to.a.z;
+    double lo = -std::numeric_limits<double>::infinity(), hi = -lo;
+    bool empty = false;
+    // a x + b >= 0 (x: a centre's X relative to the edge's first end)
+    const auto keep = [&](double a, double b) {
+      if (a > 0.0) lo = std::max(lo, -b / a);
+      else if (a < 0.0) hi = std::min(hi, -b / a);
+      else if (b < 0.0) empty = true;
+    };
+    keep(ex, z * ez);          // t >= 0
+    keep(-ex, len2 - z * ez);  // t <= 1
+    if (behind >= 0.0) keep(-ez, ex * z + half * len);  // n > -half
+    if (behind <= 0.0) keep(ez, half * len - ex * z);   // n < half
+    if (empty || lo > hi) continue;
+    // Columns whose centre ox + (c + 0.5) dx lies in [lo, hi].
+    const double c_lo = std::ceil((lo - ox) / dx_ - 0.5), c_hi = std::floor((hi - ox) / dx_ - 0.5);
+    lo_c = int(std::clamp(c_lo - wc0, 0.0, double(ww)));
+    hi_c = int(std::clamp(c_hi + 1.0 - wc0, 0.0, double(ww)));
+  }
+  settle_cells_.clear();
+  settle_seeds_[0].clear();
+  settle_seeds_[1].clear();
+  settle_q_ = 0;
+  settle_phase_ = SettlePhase::kSeed;
+}
+
+std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int64_t budget) {
+  if (settle_phase_ == SettlePhase::kIdle) return 0;
+  const int wc0 = settle_wc0_, wr0 = settle_wr0_, ww = settle_ww_, wh = settle_wh_;
+  float* h = grid.edit_layers().height_m;
+  float* low = settle_low_.data();
+  float* high = settle_high_.data();
+  std::uint8_t* done = settle_done_.data();
+  constexpr std::uint8_t kLowDone = 1, kHighDone = 2, kListed = 4, kInPatch = kSettleExcluded;
+  const int* row_lo = settle_row_lo_.data();
+  const int* row_hi = settle_row_hi_.data();
+  std::int64_t work = 0;
+  const auto walled = [&](int lc, int lr) {
+    return (lc >= row_lo[lr] && lc < row_hi[lr]) || obstacle_[std::int64_t(wr0 + lr) * cols_ + wc0 + lc] != 0;
+  };
+  const auto inner = [&](int lc, int lr) { return lc > 0 && lr > 0 && lc < ww - 1 && lr < wh - 1; };
+  std::int32_t offset[8];
+  for (int k = 0; k < 8; ++k) offset[k] = kNeighbours[k].dr * ww + kNeighbours[k].dc;
+  std::vector<std::int32_t>& touched = settle_cells_;
+  const auto list = [&](std::int32_t l) {
+    if (!(done[l] & kListed)) {
+      done[l] |= kListed;
+      touched.push_back(l);
+    }
+  };
+  // The lanes k (bits) where sign ((a - b_k) - limit_k) > tol, b_k the 8
+  // neighbours of window cell l in `v` (steep_now's test and order).
+  const auto steep_from = [&](const float* v, std::int32_t l, float a, float tol, float sign) -> unsigned {
+#if defined(__SSE2__)
+    __m128 n0, n1;
+    load_neighbours(v + l, ww, n0, n1);
+    const __m128 va = _mm_set1_ps(a), vs = _mm_set1_ps(sign);
+    const __m128 e0 = _mm_sub_ps(_mm_mul_ps(vs, _mm_sub_ps(va, n0)), _mm_loadu_ps(limit8_));
+    const __m128 e1 = _mm_sub_ps(_mm_mul_ps(vs, _mm_sub_ps(va, n1)), _mm_loadu_ps(limit8_ + 4));
+    return above_mask(e0, e1, tol);
+#else
+    unsigned m = 0;
+    for (int k = 0; k < 8; ++k) m |= unsigned(sign * (a - v[l + offset[k]]) - limit8_[k] > tol) << k;
+    return m;
+#endif
+  };
+  std::vector<std::pair<float, std::int32_t>>& low_seeds = settle_seeds_[0];
+  std::vector<std::pair<float, std::int32_t>>& high_seeds = settle_seeds_[1];
+
+  // 1. The steep pairs: from each cell the passes would examine (those the
+  // displacement and the spill left too steep, and any carried over), each
+  // neighbour it stands above by more than the pair's limit and the
+  // tolerance. Its low end seeds the low surface, its high end the high
+  // one. (The lists do not change while a settle is under way: the passes
+  // wait for it.)
+  if (settle_phase_ == SettlePhase::kSeed) {
+    const std::size_t from_active = active_.size() - examined_;
+    const std::size_t total = from_active + next_.size();
+    for (; settle_q_ < total && work + 8 <= budget; ++settle_q_) {
+      const std::uint32_t a = settle_q_ < from_active ? active_[examined_ + settle_q_] : next_[settle_q_ - from_active];
+      const int lc = col_of(a) - wc0, lr = row_of(a) - wr0;
+      if (lc < 0 || lr < 0 || lc >= ww || lr >= wh || !inner(lc, lr) || walled(lc, lr)) continue;
+      work += 8;
+      const std::int32_t la = lr * ww + lc;
+      for (unsigned steep = steep_from(low, la, low[la], tolerance_m_, 1.0f); steep != 0; steep &= steep - 1) {
+        const int k = std::countr_zero(steep);
+        if (walled(lc + kNeighbours[k].dc, lr + kNeighbours[k].dr) || low_seeds.size() == low_seeds.capacity())
+          continue;
+        const std::int32_t lb = la + offset[k];
+        list(la);
+        list(lb);
+        low_seeds.push_back({low[lb], lb});
+        high_seeds.push_back({-low[la], la});
+      }
+    }
+    if (settle_q_ < total) return work;
+    if (low_seeds.empty()) {
+      settle_phase_ = SettlePhase::kIdle;
+      return work;
+    }
+    settle_phase_ = SettlePhase::kLow;
+    settle_b_ = settle_used_ = 0;
+    settle_entries_.clear();
+  }
+
+  // 2, 3. The largest surface under the pile that meets every pair's limit
+  // (low: min over cells y of h(y) + the limits along the stencil path to
+  // y) and the least over it (high: max of h(y) less them), each found from
+  // its seeds by Dijkstra with the limits as lengths. Its queue is buckets
+  // of keys one axis limit wide (Dinitz): a step adds at least that, so the
+  // cells of the lowest bucket are final in any order. Each bucket is a
+  // list threaded through settle_entries_. The window's border cells take
+  // values but do not pass them on; what passes the scratch is dropped
+  // (low <= h <= high still holds, so the construction below keeps the
+  // volume; the passes do the rest).
+  const double width = std::min(limit_[0], limit_[1]);
+  const auto spread = [&](std::vector<std::pair<float, std::int32_t>>& seeds, float* value, float sign,
+                          std::uint8_t done_bit) -> bool {
+    std::vector<std::pair<std::int32_t, std::int32_t>>& entries = settle_entries_;  // (cell, next)
+    const auto put = [&](float key, std::int32_t l, std::size_t at_least) {
+      const std::size_t b =
+          std::max(std::size_t(std::max(0.0, (double(key) - double(settle_kmin_)) / width)), at_least);
+      if (b >= settle_heads_.size() || entries.size() == entries.capacity()) return;
+      entries.push_back({l, settle_heads_[b]});
+      settle_heads_[b] = std::int32_t(entries.size() - 1);
+      settle_used_ = std::max(settle_used_, b + 1);
+    };
+    if (!seeds.empty()) {  // the spread's start
+      settle_kmin_ = std::numeric_limits<float>::infinity();
+      for (const auto& e : seeds) settle_kmin_ = std::min(settle_kmin_, e.first);
+      for (const auto& e : seeds) put(e.first, e.second, 0);
+      seeds.clear();
+    }
+    float cand[8];
+    for (; settle_b_ < settle_used_; ++settle_b_) {
+      const std::size_t b = settle_b_;
+      while (settle_heads_[b] >= 0) {
+        if (work + 8 > budget) return false;
+        const auto [l, next] = entries[std::size_t(settle_heads_[b])];
+        settle_heads_[b] = next;
+        if (done[l] & done_bit) continue;
+        done[l] |= done_bit;
+        const int lr = l / ww, lc = l - lr * ww;
+        if (!inner(lc, lr)) continue;
+        work += 8;
+        // The neighbours this cell's value plus (less) the pair's limit
+        // lowers (raises): those standing more than the limit above (below)
+        // it, the steep test with no tolerance.
+        const float v = value[l];
+        unsigned better = steep_from(value, l, v, 0.0f, -sign);
+        if (better == 0) continue;
+        for (int k = 0; k < 8; ++k) cand[k] = v + sign * limit8_[k];
+        for (; better != 0; better &= better - 1) {
+          const int k = std::countr_zero(better);
+          const std::int32_t m = l + offset[k];
+          if (!(sign * cand[k] < sign * value[m]) || walled(lc + kNeighbours[k].dc, lr + kNeighbours[k].dr)) continue;
+          value[m] = cand[k];
+          list(m);
+          put(sign * cand[k], m, b + 1);
+        }
+      }
+    }
+    entries.clear();
+    settle_b_ = settle_used_ = 0;
+    return true;
+  };
+  if (settle_phase_ == SettlePhase::kLow) {
+    if (!spread(low_seeds, low, 1.0f, kLowDone)) return work;
+    settle_phase_ = SettlePhase::kHigh;
+  }
+  if (settle_phase_ == SettlePhase::kHigh) {
+    if (!spread(high_seeds, high, -1.0f, kHighDone)) return work;
+    settle_phase_ = SettlePhase::kPatches;
+    settle_q_ = 0;
+  }
+
+  // 4. Each 8-connected patch of cells where the two differ settles on its
+  // own: its excess over the low surface is put back as the high one
+  // lowered by one amount, max(low, high - delta), which keeps the patch's
+  // volume and, both surfaces meeting every limit, meets them too. A patch
+  // is found and written in one go, its cells at 8 visits each.
+  std::vector<std::int32_t>& patch = settle_patch_;
+  std::vector<float>& widths = settle_widths_;
+  double gained = 0.0;
+  std::int64_t last = -1;
+  for (; settle_q_ < touched.size(); ++settle_q_) {
+    const std::int32_t l0 = touched[settle_q_];
+    if ((done[l0] & kInPatch) || !(high[l0] > low[l0])) continue;
+    // The cells this call can still pay for: a patch larger than that is
+    // cut there, and what it leaves forms a patch of its own later (each
+    // keeps its own volume).
+    const std::size_t room = std::size_t(std::max<std::int64_t>(0, (budget - work) / 8));
+    if (room == 0) break;
+    patch.clear();
+    patch.push_back(l0);
+    done[l0] |= kInPatch;
+    for (std::size_t q = 0; q < patch.size() && patch.size() < room; ++q) {
+      const std::int32_t l = patch[q];
+      const int lr = l / ww, lc = l - lr * ww;
+      for (int k = 0; k < 8 && patch.size() < room; ++k) {
+        const int mc = lc + kNeighbours[k].dc, mr = lr + kNeighbours[k].dr;
+        if (mc < 0 || mr < 0 || mc >= ww || mr >= wh) continue;
+        const std::int32_t m = l + offset[k];
+        if ((done[m] & kInPatch) || !(high[m] > low[m])) continue;
+        done[m] |= kInPatch;
+        patch.push_back(m);
+      }
+    }
+    work += 8 * std::int64_t(patch.size());
+    double excess = 0.0;
+    widths.clear();
+    for (const std::int32_t l : patch) {
+      const int lr = l / ww, lc = l - lr * ww;
+      excess += double(h[std::int64_t(wr0 + lr) * cols_ + wc0 + lc]) - double(low[l]);
+      widths.push_back(high[l] - low[l]);
+    }
+    const double delta = level_below(widths, excess);
+    for (const std::int32_t l : patch) {
+      const int lr = l / ww, lc = l - lr * ww;
+      const std::int64_t i = std::int64_t(wr0 + lr) * cols_ + wc0 + lc;
+      const float now = quantized(std::max(double(low[l]), double(high[l]) - delta));
+      const float old = h[i];
+      if (now == old) continue;
+      gained += double(now) - double(old);
+      dirty(std::uint32_t(i));
+      h[i] = now;
+      last = i;
+      candidate(std::uint32_t(i), now < old);
+      changed.include(wc0 + lc, wr0 + lr);
+    }
+  }
+  // The quantizing's rounding given back on the last cell written.
+  if (last >= 0 && gained != 0.0) give_back(h[last], -gained);
+  settle_candidates(h);
+  if (settle_q_ == touched.size()) {
+    settle_phase_ = SettlePhase::kIdle;
+    if (settle_again_) {
+      // The next one, over what the steps since displaced.
+      settle_again_ = false;
+      settle_start(grid, settle_next_from_, settle_next_to_, settle_next_rect_);
+      if (settle_phase_ != SettlePhase::kIdle && work < budget) work += settle_continue(grid, changed, budget - work);
+    }
+  }
+  return work;
+}
+
+}  // namespace terracut
