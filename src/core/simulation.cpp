@@ -172,7 +172,13 @@ const StepOutput& Simulation::finish_step() {
       kSweepOverlapCells * std::min(params_.grid.cell_x_m(), params_.grid.cell_z_m());
   Segment previous = blade_segment(params_.blade, from);
   const Segment step_from = previous;
-  if (soil_) soil_->before_cut(grid_, step_from, out_.edge);
+  // (A settle of the soil under way goes on in before_cut: soil time.)
+  double soil_before_s = 0.0;
+  if (soil_) {
+    const double t = now_s();
+    soil_->before_cut(grid_, step_from, out_.edge);
+    soil_before_s = now_s() - t;
+  }
   for (int k = 1; k <= substeps; ++k) {
     double t = double(k) / substeps;
     BladePose pose = k == substeps ? out_.pose
@@ -192,7 +198,7 @@ const StepOutput& Simulation::finish_step() {
   has_previous_ = true;
   ++step_count_;
   const double cut_end = now_s();
-  out_.timers.cut_s = cut_end - cut_start;
+  out_.timers.cut_s = cut_end - cut_start - soil_before_s;
   out_.changed = out_.cut.changed;
 
   // Soil that flows: what was cut goes ahead of the blade, slopes relax.
@@ -201,7 +207,7 @@ const StepOutput& Simulation::finish_step() {
     out_.soil = soil_->after_cut(grid_, step_from, out_.edge, out_.pose.orientation);
     out_.changed.include(out_.soil.changed);
     soil_end = now_s();
-    out_.timers.soil_s = soil_end - cut_end;
+    out_.timers.soil_s = soil_end - cut_end + soil_before_s;
   }
 
   // The soil's physical force on the tool, from the terrain the step leaves.
