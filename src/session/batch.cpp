@@ -324,6 +324,7 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
                    {"relaxation",
                     {{"passes", s.passes},
                      {"pair_checks", s.pair_checks},
+                     {"settle_visits", s.settle_visits},
                      {"max_backlog_cells", s.max_backlog_cells},
                      {"final_backlog_cells", s.final_backlog_cells},
                      {"capped_steps", s.capped_steps},
@@ -476,6 +477,7 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
         soil.left_over_edge_m3 += out.soil.left_over_edge_m3;
         soil.passes += out.soil.passes;
         soil.pair_checks += out.soil.pair_checks;
+        soil.settle_visits += out.soil.settle_visits;
         soil.max_backlog_cells = std::max(soil.max_backlog_cells, out.soil.backlog_cells);
         soil.capped_steps += out.soil.reached_cap ? 1 : 0;
         soil.bucket_in_m3 += out.soil.bucket_in_m3;

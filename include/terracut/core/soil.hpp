@@ -256,9 +256,9 @@ struct SoilStepResult {
   /// The relaxation stopped at the work cap (max_pair_checks_per_step) with
   /// work left, the settle of the displaced pile or the passes; the rest is
   /// done in later steps. A push on 1 cm cells reaches it on about 1 % of
-  /// its steps, one on 5 mm cells on 15 to 40 % (the settle of a displacing
+  /// its steps, one on 5 mm cells on 6 to 48 % (the settle of a displacing
   /// step spread over the steps after it); the pile the capped run leaves
-  /// is then within 3.6 % of the soil ahead, and a cell's rise at the peak,
+  /// is then within 3.3 % of the soil ahead, and a cell's rise at the peak,
   /// of the converged one (docs/soil.md, "The displaced pile settled at
   /// once").
   bool reached_cap = false;

@@ -111,6 +111,7 @@ struct SoilRunStats {
   double left_over_edge_m3 = 0.0;    ///< soil that left over an open edge, m^3
   std::int64_t passes = 0;           ///< relaxation passes
   std::int64_t pair_checks = 0;      ///< neighbour pairs examined
+  std::int64_t settle_visits = 0;    ///< of them, the settle of the displaced pile's (soil.md)
   std::int64_t max_backlog_cells = 0;  ///< largest number of cells carried to the next step
   std::int64_t final_backlog_cells = 0;  ///< cells still active at the end
   std::int64_t capped_steps = 0;         ///< steps whose relaxation stopped at the work cap (SoilStepResult::reached_cap)
