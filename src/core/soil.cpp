@@ -216,7 +216,7 @@ void SoilFlow::wake_held(const Segment* edge) {
 
 void SoilFlow::wake(const Rect& rect) {
   if (rect.empty()) return;
-  settle_abort();  // heights written by another hand
+  settle_exclude(Rect{rect.c0 - 1, rect.r0 - 1, rect.c1 + 1, rect.r1 + 1});  // heights another hand wrote
   const int c0 = std::max(rect.c0 - 1, 0), c1 = std::min(rect.c1 + 1, cols_);
   const int r0 = std::max(rect.r0 - 1, 0), r1 = std::min(rect.r1 + 1, rows_);
   for (int r = r0; r < r1; ++r)
@@ -259,7 +259,8 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     if (settle_phase_ == SettlePhase::kIdle) {
       settle_start(grid, from, to, out.changed);
     } else {
-      if (!settle_again_) settle_next_rect_ = settle_rect_;
+      // (the cells the steps since wrote: the one under way settles the rest)
+      if (!settle_again_) settle_next_rect_ = out.changed;
       settle_next_rect_.include(out.changed.c0, out.changed.r0);
       settle_next_rect_.include(out.changed.c1 - 1, out.changed.r1 - 1);
       settle_next_from_ = from;

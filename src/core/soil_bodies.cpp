@@ -32,10 +32,12 @@ void SoilFlow::set_obstacles(std::span<const SoilObstacle> obstacles) noexcept {
     }
     if (same && k == obstacles_.size()) return;
   }
-  settle_abort();  // a settle under way found its walls with the old bodies
   // Clear the old ones; the soil banked against them may now slide on, so
   // the cells along their sides (inside and out) are examined again.
+  // A settle under way leaves the cells under the old and the new bodies
+  // alone (its walls were found with the old ones).
   for (const SoilObstacle& o : obstacles_) {
+    settle_exclude(o.cells);
     for (int r = o.cells.r0; r < o.cells.r1; ++r)
       std::fill_n(obstacle_.begin() + std::int64_t(r) * cols_ + o.cells.c0, o.cells.c1 - o.cells.c0, 0);
     const int c0 = std::max(o.cells.c0 - 1, 0), c1 = std::min(o.cells.c1, cols_ - 1);
@@ -51,6 +53,7 @@ void SoilFlow::set_obstacles(std::span<const SoilObstacle> obstacles) noexcept {
     const SoilObstacle o = clipped(given);
     if (o.cells.empty() || !(o.bottom_m == o.bottom_m)) continue;  // off the grid, or NaN
     obstacles_.push_back(o);
+    settle_exclude(o.cells);
     const auto id = std::uint8_t(obstacles_.size());
     for (int r = o.cells.r0; r < o.cells.r1; ++r)
       for (int c = o.cells.c0; c < o.cells.c1; ++c) {

@@ -62,7 +62,7 @@ inline constexpr int kEndRounds = 6;
 /// this many more round them.
 inline constexpr int kSettleMarginCells = 16;
 /// Its buckets of keys, each an axis pair's limit wide: heights up to this
-/// many limits apart (6.9 m on 5 mm cells at 34 degrees); what lies beyond
+/// many limits apart (13.8 m on 5 mm cells at 34 degrees); what lies beyond
 /// is left to the passes.
 inline constexpr std::size_t kSettleBuckets = 4096;
 /// Rows of pile ahead of the blade that the settle's scratch is sized for, beside the blade's square and the spill's windows round its ends

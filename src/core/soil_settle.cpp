@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <bit>
-#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -84,6 +83,16 @@ void SoilFlow::settle_abort() {
   settle_phase_ = SettlePhase::kIdle;
 }
 
+void SoilFlow::settle_exclude(const Rect& rect) {
+  if (settle_phase_ == SettlePhase::kIdle || rect.empty()) return;
+  const int c0 = std::max(rect.c0, settle_wc0_), c1 = std::min(rect.c1, settle_wc0_ + settle_ww_);
+  const int r0 = std::max(rect.r0, settle_wr0_), r1 = std::min(rect.r1, settle_wr0_ + settle_wh_);
+  for (int r = r0; r < r1; ++r)
+    for (int c = c0; c < c1; ++c)
+      settle_done_[std::size_t(r - settle_wr0_) * std::size_t(settle_ww_) + std::size_t(c - settle_wc0_)] |=
+          kSettleExcluded;
+}
+
 void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed) {
   if (settle_phase_ != SettlePhase::kIdle) settle_abort();
   if (changed.empty() || settle_low_.empty()) return;
@@ -93,7 +102,6 @@ void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment
   const int wr0 = std::max(0, changed.r0 - kSettleMarginCells), wr1 = std::min(rows_, changed.r1 + kSettleMarginCells);
   const int ww = wc1 - wc0, wh = wr1 - wr0;
   if (ww < 3 || wh < 3 || std::size_t(ww) * std::size_t(wh) > settle_low_.size()) return;
-  settle_rect_ = changed;
   settle_wc0_ = wc0;
   settle_wr0_ = wr0;
   settle_ww_ = ww;
@@ -152,6 +160,17 @@ void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment
   settle_seeds_[1].clear();
   settle_q_ = 0;
   settle_phase_ = SettlePhase::kSeed;
+}
+
+std::int64_t SoilFlow::settle_finish(HeightGrid& grid, Rect& changed, std::int64_t budget, std::int64_t work) {
+  settle_phase_ = SettlePhase::kIdle;
+  if (settle_again_) {
+    // The next one, over what the steps since displaced.
+    settle_again_ = false;
+    settle_start(grid, settle_next_from_, settle_next_to_, settle_next_rect_);
+    if (settle_phase_ != SettlePhase::kIdle && work < budget) work += settle_continue(grid, changed, budget - work);
+  }
+  return work;
 }
 
 std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int64_t budget) {
@@ -224,10 +243,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       }
     }
     if (settle_q_ < total) return work;
-    if (low_seeds.empty()) {
-      settle_phase_ = SettlePhase::kIdle;
-      return work;
-    }
+    if (low_seeds.empty()) return settle_finish(grid, changed, budget, work);
     settle_phase_ = SettlePhase::kLow;
     settle_b_ = settle_used_ = 0;
     settle_entries_.clear();
@@ -316,34 +332,49 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   for (; settle_q_ < touched.size(); ++settle_q_) {
     const std::int32_t l0 = touched[settle_q_];
     if ((done[l0] & kInPatch) || !(high[l0] > low[l0])) continue;
-    // The cells this call can still pay for: a patch larger than that is
-    // cut there, and what it leaves forms a patch of its own later (each
-    // keeps its own volume).
+    // A patch larger than what this call can still pay for is cut there,
+    // and what it leaves forms a patch of its own later (each keeps its own
+    // volume; the passes see the seam), unless what is left is under a
+    // quarter of a step's cap: then the patch waits for the next step.
+    const bool fresh = budget - work >= params_.max_pair_checks_per_step / 4;
     const std::size_t room = std::size_t(std::max<std::int64_t>(0, (budget - work) / 8));
     if (room == 0) break;
     patch.clear();
     patch.push_back(l0);
     done[l0] |= kInPatch;
-    for (std::size_t q = 0; q < patch.size() && patch.size() < room; ++q) {
+    bool cut = false;
+    for (std::size_t q = 0; q < patch.size() && !cut; ++q) {
       const std::int32_t l = patch[q];
       const int lr = l / ww, lc = l - lr * ww;
-      for (int k = 0; k < 8 && patch.size() < room; ++k) {
+      for (int k = 0; k < 8; ++k) {
         const int mc = lc + kNeighbours[k].dc, mr = lr + kNeighbours[k].dr;
         if (mc < 0 || mr < 0 || mc >= ww || mr >= wh) continue;
         const std::int32_t m = l + offset[k];
         if ((done[m] & kInPatch) || !(high[m] > low[m])) continue;
+        if (patch.size() == room) {
+          cut = true;
+          break;
+        }
         done[m] |= kInPatch;
         patch.push_back(m);
       }
     }
     work += 8 * std::int64_t(patch.size());
-    double excess = 0.0;
+    if (cut && !fresh) {
+      for (const std::int32_t l : patch) done[l] &= std::uint8_t(~kInPatch);
+      break;  // (the search is paid for; the next step finds it again)
+    }
+    double excess = 0.0, sum_widths = 0.0;
     widths.clear();
     for (const std::int32_t l : patch) {
       const int lr = l / ww, lc = l - lr * ww;
       excess += double(h[std::int64_t(wr0 + lr) * cols_ + wc0 + lc]) - double(low[l]);
       widths.push_back(high[l] - low[l]);
+      sum_widths += double(widths.back());
     }
+    // A height some writer changed without a word (outside low..high)
+    // would make the balance put soil where none was: left to the passes.
+    if (!(excess >= 0.0 && excess <= sum_widths)) continue;
     const double delta = level_below(widths, excess);
     for (const std::int32_t l : patch) {
       const int lr = l / ww, lc = l - lr * ww;
@@ -362,15 +393,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // The quantizing's rounding given back on the last cell written.
   if (last >= 0 && gained != 0.0) give_back(h[last], -gained);
   settle_candidates(h);
-  if (settle_q_ == touched.size()) {
-    settle_phase_ = SettlePhase::kIdle;
-    if (settle_again_) {
-      // The next one, over what the steps since displaced.
-      settle_again_ = false;
-      settle_start(grid, settle_next_from_, settle_next_to_, settle_next_rect_);
-      if (settle_phase_ != SettlePhase::kIdle && work < budget) work += settle_continue(grid, changed, budget - work);
-    }
-  }
+  if (settle_q_ == touched.size()) return settle_finish(grid, changed, budget, work);
   return work;
 }
 

@@ -145,9 +145,9 @@ TEST(SoilConvergence, TheHalfMetreBladesPeakOnFiveMillimetreCellsIsTheConvergedO
 
 // A step listener that, every third step, moves a millimetre of soil
 // between two cells of the pile ahead of the blade and reports it, as the
-// Bullet world does when a body pushes soil aside: a settle under way is
-// dropped (its surfaces were found from the heights before; 12 are, in the
-// test below), and the soil must still be kept and settle.
+// Bullet world does when a body pushes soil aside: the cells it wrote (and
+// their neighbours) leave a settle under way, whose surfaces were found
+// from the heights before, and the soil must still be kept and settle.
 class Meddler : public StepListener {
  public:
   Meddler(Simulation& sim, int cols, double cell_m) : sim_(sim), cols_(cols), cell_(cell_m) {}
@@ -172,7 +172,7 @@ class Meddler : public StepListener {
   int n_ = 0;
 };
 
-TEST(SoilConvergence, ASettleDroppedForAnotherWritersEditKeepsTheSoil) {
+TEST(SoilConvergence, AnotherWritersEditDuringASettleKeepsTheSoil) {
   const double width = 0.5, cell = 0.005, travel = 0.4, speed = 1.0;
   const scenes::Bulldoze scene = push_scene(width, cell, travel);
   Simulation sim = push_simulation(scene, SoilFlowParams{}.max_pair_checks_per_step);

@@ -256,9 +256,9 @@ struct SoilStepResult {
   /// The relaxation stopped at the work cap (max_pair_checks_per_step) with
   /// work left, the settle of the displaced pile or the passes; the rest is
   /// done in later steps. A push on 1 cm cells reaches it on about 1 % of
-  /// its steps, one on 5 mm cells on 6 to 48 % (the settle of a displacing
+  /// its steps, one on 5 mm cells on 7 to 49 % (the settle of a displacing
   /// step spread over the steps after it); the pile the capped run leaves
-  /// is then within 3.3 % of the soil ahead, and a cell's rise at the peak,
+  /// is then within 4.1 % of the soil ahead, and a cell's rise at the peak,
   /// of the converged one (docs/soil.md, "The displaced pile settled at
   /// once").
   bool reached_cap = false;
@@ -442,10 +442,14 @@ class SoilFlow {
   /// settle_start sets it up over the window round `changed`, replacing
   /// one under way; settle_continue does up to `budget` visits of it and
   /// returns them (it is done when settle_phase_ is back to kIdle; the
-  /// passes wait for it); settle_abort drops it (heights another writer
-  /// changed).
+  /// passes wait for it); settle_abort drops it.
   void settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed);
   std::int64_t settle_continue(HeightGrid& grid, Rect& changed, std::int64_t budget);
+  /// Back to kIdle after `work` visits; starts the chained settle, if any,
+  /// with what is left of `budget`. Returns the visits done.
+  std::int64_t settle_finish(HeightGrid& grid, Rect& changed, std::int64_t budget, std::int64_t work);
+  /// settle_exclude for every cell of `rect`.
+  void settle_exclude(const Rect& rect);
   void settle_abort();
   /// Another writer changed `cell` while a settle is under way: the cell
   /// takes no part in its patches (each still keeps its own volume, from
@@ -469,7 +473,6 @@ class SoilFlow {
   // The settle's window (first column and row, columns, rows); where it is
   // in its phase (the list index of the seeding and the patches; the
   // spread's current bucket, the buckets used and the lowest key).
-  Rect settle_rect_{};  // the cells it was started for (the window less its margin)
   int settle_wc0_ = 0, settle_wr0_ = 0, settle_ww_ = 0, settle_wh_ = 0;
   std::size_t settle_q_ = 0, settle_b_ = 0, settle_used_ = 0;
   float settle_kmin_ = 0.0f;
