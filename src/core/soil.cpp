@@ -261,8 +261,7 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     } else {
       // (the cells the steps since wrote: the one under way settles the rest)
       if (!settle_again_) settle_next_rect_ = out.changed;
-      settle_next_rect_.include(out.changed.c0, out.changed.r0);
-      settle_next_rect_.include(out.changed.c1 - 1, out.changed.r1 - 1);
+      else settle_next_rect_.include(out.changed);
       settle_next_from_ = from;
       settle_next_to_ = to;
       settle_again_ = true;
@@ -286,11 +285,8 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   const bool cut_now = out.displaced_volume_m3 > 0.0 || out.bucket_in_m3 > 0.0;
   wake_held(cut_now || cut_last_step_ ? nullptr : &to);
   cut_last_step_ = cut_now;
-  if (settle_phase_ != SettlePhase::kIdle) {
-    const std::int64_t done = settle_continue(grid, out.changed, params_.max_pair_checks_per_step - ends_work_);
-    out.settle_visits += done;
-    ends_work_ += done;
-  }
+  if (settle_phase_ != SettlePhase::kIdle)
+    out.settle_visits += settle_charged(grid, out.changed, params_.max_pair_checks_per_step - ends_work_);
   // The blade's wall matters only to a pass: marked only when one runs.
   if (settle_phase_ != SettlePhase::kIdle) {
     out.reached_cap = true;  // the settle goes on in the next step

@@ -20,10 +20,8 @@ void SoilFlow::before_cut(HeightGrid& grid, const Segment& from, const Segment& 
   // for it.
   settle_changed_ = Rect{};
   settle_early_visits_ = 0;
-  if (settle_phase_ != SettlePhase::kIdle) {
-    settle_early_visits_ = settle_continue(grid, settle_changed_, params_.max_pair_checks_per_step);
-    ends_work_ += settle_early_visits_;
-  }
+  if (settle_phase_ != SettlePhase::kIdle)
+    settle_early_visits_ = settle_charged(grid, settle_changed_, params_.max_pair_checks_per_step);
   // The bounding rectangle of the four endpoints, plus a cell.
   const GridSpec& spec = grid.spec();
   double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;

@@ -522,8 +522,7 @@ SoilStepResult SoilFlow::relax(HeightGrid& grid) {
   clear_hull();        // nor a bucket
   if (settle_phase_ != SettlePhase::kIdle) {
     // A settle under way goes on first; the passes wait for it.
-    out.settle_visits = settle_continue(grid, out.changed, params_.max_pair_checks_per_step);
-    ends_work_ += out.settle_visits;
+    out.settle_visits = settle_charged(grid, out.changed, params_.max_pair_checks_per_step);
     if (settle_phase_ != SettlePhase::kIdle) {
       out.pair_checks = ends_work_;
       ends_work_ = 0;

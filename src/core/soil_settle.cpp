@@ -220,8 +220,8 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // displacement and the spill left too steep, and any carried over), each
   // neighbour it stands above by more than the pair's limit and the
   // tolerance. Its low end seeds the low surface, its high end the high
-  // one. (The lists do not change while a settle is under way: the passes
-  // wait for it.)
+  // one. (While a settle is under way the passes wait, so the lists only
+  // grow at their end, and settle_q_ stays valid across steps.)
   if (settle_phase_ == SettlePhase::kSeed) {
     const std::size_t from_active = active_.size() - examined_;
     const std::size_t total = from_active + next_.size();

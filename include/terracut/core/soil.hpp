@@ -445,6 +445,12 @@ class SoilFlow {
   /// passes wait for it); settle_abort drops it.
   void settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed);
   std::int64_t settle_continue(HeightGrid& grid, Rect& changed, std::int64_t budget);
+  /// settle_continue, its visits charged to the step's cap (ends_work_).
+  std::int64_t settle_charged(HeightGrid& grid, Rect& changed, std::int64_t budget) {
+    const std::int64_t done = settle_continue(grid, changed, budget);
+    ends_work_ += done;
+    return done;
+  }
   /// Back to kIdle after `work` visits; starts the chained settle, if any,
   /// with what is left of `budget`. Returns the visits done.
   std::int64_t settle_finish(HeightGrid& grid, Rect& changed, std::int64_t budget, std::int64_t work);
@@ -466,7 +472,7 @@ class SoilFlow {
   enum class SettlePhase : std::uint8_t { kIdle, kSeed, kLow, kHigh, kPatches };
   SettlePhase settle_phase_ = SettlePhase::kIdle;
   // A step displaced soil while a settle was under way: another follows it
-  // (over the union of the windows), before the passes.
+  // (over the cells the steps since changed), before the passes.
   bool settle_again_ = false;
   Rect settle_next_rect_{};
   Segment settle_next_from_{}, settle_next_to_{};
