@@ -75,9 +75,23 @@ void SoilFlow::reserve_settle(std::size_t window_cells) {
   touch_reserved(settle_entries_);
 }
 
+void SoilFlow::settle_compact_rest() {
+  const std::size_t from_active = active_.size() - examined_;
+  const std::size_t total = from_active + next_.size();
+  for (; settle_q_ < total; ++settle_q_) {
+    if (settle_q_ < from_active)
+      active_.set(examined_ + settle_keep_active_++, active_[examined_ + settle_q_]);
+    else
+      next_.set(settle_keep_next_++, next_[settle_q_ - from_active]);
+  }
+  active_.truncate(examined_ + settle_keep_active_);
+  next_.truncate(settle_keep_next_);
+}
+
 void SoilFlow::settle_abort() {
   settle_again_ = false;
   if (settle_phase_ == SettlePhase::kIdle) return;
+  if (settle_phase_ == SettlePhase::kSeed) settle_compact_rest();
   // The buckets' lists still holding entries are emptied.
   std::fill(settle_heads_.begin(), settle_heads_.end(), -1);
   settle_phase_ = SettlePhase::kIdle;
@@ -91,6 +105,7 @@ void SoilFlow::settle_exclude(const Rect& rect) {
     for (int c = c0; c < c1; ++c)
       settle_done_[std::size_t(r - settle_wr0_) * std::size_t(settle_ww_) + std::size_t(c - settle_wc0_)] |=
           kSettleExcluded;
+  if (r0 < r1 && c0 < c1) settle_drop_ok_ = false;
 }
 
 void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed) {
@@ -159,6 +174,8 @@ void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment
   settle_seeds_[0].clear();
   settle_seeds_[1].clear();
   settle_q_ = 0;
+  settle_keep_active_ = settle_keep_next_ = 0;
+  settle_drop_ok_ = true;
   settle_phase_ = SettlePhase::kSeed;
 }
 
@@ -220,18 +237,38 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // displacement and the spill left too steep, and any carried over), each
   // neighbour it stands above by more than the pair's limit and the
   // tolerance. Its low end seeds the low surface, its high end the high
-  // one. (While a settle is under way the passes wait, so the lists only
-  // grow at their end, and settle_q_ stays valid across steps.)
+  // one. A cell with no such neighbour would shed nothing in a pass: it
+  // leaves the lists (the passes would drop it after the same test; a
+  // change that makes it steep again queues it again). Without that, a
+  // backlog the waiting passes left in the lists was tested again by every
+  // settle after, which then took longer, and on a long push the settles
+  // took every step's budget (docs/soil.md, "Long pushes"). (While a settle
+  // is under way the passes wait, so the lists only grow at their end, and
+  // settle_q_ stays valid across steps.)
   if (settle_phase_ == SettlePhase::kSeed) {
     const std::size_t from_active = active_.size() - examined_;
     const std::size_t total = from_active + next_.size();
     for (; settle_q_ < total && work + 8 <= budget; ++settle_q_) {
-      const std::uint32_t a = settle_q_ < from_active ? active_[examined_ + settle_q_] : next_[settle_q_ - from_active];
+      const bool in_active = settle_q_ < from_active;
+      const std::uint32_t a = in_active ? active_[examined_ + settle_q_] : next_[settle_q_ - from_active];
+      const auto keep = [&] {
+        if (in_active) active_.set(examined_ + settle_keep_active_++, a);
+        else next_.set(settle_keep_next_++, a);
+      };
       const int lc = col_of(a) - wc0, lr = row_of(a) - wr0;
-      if (lc < 0 || lr < 0 || lc >= ww || lr >= wh || !inner(lc, lr) || walled(lc, lr)) continue;
+      if (lc < 0 || lr < 0 || lc >= ww || lr >= wh || !inner(lc, lr) || walled(lc, lr)) {
+        keep();
+        continue;
+      }
       work += 8;
       const std::int32_t la = lr * ww + lc;
-      for (unsigned steep = steep_from(low, la, low[la], tolerance_m_, 1.0f); steep != 0; steep &= steep - 1) {
+      const unsigned steep_mask = steep_from(low, la, low[la], tolerance_m_, 1.0f);
+      if (steep_mask == 0 && settle_drop_ok_) {
+        if (!in_active) clear_flag(a, kQueued);
+        continue;
+      }
+      keep();
+      for (unsigned steep = steep_mask; steep != 0; steep &= steep - 1) {
         const int k = std::countr_zero(steep);
         if (walled(lc + kNeighbours[k].dc, lr + kNeighbours[k].dr) || low_seeds.size() == low_seeds.capacity())
           continue;
@@ -243,6 +280,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       }
     }
     if (settle_q_ < total) return work;
+    settle_compact_rest();
     if (low_seeds.empty()) return settle_finish(grid, changed, budget, work);
     settle_phase_ = SettlePhase::kLow;
     settle_b_ = settle_used_ = 0;

@@ -169,6 +169,8 @@ class CellList {
     if (size_ == buf_.size()) buf_.resize(2 * buf_.size());
   }
   std::uint32_t operator[](std::size_t i) const { return buf_[i]; }
+  /// Overwrites element i (i < size()): a list compacted in place.
+  void set(std::size_t i, std::uint32_t cell) { buf_[i] = cell; }
   const std::uint32_t* begin() const { return buf_.data(); }
   const std::uint32_t* end() const { return buf_.data() + size_; }
   void swap(CellList& other) noexcept {
@@ -465,6 +467,7 @@ class SoilFlow {
     const int lc = col_of(std::uint32_t(cell)) - settle_wc0_, lr = row_of(std::uint32_t(cell)) - settle_wr0_;
     if (lc < 0 || lr < 0 || lc >= settle_ww_ || lr >= settle_wh_) return;
     settle_done_[std::size_t(lr) * std::size_t(settle_ww_) + std::size_t(lc)] |= kSettleExcluded;
+    settle_drop_ok_ = false;
   }
   static constexpr std::uint8_t kSettleExcluded = 8;  // (also "in a patch": either way not open)
   /// Sizes the settle's scratch for a window of this many cells.
@@ -481,6 +484,16 @@ class SoilFlow {
   // spread's current bucket, the buckets used and the lowest key).
   int settle_wc0_ = 0, settle_wr0_ = 0, settle_ww_ = 0, settle_wh_ = 0;
   std::size_t settle_q_ = 0, settle_b_ = 0, settle_used_ = 0;
+  // The seed phase drops the listed cells it finds standing at rest (the
+  // test a pass would make of them), compacting the lists in place: where
+  // the kept ones of active_'s unexamined tail and of next_ have been
+  // written so far. Only while no height in the window changed since the
+  // settle began (settle_drop_ok_): the window's copy is then the grid.
+  std::size_t settle_keep_active_ = 0, settle_keep_next_ = 0;
+  bool settle_drop_ok_ = false;
+  /// Ends the seed phase's compaction: the entries not read yet move down
+  /// to the kept ones, and both lists are cut there.
+  void settle_compact_rest();
   float settle_kmin_ = 0.0f;
   // What before_cut's share of the settle changed and did, for after_cut's
   // result.
