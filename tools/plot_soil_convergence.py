@@ -2,17 +2,18 @@
 """The pile a push leaves at the default work cap against the converged one.
 
 Usage: PYTHONPATH=build/python /usr/bin/python3 tools/plot_soil_convergence.py
-           [--out FILE.png] [--quiet]
+           [--travel METRES] [--out FILE.png] [--quiet]
 
 Runs, with the terracut module, a 1 m blade cutting 4 cm into a 20 cm layer
-of dry sand (repose 34 degrees) on 5 mm cells, pushed 0.8 m along +Z and then
-held still for 0.2 s, at 0.25 m/s and at 1 m/s, each twice: at the default
+of dry sand (repose 34 degrees) on 5 mm cells, pushed 0.8 m (--travel: 0.1 to
+3 m) along +Z and then held still for 0.2 s, at 0.25 m/s and at 1 m/s, each twice: at the default
 work cap (soil.max_pair_checks_per_step = 50000, what a 1 kHz step does) and
 with the cap lifted (1e9: the converged answer). It plots the centre-line
 profiles of the four piles, their sections across the push 10 cm ahead of
 the edge (where they differ: the pile's ends), and prints, for each speed, the soil above the
 layer ahead of the blade within its width and the pile's peak.
-Default output: docs/images/soil_capped_vs_converged.png.
+Default output: docs/images/soil_capped_vs_converged.png, or with --travel
+docs/images/soil_capped_vs_converged_<travel>m.png.
 
 Exit codes: 0 done; 2 bad arguments; 3 numpy, matplotlib or terracut missing.
 """
@@ -67,12 +68,24 @@ def push(speed, cap):
 
 
 def main(argv):
-    out, quiet = os.path.join("docs", "images", "soil_capped_vs_converged.png"), False
+    global TRAVEL, ROWS
+    out, quiet = None, False
     args = argv[1:]
     while args:
         a = args.pop(0)
         if a == "--out" and args:
             out = args.pop(0)
+        elif a == "--travel" and args:
+            value = args.pop(0)
+            try:
+                TRAVEL = float(value)
+            except ValueError:
+                fail(f"--travel {value!r} is not a number of metres")
+            if not 0.1 <= TRAVEL <= 3.0:
+                fail(f"--travel {value!r} is outside 0.1 to 3 m")
+            ROWS = int(round((TRAVEL + 1.4) / CELL))
+            if out is None:
+                out = os.path.join("docs", "images", f"soil_capped_vs_converged_{TRAVEL:g}m.png")
         elif a == "--quiet":
             quiet = True
         elif a in ("-h", "--help"):
@@ -80,6 +93,8 @@ def main(argv):
             return 0
         else:
             fail(f"unknown argument {a!r} (see --help)")
+    if out is None:
+        out = os.path.join("docs", "images", "soil_capped_vs_converged.png")
     fig, grid = plt.subplots(2, 2, figsize=(12, 8.0), sharey="row")
     axes, across = grid[0], grid[1]
     z = (np.arange(ROWS) + 0.5) * CELL - (Z0 + TRAVEL)
@@ -113,7 +128,7 @@ def main(argv):
         ax.legend(fontsize=8, loc="upper right")
     axes[0].set_ylabel("height above the layer, centre line (m)")
     across[0].set_ylabel("height above the layer (m)")
-    fig.suptitle("1 m blade, 4 cm cut, 0.8 m push on 5 mm cells, then 0.2 s still: "
+    fig.suptitle(f"1 m blade, 4 cm cut, {TRAVEL:g} m push on 5 mm cells, then 0.2 s still: "
                  "the pile at the default work cap and with the cap lifted", fontsize=10)
     save_figure(fig, out, fail, quiet, "plot_soil_convergence.py")
     return 0

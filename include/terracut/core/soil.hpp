@@ -257,12 +257,13 @@ struct SoilStepResult {
   std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
   /// The relaxation stopped at the work cap (max_pair_checks_per_step) with
   /// work left, the settle of the displaced pile or the passes; the rest is
-  /// done in later steps. A push on 1 cm cells reaches it on about 1 % of
-  /// its steps, one on 5 mm cells on 7 to 49 % (the settle of a displacing
-  /// step spread over the steps after it); the pile the capped run leaves
-  /// is then within 4.1 % of the soil ahead, and a cell's rise at the peak,
-  /// of the converged one (docs/soil.md, "The displaced pile settled at
-  /// once").
+  /// done in later steps. A 0.8 m push on 1 cm cells reaches it on about
+  /// 1 % of its steps, one on 5 mm cells on 6 to 44 % (the settle of a
+  /// displacing step spread over the steps after it); the pile the capped
+  /// run leaves is then within 4.35 % of the soil ahead, and a cell's rise
+  /// at the peak, of the converged one (docs/soil.md, "The displaced pile
+  /// settled at once"). Pushed 1.6 m on 5 mm cells it can miss by 8 to
+  /// 11 % (docs/soil.md, "Long pushes").
   bool reached_cap = false;
   /// Fluxes examined in an earlier step and dropped in this one because a
   /// cell they join changed (or the tool moved into their way) meanwhile:
