@@ -358,7 +358,12 @@ class SoilFlow {
 
   /// Cells still active (the backlog).
   std::int64_t active_cells() const {
-    return std::int64_t(active_.size() - examined_ + fluxes_.size() - applied_ + next_.size());
+    // (While a settle's seed phase compacts the lists, the slots of the
+    // cells it dropped are still inside them until it ends.)
+    const std::size_t dropped = settle_phase_ == SettlePhase::kSeed
+                                    ? settle_q_ - settle_keep_active_ - settle_keep_next_
+                                    : 0;
+    return std::int64_t(active_.size() - examined_ + fluxes_.size() - applied_ + next_.size() - dropped);
   }
   const SoilFlowParams& params() const { return params_; }
 
