@@ -69,7 +69,7 @@ def push(speed, cap):
 
 def main(argv):
     global TRAVEL, ROWS
-    out, quiet = None, False
+    out, quiet, suffix = None, False, ""
     args = argv[1:]
     while args:
         a = args.pop(0)
@@ -84,8 +84,7 @@ def main(argv):
             if not 0.1 <= TRAVEL <= 3.0:
                 fail(f"--travel {value!r} is outside 0.1 to 3 m")
             ROWS = int(round((TRAVEL + 1.4) / CELL))
-            if out is None:
-                out = os.path.join("docs", "images", f"soil_capped_vs_converged_{TRAVEL:g}m.png")
+            suffix = f"_{TRAVEL:g}m"
         elif a == "--quiet":
             quiet = True
         elif a in ("-h", "--help"):
@@ -94,7 +93,7 @@ def main(argv):
         else:
             fail(f"unknown argument {a!r} (see --help)")
     if out is None:
-        out = os.path.join("docs", "images", "soil_capped_vs_converged.png")
+        out = os.path.join("docs", "images", f"soil_capped_vs_converged{suffix}.png")
     fig, grid = plt.subplots(2, 2, figsize=(12, 8.0), sharey="row")
     axes, across = grid[0], grid[1]
     z = (np.arange(ROWS) + 0.5) * CELL - (Z0 + TRAVEL)

@@ -75,14 +75,17 @@ void SoilFlow::reserve_settle(std::size_t window_cells) {
   touch_reserved(settle_entries_);
 }
 
+void SoilFlow::settle_keep(std::uint32_t cell, bool in_active) {
+  if (in_active) active_.set(examined_ + settle_keep_active_++, cell);
+  else next_.set(settle_keep_next_++, cell);
+}
+
 void SoilFlow::settle_compact_rest() {
   const std::size_t from_active = active_.size() - examined_;
   const std::size_t total = from_active + next_.size();
   for (; settle_q_ < total; ++settle_q_) {
-    if (settle_q_ < from_active)
-      active_.set(examined_ + settle_keep_active_++, active_[examined_ + settle_q_]);
-    else
-      next_.set(settle_keep_next_++, next_[settle_q_ - from_active]);
+    const bool in_active = settle_q_ < from_active;
+    settle_keep(in_active ? active_[examined_ + settle_q_] : next_[settle_q_ - from_active], in_active);
   }
   active_.truncate(examined_ + settle_keep_active_);
   next_.truncate(settle_keep_next_);
@@ -251,13 +254,9 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
     for (; settle_q_ < total && work + 8 <= budget; ++settle_q_) {
       const bool in_active = settle_q_ < from_active;
       const std::uint32_t a = in_active ? active_[examined_ + settle_q_] : next_[settle_q_ - from_active];
-      const auto keep = [&] {
-        if (in_active) active_.set(examined_ + settle_keep_active_++, a);
-        else next_.set(settle_keep_next_++, a);
-      };
       const int lc = col_of(a) - wc0, lr = row_of(a) - wr0;
       if (lc < 0 || lr < 0 || lc >= ww || lr >= wh || !inner(lc, lr) || walled(lc, lr)) {
-        keep();
+        settle_keep(a, in_active);
         continue;
       }
       work += 8;
@@ -267,7 +266,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         if (!in_active) clear_flag(a, kQueued);
         continue;
       }
-      keep();
+      settle_keep(a, in_active);
       for (unsigned steep = steep_mask; steep != 0; steep &= steep - 1) {
         const int k = std::countr_zero(steep);
         if (walled(lc + kNeighbours[k].dc, lr + kNeighbours[k].dr) || low_seeds.size() == low_seeds.capacity())

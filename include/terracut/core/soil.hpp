@@ -497,6 +497,9 @@ class SoilFlow {
   // settle began (settle_drop_ok_): the window's copy is then the grid.
   std::size_t settle_keep_active_ = 0, settle_keep_next_ = 0;
   bool settle_drop_ok_ = false;
+  /// Keeps a listed cell the seed phase read: written at the next kept
+  /// slot of its list (active_'s unexamined tail or next_).
+  void settle_keep(std::uint32_t cell, bool in_active);
   /// Ends the seed phase's compaction: the entries not read yet move down
   /// to the kept ones, and both lists are cut there.
   void settle_compact_rest();
