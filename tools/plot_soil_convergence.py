@@ -20,6 +20,7 @@ Exit codes: 0 done; 2 bad arguments; 3 numpy, matplotlib or terracut missing.
 import os
 import sys
 
+import soil_push
 from plot_common import import_plotting, make_fail, save_figure
 
 fail = make_fail("plot_soil_convergence.py")
@@ -29,42 +30,17 @@ try:
 except ImportError:
     fail("missing Python module 'terracut' (build it, then PYTHONPATH=build/python)", 3)
 
-CELL = 0.005
-WIDTH, DEPTH, LAYER, TRAVEL, HOLD = 1.0, 0.04, 0.2, 0.8, 0.2
+CELL, WIDTH, TRAVEL = 0.005, 1.0, 0.8
 COLS = int(round((WIDTH + 1.6) / CELL))
 ROWS = int(round((TRAVEL + 1.4) / CELL))
-X, Z0 = 0.5 * COLS * CELL, 0.4
+LAYER, Z0 = soil_push.LAYER, soil_push.Z0
 ACROSS_M = 0.1
 
 
 def push(speed, cap):
     """(heights (rows, cols), soil ahead m^3, peak m) after the push and the hold."""
-    scenario = terracut.Scenario.from_dict({
-        "name": "converge",
-        "terrain": {"generator": "plane", "resolution": [COLS, ROWS],
-                    "size_m": [COLS * CELL, ROWS * CELL], "origin_m": [0, 0, 0],
-                    "full_scale_m": 0.6, "plane": {"height_m": LAYER}},
-        "soil": {"model": "flow", "repose_deg": 34, "max_pair_checks_per_step": cap},
-        "blade": {"length_m": WIDTH},
-        "cuts": [{"name": "push", "keyframes": [
-            {"t_s": 0.0, "position_m": [X, LAYER - DEPTH, Z0], "rotation_deg": [0, 0, 0]},
-            {"t_s": TRAVEL / speed, "position_m": [X, LAYER - DEPTH, Z0 + TRAVEL], "rotation_deg": [0, 0, 0]}]}],
-    })
-    sim = terracut.Simulation(scenario)
-    steps = int(round(TRAVEL / speed * 1000.0))
-    s = np.minimum(np.arange(steps + int(round(HOLD * 1000.0)) + 1) / steps, 1.0)
-    poses = np.zeros((len(s), 7))
-    poses[:, 0] = X
-    poses[:, 1] = LAYER - DEPTH
-    poses[:, 2] = Z0 + TRAVEL * s
-    poses[:, 3] = 1.0
-    sim.step(poses)
-    h = np.array(sim.heights, dtype=np.float64)
-    z = (np.arange(ROWS) + 0.5) * CELL
-    x = (np.arange(COLS) + 0.5) * CELL
-    ahead = (z[:, None] > Z0 + TRAVEL) & (np.abs(x[None, :] - X) < 0.5 * WIDTH)
-    above = np.where(ahead, np.maximum(h - LAYER, 0.0), 0.0)
-    return h, above.sum() * CELL * CELL, above.max()
+    p = soil_push.push(terracut, np, WIDTH, CELL, speed, cap, TRAVEL)
+    return p["heights"], p["ahead"], p["peak"]
 
 
 def main(argv):
@@ -97,8 +73,9 @@ def main(argv):
     fig, grid = plt.subplots(2, 2, figsize=(12, 8.0), sharey="row")
     axes, across = grid[0], grid[1]
     z = (np.arange(ROWS) + 0.5) * CELL - (Z0 + TRAVEL)
-    x = (np.arange(COLS) + 0.5) * CELL - X
-    centre = int(X / CELL)
+    x_blade = 0.5 * COLS * CELL
+    x = (np.arange(COLS) + 0.5) * CELL - x_blade
+    centre = int(x_blade / CELL)
     # The row ACROSS_M ahead of the edge: the pile's ends, where the capped
     # run differs (the centre line is the same in both).
     row = int((Z0 + TRAVEL + ACROSS_M) / CELL)

@@ -39,10 +39,17 @@ class StepColumns {
     // The physical force, as force.csv has it (session::force_columns()).
     std::size_t k = kTimePose + kOwn;
     for (const session::ForceColumn& c : session::force_columns()) d[k++] = c.get(o);
-    const std::int64_t n[] = {o.step,       o.contact.cells_visited + o.cut.cells_visited,
-                              o.substeps,   o.changed.c0,
-                              o.changed.r0, o.changed.c1,
-                              o.changed.r1, cut};
+    const std::int64_t n[] = {o.step,
+                              o.contact.cells_visited + o.cut.cells_visited,
+                              o.substeps,
+                              o.changed.c0,
+                              o.changed.r0,
+                              o.changed.c1,
+                              o.changed.r1,
+                              o.soil.pair_checks,
+                              o.soil.reached_cap ? 1 : 0,
+                              o.soil.backlog_cells,
+                              cut};
     columns_.set(i, d, n);
   }
 
@@ -60,8 +67,8 @@ class StepColumns {
     return names;
   }
   static std::vector<const char*> int_names(bool with_cut) {
-    std::vector<const char*> names = {"step",       "cells_visited", "substeps",  "changed_c0",
-                                      "changed_r0", "changed_c1",    "changed_r1"};
+    std::vector<const char*> names = {"step",       "cells_visited", "substeps",   "changed_c0",  "changed_r0",
+                                      "changed_c1", "changed_r1",    "soil_work",  "soil_capped", "soil_backlog"};
     if (with_cut) names.push_back("cut");
     return names;
   }
@@ -259,6 +266,14 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("changed", [](const StepResult& r) { return rect_tuple(r.out.changed); },
                              "(c0, r0, c1, r1): half-open rectangle of samples the step changed.")
       .def_property_readonly("substeps", [](const StepResult& r) { return r.out.substeps; })
+      .def_property_readonly("soil_work", [](const StepResult& r) { return r.out.soil.pair_checks; },
+                             "The soil relaxation's work this step, neighbour visits (soil flow; at most "
+                             "soil.max_pair_checks_per_step).")
+      .def_property_readonly("soil_capped", [](const StepResult& r) { return r.out.soil.reached_cap; },
+                             "True when the work cap stopped the soil's relaxation this step: what it left "
+                             "goes on in later steps, and can change a pushed pile (docs/soil.md).")
+      .def_property_readonly("soil_backlog", [](const StepResult& r) { return r.out.soil.backlog_cells; },
+                             "Cells left queued for the soil's relaxation after this step.")
       .def_property_readonly("listener_force_n", [](const StepResult& r) {
             return tuple3(r.out.listener_force_world_n);
           }, "Force of the step listeners (the rigid bodies) on the tool, world N.")
@@ -357,7 +372,9 @@ contact_length (m), section_area (m^2), max_depth (m), removed_volume (m^3: with
 soil flow a pile cut again counts again), displaced_volume (m^3, a pile pushed
 on counts at every step), cut_from_ground (m^3, the cut below the initial
 surface), listener_fx..fz (N), step_s (s), cells_visited,
-substeps, changed_c0, changed_r0, changed_c1, changed_r1.)doc")
+substeps, changed_c0, changed_r0, changed_c1, changed_r1, soil_work (the soil
+relaxation's neighbour visits), soil_capped (1 where the work cap stopped it),
+soil_backlog (cells left queued).)doc")
       .def("run", &run_sequence, py::arg("cuts") = py::none(),
            "Steps the scenario's sequence (or the given cuts: names or indices, or 'A,B,C') as `terracut "
            "run` does, each cut a separate stroke, and returns the step() columns plus 'cut' "

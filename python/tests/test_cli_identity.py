@@ -84,6 +84,32 @@ def test_run_returns_the_soils_warnings(tmp_path):
     assert terracut.run(terracut.Scenario.from_dict(d), tmp_path / "square")["warnings"] == []
 
 
+def test_the_steps_say_when_the_work_cap_stopped_the_soil(tmp_path):
+    # The run's count of capped steps is the sum of the steps' soil_capped
+    # column, no step passed the cap, and the single steps' results say the
+    # same as the batched columns.
+    d = small_exp1_dict()
+    d["soil"] = {"model": "flow", "repose_deg": 34, "max_pair_checks_per_step": 1000}
+    scenario = terracut.Scenario.from_dict(d)
+    result = terracut.run(scenario, tmp_path / "capped")
+    columns = terracut.Simulation(scenario).run()
+    capped = columns["soil_capped"]
+    assert set(np.unique(capped)) <= {0, 1}
+    assert int(capped.sum()) == result["soil"]["capped_steps"] > 0
+    assert columns["soil_work"].max() <= 1000
+    assert (columns["soil_backlog"] >= 0).all()
+    sim = terracut.Simulation(scenario)
+    poses = scenario.cut_poses("horizontal")[:200]
+    singles = [sim.step(p) for p in poses.tolist()]
+    again = terracut.Simulation(scenario).step(poses)
+    np.testing.assert_array_equal(again["soil_capped"], [int(s.soil_capped) for s in singles])
+    np.testing.assert_array_equal(again["soil_work"], [s.soil_work for s in singles])
+    np.testing.assert_array_equal(again["soil_backlog"], [s.soil_backlog for s in singles])
+    # Lifted, the cap never stops it.
+    d["soil"]["max_pair_checks_per_step"] = 1000000000
+    assert terracut.Simulation(terracut.Scenario.from_dict(d)).run()["soil_capped"].sum() == 0
+
+
 def test_run_names_what_moved(tmp_path):
     # With soil that flows the sum of the steps' cuts counts a pushed pile
     # again at every step: the run also says what the blade cut from the

@@ -172,7 +172,7 @@ const StepOutput& Simulation::finish_step() {
       kSweepOverlapCells * std::min(params_.grid.cell_x_m(), params_.grid.cell_z_m());
   Segment previous = blade_segment(params_.blade, from);
   const Segment step_from = previous;
-  // (A settle of the soil under way goes on in before_cut: soil time.)
+  // (before_cut remembers the heights the cut may change: soil time.)
   double soil_before_s = 0.0;
   if (soil_) {
     const double t = now_s();

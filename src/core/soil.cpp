@@ -230,13 +230,6 @@ void SoilFlow::wake(const Rect& rect) {
 SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const Segment& to,
                                    const Quat& orientation) {
   SoilStepResult out;
-  // What before_cut's share of a settle did.
-  out.settle_visits = settle_early_visits_;
-  if (!settle_changed_.empty()) {
-    out.changed = settle_changed_;
-    settle_changed_ = Rect{};
-  }
-  settle_early_visits_ = 0;
   double room = 0.0, holds = 0.0;
   if (blade_spec_.bucket.enabled()) {
     holds = bucket_retained_m3(blade_spec_, orientation, params_.material.repose_deg);
@@ -254,7 +247,13 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   // construction (soil_settle.cpp), spread over as many steps as the work
   // cap asks while the passes wait. A step that displaces soil while one is
   // still under way lets it go on without the cells it wrote, and another
-  // follows it, over both steps' cells, before the passes run.
+  // follows it, over both steps' cells, before the passes run. A settle
+  // under way goes on only below, after this step's displacement and spill:
+  // it once went first, in before_cut, and at a step that cut soil again
+  // while it ran it took the whole cap, the spill round the ends found none
+  // left, and what the spill should have put in the trench's first rows
+  // came down by passes over the next 15 steps, ten times the converged
+  // work (docs/soil.md, "The spill comes before a settle under way").
   if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0) {
     if (settle_phase_ == SettlePhase::kIdle) {
       settle_start(grid, from, to, out.changed);

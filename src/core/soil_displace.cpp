@@ -15,13 +15,8 @@ namespace terracut {
 using namespace soil_internal;
 
 void SoilFlow::before_cut(HeightGrid& grid, const Segment& from, const Segment& to) {
-  // A settle under way goes on before the cut changes any height (its
-  // surfaces were found from the heights before it); the step's passes wait
-  // for it.
-  settle_changed_ = Rect{};
-  settle_early_visits_ = 0;
-  if (settle_phase_ != SettlePhase::kIdle)
-    settle_early_visits_ = settle_charged(grid, settle_changed_, params_.max_pair_checks_per_step);
+  // (A settle under way goes on in after_cut, once this step's displacement
+  // and its spill round the blade's ends have had their share of the cap.)
   // The bounding rectangle of the four endpoints, plus a cell.
   const GridSpec& spec = grid.spec();
   double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;

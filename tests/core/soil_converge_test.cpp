@@ -55,10 +55,11 @@ Simulation push_simulation(const scenes::Bulldoze& scene, std::int64_t cap) {
   return Simulation(scene.params(soil), scene.heights());
 }
 
-// That blade pushed 0.8 m at speed, then held still for hold_s (the
-// relaxation goes on).
-Pile push(double width_m, double cell_m, double speed_m_per_s, std::int64_t cap, double hold_s = 0.2) {
-  const double travel = 0.8, layer = kLayer;
+// That blade pushed travel_m (0.8 m unless said) at speed, then held still
+// for hold_s (the relaxation goes on).
+Pile push(double width_m, double cell_m, double speed_m_per_s, std::int64_t cap, double hold_s = 0.2,
+          double travel_m = 0.8) {
+  const double travel = travel_m, layer = kLayer;
   const scenes::Bulldoze scene = push_scene(width_m, cell_m, travel);
   const int cols = scene.cols, rows = scene.rows;
   Simulation sim = push_simulation(scene, cap);
@@ -90,12 +91,12 @@ Pile push(double width_m, double cell_m, double speed_m_per_s, std::int64_t cap,
   return pile;
 }
 
-void expect_converged(double width_m, double cell_m, double speed_m_per_s) {
-  const Pile capped = push(width_m, cell_m, speed_m_per_s, SoilFlowParams{}.max_pair_checks_per_step);
-  const Pile converged = push(width_m, cell_m, speed_m_per_s, kLifted);
+void expect_converged(double width_m, double cell_m, double speed_m_per_s, double travel_m = 0.8) {
+  const Pile capped = push(width_m, cell_m, speed_m_per_s, SoilFlowParams{}.max_pair_checks_per_step, 0.2, travel_m);
+  const Pile converged = push(width_m, cell_m, speed_m_per_s, kLifted, 0.2, travel_m);
   const std::string what = std::to_string(width_m) + " m blade, " + std::to_string(cell_m * 1000.0) + " mm cells, " +
-                           std::to_string(speed_m_per_s) + " m/s (" + std::to_string(capped.capped_steps) +
-                           " steps at the cap)";
+                           std::to_string(speed_m_per_s) + " m/s, " + std::to_string(travel_m) + " m (" +
+                           std::to_string(capped.capped_steps) + " steps at the cap)";
   ASSERT_GT(converged.ahead_m3, 0.0) << what;
   // The settle and the passes together stay within the cap in every step.
   EXPECT_LE(capped.most_step_visits, SoilFlowParams{}.max_pair_checks_per_step) << what;
@@ -141,6 +142,21 @@ TEST(SoilConvergence, TheHalfMetreBladesPeakOnFiveMillimetreCellsIsTheConvergedO
   // (soil_settle.cpp) builds the stable surface instead, spread over the
   // steps after a displacing one at the cap.
   for (const double speed : {0.5, 1.0}) expect_converged(0.5, 0.005, speed);
+}
+
+TEST(SoilConvergence, ALongSlowPushOnFiveMillimetreCellsKeepsTheConvergedPile) {
+  // At 0.25 and 0.5 m/s the edge lands on a row of cell centres at its
+  // crossing, and the next step's cut takes that row again (what the spill
+  // round the ends put in it) and displaces it: a step that cuts while the
+  // crossing's settle is under way. The settle used to go on first, in
+  // before_cut, and took the whole cap; the spill round the ends then found
+  // none left, and what it should have put in the trench's first rows came
+  // down by passes over the next 15 steps at the cap. Pushed 1.6 m, the
+  // 0.5 m blade's capped pile held 8.1 % less soil ahead than the converged
+  // one, its peak 5.9 mm lower, at 0.25 m/s (4.9 % and 3.8 mm at 0.5 m/s).
+  // The settle under way now goes on after the step's displacement and
+  // spill (docs/soil.md, "The spill comes before a settle under way").
+  for (const double speed : {0.25, 0.5}) expect_converged(0.5, 0.005, speed, 1.6);
 }
 
 // A step listener that, every third step, moves a millimetre of soil
@@ -275,17 +291,27 @@ TEST(SoilConvergence, TheLeastCapsStillMoveSoilWithTheBladeIn) {
   // Splitting a pass at the cap keeps room to apply what was examined (up
   // to 1040 visits for one cell), from a cap of 4160 on; at the least cap
   // allowed, 1000, and on either side of 4160, the relaxation must still
-  // move soil while the blade pushes, and never pass the cap.
+  // move soil while the blade pushes, never pass the cap, and bring the
+  // pile to rest once the blade stands still (a cap too small for any pass
+  // or settle to finish would leave it steep for ever).
   for (const std::int64_t cap : {std::int64_t(1000), std::int64_t(4159), std::int64_t(4160), std::int64_t(5000)}) {
     const scenes::Bulldoze scene = push_scene(0.3, 0.01, 0.1);
     Simulation sim = push_simulation(scene, cap);
     std::int64_t moved = 0;
-    for (int i = 0; i <= 200; ++i) {
-      const StepOutput& out = sim.step(scene.pose(kStartZ + 0.1 * std::min(1.0, i / 100.0)));
+    int i = 0;
+    for (; i <= 100; ++i) {
+      const StepOutput& out = sim.step(scene.pose(kStartZ + 0.1 * i / 100.0));
       EXPECT_LE(out.soil.pair_checks, cap) << "cap " << cap << ", step " << i;
       moved += out.soil.moved_pairs;
     }
-    EXPECT_GT(moved, 1000) << "cap " << cap;
+    EXPECT_GT(moved, 0) << "cap " << cap;
+    bool at_rest = false;
+    for (; i <= 20000 && !at_rest; ++i) {
+      const StepOutput& out = sim.step(scene.pose(kStartZ + 0.1));
+      EXPECT_LE(out.soil.pair_checks, cap) << "cap " << cap << ", step " << i;
+      at_rest = !out.soil.reached_cap && out.soil.backlog_cells == 0;
+    }
+    EXPECT_TRUE(at_rest) << "cap " << cap << ": still steep or capped at step " << i;
   }
 }
 

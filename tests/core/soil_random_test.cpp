@@ -172,7 +172,9 @@ TEST(SoilRandom, PushesNobodyChoseKeepTheSoilsVolume) {
                                      << ", against " << o.bound_m3 << " m^3 of rounding by then";
     EXPECT_TRUE(o.heights_ok) << o.what;
     // (Float rounding of heights under 1 m: far below a micrometre.)
-    if (o.settled_checked) EXPECT_LE(o.steepest_over_m, 1e-6) << o.what << ": left steeper than its limit, settled";
+    if (o.settled_checked) {
+      EXPECT_LE(o.steepest_over_m, 1e-6) << o.what << ": left steeper than its limit, settled";
+    }
   }
 }
 

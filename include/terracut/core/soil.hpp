@@ -504,10 +504,6 @@ class SoilFlow {
   /// to the kept ones, and both lists are cut there.
   void settle_compact_rest();
   float settle_kmin_ = 0.0f;
-  // What before_cut's share of the settle changed and did, for after_cut's
-  // result.
-  Rect settle_changed_{};
-  std::int64_t settle_early_visits_ = 0;
   // Its scratch, per window cell: its state bits, the low and high
   // surfaces; per row, the columns the blade walls off; the cells changed,
   // a patch, its widths, the seeds, and the buckets' lists (entries: cell,

@@ -1,0 +1,103 @@
+#!/usr/bin/python3
+"""Pushes at the default work cap against the same pushes with it lifted.
+
+Usage: PYTHONPATH=build/python /usr/bin/python3 tools/soil_convergence_sweep.py
+           [--travel METRES] [--blades 0.3,0.5,...] [--cells 0.005,0.01]
+           [--speeds 0.25,0.5,0.75,1] [--cap VISITS]
+
+For every blade width, cell size and speed, the push of tools/soil_push.py
+(a 4 cm cut into a 20 cm layer of dry sand, pushed --travel metres, 0.8 by
+default, then 0.2 s still) is run twice: at the work cap (--cap, the default
+50000 neighbour visits a step) and with the cap lifted (1e9: the converged
+answer). Prints a Markdown table: the capped soil ahead of the blade against
+the converged (per cent), the capped peak less the converged (mm), the steps
+the cap stopped out of the push's, and both runs' work; a miss of the bounds
+(5 % of the soil ahead, one cell's repose rise at the peak: tan 34 x the
+cell) is in bold, and the last line counts them. Defaults: the blades 0.3,
+0.5, 0.75, 1, 1.5 and 2 m, cells of 5 and 10 mm, 0.25 to 1 m/s (48 pushes,
+about 2 minutes on one core).
+
+Exit codes: 0 done (misses or not); 2 bad arguments; 3 numpy or terracut missing.
+"""
+import math
+import sys
+
+from plot_common import make_fail
+from soil_push import push
+
+fail = make_fail("soil_convergence_sweep.py")
+try:
+    import numpy as np
+except ImportError:
+    fail("missing Python module 'numpy' (Debian: apt-get install python3-numpy)", 3)
+try:
+    import terracut
+except ImportError:
+    fail("missing Python module 'terracut' (build it, then PYTHONPATH=build/python)", 3)
+
+
+def numbers(flag, text, lo, hi):
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        fail(f"{flag} {text!r}: not a comma-separated list of numbers")
+    for v in values:
+        if not lo <= v <= hi:
+            fail(f"{flag}: {v:g} is outside {lo:g} to {hi:g}")
+    return values
+
+
+def main(argv):
+    travel, cap = 0.8, 50000
+    blades, cells, speeds = [0.3, 0.5, 0.75, 1.0, 1.5, 2.0], [0.005, 0.01], [0.25, 0.5, 0.75, 1.0]
+    args = argv[1:]
+    while args:
+        a = args.pop(0)
+        if a in ("-h", "--help"):
+            print(__doc__)
+            return 0
+        if not args:
+            fail(f"{a!r} needs a value (see --help)")
+        value = args.pop(0)
+        if a == "--travel":
+            travel = numbers(a, value, 0.1, 3.0)[0]
+        elif a == "--blades":
+            blades = numbers(a, value, 0.05, 4.0)
+        elif a == "--cells":
+            cells = numbers(a, value, 0.002, 0.05)
+        elif a == "--speeds":
+            speeds = numbers(a, value, 0.01, 2.0)
+        elif a == "--cap":
+            cap = numbers(a, value, 1000, 1e9)[0]
+        else:
+            fail(f"unknown argument {a!r} (see --help)")
+    slope = math.tan(math.radians(34.0))
+    print(f"Pushes of {travel:g} m, 0.2 s held; capped at {int(cap)} visits a step against the cap lifted.\n")
+    print("| blade | cells | " + " | ".join(f"{v:g} m/s" for v in speeds) + " | converged work (M visits), "
+          + " / ".join(f"{v:g}" for v in speeds) + " m/s |")
+    print("|---" * (3 + len(speeds)) + "|")
+    misses = worst_rel = worst_peak = 0.0
+    for cell in cells:
+        for width in blades:
+            row, works = [], []
+            for speed in speeds:
+                capped = push(terracut, np, width, cell, speed, cap, travel)
+                lifted = push(terracut, np, width, cell, speed, 1e9, travel)
+                rel = capped["ahead"] / lifted["ahead"] - 1.0
+                peak_mm = 1000.0 * (capped["peak"] - lifted["peak"])
+                miss = abs(rel) > 0.05 or abs(peak_mm) > 1000.0 * slope * cell
+                misses += miss
+                worst_rel, worst_peak = max(worst_rel, abs(rel)), max(worst_peak, abs(peak_mm))
+                steps = int(round(travel / speed * 1000.0))
+                text = f"{100 * rel:+.1f} %, {peak_mm:+.1f} mm, {capped['capped']}/{steps}"
+                row.append(f"**{text}**" if miss else text)
+                works.append(f"{lifted['work'] / 1e6:.1f}")
+            print(f"| {width:g} m | {1000 * cell:g} mm | " + " | ".join(row) + " | " + " / ".join(works) + " |")
+            sys.stdout.flush()
+    print(f"\n{int(misses)} of {len(cells) * len(blades) * len(speeds)} pushes miss a bound; "
+          f"worst {100 * worst_rel:.2f} % of the soil ahead, {worst_peak:.1f} mm at the peak.")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

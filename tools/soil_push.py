@@ -1,0 +1,51 @@
+"""The push that measures the soil relaxation's convergence, shared by
+tools/plot_soil_convergence.py and tools/soil_convergence_sweep.py (and the
+same as push() in tests/core/soil_converge_test.cpp): a blade of width_m
+cutting 4 cm into a 20 cm layer of dry sand (repose 34 degrees) on square
+cells of cell_m, pushed travel_m along +Z from z = 0.4 m at speed_m_per_s
+(1 kHz steps), then held still for hold_s, with the relaxation's work cap at
+cap neighbour visits a step (50000 is the default; 1e9 lifts it: the
+converged answer). The grid is (width + 1.6) / cell by (travel + 1.4) / cell
+cells."""
+
+DEPTH, LAYER, Z0 = 0.04, 0.2, 0.4
+
+
+def push(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m=0.8, hold_s=0.2):
+    """A dict: heights (rows, cols) after the hold; ahead (m^3 of soil above
+    the layer ahead of the edge within the blade's width) and peak (its
+    highest point above the layer, m); capped (steps the cap stopped), work
+    (neighbour visits in all), most (the largest step's), and x, the blade's
+    centre (m)."""
+    cols = int(round((width_m + 1.6) / cell_m))
+    rows = int(round((travel_m + 1.4) / cell_m))
+    x = 0.5 * cols * cell_m
+    scenario = terracut.Scenario.from_dict({
+        "name": "converge",
+        "terrain": {"generator": "plane", "resolution": [cols, rows],
+                    "size_m": [cols * cell_m, rows * cell_m], "origin_m": [0, 0, 0],
+                    "full_scale_m": 0.6, "plane": {"height_m": LAYER}},
+        "soil": {"model": "flow", "repose_deg": 34, "max_pair_checks_per_step": int(cap)},
+        "blade": {"length_m": width_m},
+        "cuts": [{"name": "push", "keyframes": [
+            {"t_s": 0.0, "position_m": [x, LAYER - DEPTH, Z0], "rotation_deg": [0, 0, 0]},
+            {"t_s": travel_m / speed_m_per_s, "position_m": [x, LAYER - DEPTH, Z0 + travel_m],
+             "rotation_deg": [0, 0, 0]}]}],
+    })
+    sim = terracut.Simulation(scenario)
+    steps = int(round(travel_m / speed_m_per_s * 1000.0))
+    s = np.minimum(np.arange(steps + int(round(hold_s * 1000.0)) + 1) / steps, 1.0)
+    poses = np.zeros((len(s), 7))
+    poses[:, 0] = x
+    poses[:, 1] = LAYER - DEPTH
+    poses[:, 2] = Z0 + travel_m * s
+    poses[:, 3] = 1.0
+    columns = sim.step(poses)
+    h = np.array(sim.heights, dtype=np.float64)
+    z = (np.arange(rows) + 0.5) * cell_m
+    xs = (np.arange(cols) + 0.5) * cell_m
+    ahead = (z[:, None] > Z0 + travel_m) & (np.abs(xs[None, :] - x) < 0.5 * width_m)
+    above = np.where(ahead, np.maximum(h - LAYER, 0.0), 0.0)
+    return {"heights": h, "ahead": float(above.sum() * cell_m * cell_m), "peak": float(above.max()),
+            "capped": int(columns["soil_capped"].sum()), "work": int(columns["soil_work"].sum()),
+            "most": int(columns["soil_work"].max()), "x": x}
