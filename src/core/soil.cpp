@@ -190,13 +190,13 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
     }
 }
 
-void SoilFlow::wake_held(const Segment* edge) {
+bool SoilFlow::wake_held(const Segment* edge) {
   // Soil the blade held up is examined again once the blade is elsewhere
   // (or gone); while it stands still, nothing it holds can move.
   // "Elsewhere": an end moved by a quarter of a cell or more (what the
   // blade holds changes only where its line crosses a cell's centre or
   // edge; a step of 0.6 mm on 1 cm cells would wake them every step).
-  if (held_.empty()) return;
+  if (held_.empty()) return false;
   if (edge != nullptr) {
     const double q2 = kHeldMoveCells * kHeldMoveCells * std::min(dx_ * dx_, dz_ * dz_);
     const auto near = [&](const Vec3& p, const Vec3& q) {
@@ -205,13 +205,14 @@ void SoilFlow::wake_held(const Segment* edge) {
     };
     if (near(edge->a, held_edge_.a) && near(edge->b, held_edge_.b) &&
         (hull_cells_.empty() || (near(hull_heel_.a, held_heel_.a) && near(hull_heel_.b, held_heel_.b))))
-      return;
+      return false;
   }
   for (std::uint32_t cell : held_) {
     clear_flag(cell, kHeld);
     activate(cell);
   }
   held_.clear();
+  return true;
 }
 
 void SoilFlow::wake(const Rect& rect) {
@@ -282,8 +283,14 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   // the edge stood on when it cut it is behind it from the next step on):
   // all are examined again.
   const bool cut_now = out.displaced_volume_m3 > 0.0 || out.bucket_in_m3 > 0.0;
-  wake_held(cut_now || cut_last_step_ ? nullptr : &to);
+  const bool woke = wake_held(cut_now || cut_last_step_ ? nullptr : &to);
   cut_last_step_ = cut_now;
+  // What the blade held at its ends slides round them once it has moved
+  // on: the spill round the ends runs again (it ran above only in a step
+  // that displaced soil). Left to the passes, that soil drained through the
+  // cells at each end a millimetre a pass, for about 100 passes after each
+  // row crossing (docs/soil.md, "The held soil spills round the ends").
+  if (woke && !cut_now && !blade_spec_.bucket.enabled()) spill_round_ends(grid, from, to, out);
   if (settle_phase_ != SettlePhase::kIdle)
     out.settle_visits += settle_charged(grid, out.changed, params_.max_pair_checks_per_step - ends_work_);
   // The blade's wall matters only to a pass: marked only when one runs.

@@ -381,7 +381,10 @@ class SoilFlow {
     set_flag(a, kHeld);
     held_.push_back(a);
   }
-  void wake_held(const Segment* edge);
+  /// Queues the cells the blade or hull held once they have moved (edge:
+  /// where the blade's edge stands now; nullptr: all). Returns whether any
+  /// were woken.
+  bool wake_held(const Segment* edge);
   void mark_blade(const HeightGrid& grid, const Segment& from, const Segment& edge);
   void clear_blade();
   /// Whether the blade stops soil at height top_m flowing from cell
