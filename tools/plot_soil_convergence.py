@@ -73,7 +73,7 @@ def main(argv):
     fig, grid = plt.subplots(2, 2, figsize=(12, 8.0), sharey="row")
     axes, across = grid[0], grid[1]
     z = (np.arange(ROWS) + 0.5) * CELL - (Z0 + TRAVEL)
-    x_blade = 0.5 * COLS * CELL
+    x_blade = soil_push.push_x(WIDTH, CELL)
     x = (np.arange(COLS) + 0.5) * CELL - x_blade
     centre = int(x_blade / CELL)
     # The row ACROSS_M ahead of the edge: the pile's ends, where the capped

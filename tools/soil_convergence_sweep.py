@@ -11,13 +11,15 @@ default, then 0.2 s still) is run twice: at the work cap (--cap, the default
 50000 neighbour visits a step) and with the cap lifted (1e9: the converged
 answer). Prints a Markdown table: the capped soil ahead of the blade against
 the converged (per cent), the capped peak less the converged (mm), the steps
-the cap stopped out of the push's, and both runs' work; a miss of the bounds
+the cap stopped (the push's and the 0.2 s hold's) over the push's steps, and
+the converged run's work; a miss of the bounds
 (5 % of the soil ahead, one cell's repose rise at the peak: tan 34 x the
 cell) is in bold, and the last line counts them. Defaults: the blades 0.3,
 0.5, 0.75, 1, 1.5 and 2 m, cells of 5 and 10 mm, 0.25 to 1 m/s (48 pushes,
 about 2 minutes on one core).
 
-Exit codes: 0 done (misses or not); 2 bad arguments; 3 numpy or terracut missing.
+Exit codes: 0 done (misses or not); 2 bad arguments; 3 numpy or terracut
+missing; 4 a converged push left no soil ahead (a blade above the layer).
 """
 import math
 import sys
@@ -34,6 +36,16 @@ try:
     import terracut
 except ImportError:
     fail("missing Python module 'terracut' (build it, then PYTHONPATH=build/python)", 3)
+
+
+def number(flag, text, lo, hi):
+    try:
+        value = float(text)
+    except ValueError:
+        fail(f"{flag} {text!r}: not a number")
+    if not lo <= value <= hi:
+        fail(f"{flag}: {value:g} is outside {lo:g} to {hi:g}")
+    return value
 
 
 def numbers(flag, text, lo, hi):
@@ -56,21 +68,21 @@ def main(argv):
         if a in ("-h", "--help"):
             print(__doc__)
             return 0
+        if a not in ("--travel", "--blades", "--cells", "--speeds", "--cap"):
+            fail(f"unknown argument {a!r} (see --help)")
         if not args:
-            fail(f"{a!r} needs a value (see --help)")
+            fail(f"{a} needs a value (see --help)")
         value = args.pop(0)
         if a == "--travel":
-            travel = numbers(a, value, 0.1, 3.0)[0]
+            travel = number(a, value, 0.1, 3.0)
         elif a == "--blades":
             blades = numbers(a, value, 0.05, 4.0)
         elif a == "--cells":
             cells = numbers(a, value, 0.002, 0.05)
         elif a == "--speeds":
             speeds = numbers(a, value, 0.01, 2.0)
-        elif a == "--cap":
-            cap = numbers(a, value, 1000, 1e9)[0]
         else:
-            fail(f"unknown argument {a!r} (see --help)")
+            cap = number(a, value, 1000, 1e9)
     slope = math.tan(math.radians(34.0))
     print(f"Pushes of {travel:g} m, 0.2 s held; capped at {int(cap)} visits a step against the cap lifted.\n")
     print("| blade | cells | " + " | ".join(f"{v:g} m/s" for v in speeds) + " | converged work (M visits), "
@@ -83,6 +95,9 @@ def main(argv):
             for speed in speeds:
                 capped = push(terracut, np, width, cell, speed, cap, travel)
                 lifted = push(terracut, np, width, cell, speed, 1e9, travel)
+                if not lifted["ahead"] > 0.0:
+                    fail(f"the {width:g} m blade's converged push left no soil ahead of it "
+                         f"({1000 * cell:g} mm cells, {speed:g} m/s): no ratio to give", 4)
                 rel = capped["ahead"] / lifted["ahead"] - 1.0
                 peak_mm = 1000.0 * (capped["peak"] - lifted["peak"])
                 miss = abs(rel) > 0.05 or abs(peak_mm) > 1000.0 * slope * cell

@@ -375,7 +375,7 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   // and carries the pass over as without a tool.
   const std::int64_t cap = params_.max_pair_checks_per_step;
   const bool split_at_cap = (blade_.present || !hull_cells_.empty()) && cap >= kLeastSplitCap;
-  // What the spill round the blade's ends spent this step counts too.
+  // What the spill round the blade's ends and the settle spent this step counts too.
   std::int64_t work = ends_work_;
   ends_work_ = 0;
   // A pass left over from an earlier step was examined against the blade,

@@ -258,12 +258,13 @@ struct SoilStepResult {
   /// The relaxation stopped at the work cap (max_pair_checks_per_step) with
   /// work left, the settle of the displaced pile or the passes; the rest is
   /// done in later steps. A 0.8 m push on 1 cm cells reaches it on about
-  /// 1 % of its steps, one on 5 mm cells on 6 to 44 % (the settle of a
+  /// 1 % of its steps, one on 5 mm cells on 7 to 41 % (the settle of a
   /// displacing step spread over the steps after it); the pile the capped
-  /// run leaves is then within 4.35 % of the soil ahead, and a cell's rise
-  /// at the peak, of the converged one (docs/soil.md, "The displaced pile
-  /// settled at once"). Pushed 1.6 m on 5 mm cells it can miss by 8 to
-  /// 11 % (docs/soil.md, "Long pushes").
+  /// run leaves is then within 1.1 % of the soil ahead, and a cell's rise
+  /// at the peak, of the converged one (docs/soil.md, "The held soil spills
+  /// round the ends"). At 1 m/s on 5 mm cells a long push's converged work
+  /// outgrows the cap: pushed 1.6 m the 1 m blade's pile holds 8 % more,
+  /// pushed 2.4 m the 1 to 2 m blades' 15 to 44 % more.
   bool reached_cap = false;
   /// Fluxes examined in an earlier step and dropped in this one because a
   /// cell they join changed (or the tool moved into their way) meanwhile:
@@ -444,7 +445,7 @@ class SoilFlow {
   std::vector<std::uint8_t> ends_state_;
   double ends_s_[2] = {0.0, 0.0};  // each end's cone height at the last call
   bool cut_last_step_ = false;     // the last after_cut displaced or took in soil
-  std::int64_t ends_work_ = 0;     // visits spill_round_ends spent this step (charged to the cap by run_passes)
+  std::int64_t ends_work_ = 0;     // visits the spill and the settle spent this step (charged to the cap by run_passes)
   std::vector<std::pair<double, int>> ends_keys_;  // the round's donors' and receivers' cone keys
   std::vector<std::int32_t> ends_queue_;           // the round's sets, window cells in the order found
   /// What the displacement and the spill left steeper than a pair's limit
