@@ -31,8 +31,7 @@ except ImportError:
     fail("missing Python module 'terracut' (build it, then PYTHONPATH=build/python)", 3)
 
 CELL, WIDTH, TRAVEL = 0.005, 1.0, 0.8
-COLS = int(round((WIDTH + 1.6) / CELL))
-ROWS = int(round((TRAVEL + 1.4) / CELL))
+COLS, ROWS = soil_push.grid_shape(WIDTH, CELL, TRAVEL)
 LAYER, Z0 = soil_push.LAYER, soil_push.Z0
 ACROSS_M = 0.1
 
@@ -44,7 +43,7 @@ def push(speed, cap):
 
 
 def main(argv):
-    global TRAVEL, ROWS
+    global TRAVEL, COLS, ROWS
     out, quiet, suffix = None, False, ""
     args = argv[1:]
     while args:
@@ -59,7 +58,7 @@ def main(argv):
                 fail(f"--travel {value!r} is not a number of metres")
             if not 0.1 <= TRAVEL <= 3.0:
                 fail(f"--travel {value!r} is outside 0.1 to 3 m")
-            ROWS = int(round((TRAVEL + 1.4) / CELL))
+            COLS, ROWS = soil_push.grid_shape(WIDTH, CELL, TRAVEL)
             suffix = f"_{TRAVEL:g}m"
         elif a == "--quiet":
             quiet = True

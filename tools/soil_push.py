@@ -11,19 +11,22 @@ cells."""
 DEPTH, LAYER, Z0 = 0.04, 0.2, 0.4
 
 
+def grid_shape(width_m, cell_m, travel_m):
+    """(cols, rows) of the push's grid."""
+    return int(round((width_m + 1.6) / cell_m)), int(round((travel_m + 1.4) / cell_m))
+
+
 def push_x(width_m, cell_m):
     """X of the blade's centre (m): the middle of the grid's width."""
-    return 0.5 * int(round((width_m + 1.6) / cell_m)) * cell_m
+    return 0.5 * grid_shape(width_m, cell_m, 0.0)[0] * cell_m
 
 
 def push(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m=0.8, hold_s=0.2):
     """A dict: heights (rows, cols) after the hold; ahead (m^3 of soil above
     the layer ahead of the edge within the blade's width) and peak (its
-    highest point above the layer, m); capped (steps the cap stopped), work
-    (neighbour visits in all) and x, the blade's centre (m). The steps
-    counted are the push's and the hold's."""
-    cols = int(round((width_m + 1.6) / cell_m))
-    rows = int(round((travel_m + 1.4) / cell_m))
+    highest point above the layer, m); capped (steps the cap stopped) and
+    work (neighbour visits in all), over the push's and the hold's steps."""
+    cols, rows = grid_shape(width_m, cell_m, travel_m)
     x = push_x(width_m, cell_m)
     scenario = terracut.Scenario.from_dict({
         "name": "converge",
@@ -52,4 +55,4 @@ def push(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m=0.8, hold_s
     ahead = (z[:, None] > Z0 + travel_m) & (np.abs(xs[None, :] - x) < 0.5 * width_m)
     above = np.where(ahead, np.maximum(h - LAYER, 0.0), 0.0)
     return {"heights": h, "ahead": float(above.sum() * cell_m * cell_m), "peak": float(above.max()),
-            "capped": int(columns["soil_capped"].sum()), "work": int(columns["soil_work"].sum()), "x": x}
+            "capped": int(columns["soil_capped"].sum()), "work": int(columns["soil_work"].sum())}
