@@ -207,6 +207,12 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   std::size_t k = 0;
   for (int row = r.r0; row < r.r1; ++row)
     for (int c = r.c0; c < r.c1; ++c, ++k) after_cut_[k] = layers.height_m[std::int64_t(row) * cols_ + c];
+  // The cells a sample's push passes, one step apart from the first cell
+  // ahead (the shift, the fill and the rest each walk them from there):
+  // found once a sample, as far as one of them reads.
+  std::int64_t walk_cell[kMaxPushCells];
+  bool walk_off[kMaxPushCells];
+  const bool open_edge = params_.edge == SoilEdge::kOpen;
   k = 0;
   for (int row = r.r0; row < r.r1; ++row)
     for (int c = r.c0; c < r.c1; ++c, ++k) {
@@ -245,25 +251,42 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
         const int tr = floor_within(to_cells(z + nz * along, spec.origin_m.z, dz_), 0, rows_ - 1);
         return std::int64_t(tr) * cols_ + tc;
       };
+      // Step m (< kMaxPushCells) of the walk from `go`: its cell (the last
+      // on the grid where the walk has left it) and whether it lies beyond
+      // an open edge.
+      int walked = 0;
+      const auto walk_to = [&](int m) {
+        for (; walked <= m; ++walked) {
+          const double along = go + side * walked * step;
+          walk_off[walked] = open_edge && beyond(along);
+          walk_cell[walked] = cell_at(along);
+        }
+      };
+      const auto walk = [&](int m) {
+        walk_to(m);
+        return walk_cell[m];
+      };
+      const auto walk_beyond = [&](int m) {
+        walk_to(m);
+        return walk_off[m];
+      };
       // The rest of the cut lands where an avalanche down the face ahead
-      // would leave it: the cells along the push from `from` (metres along
-      // the normal from this sample's centre), up to the first one above
-      // it, are filled to one line falling at the repose slope, the line as
+      // would leave it: the cells of the walk from the first cell ahead,
+      // up to the first one above it, are filled to one line falling at the repose slope, the line as
       // high as the volume `volume` (metres of height on one cell) needs.
       // Cells beyond an open edge stand for the bare ground there (height
       // 0): what fills them leaves the terrain. A wall or a body ends the
       // run. Returns what found no cell (all of it when the first cell is
       // a body's or the grid's end), for the caller to put down.
-      const auto fill_ahead = [&](double from, float volume) -> float {
+      const auto fill_ahead = [&](float volume) -> float {
         std::int64_t cells[kMaxPushCells];
         double reach[kMaxPushCells];  // the line's height at the first cell that just reaches this one
         int count = 0;
         double sum = 0.0, line = 0.0;
         std::int64_t last = -1;
         for (int m = 0; m < kMaxPushCells; ++m) {
-          const double along = from + side * m * step;
-          const bool off = params_.edge == SoilEdge::kOpen && beyond(along);
-          const std::int64_t u = off ? -1 : cell_at(along);
+          const bool off = walk_beyond(m);
+          const std::int64_t u = off ? -1 : walk(m);
           if (!off && (u == last || obstacle_[u] != 0)) break;  // against the grid's edge, or a body
           const double b = (off ? 0.0 : double(layers.height_m[u])) + limit_step * m;
           if (count > 0 && !(b < line)) break;  // at or above the line: nothing reaches it
@@ -307,13 +330,13 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       const float edge_top = after_cut_[k];  // the cut column's new height
       std::int64_t ray[kMaxPushCells];
       int length = 0;
-      ray[length++] = cell_at(go);
+      ray[length++] = walk(0);
       float previous = before_[k];
       // A bucket taking soil in does not push a pile.
       if (kept == 0.0f && layers.height_m[ray[0]] < previous && !(layers.height_m[ray[0]] < edge_top) &&
           !obstructed(std::uint32_t(ray[0]))) {
         while (length < kMaxPushCells) {
-          const std::int64_t next = cell_at(go + side * length * step);
+          const std::int64_t next = walk(length);
           if (next == ray[length - 1]) break;  // against the grid's edge
           const float here = layers.height_m[ray[length - 1]], ahead = layers.height_m[next];
           if (!(ahead < here) || ahead < edge_top || obstructed(std::uint32_t(next))) break;
@@ -338,21 +361,21 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       const float raised = length > 0 ? before_[k] - previous : 0.0f;
       float rest = lost - raised;
       out.displaced_volume_m3 += double(lost) * spec.cell_area_m2();
-      if (rest > 0.0f) rest = fill_ahead(go, rest);
+      if (rest > 0.0f) rest = fill_ahead(rest);
       std::int64_t t = length > 0 ? ray[length - 1] : ray[0];
       float level = length > 0 ? layers.height_m[t] : before_[k];
       // The last cell reached that is not under a rigid body (the cut
       // column itself when the body stands right ahead).
       std::int64_t free = length > 0 ? t : i;
       for (int m = length > 0 ? length : 0; m < kMaxPushCells && rest > 0.0f; ++m) {
-        if (params_.edge == SoilEdge::kOpen && beyond(go + side * m * step)) {
+        if (walk_beyond(m)) {
           // Pushed off the terrain: it is gone, and counted.
           out.left_over_edge_m3 += double(rest) * spec.cell_area_m2();
           taken -= double(rest);
           rest = 0.0f;
           break;
         }
-        const std::int64_t u = cell_at(go + side * m * step);
+        const std::int64_t u = walk(m);
         if (u == t && m > 0) break;  // against the grid's edge
         t = u;
         if (obstacle_[u] != 0) break;  // never into, under or through a body
