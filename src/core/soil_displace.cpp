@@ -241,16 +241,6 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       const double go = side * (kDepositAheadCells * cell) - s;
       // Beyond a wall, a target is its last cell; beyond an open edge, the
       // soil leaves the terrain.
-      const auto beyond = [&](double along) {
-        const double u = to_cells(x + nx * along, spec.origin_m.x, dx_);
-        const double v = to_cells(z + nz * along, spec.origin_m.z, dz_);
-        return u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_;
-      };
-      const auto cell_at = [&](double along) {
-        const int tc = floor_within(to_cells(x + nx * along, spec.origin_m.x, dx_), 0, cols_ - 1);
-        const int tr = floor_within(to_cells(z + nz * along, spec.origin_m.z, dz_), 0, rows_ - 1);
-        return std::int64_t(tr) * cols_ + tc;
-      };
       // Step m (< kMaxPushCells) of the walk from `go`: its cell (the last
       // on the grid where the walk has left it) and whether it lies beyond
       // an open edge.
@@ -258,8 +248,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       const auto walk_to = [&](int m) {
         for (; walked <= m; ++walked) {
           const double along = go + side * walked * step;
-          walk_off[walked] = open_edge && beyond(along);
-          walk_cell[walked] = cell_at(along);
+          const double u = to_cells(x + nx * along, spec.origin_m.x, dx_);
+          const double v = to_cells(z + nz * along, spec.origin_m.z, dz_);
+          walk_off[walked] = open_edge && (u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_);
+          walk_cell[walked] = std::int64_t(floor_within(v, 0, rows_ - 1)) * cols_ + floor_within(u, 0, cols_ - 1);
         }
       };
       const auto walk = [&](int m) {
