@@ -212,6 +212,9 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   // found once a sample, as far as one of them reads.
   std::int64_t walk_cell[kMaxPushCells];
   bool walk_off[kMaxPushCells];
+  // The heights the push's shift gives the cells of its run, and what the
+  // fill puts on each cell of the walk: found first, written once.
+  float shifted[kMaxPushCells], add_at[kMaxPushCells];
   const bool open_edge = params_.edge == SoilEdge::kOpen;
   k = 0;
   for (int row = r.r0; row < r.r1; ++row)
@@ -264,13 +267,17 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       };
       // The rest of the cut lands where an avalanche down the face ahead
       // would leave it: the cells of the walk from the first cell ahead,
-      // up to the first one above it, are filled to one line falling at the repose slope, the line as
-      // high as the volume `volume` (metres of height on one cell) needs.
+      // up to the first one above it, are filled to one line falling at
+      // the repose slope, the line as high as the volume `volume` (metres
+      // of height on one cell) needs.
       // Cells beyond an open edge stand for the bare ground there (height
       // 0): what fills them leaves the terrain. A wall or a body ends the
-      // run. Returns what found no cell (all of it when the first cell is
-      // a body's or the grid's end), for the caller to put down.
-      const auto fill_ahead = [&](float volume) -> float {
+      // run. It reads the first `length` cells at their shifted heights
+      // and writes nothing: what each cell of the walk takes goes in
+      // add_at. Returns how many cells of the walk it reached (0: none, all
+      // of it is the caller's to put down, when the first cell is a body's
+      // or the grid's end).
+      const auto fill_ahead = [&](float volume, int length) -> int {
         std::int64_t cells[kMaxPushCells];
         double reach[kMaxPushCells];  // the line's height at the first cell that just reaches this one
         int count = 0;
@@ -280,7 +287,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           const bool off = walk_beyond(m);
           const std::int64_t u = off ? -1 : walk(m);
           if (!off && (u == last || obstacle_[u] != 0)) break;  // against the grid's edge, or a body
-          const double b = (off ? 0.0 : double(layers.height_m[u])) + limit_step * m;
+          const double b = (off ? 0.0 : double(m < length ? shifted[m] : layers.height_m[u])) + limit_step * m;
           if (count > 0 && !(b < line)) break;  // at or above the line: nothing reaches it
           cells[count] = u;
           reach[count] = b;
@@ -289,7 +296,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           line = (double(volume) + sum) / count;
           if (!off) last = u;
         }
-        if (count == 0) return volume;
+        if (count == 0) return 0;
         // A cell of the run above the final line (a hump) takes nothing:
         // without it the line comes lower, until no more drop out.
         for (int in = count;;) {
@@ -303,15 +310,16 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
         }
         for (int j = 0; j < count; ++j) {
           const double add = line - reach[j];
+          add_at[j] = 0.0f;
           if (!(add > 0.0)) continue;
           if (cells[j] < 0) {
             out.left_over_edge_m3 += add * spec.cell_area_m2();
             taken -= add;
           } else {
-            put_down(cells[j], float(add));
+            add_at[j] = float(add);
           }
         }
-        return 0.0f;
+        return count;
       };
       // The blade pushes what stands in front of it: along the push, the
       // descending profile ahead (cells above the edge's height) moves on by
@@ -335,12 +343,8 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           ray[length++] = next;
         }
         for (int j = 0; j < length; ++j) {
-          const std::int64_t cell_j = ray[j];
-          const float old = layers.height_m[cell_j];
-          write(cell_j, previous);
-          out.changed.include(col_of(std::uint32_t(cell_j)), row_of(std::uint32_t(cell_j)));
-          candidate(std::uint32_t(cell_j), previous < old);
-          previous = old;
+          shifted[j] = previous;
+          previous = layers.height_m[ray[j]];
         }
       } else {
         length = 0;  // nothing to push: the cut soil goes to the first cell ahead
@@ -353,7 +357,25 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       const float raised = length > 0 ? before_[k] - previous : 0.0f;
       float rest = lost - raised;
       out.displaced_volume_m3 += double(lost) * spec.cell_area_m2();
-      if (rest > 0.0f) rest = fill_ahead(rest);
+      const int filled = rest > 0.0f ? fill_ahead(rest, length) : 0;
+      if (filled > 0) rest = 0.0f;
+      // The run's cells take their shifted heights and what the fill put on
+      // them in one write (as put_down would, in the same float steps);
+      // should one rise above the ceiling, the shift is written first and
+      // the fill put down after, so that put_down spreads the overflow.
+      bool over_ceiling = false;
+      for (int j = 0; j < std::min(length, filled); ++j)
+        if (add_at[j] > 0.0f && std::max(0.0f, shifted[j] + add_at[j]) > ceiling_m_) over_ceiling = true;
+      for (int j = 0; j < length; ++j) {
+        const std::int64_t cell_j = ray[j];
+        const float old = layers.height_m[cell_j];
+        const bool add = !over_ceiling && j < filled && add_at[j] > 0.0f;
+        write(cell_j, add ? std::max(0.0f, shifted[j] + add_at[j]) : shifted[j]);
+        out.changed.include(col_of(std::uint32_t(cell_j)), row_of(std::uint32_t(cell_j)));
+        candidate(std::uint32_t(cell_j), shifted[j] < old);
+      }
+      for (int j = over_ceiling ? 0 : std::min(length, filled); j < filled; ++j)
+        if (add_at[j] > 0.0f) put_down(walk_cell[j], add_at[j]);
       std::int64_t t = length > 0 ? ray[length - 1] : ray[0];
       float level = length > 0 ? layers.height_m[t] : before_[k];
       // The last cell reached that is not under a rigid body (the cut
