@@ -7,8 +7,8 @@ Usage: PYTHONPATH=build/python /usr/bin/python3 tools/soil_convergence_sweep.py
 
 For every blade width, cell size and speed, the push of tools/soil_push.py
 (a 4 cm cut into a 20 cm layer of dry sand, pushed --travel metres, 0.8 by
-default, then 0.2 s still) is run twice: at the work cap (--cap, the default
-50000 neighbour visits a step) and with the cap lifted (1e9: the converged
+default, then 0.2 s still) is run twice: at the work cap (--cap, by default
+the library's, soil.max_pair_checks_per_step) and with the cap lifted (1e9: the converged
 answer). Prints a Markdown table: the capped soil ahead of the blade against
 the converged (per cent), the capped peak less the converged (mm), the steps
 the cap stopped (the push's and the 0.2 s hold's) over the push's steps, and
@@ -53,7 +53,7 @@ def numbers(flag, text, lo, hi):
 
 
 def main(argv):
-    travel, cap = 0.8, 50000
+    travel, cap = 0.8, None
     blades, cells, speeds = [0.3, 0.5, 0.75, 1.0, 1.5, 2.0], [0.005, 0.01], [0.25, 0.5, 0.75, 1.0]
     args = argv[1:]
     while args:
@@ -77,7 +77,8 @@ def main(argv):
         else:
             cap = number(a, value, 1000, 1e9)
     slope = math.tan(math.radians(34.0))
-    print(f"Pushes of {travel:g} m, 0.2 s held; capped at {int(cap)} visits a step against the cap lifted.\n")
+    at = "the default cap" if cap is None else f"{int(cap)} visits a step"
+    print(f"Pushes of {travel:g} m, 0.2 s held; capped at {at} against the cap lifted.\n")
     print("| blade | cells | " + " | ".join(f"{v:g} m/s" for v in speeds) + " | converged work (M visits), "
           + " / ".join(f"{v:g}" for v in speeds) + " m/s |")
     print("|---" * (3 + len(speeds)) + "|")

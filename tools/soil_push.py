@@ -4,8 +4,8 @@ same as push() in tests/core/soil_converge_test.cpp): a blade of width_m
 cutting 4 cm into a 20 cm layer of dry sand (repose 34 degrees) on square
 cells of cell_m, pushed travel_m along +Z from z = 0.4 m at speed_m_per_s
 (1 kHz steps), then held still for hold_s, with the relaxation's work cap at
-cap neighbour visits a step (50000 is the default; 1e9 lifts it: the
-converged answer). The grid is (width + 1.6) / cell by (travel + 1.4) / cell
+cap neighbour visits a step (None: the library's default,
+soil.max_pair_checks_per_step; 1e9 lifts it: the converged answer). The grid is (width + 1.6) / cell by (travel + 1.4) / cell
 cells."""
 
 DEPTH, LAYER, Z0 = 0.04, 0.2, 0.4
@@ -28,12 +28,15 @@ def push(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m=0.8, hold_s
     work (neighbour visits in all), over the push's and the hold's steps."""
     cols, rows = grid_shape(width_m, cell_m, travel_m)
     x = push_x(width_m, cell_m)
+    soil = {"model": "flow", "repose_deg": 34}
+    if cap is not None:
+        soil["max_pair_checks_per_step"] = int(cap)
     scenario = terracut.Scenario.from_dict({
         "name": "converge",
         "terrain": {"generator": "plane", "resolution": [cols, rows],
                     "size_m": [cols * cell_m, rows * cell_m], "origin_m": [0, 0, 0],
                     "full_scale_m": 0.6, "plane": {"height_m": LAYER}},
-        "soil": {"model": "flow", "repose_deg": 34, "max_pair_checks_per_step": int(cap)},
+        "soil": soil,
         "blade": {"length_m": width_m},
         "cuts": [{"name": "push", "keyframes": [
             {"t_s": 0.0, "position_m": [x, LAYER - DEPTH, Z0], "rotation_deg": [0, 0, 0]},

@@ -65,6 +65,16 @@ inline constexpr int kEndRounds = 6;
 /// every row crossing of a 1 m blade on 5 mm cells once the pile stood
 /// 0.6 m long (docs/soil.md, "The settle's window").
 inline constexpr int kSettleMarginCells = 32;
+/// What the work cap charges the settle for a cell it handles in any of its
+/// phases (a seed's test, a cell of either spread, a cell of a patch), in
+/// the cap's unit, the passes' neighbour visit: its 8 neighbours are read
+/// and compared in one pair of SSE loads, so a cell costs about 27 ns on
+/// the project's 2-core machine (3.3 to 3.5 ns for each of 8 visits
+/// charged before 2026-12-06), about 4.6 of the collapse's pass visits
+/// (5.9 ns in its worst tick). At 8 it was charged twice its time against
+/// the passes, and the settle of a 1 m/s push on 5 mm cells outgrew the cap
+/// (docs/soil.md, "The settle charged for its time").
+inline constexpr std::int64_t kSettleCellVisits = 4;
 /// Its buckets of keys, each an axis pair's limit wide: heights up to this
 /// many limits apart (13.8 m on 5 mm cells at 34 degrees); what lies beyond
 /// is left to the passes.

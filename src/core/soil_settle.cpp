@@ -251,7 +251,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   if (settle_phase_ == SettlePhase::kSeed) {
     const std::size_t from_active = active_.size() - examined_;
     const std::size_t total = from_active + next_.size();
-    for (; settle_q_ < total && work + 8 <= budget; ++settle_q_) {
+    for (; settle_q_ < total && work + kSettleCellVisits <= budget; ++settle_q_) {
       const bool in_active = settle_q_ < from_active;
       const std::uint32_t a = in_active ? active_[examined_ + settle_q_] : next_[settle_q_ - from_active];
       const int lc = col_of(a) - wc0, lr = row_of(a) - wr0;
@@ -259,7 +259,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         settle_keep(a, in_active);
         continue;
       }
-      work += 8;
+      work += kSettleCellVisits;
       const std::int32_t la = lr * ww + lc;
       const unsigned steep_mask = steep_from(low, la, low[la], tolerance_m_, 1.0f);
       if (steep_mask == 0 && settle_drop_ok_) {
@@ -318,14 +318,14 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
     for (; settle_b_ < settle_used_; ++settle_b_) {
       const std::size_t b = settle_b_;
       while (settle_heads_[b] >= 0) {
-        if (work + 8 > budget) return false;
+        if (work + kSettleCellVisits > budget) return false;
         const auto [l, next] = entries[std::size_t(settle_heads_[b])];
         settle_heads_[b] = next;
         if (done[l] & done_bit) continue;
         done[l] |= done_bit;
         const int lr = l / ww, lc = l - lr * ww;
         if (!inner(lc, lr)) continue;
-        work += 8;
+        work += kSettleCellVisits;
         // The neighbours this cell's value plus (less) the pair's limit
         // lowers (raises): those standing more than the limit above (below)
         // it, the steep test with no tolerance.
@@ -361,7 +361,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // own: its excess over the low surface is put back as the high one
   // lowered by one amount, max(low, high - delta), which keeps the patch's
   // volume and, both surfaces meeting every limit, meets them too. A patch
-  // is found and written in one go, its cells at 8 visits each.
+  // is found and written in one go, its cells at kSettleCellVisits each.
   std::vector<std::int32_t>& patch = settle_patch_;
   std::vector<float>& widths = settle_widths_;
   double gained = 0.0;
@@ -374,7 +374,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
     // volume; the passes see the seam), unless what is left is under a
     // quarter of a step's cap: then the patch waits for the next step.
     const bool fresh = budget - work >= params_.max_pair_checks_per_step / 4;
-    const std::size_t room = std::size_t(std::max<std::int64_t>(0, (budget - work) / 8));
+    const std::size_t room = std::size_t(std::max<std::int64_t>(0, (budget - work) / kSettleCellVisits));
     if (room == 0) break;
     patch.clear();
     patch.push_back(l0);
@@ -396,7 +396,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         patch.push_back(m);
       }
     }
-    work += 8 * std::int64_t(patch.size());
+    work += kSettleCellVisits * std::int64_t(patch.size());
     if (cut && !fresh) {
       for (const std::int32_t l : patch) done[l] &= std::uint8_t(~kInPatch);
       break;  // (the search is paid for; the next step finds it again)

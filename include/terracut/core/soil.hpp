@@ -220,11 +220,13 @@ struct SoilFlowParams {
   SoilMaterial material{};
   /// Work cap of one step's relaxation, in neighbour visits, in
   /// [1000, 1e9]: 8 per cell examined, 1 per flux applied, 8 per fallen
-  /// cell's test of its neighbours. A step never does more; the rest is
-  /// carried on in the next step (see above). A visit costs about 6 ns on
-  /// the project's 2-core machine, so a step at the default cap costs up to
-  /// about 0.5 ms there at a quiet load (docs/soil.md, "Speed: the second
-  /// pass"): it is a work bound, not a clock; a lower cap is a tighter
+  /// cell's test of its neighbours; the settle of a displaced pile charges 4
+  /// a cell it handles. A step never does more; the rest is carried on in
+  /// the next step (see above). A visit costs about 6 ns on the project's
+  /// 2-core machine (a settle's charged visit about 7), so a step at the
+  /// default cap costs up to about 0.5 ms there at a quiet load
+  /// (docs/soil.md, "Speed: the second pass", "The settle charged for its
+  /// time"): it is a work bound, not a clock; a lower cap is a tighter
   /// time bound, but lets a pushed pile lag further behind the blade.
   std::int64_t max_pair_checks_per_step = 50000;
   /// The grid's edge: a wall, or open (bare ground beyond it at height 0).
