@@ -1077,8 +1077,8 @@ std::string report_markdown(const Report& r) {
   // ---- 6 ----
   md << "## 6. Speed (this machine; informative, not a check)\n\n"
      << "The soil phase's time per step (`StepTimers::soil_s`: displacement and relaxation) "
-        "and the whole step's, in the bulldozing runs above, with the default work cap "
-        "(200000 pair checks per step).\n\n"
+        "and the whole step's, in the bulldozing runs above, with the default work cap ("
+     << SoilFlowParams{}.max_pair_checks_per_step << " neighbour visits per step).\n\n"
      << "| blade | steps | soil p50 (us) | soil p99 (us) | soil max (us) | step p50 (us) | step "
         "p99 (us) | largest backlog (cells) |\n|---|---|---|---|---|---|---|---|\n";
   for (const DozeResult& d : r.dozes)
