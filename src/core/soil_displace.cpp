@@ -213,7 +213,8 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   std::int64_t walk_cell[kMaxPushCells];
   bool walk_off[kMaxPushCells];
   // The heights the push's shift gives the cells of its run, and what the
-  // fill puts on each cell of the walk: found first, written once.
+  // fill puts on each cell of the walk (negative: nothing): found first,
+  // written once.
   float shifted[kMaxPushCells], add_at[kMaxPushCells];
   const bool open_edge = params_.edge == SoilEdge::kOpen;
   k = 0;
@@ -272,11 +273,13 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       // of height on one cell) needs.
       // Cells beyond an open edge stand for the bare ground there (height
       // 0): what fills them leaves the terrain. A wall or a body ends the
-      // run. It reads the first `length` cells at their shifted heights
-      // and writes nothing: what each cell of the walk takes goes in
-      // add_at. Returns how many cells of the walk it reached (0: none, all
-      // of it is the caller's to put down, when the first cell is a body's
-      // or the grid's end).
+      // run. It reads the run's `length` cells at their shifted heights
+      // (the last of them also where the walk, having left the grid over
+      // an open edge, comes back on it: the same clamped cell) and writes
+      // nothing: what each cell of the walk takes goes in add_at. Returns
+      // how many cells of the walk it reached (0: none, all of it is the
+      // caller's to put down, when the first cell is a body's or the
+      // grid's end).
       const auto fill_ahead = [&](float volume, int length) -> int {
         std::int64_t cells[kMaxPushCells];
         double reach[kMaxPushCells];  // the line's height at the first cell that just reaches this one
@@ -287,7 +290,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           const bool off = walk_beyond(m);
           const std::int64_t u = off ? -1 : walk(m);
           if (!off && (u == last || obstacle_[u] != 0)) break;  // against the grid's edge, or a body
-          const double b = (off ? 0.0 : double(m < length ? shifted[m] : layers.height_m[u])) + limit_step * m;
+          const float now = m < length                                     ? shifted[m]
+                            : length > 0 && u == walk_cell[length - 1] ? shifted[length - 1]
+                                                                       : layers.height_m[u];
+          const double b = (off ? 0.0 : double(now)) + limit_step * m;
           if (count > 0 && !(b < line)) break;  // at or above the line: nothing reaches it
           cells[count] = u;
           reach[count] = b;
@@ -310,7 +316,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
         }
         for (int j = 0; j < count; ++j) {
           const double add = line - reach[j];
-          add_at[j] = 0.0f;
+          add_at[j] = -1.0f;
           if (!(add > 0.0)) continue;
           if (cells[j] < 0) {
             out.left_over_edge_m3 += add * spec.cell_area_m2();
@@ -363,19 +369,26 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       // them in one write (as put_down would, in the same float steps);
       // should one rise above the ceiling, the shift is written first and
       // the fill put down after, so that put_down spreads the overflow.
+      // (The last cell written is the one that takes the writes' rounding
+      // at the end: the last the fill put soil on, as when the fill wrote
+      // after the shift.)
+      const int in_run = std::min(length, filled);
       bool over_ceiling = false;
-      for (int j = 0; j < std::min(length, filled); ++j)
-        if (add_at[j] > 0.0f && std::max(0.0f, shifted[j] + add_at[j]) > ceiling_m_) over_ceiling = true;
+      for (int j = 0; j < in_run; ++j)
+        if (add_at[j] >= 0.0f && std::max(0.0f, shifted[j] + add_at[j]) > ceiling_m_) over_ceiling = true;
+      int last_add = -1;
       for (int j = 0; j < length; ++j) {
         const std::int64_t cell_j = ray[j];
         const float old = layers.height_m[cell_j];
-        const bool add = !over_ceiling && j < filled && add_at[j] > 0.0f;
+        const bool add = !over_ceiling && j < filled && add_at[j] >= 0.0f;
         write(cell_j, add ? std::max(0.0f, shifted[j] + add_at[j]) : shifted[j]);
         out.changed.include(col_of(std::uint32_t(cell_j)), row_of(std::uint32_t(cell_j)));
         candidate(std::uint32_t(cell_j), shifted[j] < old);
+        if (add) last_add = j;
       }
-      for (int j = over_ceiling ? 0 : std::min(length, filled); j < filled; ++j)
-        if (add_at[j] > 0.0f) put_down(walk_cell[j], add_at[j]);
+      if (last_add >= 0) last_put = ray[last_add];
+      for (int j = over_ceiling ? 0 : in_run; j < filled; ++j)
+        if (add_at[j] >= 0.0f) put_down(walk_cell[j], add_at[j]);
       std::int64_t t = length > 0 ? ray[length - 1] : ray[0];
       float level = length > 0 ? layers.height_m[t] : before_[k];
       // The last cell reached that is not under a rigid body (the cut

@@ -70,7 +70,7 @@ inline constexpr int kSettleMarginCells = 32;
 /// the cap's unit, the passes' neighbour visit: its 8 neighbours are read
 /// and compared in one pair of SSE loads, so a cell costs about 27 ns on
 /// the project's 2-core machine (3.3 to 3.5 ns for each of 8 visits
-/// charged before 2026-12-06), about 4.6 of the collapse's pass visits
+/// charged until 2026-12-06), about 4.6 of the collapse's pass visits
 /// (5.9 ns in its worst tick). At 8 it was charged twice its time against
 /// the passes, and the settle of a 1 m/s push on 5 mm cells outgrew the cap
 /// (docs/soil.md, "The settle charged for its time").
