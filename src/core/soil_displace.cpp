@@ -290,10 +290,11 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
           const bool off = walk_beyond(m);
           const std::int64_t u = off ? -1 : walk(m);
           if (!off && (u == last || obstacle_[u] != 0)) break;  // against the grid's edge, or a body
-          const float now = m < length                                     ? shifted[m]
+          const float now = off                                        ? 0.0f
+                            : m < length                                 ? shifted[m]
                             : length > 0 && u == walk_cell[length - 1] ? shifted[length - 1]
-                                                                       : layers.height_m[u];
-          const double b = (off ? 0.0 : double(now)) + limit_step * m;
+                                                                         : layers.height_m[u];
+          const double b = double(now) + limit_step * m;
           if (count > 0 && !(b < line)) break;  // at or above the line: nothing reaches it
           cells[count] = u;
           reach[count] = b;
