@@ -243,11 +243,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       const double s = (x - to.a.x) * nx + (z - to.a.z) * nz;
       const double side = moving || s >= 0.0 ? 1.0 : -1.0;
       const double go = side * (kDepositAheadCells * cell) - s;
-      // Beyond a wall, a target is its last cell; beyond an open edge, the
+      // Step m (< kMaxPushCells) of the walk from `go`: its cell and whether
+      // it lies beyond an open edge. Beyond a wall, a target is the walk's
+      // last cell on the grid (the cell repeats); beyond an open edge, the
       // soil leaves the terrain.
-      // Step m (< kMaxPushCells) of the walk from `go`: its cell (the last
-      // on the grid where the walk has left it) and whether it lies beyond
-      // an open edge.
       int walked = 0;
       const auto walk_to = [&](int m) {
         for (; walked <= m; ++walked) {
@@ -333,29 +332,29 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
       // one cell, the cut column's height taking the first cell's place, as
       // a pile pushed by a blade does; what the shift does not account for
       // (the cut layer itself) is put down just beyond the pile's toe. On
-      // flat ground nothing shifts and the cut soil is put down ahead.
+      // flat ground nothing shifts and the cut soil is put down ahead. The
+      // run is the walk's first `length` cells.
       const float edge_top = after_cut_[k];  // the cut column's new height
-      std::int64_t ray[kMaxPushCells];
-      int length = 0;
-      ray[length++] = walk(0);
+      const std::int64_t first = walk(0);
+      int length = 1;
       float previous = before_[k];
       // A bucket taking soil in does not push a pile.
-      if (kept == 0.0f && layers.height_m[ray[0]] < previous && !(layers.height_m[ray[0]] < edge_top) &&
-          !obstructed(std::uint32_t(ray[0]))) {
+      if (kept == 0.0f && layers.height_m[first] < previous && !(layers.height_m[first] < edge_top) &&
+          !obstructed(std::uint32_t(first))) {
         while (length < kMaxPushCells) {
           const std::int64_t next = walk(length);
-          if (next == ray[length - 1]) break;  // against the grid's edge
-          const float here = layers.height_m[ray[length - 1]], ahead = layers.height_m[next];
+          if (next == walk_cell[length - 1]) break;  // against the grid's edge
+          const float here = layers.height_m[walk_cell[length - 1]], ahead = layers.height_m[next];
           if (!(ahead < here) || ahead < edge_top || obstructed(std::uint32_t(next))) break;
-          ray[length++] = next;
+          ++length;
         }
         for (int j = 0; j < length; ++j) {
           shifted[j] = previous;
-          previous = layers.height_m[ray[j]];
+          previous = layers.height_m[walk_cell[j]];
         }
       } else {
         length = 0;  // nothing to push: the cut soil goes to the first cell ahead
-        previous = layers.height_m[ray[0]];
+        previous = layers.height_m[first];
       }
       // What is left: the lost height less what the shift raised (which
       // telescopes to the cut column's old height less the toe's old
@@ -379,7 +378,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
         if (add_at[j] >= 0.0f && std::max(0.0f, shifted[j] + add_at[j]) > ceiling_m_) over_ceiling = true;
       int last_add = -1;
       for (int j = 0; j < length; ++j) {
-        const std::int64_t cell_j = ray[j];
+        const std::int64_t cell_j = walk_cell[j];
         const float old = layers.height_m[cell_j];
         const bool add = !over_ceiling && j < filled && add_at[j] >= 0.0f;
         write(cell_j, add ? std::max(0.0f, shifted[j] + add_at[j]) : shifted[j]);
@@ -387,10 +386,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
         candidate(std::uint32_t(cell_j), shifted[j] < old);
         if (add) last_add = j;
       }
-      if (last_add >= 0) last_put = ray[last_add];
+      if (last_add >= 0) last_put = walk_cell[last_add];
       for (int j = over_ceiling ? 0 : in_run; j < filled; ++j)
         if (add_at[j] >= 0.0f) put_down(walk_cell[j], add_at[j]);
-      std::int64_t t = length > 0 ? ray[length - 1] : ray[0];
+      std::int64_t t = length > 0 ? walk_cell[length - 1] : first;
       float level = length > 0 ? layers.height_m[t] : before_[k];
       // The last cell reached that is not under a rigid body (the cut
       // column itself when the body stands right ahead).
