@@ -98,6 +98,7 @@ void SoilFlow::settle_abort() {
   // The buckets' lists still holding entries are emptied.
   std::fill(settle_heads_.begin(), settle_heads_.end(), -1);
   settle_phase_ = SettlePhase::kIdle;
+  settle_patch_stage_ = PatchStage::kNone;
 }
 
 void SoilFlow::settle_exclude(const Rect& rect) {
@@ -108,7 +109,10 @@ void SoilFlow::settle_exclude(const Rect& rect) {
     for (int c = c0; c < c1; ++c)
       settle_done_[std::size_t(r - settle_wr0_) * std::size_t(settle_ww_) + std::size_t(c - settle_wc0_)] |=
           kSettleExcluded;
-  if (r0 < r1 && c0 < c1) settle_drop_ok_ = false;
+  if (r0 < r1 && c0 < c1) {
+    settle_drop_ok_ = false;
+    ++settle_exclusions_;
+  }
 }
 
 void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed) {
@@ -177,6 +181,7 @@ void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment
   settle_seeds_[0].clear();
   settle_seeds_[1].clear();
   settle_q_ = 0;
+  settle_patch_stage_ = PatchStage::kNone;
   settle_keep_active_ = settle_keep_next_ = 0;
   settle_drop_ok_ = true;
   settle_phase_ = SettlePhase::kSeed;
@@ -200,7 +205,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   float* low = settle_low_.data();
   float* high = settle_high_.data();
   std::uint8_t* done = settle_done_.data();
-  constexpr std::uint8_t kLowDone = 1, kHighDone = 2, kListed = 4, kInPatch = kSettleExcluded;
+  constexpr std::uint8_t kLowDone = 1, kHighDone = 2, kListed = 4, kInPatch = 8;
   const int* row_lo = settle_row_lo_.data();
   const int* row_hi = settle_row_hi_.data();
   std::int64_t work = 0;
@@ -361,76 +366,136 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // own: its excess over the low surface is put back as the high one
   // lowered by one amount, max(low, high - delta), which keeps the patch's
   // volume and, both surfaces meeting every limit, meets them too. A patch
-  // is found and written in one go, its cells at kSettleCellVisits each.
+  // is found over as many calls as its search needs (kPatchSearchVisits a
+  // cell), then balanced in one call (kPatchSolveVisits a cell) and written
+  // in one call (kPatchWriteVisits a cell), both in the same one when it
+  // has room: a pushed pile's face, one patch of tens of thousands of
+  // cells, keeps its volume as a whole. (Cut where a call's budget ran out,
+  // each piece kept its own, and the middle of the face could not pass its
+  // share along the ridge to the ends: docs/soil.md, "A patch is found
+  // across steps".) Only a patch larger than half a step's cap is cut, its
+  // pieces settling on their own. A cell another writer changes meanwhile
+  // (kSettleExcluded) leaves the patch: it is not balanced or, changed
+  // after the balance, not written; what the written cells then gain or
+  // lose is given back with the quantizing's rounding.
   std::vector<std::int32_t>& patch = settle_patch_;
   std::vector<float>& widths = settle_widths_;
+  const std::size_t most_cells =
+      std::size_t(std::max<std::int64_t>(1, params_.max_pair_checks_per_step / (2 * kPatchWriteVisits)));
+  const auto open = [&](std::int32_t l) { return !(done[l] & (kInPatch | kSettleExcluded)) && high[l] > low[l]; };
   double gained = 0.0;
   std::int64_t last = -1;
-  for (; settle_q_ < touched.size(); ++settle_q_) {
-    const std::int32_t l0 = touched[settle_q_];
-    if ((done[l0] & kInPatch) || !(high[l0] > low[l0])) continue;
-    // A patch larger than what this call can still pay for is cut there,
-    // and what it leaves forms a patch of its own later (each keeps its own
-    // volume; the passes see the seam), unless what is left is under a
-    // quarter of a step's cap: then the patch waits for the next step.
-    const bool fresh = budget - work >= params_.max_pair_checks_per_step / 4;
-    const std::size_t room = std::size_t(std::max<std::int64_t>(0, (budget - work) / kSettleCellVisits));
-    if (room == 0) break;
-    patch.clear();
-    patch.push_back(l0);
-    done[l0] |= kInPatch;
-    bool cut = false;
-    for (std::size_t q = 0; q < patch.size() && !cut; ++q) {
-      const std::int32_t l = patch[q];
-      const int lr = l / ww, lc = l - lr * ww;
-      for (int k = 0; k < 8; ++k) {
-        const int mc = lc + kNeighbours[k].dc, mr = lr + kNeighbours[k].dr;
-        if (mc < 0 || mr < 0 || mc >= ww || mr >= wh) continue;
-        const std::int32_t m = l + offset[k];
-        if ((done[m] & kInPatch) || !(high[m] > low[m])) continue;
-        if (patch.size() == room) {
-          cut = true;
-          break;
+  for (;;) {
+    if (settle_patch_stage_ == PatchStage::kNone) {
+      while (settle_q_ < touched.size() && !open(touched[settle_q_])) ++settle_q_;
+      if (settle_q_ == touched.size() || work + kPatchSearchVisits > budget) break;
+      const std::int32_t l0 = touched[settle_q_];
+      patch.clear();
+      patch.push_back(l0);
+      done[l0] |= kInPatch;
+      work += kPatchSearchVisits;
+      settle_patch_next_ = 0;
+      settle_patch_stage_ = PatchStage::kSearch;
+    }
+    if (settle_patch_stage_ == PatchStage::kSearch) {
+      // Breadth first from the first cell; a cell's neighbours are paid for
+      // as they join (a cell whose expansion the budget stopped is expanded
+      // again in the next call, its joined neighbours already marked).
+      bool paid_out = false, cut = false;
+      for (; settle_patch_next_ < patch.size() && !paid_out && !cut; ++settle_patch_next_) {
+        const std::int32_t l = patch[settle_patch_next_];
+        const int lr = l / ww, lc = l - lr * ww;
+        for (int k = 0; k < 8; ++k) {
+          const int mc = lc + kNeighbours[k].dc, mr = lr + kNeighbours[k].dr;
+          if (mc < 0 || mr < 0 || mc >= ww || mr >= wh) continue;
+          const std::int32_t m = l + offset[k];
+          if (!open(m)) continue;
+          if (patch.size() == most_cells) {
+            cut = true;
+            break;
+          }
+          if (work + kPatchSearchVisits > budget) {
+            paid_out = true;
+            break;
+          }
+          done[m] |= kInPatch;
+          patch.push_back(m);
+          work += kPatchSearchVisits;
         }
-        done[m] |= kInPatch;
-        patch.push_back(m);
       }
+      if (paid_out) {
+        --settle_patch_next_;
+        break;
+      }
+      settle_patch_stage_ = PatchStage::kSolve;
     }
-    work += kSettleCellVisits * std::int64_t(patch.size());
-    if (cut && !fresh) {
-      for (const std::int32_t l : patch) done[l] &= std::uint8_t(~kInPatch);
-      break;  // (the search is paid for; the next step finds it again)
+    // A patch this call's whole budget cannot balance (or write) is cut to
+    // what it can: its first cells in the search's order, still connected;
+    // the rest are found again later. (Else it waits for a step with more
+    // room: while a blade pushes at a low cap, the spill round the ends can
+    // keep every step's budget under the patch's size, and the settle, and
+    // the passes behind it, would wait until the blade stops.)
+    const auto fit = [&](std::int64_t per_cell) {
+      if (per_cell * std::int64_t(patch.size()) <= budget - work) return true;
+      if (per_cell * std::int64_t(patch.size()) <= budget) return false;  // a later call has the room
+      const std::size_t keep = std::size_t(std::max<std::int64_t>(1, (budget - work) / per_cell));
+      for (std::size_t j = keep; j < patch.size(); ++j) done[patch[j]] &= std::uint8_t(~kInPatch);
+      patch.resize(keep);
+      return per_cell * std::int64_t(keep) <= budget - work;
+    };
+    if (settle_patch_stage_ == PatchStage::kWrite &&
+        (settle_balanced_at_ != settle_exclusions_ || kPatchWriteVisits * std::int64_t(patch.size()) > budget)) {
+      settle_patch_stage_ = PatchStage::kSolve;  // balanced again, without the cells that left
     }
-    double excess = 0.0, sum_widths = 0.0;
-    widths.clear();
-    for (const std::int32_t l : patch) {
-      const int lr = l / ww, lc = l - lr * ww;
-      excess += double(h[std::int64_t(wr0 + lr) * cols_ + wc0 + lc]) - double(low[l]);
-      widths.push_back(high[l] - low[l]);
-      sum_widths += double(widths.back());
+    if (settle_patch_stage_ == PatchStage::kSolve) {
+      if (!fit(kPatchSolveVisits)) break;
+      work += kPatchSolveVisits * std::int64_t(patch.size());
+      double excess = 0.0, sum_widths = 0.0;
+      widths.clear();
+      for (const std::int32_t l : patch) {
+        if (done[l] & kSettleExcluded) continue;
+        const int lr = l / ww, lc = l - lr * ww;
+        excess += double(h[std::int64_t(wr0 + lr) * cols_ + wc0 + lc]) - double(low[l]);
+        widths.push_back(high[l] - low[l]);
+        sum_widths += double(widths.back());
+      }
+      // A height some writer changed without a word (outside low..high)
+      // would make the balance put soil where none was: left to the passes.
+      if (!(excess >= 0.0 && excess <= sum_widths)) {
+        settle_patch_stage_ = PatchStage::kNone;
+        ++settle_q_;
+        continue;
+      }
+      settle_delta_ = level_below(widths, excess);
+      settle_balanced_at_ = settle_exclusions_;
+      settle_patch_stage_ = PatchStage::kWrite;
     }
-    // A height some writer changed without a word (outside low..high)
-    // would make the balance put soil where none was: left to the passes.
-    if (!(excess >= 0.0 && excess <= sum_widths)) continue;
-    const double delta = level_below(widths, excess);
-    for (const std::int32_t l : patch) {
-      const int lr = l / ww, lc = l - lr * ww;
-      const std::int64_t i = std::int64_t(wr0 + lr) * cols_ + wc0 + lc;
-      const float now = quantized(std::max(double(low[l]), double(high[l]) - delta));
-      const float old = h[i];
-      if (now == old) continue;
-      gained += double(now) - double(old);
-      dirty(std::uint32_t(i));
-      h[i] = now;
-      last = i;
-      candidate(std::uint32_t(i), now < old);
-      changed.include(wc0 + lc, wr0 + lr);
+    if (settle_patch_stage_ == PatchStage::kWrite) {
+      if (work + kPatchWriteVisits * std::int64_t(patch.size()) > budget) break;
+      work += kPatchWriteVisits * std::int64_t(patch.size());
+      for (const std::int32_t l : patch) {
+        if (done[l] & kSettleExcluded) continue;
+        const int lr = l / ww, lc = l - lr * ww;
+        const std::int64_t i = std::int64_t(wr0 + lr) * cols_ + wc0 + lc;
+        const float now = quantized(std::max(double(low[l]), double(high[l]) - settle_delta_));
+        const float old = h[i];
+        if (now == old) continue;
+        gained += double(now) - double(old);
+        dirty(std::uint32_t(i));
+        h[i] = now;
+        last = i;
+        candidate(std::uint32_t(i), now < old);
+        changed.include(wc0 + lc, wr0 + lr);
+      }
+      settle_patch_stage_ = PatchStage::kNone;
+      ++settle_q_;
     }
   }
   // The quantizing's rounding given back on the last cell written.
   if (last >= 0 && gained != 0.0) give_back(h[last], -gained);
   settle_candidates(h);
-  if (settle_q_ == touched.size()) return settle_finish(grid, changed, budget, work);
+  if (settle_q_ == touched.size() && settle_patch_stage_ == PatchStage::kNone)
+    return settle_finish(grid, changed, budget, work);
   return work;
 }
 
