@@ -107,12 +107,8 @@ void SoilFlow::settle_exclude(const Rect& rect) {
   const int r0 = std::max(rect.r0, settle_wr0_), r1 = std::min(rect.r1, settle_wr0_ + settle_wh_);
   for (int r = r0; r < r1; ++r)
     for (int c = c0; c < c1; ++c)
-      settle_done_[std::size_t(r - settle_wr0_) * std::size_t(settle_ww_) + std::size_t(c - settle_wc0_)] |=
-          kSettleExcluded;
-  if (r0 < r1 && c0 < c1) {
-    settle_drop_ok_ = false;
-    ++settle_exclusions_;
-  }
+      settle_leave(settle_done_[std::size_t(r - settle_wr0_) * std::size_t(settle_ww_) + std::size_t(c - settle_wc0_)]);
+  if (r0 < r1 && c0 < c1) settle_drop_ok_ = false;
 }
 
 void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed) {
@@ -205,7 +201,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   float* low = settle_low_.data();
   float* high = settle_high_.data();
   std::uint8_t* done = settle_done_.data();
-  constexpr std::uint8_t kLowDone = 1, kHighDone = 2, kListed = 4, kInPatch = 8;
+  constexpr std::uint8_t kLowDone = 1, kHighDone = 2, kListed = 4;
   const int* row_lo = settle_row_lo_.data();
   const int* row_hi = settle_row_hi_.data();
   std::int64_t work = 0;
@@ -366,23 +362,34 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // own: its excess over the low surface is put back as the high one
   // lowered by one amount, max(low, high - delta), which keeps the patch's
   // volume and, both surfaces meeting every limit, meets them too. A patch
-  // is found over as many calls as its search needs (kPatchSearchVisits a
-  // cell), then balanced in one call (kPatchSolveVisits a cell) and written
-  // in one call (kPatchWriteVisits a cell), both in the same one when it
-  // has room: a pushed pile's face, one patch of tens of thousands of
-  // cells, keeps its volume as a whole. (Cut where a call's budget ran out,
-  // each piece kept its own, and the middle of the face could not pass its
-  // share along the ridge to the ends: docs/soil.md, "A patch is found
-  // across steps".) Only a patch larger than half a step's cap is cut, its
-  // pieces settling on their own. A cell another writer changes meanwhile
-  // (kSettleExcluded) leaves the patch: it is not balanced or, changed
-  // after the balance, not written; what the written cells then gain or
-  // lose is given back with the quantizing's rounding.
+  // is searched over as many calls as it needs (kPatchSearchVisits a cell),
+  // then balanced in one call (kPatchSolveVisits a cell) and written in one
+  // call (kPatchWriteVisits a cell), both in the same one when it has room:
+  // a pushed pile's face, one patch of tens of thousands of cells, keeps
+  // its volume as a whole. (Cut where a call's budget ran out, each piece
+  // kept its own, and the middle of the face could not pass its share
+  // along the ridge to the ends: docs/soil.md, "A patch is found across
+  // steps".) A cell another writer changes meanwhile (kSettleExcluded)
+  // leaves the patch: it is not balanced, and if it leaves after the
+  // balance the patch is balanced again, up to kPatchRebalances times,
+  // after which the rest is written and what the cells that left would
+  // have taken or given is given back with the quantizing's rounding.
+  // A patch is cut at half the cap; a call without the room to balance or
+  // write the patch under way leaves it to the next (one whose spill round
+  // the ends took more than half the cap has none).
   std::vector<std::int32_t>& patch = settle_patch_;
   std::vector<float>& widths = settle_widths_;
+  const std::int64_t cap = params_.max_pair_checks_per_step;
   const std::size_t most_cells =
-      std::size_t(std::max<std::int64_t>(1, params_.max_pair_checks_per_step / (2 * kPatchWriteVisits)));
-  const auto open = [&](std::int32_t l) { return !(done[l] & (kInPatch | kSettleExcluded)) && high[l] > low[l]; };
+      std::size_t(std::max<std::int64_t>(1, cap / (2 * std::max(kPatchSolveVisits, kPatchWriteVisits))));
+  const auto open = [&](std::int32_t l) {
+    return !(done[l] & (kSettleInPatch | kSettleExcluded)) && high[l] > low[l];
+  };
+  // Whether this call can still pay per_cell visits for each cell of the
+  // patch under way.
+  const auto room_for = [&](std::int64_t per_cell) {
+    return per_cell * std::int64_t(patch.size()) <= budget - work;
+  };
   double gained = 0.0;
   std::int64_t last = -1;
   for (;;) {
@@ -392,9 +399,10 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       const std::int32_t l0 = touched[settle_q_];
       patch.clear();
       patch.push_back(l0);
-      done[l0] |= kInPatch;
+      done[l0] |= kSettleInPatch | kSettleCurrent;
       work += kPatchSearchVisits;
       settle_patch_next_ = 0;
+      settle_patch_rebalances_ = 0;
       settle_patch_stage_ = PatchStage::kSearch;
     }
     if (settle_patch_stage_ == PatchStage::kSearch) {
@@ -410,7 +418,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
           if (mc < 0 || mr < 0 || mc >= ww || mr >= wh) continue;
           const std::int32_t m = l + offset[k];
           if (!open(m)) continue;
-          if (patch.size() == most_cells) {
+          if (patch.size() >= most_cells) {
             cut = true;
             break;
           }
@@ -418,7 +426,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
             paid_out = true;
             break;
           }
-          done[m] |= kInPatch;
+          done[m] |= kSettleInPatch | kSettleCurrent;
           patch.push_back(m);
           work += kPatchSearchVisits;
         }
@@ -429,26 +437,12 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       }
       settle_patch_stage_ = PatchStage::kSolve;
     }
-    // A patch this call's whole budget cannot balance (or write) is cut to
-    // what it can: its first cells in the search's order, still connected;
-    // the rest are found again later. (Else it waits for a step with more
-    // room: while a blade pushes at a low cap, the spill round the ends can
-    // keep every step's budget under the patch's size, and the settle, and
-    // the passes behind it, would wait until the blade stops.)
-    const auto fit = [&](std::int64_t per_cell) {
-      if (per_cell * std::int64_t(patch.size()) <= budget - work) return true;
-      if (per_cell * std::int64_t(patch.size()) <= budget) return false;  // a later call has the room
-      const std::size_t keep = std::size_t(std::max<std::int64_t>(1, (budget - work) / per_cell));
-      for (std::size_t j = keep; j < patch.size(); ++j) done[patch[j]] &= std::uint8_t(~kInPatch);
-      patch.resize(keep);
-      return per_cell * std::int64_t(keep) <= budget - work;
-    };
-    if (settle_patch_stage_ == PatchStage::kWrite &&
-        (settle_balanced_at_ != settle_exclusions_ || kPatchWriteVisits * std::int64_t(patch.size()) > budget)) {
+    if (settle_patch_stage_ == PatchStage::kWrite && settle_patch_left_ != settle_balanced_at_ &&
+        settle_patch_rebalances_ < kPatchRebalances) {
       settle_patch_stage_ = PatchStage::kSolve;  // balanced again, without the cells that left
     }
     if (settle_patch_stage_ == PatchStage::kSolve) {
-      if (!fit(kPatchSolveVisits)) break;
+      if (!room_for(kPatchSolveVisits)) break;
       work += kPatchSolveVisits * std::int64_t(patch.size());
       double excess = 0.0, sum_widths = 0.0;
       widths.clear();
@@ -462,18 +456,21 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       // A height some writer changed without a word (outside low..high)
       // would make the balance put soil where none was: left to the passes.
       if (!(excess >= 0.0 && excess <= sum_widths)) {
+        for (const std::int32_t l : patch) done[l] &= std::uint8_t(~kSettleCurrent);
         settle_patch_stage_ = PatchStage::kNone;
         ++settle_q_;
         continue;
       }
       settle_delta_ = level_below(widths, excess);
-      settle_balanced_at_ = settle_exclusions_;
+      settle_balanced_at_ = settle_patch_left_;
+      ++settle_patch_rebalances_;
       settle_patch_stage_ = PatchStage::kWrite;
     }
     if (settle_patch_stage_ == PatchStage::kWrite) {
-      if (work + kPatchWriteVisits * std::int64_t(patch.size()) > budget) break;
+      if (!room_for(kPatchWriteVisits)) break;
       work += kPatchWriteVisits * std::int64_t(patch.size());
       for (const std::int32_t l : patch) {
+        done[l] &= std::uint8_t(~kSettleCurrent);
         if (done[l] & kSettleExcluded) continue;
         const int lr = l / ww, lc = l - lr * ww;
         const std::int64_t i = std::int64_t(wr0 + lr) * cols_ + wc0 + lc;
@@ -494,8 +491,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // The quantizing's rounding given back on the last cell written.
   if (last >= 0 && gained != 0.0) give_back(h[last], -gained);
   settle_candidates(h);
-  if (settle_q_ == touched.size() && settle_patch_stage_ == PatchStage::kNone)
-    return settle_finish(grid, changed, budget, work);
+  if (settle_q_ == touched.size()) return settle_finish(grid, changed, budget, work);
   return work;
 }
 

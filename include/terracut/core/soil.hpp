@@ -478,11 +478,18 @@ class SoilFlow {
     if (settle_phase_ == SettlePhase::kIdle) return;
     const int lc = col_of(std::uint32_t(cell)) - settle_wc0_, lr = row_of(std::uint32_t(cell)) - settle_wr0_;
     if (lc < 0 || lr < 0 || lc >= settle_ww_ || lr >= settle_wh_) return;
-    settle_done_[std::size_t(lr) * std::size_t(settle_ww_) + std::size_t(lc)] |= kSettleExcluded;
+    settle_leave(settle_done_[std::size_t(lr) * std::size_t(settle_ww_) + std::size_t(lc)]);
     settle_drop_ok_ = false;
-    ++settle_exclusions_;
   }
-  static constexpr std::uint8_t kSettleExcluded = 16;
+  // A window cell's state bits of the settle's patches: in a patch found
+  // (kSettleInPatch), in the one under way (kSettleCurrent), changed by
+  // another writer (kSettleExcluded).
+  static constexpr std::uint8_t kSettleInPatch = 8, kSettleExcluded = 16, kSettleCurrent = 32;
+  /// Marks a window cell excluded, counting it if it leaves the patch under way.
+  void settle_leave(std::uint8_t& bits) {
+    if ((bits & kSettleCurrent) && !(bits & kSettleExcluded)) ++settle_patch_left_;
+    bits |= kSettleExcluded;
+  }
   /// Sizes the settle's scratch for a window of this many cells.
   void reserve_settle(std::size_t window_cells);
   enum class SettlePhase : std::uint8_t { kIdle, kSeed, kLow, kHigh, kPatches };
@@ -498,14 +505,15 @@ class SoilFlow {
   int settle_wc0_ = 0, settle_wr0_ = 0, settle_ww_ = 0, settle_wh_ = 0;
   std::size_t settle_q_ = 0, settle_b_ = 0, settle_used_ = 0;
   // The patch under way (settle_patch_, from touched[settle_q_]): searched
-  // up to settle_patch_next_, balanced (its delta), or written.
+  // up to settle_patch_next_, balanced (its delta) or to be written; its
+  // balances, and the cells that left it (in all, and when it was
+  // balanced).
   enum class PatchStage : std::uint8_t { kNone, kSearch, kSolve, kWrite };
   PatchStage settle_patch_stage_ = PatchStage::kNone;
   std::size_t settle_patch_next_ = 0;
   double settle_delta_ = 0.0;
-  // Cells excluded so far, and when the patch under way was balanced: a
-  // cell leaving it since means a new balance before the write.
-  std::uint64_t settle_exclusions_ = 0, settle_balanced_at_ = 0;
+  int settle_patch_rebalances_ = 0;
+  std::uint64_t settle_patch_left_ = 0, settle_balanced_at_ = 0;
   // The seed phase drops the listed cells it finds standing at rest (the
   // test a pass would make of them), compacting the lists in place: where
   // the kept ones of active_'s unexamined tail and of next_ have been
