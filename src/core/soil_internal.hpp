@@ -83,7 +83,7 @@ inline constexpr std::int64_t kPatchSearchVisits = 2, kPatchSolveVisits = 1, kPa
 static_assert(kPatchSearchVisits + kPatchSolveVisits + kPatchWriteVisits == kSettleCellVisits);
 /// The most balances of one patch whose cells other writers change between
 /// its balance and its write (the next crossing's displacement shifts the
-/// pile under it) before it is written without them.
+/// pile under it); after them it is left to the passes unwritten.
 inline constexpr int kPatchRebalances = 3;
 /// Its buckets of keys, each an axis pair's limit wide: heights up to this
 /// many limits apart (13.8 m on 5 mm cells at 34 degrees); what lies beyond

@@ -370,13 +370,14 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // kept its own, and the middle of the face could not pass its share
   // along the ridge to the ends: docs/soil.md, "A patch is found across
   // steps".) A cell another writer changes meanwhile (kSettleExcluded)
-  // leaves the patch: it is not balanced, and if it leaves after the
-  // balance the patch is balanced again, up to kPatchRebalances times,
-  // after which the rest is written and what the cells that left would
-  // have taken or given is given back with the quantizing's rounding.
+  // leaves the patch: it is not balanced, and if one leaves between the
+  // balance and the write the patch is balanced again; after
+  // kPatchRebalances balances in all it is left to the passes unwritten.
   // A patch is cut at half the cap; a call without the room to balance or
-  // write the patch under way leaves it to the next (one whose spill round
-  // the ends took more than half the cap has none).
+  // write the patch under way leaves it to the next (while the blade
+  // pushes, the spill round the ends can leave a step too little for a
+  // large patch; the settle, and the passes behind it, then wait for a
+  // step with the room, at the latest the first after the blade stops).
   std::vector<std::int32_t>& patch = settle_patch_;
   std::vector<float>& widths = settle_widths_;
   const std::int64_t cap = params_.max_pair_checks_per_step;
@@ -437,9 +438,16 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       }
       settle_patch_stage_ = PatchStage::kSolve;
     }
-    if (settle_patch_stage_ == PatchStage::kWrite && settle_patch_left_ != settle_balanced_at_ &&
-        settle_patch_rebalances_ < kPatchRebalances) {
-      settle_patch_stage_ = PatchStage::kSolve;  // balanced again, without the cells that left
+    if (settle_patch_stage_ == PatchStage::kWrite && settle_patch_left_ != settle_balanced_at_) {
+      if (settle_patch_rebalances_ < kPatchRebalances) {
+        settle_patch_stage_ = PatchStage::kSolve;  // balanced again, without the cells that left
+      } else {
+        // Its cells keep changing under it: left to the passes, unwritten.
+        for (const std::int32_t l : patch) done[l] &= std::uint8_t(~kSettleCurrent);
+        settle_patch_stage_ = PatchStage::kNone;
+        ++settle_q_;
+        continue;
+      }
     }
     if (settle_patch_stage_ == PatchStage::kSolve) {
       if (!room_for(kPatchSolveVisits)) break;

@@ -418,14 +418,14 @@ TEST(SoilConvergence, TheLeastCapsStillMoveSoilWithTheBladeIn) {
   }
 }
 
-TEST(SoilConvergence, AtALowCapAPatchWaitsForAStepWithRoomAndThePileComesToRest) {
+TEST(SoilConvergence, AtALowCapTheSettlesPatchesKeepTheCapAndTheSoil) {
   // A patch of the settle is searched over as many calls as it needs, then
   // balanced in one call and written in one call; a call without the room
   // for either leaves the patch to the next, and cells that other writers
-  // change meanwhile leave it (soil_settle.cpp). At a cap of 1500 the 0.5 m
-  // blade's patches on 5 mm cells wait for room again and again while the
-  // blade pushes; every step must stay within the cap, the volume be
-  // kept, and the pile come to rest.
+  // change meanwhile leave it (soil_settle.cpp). At a cap of 1500, the
+  // 0.5 m blade on 5 mm cells, patches span calls while the blade pushes;
+  // every step must stay within the cap, the volume be kept, and the pile
+  // come to rest.
   const double width = 0.5, cell = 0.005, travel = 0.4, speed = 0.5;
   const std::int64_t cap = 1500;
   const scenes::Bulldoze scene = push_scene(width, cell, travel);
