@@ -84,7 +84,7 @@ static_assert(kPatchSearchVisits + kPatchSolveVisits + kPatchWriteVisits == kSet
 /// The most balances of one patch whose cells other writers change between
 /// its balance and its write (the next crossing's displacement shifts the
 /// pile under it); after them it is left to the passes unwritten.
-inline constexpr int kPatchRebalances = 3;
+inline constexpr int kPatchBalances = 3;
 /// Its buckets of keys, each an axis pair's limit wide: heights up to this
 /// many limits apart (13.8 m on 5 mm cells at 34 degrees); what lies beyond
 /// is left to the passes.

@@ -372,7 +372,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // steps".) A cell another writer changes meanwhile (kSettleExcluded)
   // leaves the patch: it is not balanced, and if one leaves between the
   // balance and the write the patch is balanced again; after
-  // kPatchRebalances balances in all it is left to the passes unwritten.
+  // kPatchBalances balances in all it is left to the passes unwritten.
   // A patch is cut at half the cap; a call without the room to balance or
   // write the patch under way leaves it to the next (while the blade
   // pushes, the spill round the ends can leave a step too little for a
@@ -391,6 +391,12 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   const auto room_for = [&](std::int64_t per_cell) {
     return per_cell * std::int64_t(patch.size()) <= budget - work;
   };
+  // The patch under way given up, unwritten: the next one.
+  const auto drop_patch = [&] {
+    for (const std::int32_t l : patch) done[l] &= std::uint8_t(~kSettleCurrent);
+    settle_patch_stage_ = PatchStage::kNone;
+    ++settle_q_;
+  };
   double gained = 0.0;
   std::int64_t last = -1;
   for (;;) {
@@ -403,7 +409,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       done[l0] |= kSettleInPatch | kSettleCurrent;
       work += kPatchSearchVisits;
       settle_patch_next_ = 0;
-      settle_patch_rebalances_ = 0;
+      settle_patch_balances_ = 0;
       settle_patch_stage_ = PatchStage::kSearch;
     }
     if (settle_patch_stage_ == PatchStage::kSearch) {
@@ -439,13 +445,10 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       settle_patch_stage_ = PatchStage::kSolve;
     }
     if (settle_patch_stage_ == PatchStage::kWrite && settle_patch_left_ != settle_balanced_at_) {
-      if (settle_patch_rebalances_ < kPatchRebalances) {
+      if (settle_patch_balances_ < kPatchBalances) {
         settle_patch_stage_ = PatchStage::kSolve;  // balanced again, without the cells that left
       } else {
-        // Its cells keep changing under it: left to the passes, unwritten.
-        for (const std::int32_t l : patch) done[l] &= std::uint8_t(~kSettleCurrent);
-        settle_patch_stage_ = PatchStage::kNone;
-        ++settle_q_;
+        drop_patch();  // its cells keep changing under it: left to the passes
         continue;
       }
     }
@@ -464,14 +467,12 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       // A height some writer changed without a word (outside low..high)
       // would make the balance put soil where none was: left to the passes.
       if (!(excess >= 0.0 && excess <= sum_widths)) {
-        for (const std::int32_t l : patch) done[l] &= std::uint8_t(~kSettleCurrent);
-        settle_patch_stage_ = PatchStage::kNone;
-        ++settle_q_;
+        drop_patch();
         continue;
       }
       settle_delta_ = level_below(widths, excess);
       settle_balanced_at_ = settle_patch_left_;
-      ++settle_patch_rebalances_;
+      ++settle_patch_balances_;
       settle_patch_stage_ = PatchStage::kWrite;
     }
     if (settle_patch_stage_ == PatchStage::kWrite) {

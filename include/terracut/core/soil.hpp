@@ -512,7 +512,7 @@ class SoilFlow {
   PatchStage settle_patch_stage_ = PatchStage::kNone;
   std::size_t settle_patch_next_ = 0;
   double settle_delta_ = 0.0;
-  int settle_patch_rebalances_ = 0;
+  int settle_patch_balances_ = 0;
   std::uint64_t settle_patch_left_ = 0, settle_balanced_at_ = 0;
   // The seed phase drops the listed cells it finds standing at rest (the
   // test a pass would make of them), compacting the lists in place: where
