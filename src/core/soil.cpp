@@ -228,9 +228,35 @@ void SoilFlow::wake(const Rect& rect) {
     }
 }
 
+const Segment& SoilFlow::motion_origin(MotionTrack& track, const Segment& from, const Segment& to,
+                                       bool by_ends) const {
+  const auto same = [](const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; };
+  if (!track.known || !same(from.a, track.last.a) || !same(from.b, track.last.b)) {
+    track.anchor = track.from = from;
+    track.known = true;
+  }
+  track.last = to;
+  const double reach = 2.0 * kMotionCells * std::max(dx_, dz_);
+  const auto moved = [reach](double x, double z) { return x * x + z * z > reach * reach; };
+  const Segment& a = track.anchor;
+  const bool far = by_ends ? moved(to.a.x - a.a.x, to.a.z - a.a.z) || moved(to.b.x - a.b.x, to.b.z - a.b.z)
+                           : moved(0.5 * (to.a.x + to.b.x - a.a.x - a.b.x), 0.5 * (to.a.z + to.b.z - a.a.z - a.b.z));
+  if (far) {
+    track.from = track.anchor;
+    track.anchor = to;
+  }
+  return track.from;
+}
+
 SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const Segment& to,
                                    const Quat& orientation) {
   SoilStepResult out;
+  // Which way the blade goes, for the displacement's push, the side behind
+  // it (the spill, the settle's wall, the passes'): from where it stood
+  // before its last move of a fiftieth of a cell, not from this step's
+  // start alone (motion_origin).
+  const Segment& moved_from = motion_origin(motion_mid_, from, to, false);
+  const Segment& ends_from = motion_origin(motion_ends_, from, to, true);
   double room = 0.0, holds = 0.0;
   if (blade_spec_.bucket.enabled()) {
     holds = bucket_retained_m3(blade_spec_, orientation, params_.material.repose_deg);
@@ -240,10 +266,10 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     const PlanMotion m = midpoint_motion(from, to);
     if (m.x * opening.x + m.z * opening.z > 0.0) room = std::max(0.0, holds - load_m3_);
   }
-  displace(grid, from, to, room, out);
+  displace(grid, moved_from, to, room, out);
   // What the push left above the repose cone through an end of the blade
   // goes round it now (the bucket's ends are its side plates: not yet).
-  if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0) spill_round_ends(grid, from, to, out);
+  if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0) spill_round_ends(grid, moved_from, to, out);
   // What they left steeper than the stencil allows settles in one
   // construction (soil_settle.cpp), spread over as many steps as the work
   // cap asks while the passes wait. A step that displaces soil while one is
@@ -257,12 +283,12 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   // work (docs/soil.md, "The spill comes before a settle under way").
   if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0) {
     if (settle_phase_ == SettlePhase::kIdle) {
-      settle_start(grid, from, to, out.changed);
+      settle_start(grid, moved_from, to, out.changed);
     } else {
       // (the cells the steps since wrote: the one under way settles the rest)
       if (!settle_again_) settle_next_rect_ = out.changed;
       else settle_next_rect_.include(out.changed);
-      settle_next_from_ = from;
+      settle_next_from_ = moved_from;
       settle_next_to_ = to;
       settle_again_ = true;
     }
@@ -290,14 +316,14 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   // that displaced soil). Left to the passes, that soil drained through the
   // cells at each end a millimetre a pass, for about 100 passes after each
   // row crossing (docs/soil.md, "The held soil spills round the ends").
-  if (woke && !cut_now && !blade_spec_.bucket.enabled()) spill_round_ends(grid, from, to, out);
+  if (woke && !cut_now && !blade_spec_.bucket.enabled()) spill_round_ends(grid, moved_from, to, out);
   if (settle_phase_ != SettlePhase::kIdle)
     out.settle_visits += settle_charged(grid, out.changed, params_.max_pair_checks_per_step - ends_work_);
   // The blade's wall matters only to a pass: marked only when one runs.
   if (settle_phase_ != SettlePhase::kIdle) {
     out.reached_cap = true;  // the settle goes on in the next step
   } else if (pending()) {
-    mark_blade(grid, from, to);
+    mark_blade(grid, ends_from, to);
     if (held_.empty()) held_edge_ = to, held_heel_ = hull_heel_;  // where the blade and hull hold what the passes find held
     run_passes(grid, out);
     clear_blade();

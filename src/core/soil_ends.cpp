@@ -64,14 +64,15 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& from, const Seg
   // is inside the blade (as blade_blocks has it).
   const double half = 0.5 * (std::abs(ez) * dx_ + std::abs(ex) * dz_) / len;
   // The side the edge came from, by the sign of the motion across its line
-  // (none when it moved along the line or stood still: displace's own test
-  // of which way the blade pushes, 1 % of a cell): the cells inside the
+  // (from motion_origin, so a blade at rest keeps the side it came from;
+  // none when it moved along the line, or less than kMotionCells of a cell
+  // since its stroke began): the cells inside the
   // blade on that side are behind it, cut, and take what comes round the
   // ends as the trench behind them does. Those ahead hold the pile against
   // the blade and take nothing here.
   const PlanMotion motion = midpoint_motion(from, to);
   const double across = (ex * motion.z - ez * motion.x) / len;
-  const double behind = std::abs(across) > 0.01 * std::max(dx_, dz_) ? -across : 0.0;
+  const double behind = std::abs(across) > kMotionCells * std::max(dx_, dz_) ? -across : 0.0;
   const double slope = std::tan(params_.material.repose_deg * std::numbers::pi / 180.0);
   const double diag = std::hypot(dx_, dz_);
   float* h = grid.edit_layers().height_m;

@@ -36,6 +36,14 @@ inline constexpr double kToleranceOfLimit = 0.02;
 /// How far, in cells, the blade's ends move before the soil it held up is
 /// examined again.
 inline constexpr double kHeldMoveCells = 0.25;
+/// How far, in cells, the blade must have moved across its line for the
+/// motion to say which side of it is the trench behind it (the spill round
+/// the ends, the settle's wall): less is rounding or a device's tremor. The
+/// motion is measured from where the blade stood before it last moved
+/// twice that (SoilFlow::motion_origin), not over one step: at 0.1 m/s on
+/// 1 cm cells a step moves 0.1 mm, 1 % of a cell, and a test of each
+/// step's motion alone took such a push for a blade at rest.
+inline constexpr double kMotionCells = 0.01;
 /// Longest run of cells the blade pushes ahead of it, per cut sample.
 inline constexpr int kMaxPushCells = 512;
 /// Longest fall line a source's soil slides down in one pass, cells (what

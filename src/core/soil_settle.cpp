@@ -140,14 +140,15 @@ void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment
   // part of the pile's surface; nor is a cell under a body. Per row of the
   // window, the columns [row_lo, row_hi) the blade walls off: the centres
   // within its span (0 <= t <= 1) and on its side of the line n > -half
-  // (n < half, or both, by the side it came from) form one interval.
+  // (or n < half, by the side it came from; with no side known, all of
+  // them) form one interval.
   const double ex = to.b.x - to.a.x, ez = to.b.z - to.a.z;
   const double len2 = ex * ex + ez * ez;
   const double len = std::sqrt(len2);
   const double half = len > 0.0 ? 0.5 * (std::abs(ez) * dx_ + std::abs(ex) * dz_) / len : 0.0;
   const PlanMotion motion = midpoint_motion(from, to);
   const double across = len > 0.0 ? (ex * motion.z - ez * motion.x) / len : 0.0;
-  const double behind = std::abs(across) > 0.01 * std::max(dx_, dz_) ? -across : 0.0;
+  const double behind = std::abs(across) > kMotionCells * std::max(dx_, dz_) ? -across : 0.0;
   const double ox = spec.origin_m.x - to.a.x;
   for (int lr = 0; lr < wh; ++lr) {
     int& lo_c = settle_row_lo_[std::size_t(lr)];
@@ -165,8 +166,16 @@ void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment
     };
     keep(ex, z * ez);          // t >= 0
     keep(-ex, len2 - z * ez);  // t <= 1
-    if (behind >= 0.0) keep(-ez, ex * z + half * len);  // n > -half
-    if (behind <= 0.0) keep(ez, half * len - ex * z);   // n < half
+    // With no side known (a stroke's first hundredth of a cell, or a blade
+    // sliding along its line), the whole span: the band alone is about a
+    // cell wide across the line, a diagonal pair can stand on its two
+    // sides, and the settle, which walls cells and does not test pairs,
+    // moved soil through the blade (a 2 m blade on 1 cm cells sliding
+    // along its line at yaw 45 degrees, on a dug trench: 3.0 cm behind
+    // it). The passes, which test each pair's crossing of the line, settle
+    // what lies in the span then.
+    if (behind > 0.0) keep(-ez, ex * z + half * len);  // n > -half
+    if (behind < 0.0) keep(ez, half * len - ex * z);   // n < half
     if (empty || lo > hi) continue;
     // Columns whose centre ox + (c + 0.5) dx lies in [lo, hi].
     const double c_lo = std::ceil((lo - ox) / dx_ - 0.5), c_hi = std::floor((hi - ox) / dx_ - 0.5);

@@ -91,7 +91,7 @@ double worst_rise_behind(const WallCase& w) {
     // less two cells: its ends stay over the obstacles either side, whose
     // cells stand below the floor (no soil to cut or to slide off them) and
     // are closed to soil coming in.
-    const double widest_yaw = w.yaw_deg + (w.motion == Motion::kTurn ? 8.0 : 0.0);
+    const double widest_yaw = std::abs(w.yaw_deg) + (w.motion == Motion::kTurn ? 8.0 : 0.0);
     const double half_channel = 0.5 * w.length_m * std::cos(widest_yaw * kDeg) - 2.0 * cell;
     const int c0 = int(std::ceil((cx - half_channel) / cell)), c1 = int(std::floor((cx + half_channel) / cell));
     for (int r = 0; r < n; ++r)
@@ -196,6 +196,65 @@ TEST(SoilWall, NoSoilCrossesTheBladeWithTheWorkCapLifted) {
       const WallCase w{1.0, yaw, 1.0, motion, false, 1000000000};
       EXPECT_LE(worst_rise_behind(w), kFloatSlack) << describe(w);
     }
+}
+
+// A slow blade: 0.05 to 0.1 m/s on 1 cm cells moves 0.05 to 0.1 mm a step,
+// at most a hundredth of a cell. The tests of which way the blade goes once
+// looked at one step's motion and took such a blade for one at rest: the
+// displacement put the soil of each centre the edge had just passed on that
+// centre's own side, behind the blade, and the settle walled off only the
+// cells the edge passes through, so a diagonal pair stepped over it (on this
+// code before it 3.7 to 5.8 cm of soil stood behind every one of them). The motion is now
+// measured since the blade last moved a fiftieth of a cell.
+TEST(SoilWall, NoSoilCrossesASlowBlade) {
+  int k = 0;
+  for (const Motion motion : {Motion::kPush, Motion::kPlunge, Motion::kLift, Motion::kTurn})
+    for (const double yaw : {0.0, 197.0}) {
+      const WallCase w{1.0, yaw, k++ % 2 == 0 ? 0.1 : 0.05, motion, false};
+      EXPECT_LE(worst_rise_behind(w), kFloatSlack) << describe(w);
+    }
+  for (const Motion motion : {Motion::kPush, Motion::kTurn}) {
+    const WallCase w{1.2, 19.0, 0.08, motion, true};
+    EXPECT_LE(worst_rise_behind(w), kFloatSlack) << describe(w);
+  }
+}
+
+// A new stroke takes its way from its own motion, not from where the last
+// stroke ended: after a lift, a blade set down 0.35 m back from where the
+// last stroke stopped and pushing slowly the other way (+Z, 0.05 m/s on
+// 1 cm cells), with its edge just short of a row of centres, cuts that row
+// in its first steps. Its soil goes ahead: the floor behind the blade stays
+// at the edge's height. (Measured from the last stroke's end, the motion
+// pointed back along -Z, and the first row's soil went behind.) The layer
+// the blade cuts is 3 mm, so that its edge where the floor begins is a step
+// gentler than the repose angle: nothing moves before the blade comes.
+TEST(SoilWall, ANewStrokeAfterALiftPushesTheWayItMoves) {
+  const int n = 100;
+  const double cell = 0.01, edge_y = kLayer - kDepth, layer = 0.003;
+  SimParams p;
+  p.grid = grid_of_cells(n, n, cell);
+  p.blade.length_m = 2.0;  // longer than the terrain is wide: no ends on it
+  p.soil.model = SoilModel::kFlow;
+  p.soil.material.repose_deg = 34.0;
+  const double start_z = 0.5049;  // the row of centres at 0.505 is cut at once
+  std::vector<float> h(std::size_t(n) * n, float(edge_y + layer));
+  for (int r = 0; r < n; ++r)
+    if ((r + 0.5) * cell < start_z)
+      for (int c = 0; c < n; ++c) h[std::size_t(r) * n + c] = float(edge_y);
+  Simulation sim(p, h);
+  // The last stroke: 5 cm along +Z near the far side, at 0.5 m/s.
+  for (int i = 0; i <= 100; ++i) sim.step({{0.5, edge_y, 0.85 + 0.0005 * i}, Quat{}});
+  sim.lift();
+  // The new one: 0.1 m along +Z from start_z at 0.05 m/s; the floor from
+  // 0.2 m back to a cell and a half behind the edge.
+  double worst = 0.0;
+  for (int i = 0; i <= 2000; ++i) {
+    const double z = start_z + 0.00005 * i;
+    sim.step({{0.5, edge_y, z}, Quat{}});
+    for (int r = 30; (r + 0.5) * cell < z - 1.5 * cell; ++r)
+      for (int c = 0; c < n; ++c) worst = std::max(worst, double(sim.grid().height(c, r)) - edge_y);
+  }
+  EXPECT_LE(worst, kFloatSlack);
 }
 
 // scenarios/push_pile.yaml stepped as `terracut run` steps it: a 0.4 m blade

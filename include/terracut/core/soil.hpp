@@ -390,6 +390,28 @@ class SoilFlow {
   bool wake_held(const Segment* edge);
   void mark_blade(const HeightGrid& grid, const Segment& from, const Segment& edge);
   void clear_blade();
+  /// The state of motion_origin: a stroke's first step (one whose `from`
+  /// is not the last step's `to`: after Simulation::lift, or the first of
+  /// all) starts it afresh, so a new stroke does not take its way from
+  /// where the last one ended.
+  struct MotionTrack {
+    Segment anchor{};  ///< the edge where the blade last moved that far
+    Segment from{};    ///< where it stood before that move
+    Segment last{};    ///< the last step's `to`
+    bool known = false;
+  };
+  /// Where the blade's motion is measured from, for a step from `from` to
+  /// `to`: the edge where it stood before it last moved 2 kMotionCells of
+  /// a cell or more in plan (so that the motion is more than the side
+  /// tests' kMotionCells), so a slow blade's motion is that of its last
+  /// few steps together, not one step's, and a blade standing still keeps
+  /// the way it last went. With by_ends the move is either end's (the
+  /// passes' wall, which looks at each end's motion), else the midpoint's
+  /// (the displacement, the spill and the settle, which look at the
+  /// midpoint's: a turning blade's ends move further than its middle, and
+  /// moves counted at the ends left the middle's under a hundredth of a
+  /// cell).
+  const Segment& motion_origin(MotionTrack& track, const Segment& from, const Segment& to, bool by_ends) const;
   /// Whether the blade stops soil at height top_m flowing from cell
   /// (hc, hr) to its neighbour (lc, lr).
   bool blade_blocks(int hc, int hr, int lc, int lr, float top_m) const;
@@ -447,6 +469,8 @@ class SoilFlow {
   std::vector<std::uint8_t> ends_state_;
   double ends_s_[2] = {0.0, 0.0};  // each end's cone height at the last call
   bool cut_last_step_ = false;     // the last after_cut displaced or took in soil
+  MotionTrack motion_mid_;   // motion_origin by the edge's midpoint
+  MotionTrack motion_ends_;  // and by its ends
   std::int64_t ends_work_ = 0;     // visits the spill and the settle spent this step (charged to the cap by run_passes)
   std::vector<std::pair<double, int>> ends_keys_;  // the round's donors' and receivers' cone keys
   std::vector<std::int32_t> ends_queue_;           // the round's sets, window cells in the order found
