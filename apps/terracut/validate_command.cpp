@@ -31,6 +31,7 @@
 #include "terracut/io/image.hpp"
 #include "terracut/session/scenario.hpp"
 #include "terracut/session/world.hpp"
+#include "terracut/validation/wall.hpp"
 
 namespace terracut::cli {
 namespace {
@@ -733,10 +734,19 @@ struct Check {
   std::string result() const { return pass ? "PASS" : gating ? "FAIL" : "INFO"; }
 };
 
+// One case of the blade-is-a-wall measure (validation/wall.hpp): the worst
+// rise above the edge's height of a sample the blade had passed.
+struct WallRun {
+  validation::WallCase what;
+  double worst_m = 0.0;
+  bool pass() const { return worst_m <= validation::kWallSlack_m; }
+};
+
 struct Report {
   std::vector<ConeResult> cones;
   std::vector<RampResult> ramps;
   std::vector<DozeResult> dozes;
+  std::vector<WallRun> walls;
   ConservationResult conservation;
   BucketResult bucket;
   std::vector<Check> checks;
@@ -849,6 +859,17 @@ std::vector<Check> make_checks(const Report& r) {
     out.push_back({id + "e", w + ": volume / initial - 1",
                    std::to_string(volume) + of + "; worst " + fmt("%.2e", worst_volume),
                    "abs <= " + fmt("%.2e", volume_tol) + " (at the end)", volume == n});
+  }
+  if (!r.walls.empty()) {
+    const auto worst = std::max_element(r.walls.begin(), r.walls.end(),
+                                        [](const WallRun& a, const WallRun& b) { return a.worst_m < b.worst_m; });
+    const int holding = int(std::count_if(r.walls.begin(), r.walls.end(), [](const WallRun& w) { return w.pass(); }));
+    out.push_back({"3.3", "the blade is a wall: no soil behind it that came through or under it (blades of 0.2 to 2 m, "
+                          "yaw 0 to 135 deg, 0.05 to 2 m/s, push, plunge, lift, turn)",
+                   std::to_string(holding) + "/" + std::to_string(r.walls.size()) + " cases; worst rise " +
+                       fmt("%.2e", worst->worst_m) + " m (" + validation::describe(worst->what) + ")",
+                   "<= " + fmt("%.0e", validation::kWallSlack_m) + " m (float rounding)",
+                   holding == int(r.walls.size())});
   }
   const ConservationResult& c = r.conservation;
   out.push_back({"4a", "mixed run of " + std::to_string(c.sequence.size()) +
@@ -1025,6 +1046,22 @@ std::string report_markdown(const Report& r) {
     md << "![Pile volume and height against distance pushed, with the mass balance and the "
           "wedge](soil_bulldozing.png)\n\n";
 
+  md << "### The blade is a wall (check 3.3)\n\n"
+     << "No soil reaches the far side of a blade through it or under it. Soil may reach the cut "
+     << "behind a blade only round its ends or down the trench's walls, so each case takes both "
+     << "away: the blade spans the terrain (2 m on 1 m, its ends off the grid) or runs in a channel "
+     << "closed by rigid obstacles beyond its ends, and the trench behind its start is already dug. "
+     << "It travels 0.3 m, 5 cm into a 20 cm layer on 1 cm cells (plunging: from 1 to 5 cm deep; "
+     << "lifting: from 5 to 1 cm; turning: its yaw from -8 to +8 deg about its centre). Every step, "
+     << "every sample it has passed (more than a cell and a half behind its line, within its span) "
+     << "must stay at the edge's height there. A slow blade (0.05 m/s, 1/200 of a cell a step) is "
+     << "among them.\n\n"
+     << "| case | worst rise behind the blade (m) | result |\n|---|---|---|\n";
+  for (const WallRun& w : r.walls)
+    md << "| " << validation::describe(w.what) << " | " << fmt("%.2e", w.worst_m) << " | " << pass_fail(w.pass())
+       << " |\n";
+  md << "\n";
+
   // ---- 4 ----
   const ConservationResult& c = r.conservation;
   md << "## 4. Conservation over a long mixed run\n\n"
@@ -1095,7 +1132,8 @@ std::string report_markdown(const Report& r) {
      << "- `slope/profiles.csv` (case, s_m, initial_m, final_m), `slope/slopes.csv`.\n"
      << "- `bulldozing/pile.csv` (every sample: the budget, the pile's shape, the wedge and "
         "its band), `bulldozing/centre.csv` (width_m, pushed_m, s_m ahead of the edge, h_m on "
-        "the centre line), `bulldozing/height_w<width>.npy` (the final heights).\n"
+        "the centre line), `bulldozing/height_w<width>.npy` (the final heights), "
+        "`bulldozing/wall.csv` (each wall case and its worst rise behind the blade, m).\n"
      << "- `conservation/scenario.yaml` (the cuts), `conservation/volume.csv` (step, t_s, cut, "
         "volume_m3, relative_error).\n"
      << "- `validate.json`: the parameters and tolerances, for `tools/plot_validate.py`.\n\n"
@@ -1166,6 +1204,9 @@ void write_outputs(const fs::path& out, const Report& r) {
       centre += s.centre_csv;
     }
   write_file(out / "bulldozing" / "pile.csv", pile);
+  std::string wall = "case,worst_rise_m\n";
+  for (const WallRun& w : r.walls) wall += "\"" + validation::describe(w.what) + "\"," + csv_number(w.worst_m) + "\n";
+  write_file(out / "bulldozing" / "wall.csv", wall);
   write_file(out / "bulldozing" / "centre.csv", centre);
   write_file(out / "checks.csv", checks_csv(r.checks));
 
@@ -1202,7 +1243,8 @@ void write_outputs(const fs::path& out, const Report& r) {
                         {"push_m", kDozePush_m},
                         {"runs", widths},
                         {"pile_csv", "bulldozing/pile.csv"},
-                        {"centre_csv", "bulldozing/centre.csv"}};
+                        {"centre_csv", "bulldozing/centre.csv"},
+                        {"wall_csv", "bulldozing/wall.csv"}};
   meta["bucket"] = {{"volume_csv", "bucket/volume.csv"},
                     {"height_npy", "bucket/height.npy"},
                     {"cell_m", kBucketCell_m},
@@ -1249,7 +1291,9 @@ Command add_validate_command(CLI::App& app) {
       "  3 bulldozing: a 1 m and a 2 m blade cutting 5 cm into a 20 cm layer, pushed 1 m at\n"
       "    0.6 mm per step; every 5 cm the budget against V = w d x (m^3), the centre line's\n"
       "    section and peak against the 2-D wedge h = sqrt(2 d x tan(repose)) (m), the trench\n"
-      "    floor (m), the volume\n"
+      "    floor (m), the volume; and the blade as a wall: blades of 0.2 to 2 m at yaws of 0\n"
+      "    to 135 degrees and 0.05 to 2 m/s, pushing, plunging, lifting and turning, leave no\n"
+      "    soil behind them that came through or under them (m)\n"
       "  4 conservation: a mixed run of cuts (along Z, turned, yawed, tilted) on flow soil;\n"
       "    the total volume against the initial one at every step (relative)\n"
       "  5 bucket: a bucket scoops (the load is what the grid lost, w d x, under its\n"
@@ -1279,6 +1323,7 @@ Command add_validate_command(CLI::App& app) {
       "                       volume_tolerance_rel\n"
       "  bulldozing/centre.csv  width_m, pushed_m, s_m (ahead of the edge), h_m (centre line)\n"
       "  bulldozing/height_w<width>.npy  float32 heights (m) after the push\n"
+      "  bulldozing/wall.csv  case, worst_rise_m: the blade-as-a-wall cases (check 3.3)\n"
       "  conservation/scenario.yaml      the mixed run's cuts (runnable with `terracut run`)\n"
       "  conservation/volume.csv         step, t_s, cut, volume_m3, relative_error,\n"
       "                                  tolerance_rel\n"
@@ -1388,6 +1433,14 @@ Command add_validate_command(CLI::App& app) {
           " m^3 of w d x = " + fmt("%.4f", last.mass_balance_m3) + " m^3, centre peak " +
           fmt("%.4f", last.centre_peak_m) + " m (wedge " + fmt("%.4f", last.wedge_m) + " m), " +
           seconds_since(t0));
+    }
+    {
+      const Clock::time_point t0 = Clock::now();
+      for (const validation::WallCase& w : validation::validation_wall_cases())
+        report.walls.push_back({w, validation::worst_rise_behind(w)});
+      const auto holding = std::count_if(report.walls.begin(), report.walls.end(), [](const WallRun& w) { return w.pass(); });
+      say("the blade as a wall: " + std::to_string(holding) + " of " + std::to_string(report.walls.size()) +
+          " cases leave no soil behind it, " + seconds_since(t0));
     }
     {
       const Clock::time_point t0 = Clock::now();

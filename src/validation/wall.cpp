@@ -1,0 +1,174 @@
+// The blade-is-a-wall measure (wall.hpp): a terrain, a blade that spans it
+// or runs in a closed channel, the trench behind its start already dug, and
+// every sample it has passed watched for soil above the edge's height.
+#include "terracut/validation/wall.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <stdexcept>
+#include <vector>
+
+#include "terracut/core/simulation.hpp"
+
+namespace terracut::validation {
+
+namespace {
+
+constexpr double kWallDeg = std::numbers::pi / 180.0;
+constexpr double kWallLayer_m = 0.2;   // the soil's surface, m
+constexpr double kWallDepth_m = 0.05;  // the cut, m
+
+const char* motion_name(WallMotion m) {
+  switch (m) {
+    case WallMotion::kPush: return "push";
+    case WallMotion::kPlunge: return "plunge";
+    case WallMotion::kLift: return "lift";
+    case WallMotion::kTurn: return "turn";
+  }
+  return "?";
+}
+
+std::string wall_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+}  // namespace
+
+std::string describe(const WallCase& w) {
+  return std::string(motion_name(w.motion)) + ", " + wall_number(w.length_m) + " m blade, yaw " + wall_number(w.yaw_deg) + " deg, " +
+         wall_number(w.speed_m_per_s) + " m/s, " + wall_number(w.cell_m * 1000.0) + " mm cells" +
+         (w.channel ? ", in a channel" : ", spanning the terrain") + ", cap " + std::to_string(w.cap);
+}
+
+double worst_rise_behind(const WallCase& w) {
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(w.length_m) || !positive(w.speed_m_per_s) || !positive(w.cell_m) || !std::isfinite(w.yaw_deg))
+    throw std::invalid_argument("worst_rise_behind: length_m, speed_m_per_s and cell_m must be finite and > 0, "
+                                "yaw_deg finite (" + describe(w) + ")");
+  if (w.cell_m > 0.05) throw std::invalid_argument("worst_rise_behind: cell_m over 0.05 m (" + describe(w) + ")");
+  const double cell = w.cell_m;
+  const double travel = 0.3;  // m
+  const double yaw = w.yaw_deg * kWallDeg;
+  // Spanning the terrain, the blade travels along its normal; in a channel
+  // (along +Z), along +Z whatever its yaw, as an angled blade does.
+  const double nx = w.channel ? 0.0 : std::sin(yaw), nz = w.channel ? 1.0 : std::cos(yaw);
+  // A square terrain; the blade's centre crosses its middle.
+  const double side_m = w.channel ? std::max(1.0, w.length_m + 0.4) : 1.0;
+  const int n = int(std::lround(side_m / cell));
+  // In the channel the blade starts with its centre on a row of cell
+  // centres, where a level edge stands on them again and again.
+  const double cx = 0.5 * side_m, cz = 0.5 * side_m + (w.channel ? 0.5 * cell : 0.0);
+  SimParams p;
+  p.grid = grid_of_cells(n, n, cell);
+  // Spanning the terrain: longer than its diagonal, so its ends are off it.
+  p.blade.length_m = w.channel ? w.length_m : 2.0 * side_m;
+  p.soil.model = SoilModel::kFlow;
+  p.soil.material.repose_deg = 34.0;
+  p.soil.max_pair_checks_per_step = w.cap;
+  const double edge_start = kWallLayer_m - kWallDepth_m;
+  std::vector<float> h(std::size_t(n) * n, float(kWallLayer_m));
+  std::vector<SoilObstacle> walls;
+  if (w.channel) {
+    // The blade's reach across the channel at the largest yaw it takes,
+    // less two cells: its ends stay over the obstacles either side, whose
+    // cells stand below the floor (no soil to cut or to slide off them) and
+    // are closed to soil coming in.
+    const double widest_yaw = std::abs(w.yaw_deg) + (w.motion == WallMotion::kTurn ? 8.0 : 0.0);
+    const double half_channel = 0.5 * w.length_m * std::cos(widest_yaw * kWallDeg) - 2.0 * cell;
+    if (!(half_channel >= 2.0 * cell))
+      throw std::invalid_argument("worst_rise_behind: in a channel the blade must reach across at least 8 cells "
+                                  "at its largest yaw (" + describe(w) + ")");
+    const int c0 = int(std::ceil((cx - half_channel) / cell)), c1 = int(std::floor((cx + half_channel) / cell));
+    for (int r = 0; r < n; ++r)
+      for (int c = 0; c < n; ++c)
+        if (c < c0 || c >= c1) h[std::size_t(r) * n + c] = float(edge_start - 0.06);
+    walls.push_back({{0, 0, c0, n}, 0.0f});
+    walls.push_back({{c1, 0, n, n}, 0.0f});
+  }
+  // The pose at step s in [0, 1]. The edge's height: level, down 4 cm
+  // over the first two thirds (a ramp of 0.2, gentler than tan 34 deg =
+  // 0.67), or up 4 cm so. Turning, the yaw swings from -8 to +8 degrees
+  // about the blade's centre while it moves on (slowly enough that every
+  // point of the blade over the terrain moves forward: none backs into the
+  // trench, beside the uncut soil ahead of the starting line).
+  const auto pose_at = [&](double s) {
+    double y = edge_start;
+    if (w.motion == WallMotion::kPlunge) y = kWallLayer_m - 0.01 - 0.04 * std::min(1.0, 1.5 * s);
+    if (w.motion == WallMotion::kLift) y = edge_start + 0.04 * std::min(1.0, 1.5 * s);
+    const double turn = w.motion == WallMotion::kTurn ? (-8.0 + 16.0 * s) * kWallDeg : 0.0;
+    const double along = -0.5 * travel + travel * s;
+    return BladePose{{cx + nx * along, y, cz + nz * along}, quat_from_axis_angle({0.0, 1.0, 0.0}, yaw + turn)};
+  };
+  // Behind the starting line the trench is already dug, to the edge's
+  // height there: no back wall at the trench's start to slump into it.
+  {
+    const BladePose start = pose_at(0.0);
+    const Vec3 e = rotate(start.orientation, {1.0, 0.0, 0.0});
+    for (int r = 0; r < n; ++r)
+      for (int c = 0; c < n; ++c) {
+        const double x = (c + 0.5) * cell - start.position_m.x, z = (r + 0.5) * cell - start.position_m.z;
+        if (e.x * z - e.z * x < 0.0) {
+          float& v = h[std::size_t(r) * n + c];
+          v = std::min(v, float(start.position_m.y));
+        }
+      }
+  }
+  Simulation sim(p, h);
+  if (w.channel) sim.soil()->set_obstacles(walls);
+  const int steps = int(std::lround(travel / w.speed_m_per_s * 1000.0));
+  // Per sample: the side of the blade's line it started on, and the edge's
+  // height where it passed it (NaN: not passed yet).
+  std::vector<int> side0(std::size_t(n) * n, 0);
+  std::vector<double> floor(std::size_t(n) * n, NAN);
+  double worst = -1.0;
+  for (int i = 0; i <= steps; ++i) {
+    const double s = double(i) / steps;
+    sim.step(pose_at(s));
+    const Segment edge = sim.last().edge;
+    // The last step's edge height over (x, z), from its pose (the edge is level across the blade).
+    const auto last_edge_y = [&](double, double) { return i > 0 ? pose_at(double(i - 1) / steps).position_m.y : 0.0; };
+    const double dxl = edge.b.x - edge.a.x, dzl = edge.b.z - edge.a.z;
+    const double len = std::hypot(dxl, dzl);
+    const HeightGrid& g = sim.grid();
+    for (int r = 0; r < n; ++r)
+      for (int c = 0; c < n; ++c) {
+        const std::size_t k = std::size_t(r) * n + c;
+        const double x = (c + 0.5) * cell, z = (r + 0.5) * cell;
+        const double d = (dxl * (z - edge.a.z) - dzl * (x - edge.a.x)) / len;  // signed distance to the line
+        const double t = ((x - edge.a.x) * dxl + (z - edge.a.z) * dzl) / (len * len);
+        // The far side at the start is the trench already dug (to the
+        // first edge's height): passed before the first step.
+        if (i == 0) side0[k] = d > 0.0 ? 1 : -1;
+        if (t < 0.0 || t > 1.0) continue;  // beyond the blade's ends
+        const bool passed = (d > 0.0 ? 1 : -1) != side0[k] || side0[k] < 0;
+        if (i == 0 && side0[k] < 0) floor[k] = pose_at(0.0).position_m.y;
+        // The cut left it at the edge's height where the edge crossed its
+        // centre, between this step's pose and the last.
+        if (passed && std::isnan(floor[k]))
+          floor[k] = std::max(edge.a.y + (edge.b.y - edge.a.y) * t, last_edge_y(x, z));
+        if (!passed || std::abs(d) <= 1.5 * cell) continue;
+        worst = std::max(worst, double(g.height(c, r)) - floor[k]);
+      }
+  }
+  return worst;
+}
+
+std::vector<WallCase> validation_wall_cases() {
+  std::vector<WallCase> cases;
+  // Spanning the terrain: every motion, yaws round the compass, speeds from
+  // slow (0.05 m/s: 1/200 of a cell a step) to 2 m/s.
+  const double speeds[] = {0.05, 0.25, 2.0};
+  int k = 0;
+  for (const WallMotion motion : {WallMotion::kPush, WallMotion::kPlunge, WallMotion::kLift, WallMotion::kTurn})
+    for (const double yaw : {0.0, 30.0, 90.0, 135.0}) cases.push_back({1.0, yaw, speeds[k++ % 3], motion, false});
+  // In a channel: short and long blades, straight and yawed.
+  for (const double length : {0.2, 0.5, 2.0})
+    for (const double yaw : {0.0, 25.0}) cases.push_back({length, yaw, speeds[k++ % 3], WallMotion::kPush, true});
+  return cases;
+}
+
+}  // namespace terracut::validation
