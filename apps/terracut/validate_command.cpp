@@ -1133,7 +1133,8 @@ std::string report_markdown(const Report& r) {
      << "- `bulldozing/pile.csv` (every sample: the budget, the pile's shape, the wedge and "
         "its band), `bulldozing/centre.csv` (width_m, pushed_m, s_m ahead of the edge, h_m on "
         "the centre line), `bulldozing/height_w<width>.npy` (the final heights), "
-        "`bulldozing/wall.csv` (each wall case and its worst rise behind the blade, m).\n"
+        "`bulldozing/wall.csv` (each wall case, one field a column, and its worst rise behind the "
+        "blade, m).\n"
      << "- `conservation/scenario.yaml` (the cuts), `conservation/volume.csv` (step, t_s, cut, "
         "volume_m3, relative_error).\n"
      << "- `validate.json`: the parameters and tolerances, for `tools/plot_validate.py`.\n\n"
@@ -1204,8 +1205,14 @@ void write_outputs(const fs::path& out, const Report& r) {
       centre += s.centre_csv;
     }
   write_file(out / "bulldozing" / "pile.csv", pile);
-  std::string wall = "case,worst_rise_m\n";
-  for (const WallRun& w : r.walls) wall += "\"" + validation::describe(w.what) + "\"," + csv_number(w.worst_m) + "\n";
+  std::string wall = "motion,blade_m,spanning,yaw_deg,speed_m_per_s,cell_m,cap,worst_rise_m\n";
+  for (const WallRun& w : r.walls) {
+    const validation::WallCase& c = w.what;
+    static const char* const motions[] = {"push", "plunge", "lift", "turn"};
+    wall += std::string(motions[int(c.motion)]) + "," + csv_number(validation::blade_length_m(c)) + "," +
+            (c.channel ? "0" : "1") + "," + csv_number(c.yaw_deg) + "," + csv_number(c.speed_m_per_s) + "," +
+            csv_number(c.cell_m) + "," + std::to_string(c.cap) + "," + csv_number(w.worst_m) + "\n";
+  }
   write_file(out / "bulldozing" / "wall.csv", wall);
   write_file(out / "bulldozing" / "centre.csv", centre);
   write_file(out / "checks.csv", checks_csv(r.checks));
@@ -1323,7 +1330,8 @@ Command add_validate_command(CLI::App& app) {
       "                       volume_tolerance_rel\n"
       "  bulldozing/centre.csv  width_m, pushed_m, s_m (ahead of the edge), h_m (centre line)\n"
       "  bulldozing/height_w<width>.npy  float32 heights (m) after the push\n"
-      "  bulldozing/wall.csv  case, worst_rise_m: the blade-as-a-wall cases (check 3.3)\n"
+      "  bulldozing/wall.csv  motion, blade_m, spanning, yaw_deg, speed_m_per_s, cell_m, cap,\n"
+      "    worst_rise_m: the blade-as-a-wall cases (check 3.3)\n"
       "  conservation/scenario.yaml      the mixed run's cuts (runnable with `terracut run`)\n"
       "  conservation/volume.csv         step, t_s, cut, volume_m3, relative_error,\n"
       "                                  tolerance_rel\n"

@@ -257,6 +257,7 @@ void Simulation::include_changed(const Rect& rect) {
 
 void Simulation::lift() {
   has_previous_ = false;
+  if (soil_) soil_->new_stroke();
   has_previous_velocity_ = false;
   heading_ = {};
   for (StepListener* listener : listeners_) listener->on_lift();

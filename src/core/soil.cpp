@@ -228,8 +228,7 @@ void SoilFlow::wake(const Rect& rect) {
     }
 }
 
-const Segment& SoilFlow::motion_origin(MotionTrack& track, const Segment& from, const Segment& to,
-                                       bool by_ends) const {
+const Segment& SoilFlow::motion_origin(MotionTrack& track, const Segment& from, const Segment& to, bool by_ends) {
   const auto same = [](const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; };
   if (!track.known || !same(from.a, track.last.a) || !same(from.b, track.last.b)) {
     track.anchor = track.from = from;
@@ -266,7 +265,7 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     const PlanMotion m = midpoint_motion(from, to);
     if (m.x * opening.x + m.z * opening.z > 0.0) room = std::max(0.0, holds - load_m3_);
   }
-  displace(grid, moved_from, to, room, out);
+  displace(grid, from, moved_from, to, room, out);
   // What the push left above the repose cone through an end of the blade
   // goes round it now (the bucket's ends are its side plates: not yet).
   if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0) spill_round_ends(grid, moved_from, to, out);

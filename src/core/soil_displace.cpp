@@ -62,7 +62,8 @@ void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& from, const Seg
   // without dividing (blade_blocks).
   blade_.half_lo = half_num * (1.0 - 1e-12);
   blade_.half_hi = half_num * (1.0 + 1e-12);
-  // Each end's motion across the line in the step (any motion counts).
+  // Each end's motion across the line since `from` (motion_origin's origin
+  // by the ends; any motion counts).
   const auto across = [&](const Vec3& was, const Vec3& is) {
     const double n = d.x * (is.z - was.z) - d.z * (is.x - was.x);
     return std::abs(n) > 1e-9 * half_num ? n : 0.0;
@@ -105,7 +106,7 @@ void SoilFlow::clear_blade() {
   blade_.present = false;
 }
 
-void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to,
+void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& moved_from, const Segment& to,
                         double bucket_room_m3, SoilStepResult& out) {
   const GridSpec& spec = grid.spec();
   const double cell = std::max(dx_, dz_);
@@ -113,15 +114,27 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   const Vec3 e = to.b - to.a;
   double nx = -e.z, nz = e.x;
   const double plan_length = std::hypot(nx, nz);
-  const auto [mx, mz] = midpoint_motion(from, to);
+  // Which way the cut soil goes: this step's motion across the edge's line
+  // where that is more than rounding (every sample the edge cut in the step
+  // lies in what it swept, on the side it came from in the step), else the
+  // motion since the blade last moved (motion_origin: a blade standing
+  // still, going straight down or sliding along its line keeps the way it
+  // went), else none (each cut sample's soil to its own side). (A test of a
+  // hundredth of a cell's motion in the step took a slow blade for one at
+  // rest, 0.1 m/s on 1 cm cells, and put the cut of each centre the edge
+  // had just passed on that centre's own side: behind the blade, at every
+  // row.)
+  const double rounding = 1e-9 * cell;
+  const PlanMotion step_motion = midpoint_motion(from, to), since_motion = midpoint_motion(moved_from, to);
   if (plan_length > 1e-12) {
     nx /= plan_length;
     nz /= plan_length;
   } else {
     // An edge seen end-on: push along the motion, or along +X at rest.
-    const double m = std::hypot(mx, mz);
-    nx = m > 1e-12 ? mx / m : 1.0;
-    nz = m > 1e-12 ? mz / m : 0.0;
+    const PlanMotion m = std::hypot(step_motion.x, step_motion.z) > 1e-12 ? step_motion : since_motion;
+    const double length = std::hypot(m.x, m.z);
+    nx = length > 1e-12 ? m.x / length : 1.0;
+    nz = length > 1e-12 ? m.z / length : 0.0;
   }
   // One cell along the push (the longer cell side across it, so the roll
   // never skips a cell).
@@ -129,15 +142,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& to
   // The repose drop over one such cell.
   const double limit_step = std::tan(params_.material.repose_deg * std::numbers::pi / 180.0) * step *
                             std::hypot(nx, nz);
-  // Any motion along the normal, more than rounding, says which way the
-  // cut soil goes: every sample the edge cut in the step lies in what it
-  // swept, on the side it came from, and a slow blade's cut pushed to each
-  // sample's own side put the soil of a centre the edge had just passed
-  // behind the blade (a test of a hundredth of a cell's motion here, at
-  // 0.1 m/s on 1 cm cells, did that at every row). The motion is measured
-  // from motion_origin, so a blade at rest after a push keeps its way.
-  const double along_motion = nx * mx + nz * mz;
-  const bool moving = std::abs(along_motion) > 1e-9 * cell;
+  const double along_step = nx * step_motion.x + nz * step_motion.z;
+  const double along_motion =
+      std::abs(along_step) > rounding ? along_step : nx * since_motion.x + nz * since_motion.z;
+  const bool moving = std::abs(along_motion) > rounding;
   if (moving && along_motion < 0.0) {
     nx = -nx;
     nz = -nz;

@@ -128,9 +128,10 @@ inline constexpr Neighbour kNeighbours[8] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 1}, 
 
 inline double to_cells(double v, double origin, double cell) { return (v - origin) / cell; }
 
-/// How far the edge's midpoint moved in plan over a step, from `from` to
-/// `to`: {x, z}, metres (the bucket's lip, the displacement's push and the
-/// spill's side the edge came from all read it).
+/// How far the edge's midpoint moved in plan from `from` to `to` (over a
+/// step, or since SoilFlow::motion_origin's origin): {x, z}, metres (the
+/// bucket's lip, the displacement's push and the spill's and the settle's
+/// side the edge came from all read it).
 struct PlanMotion {
   double x, z;
 };

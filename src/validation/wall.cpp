@@ -30,6 +30,10 @@ const char* motion_name(WallMotion m) {
   return "?";
 }
 
+// The square terrain's side, m: in a channel room for the blade and 0.2 m
+// either side of it; spanning, 1 m.
+double terrain_side_m(const WallCase& w) { return w.channel ? std::max(1.0, w.length_m + 0.4) : 1.0; }
+
 std::string wall_number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
@@ -38,10 +42,17 @@ std::string wall_number(double v) {
 
 }  // namespace
 
+double blade_length_m(const WallCase& w) {
+  // Spanning the terrain, the blade is longer than the terrain's diagonal,
+  // so its ends are off it.
+  return w.channel ? w.length_m : 2.0 * terrain_side_m(w);
+}
+
 std::string describe(const WallCase& w) {
-  return std::string(motion_name(w.motion)) + ", " + wall_number(w.length_m) + " m blade, yaw " + wall_number(w.yaw_deg) + " deg, " +
+  const std::string blade = wall_number(blade_length_m(w)) + " m blade" + (w.channel ? "" : " spanning the terrain");
+  return std::string(motion_name(w.motion)) + ", " + blade + ", yaw " + wall_number(w.yaw_deg) + " deg, " +
          wall_number(w.speed_m_per_s) + " m/s, " + wall_number(w.cell_m * 1000.0) + " mm cells" +
-         (w.channel ? ", in a channel" : ", spanning the terrain") + ", cap " + std::to_string(w.cap);
+         (w.channel ? ", in a channel" : "") + ", cap " + std::to_string(w.cap);
 }
 
 double worst_rise_behind(const WallCase& w) {
@@ -49,7 +60,9 @@ double worst_rise_behind(const WallCase& w) {
   if (!positive(w.length_m) || !positive(w.speed_m_per_s) || !positive(w.cell_m) || !std::isfinite(w.yaw_deg))
     throw std::invalid_argument("worst_rise_behind: length_m, speed_m_per_s and cell_m must be finite and > 0, "
                                 "yaw_deg finite (" + describe(w) + ")");
-  if (w.cell_m > 0.05) throw std::invalid_argument("worst_rise_behind: cell_m over 0.05 m (" + describe(w) + ")");
+  if (w.cell_m > 0.05 || w.cell_m < 0.002 || w.speed_m_per_s < 0.001)
+    throw std::invalid_argument("worst_rise_behind: cell_m must lie in [0.002, 0.05] m and speed_m_per_s be at least "
+                                "0.001 m/s (" + describe(w) + ")");
   const double cell = w.cell_m;
   const double travel = 0.3;  // m
   const double yaw = w.yaw_deg * kWallDeg;
@@ -57,7 +70,7 @@ double worst_rise_behind(const WallCase& w) {
   // (along +Z), along +Z whatever its yaw, as an angled blade does.
   const double nx = w.channel ? 0.0 : std::sin(yaw), nz = w.channel ? 1.0 : std::cos(yaw);
   // A square terrain; the blade's centre crosses its middle.
-  const double side_m = w.channel ? std::max(1.0, w.length_m + 0.4) : 1.0;
+  const double side_m = terrain_side_m(w);
   const int n = int(std::lround(side_m / cell));
   // In the channel the blade starts with its centre on a row of cell
   // centres, where a level edge stands on them again and again.
@@ -65,7 +78,7 @@ double worst_rise_behind(const WallCase& w) {
   SimParams p;
   p.grid = grid_of_cells(n, n, cell);
   // Spanning the terrain: longer than its diagonal, so its ends are off it.
-  p.blade.length_m = w.channel ? w.length_m : 2.0 * side_m;
+  p.blade.length_m = blade_length_m(w);
   p.soil.model = SoilModel::kFlow;
   p.soil.material.repose_deg = 34.0;
   p.soil.max_pair_checks_per_step = w.cap;
@@ -125,6 +138,7 @@ double worst_rise_behind(const WallCase& w) {
   std::vector<int> side0(std::size_t(n) * n, 0);
   std::vector<double> floor(std::size_t(n) * n, NAN);
   double worst = -1.0;
+  std::int64_t measured = 0;  // samples watched over the run
   for (int i = 0; i <= steps; ++i) {
     const double s = double(i) / steps;
     sim.step(pose_at(s));
@@ -152,8 +166,12 @@ double worst_rise_behind(const WallCase& w) {
           floor[k] = std::max(edge.a.y + (edge.b.y - edge.a.y) * t, last_edge_y(x, z));
         if (!passed || std::abs(d) <= 1.5 * cell) continue;
         worst = std::max(worst, double(g.height(c, r)) - floor[k]);
+        ++measured;
       }
   }
+  // (A case whose blade never passed a sample beyond the band would pass
+  // with nothing measured.)
+  if (measured == 0) throw std::invalid_argument("worst_rise_behind: no sample behind the blade to watch (" + describe(w) + ")");
   return worst;
 }
 

@@ -453,12 +453,12 @@ TEST_F(CliTest, ValidateWritesItsOutputsAndEveryCheckPasses) {
   for (const char* name :
        {"report.md", "checks.csv", "validate.json", "cone/profiles.csv", "cone/flanks.csv",
         "cone/height_34.npy", "cone/height_45.npy", "slope/profiles.csv", "slope/slopes.csv",
-        "bulldozing/pile.csv", "bulldozing/centre.csv", "bulldozing/height_w1.npy",
+        "bulldozing/pile.csv", "bulldozing/centre.csv", "bulldozing/wall.csv", "bulldozing/height_w1.npy",
         "bulldozing/height_w2.npy", "conservation/scenario.yaml", "conservation/volume.csv"})
     ASSERT_TRUE(fs::exists(out / name)) << name << "\n" << r.err;
   const std::string report = slurp(out / "report.md");
   for (const char* word : {"A column of sand collapses into a cone", "Slopes below and above",
-                           "Bulldozing", "Conservation over a long mixed run", "Speed"})
+                           "Bulldozing", "The blade is a wall", "Conservation over a long mixed run", "Speed"})
     EXPECT_NE(report.find(word), std::string::npos) << word;
   EXPECT_EQ(report.find("soil_cone.png"), std::string::npos);  // --no-plot: no figure links
   // The mixed run's scenario is one `terracut run` accepts.

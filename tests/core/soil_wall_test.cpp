@@ -26,10 +26,10 @@ constexpr double kDepth = 0.05;  // the cut, m
 constexpr double kFloatSlack = 1e-5;
 
 // A new stroke takes its way from its own motion, not from where the last
-// stroke ended: after a lift, a blade set down 0.35 m back from where the
-// last stroke stopped and pushing slowly the other way (+Z, 0.05 m/s on
-// 1 cm cells), with its edge just short of a row of centres, cuts that row
-// in its first steps. Its soil goes ahead: the floor behind the blade stays
+// stroke ended: after a lift, a blade set down 0.4 m short of where the
+// last stroke stopped (the way from that stop to it points along -Z) and
+// pushing slowly along +Z (0.05 m/s on 1 cm cells), with its edge just
+// short of a row of centres, cuts that row in its first steps. Its soil goes ahead: the floor behind the blade stays
 // at the edge's height. (Measured from the last stroke's end, the motion
 // pointed back along -Z, and the first row's soil went behind.) The layer
 // the blade cuts is 3 mm, so that its edge where the floor begins is a step

@@ -336,6 +336,14 @@ class SoilFlow {
   SoilStepResult after_cut(HeightGrid& grid, const Segment& from, const Segment& to,
                            const Quat& orientation = {});
 
+  /// A new stroke begins (Simulation::lift): which way the blade goes is
+  /// measured afresh from its next step (motion_origin), not from where the
+  /// last stroke ended, even where the new one starts at that very pose.
+  void new_stroke() {
+    motion_mid_.known = false;
+    motion_ends_.known = false;
+  }
+
   /// Relaxation only (no blade): e.g. between strokes, or a settling run.
   SoilStepResult relax(HeightGrid& grid);
 
@@ -390,9 +398,9 @@ class SoilFlow {
   bool wake_held(const Segment* edge);
   void mark_blade(const HeightGrid& grid, const Segment& from, const Segment& edge);
   void clear_blade();
-  /// The state of motion_origin: a stroke's first step (one whose `from`
-  /// is not the last step's `to`: after Simulation::lift, or the first of
-  /// all) starts it afresh, so a new stroke does not take its way from
+  /// The state of motion_origin: a new stroke (new_stroke, which
+  /// Simulation::lift calls; or a step whose `from` is not the last step's
+  /// `to`) starts it afresh, so a new stroke does not take its way from
   /// where the last one ended.
   struct MotionTrack {
     Segment anchor{};  ///< the edge where the blade last moved that far
@@ -401,9 +409,9 @@ class SoilFlow {
     bool known = false;
   };
   /// Where the blade's motion is measured from, for a step from `from` to
-  /// `to`: the edge where it stood before it last moved 2 kMotionCells of
-  /// a cell or more in plan (so that the motion is more than the side
-  /// tests' kMotionCells), so a slow blade's motion is that of its last
+  /// `to`: the edge where it stood before it last moved more than 2
+  /// kMotionCells of a cell in plan (so that the motion is more than the
+  /// side tests' kMotionCells), so a slow blade's motion is that of its last
   /// few steps together, not one step's, and a blade standing still keeps
   /// the way it last went. With by_ends the move is either end's (the
   /// passes' wall, which looks at each end's motion), else the midpoint's
@@ -411,7 +419,7 @@ class SoilFlow {
   /// midpoint's: a turning blade's ends move further than its middle, and
   /// moves counted at the ends left the middle's under a hundredth of a
   /// cell).
-  const Segment& motion_origin(MotionTrack& track, const Segment& from, const Segment& to, bool by_ends) const;
+  const Segment& motion_origin(MotionTrack& track, const Segment& from, const Segment& to, bool by_ends);
   /// Whether the blade stops soil at height top_m flowing from cell
   /// (hc, hr) to its neighbour (lc, lr).
   bool blade_blocks(int hc, int hr, int lc, int lr, float top_m) const;
@@ -432,7 +440,12 @@ class SoilFlow {
   /// Whether cell a stands steeper than a pair's limit and the tolerance
   /// toward some neighbour (examine's test, without the blade).
   bool steep_now(std::uint32_t a, const float* h) const;
-  void displace(HeightGrid& grid, const Segment& from, const Segment& to, double bucket_room_m3,
+  /// The cut soil pushed ahead of the edge `to`: the way it goes is this
+  /// step's motion (from `from`) where that crosses the edge's line by more
+  /// than rounding, else the motion since `moved_from` (motion_origin: a
+  /// blade that stands still or goes straight down keeps the way it went).
+  void displace(HeightGrid& grid, const Segment& from, const Segment& moved_from, const Segment& to,
+                double bucket_room_m3,
                 SoilStepResult& out);
   void beside_body(const HeightGrid& grid, double x, double z, double tx, double tz,
                    std::int64_t& first, std::int64_t& second) const;
@@ -458,8 +471,8 @@ class SoilFlow {
   void run_passes(HeightGrid& grid, SoilStepResult& out);
   /// The soil above the repose cone through each end of the edge `to`
   /// slides round it, down to the cells under the cone, those the edge has
-  /// just cut behind it included (soil_ends.cpp); `from` is where the edge
-  /// was, for which side is behind.
+  /// just cut behind it included (soil_ends.cpp); `from` is where its
+  /// motion is measured from (motion_origin), for which side is behind.
   void spill_round_ends(HeightGrid& grid, const Segment& from, const Segment& to, SoilStepResult& out);
   // spill_round_ends' window round an end's apex (the first cell past it),
   // per cell: where it lies, its distance to the apex, and donor / receiver
@@ -617,9 +630,9 @@ class SoilFlow {
     double ax = 0.0, az = 0.0, dx = 0.0, dz = 0.0, ay = 0.0, dy = 0.0;
     bool present = false;
     double len2 = 0.0, len = 0.0, half = 0.0, half_lo = 0.0, half_hi = 0.0;
-    // Each end's motion in the step across the edge's line (as n's
-    // numerator, dx z - dz x), 0 when it did not cross it: the side the edge
-    // came from is the other one.
+    // Each end's motion across the edge's line since motion_origin's
+    // origin by the ends (as n's numerator, dx z - dz x), 0 when it did not
+    // cross it: the side the edge came from is the other one.
     double across_a = 0.0, across_b = 0.0;
   };
   BladeLine blade_{};

@@ -29,7 +29,7 @@ enum class WallMotion {
 };
 
 struct WallCase {
-  double length_m = 1.0;  ///< the blade in a channel (spanning: twice the terrain)
+  double length_m = 1.0;  ///< the blade in a channel (spanning the terrain it is 2 m, twice the terrain's side)
   double yaw_deg = 0.0;   ///< about +Y (0: along X, travelling along +Z)
   double speed_m_per_s = 1.0;  ///< along its travel, at 1 kHz
   WallMotion motion = WallMotion::kPush;
@@ -38,13 +38,20 @@ struct WallCase {
   double cell_m = 0.01;
 };
 
-/// The case in words, for messages.
+/// The blade's length as simulated, m: length_m in a channel, 2 m spanning
+/// the terrain.
+double blade_length_m(const WallCase& w);
+
+/// The case in words, for messages (the blade's length as simulated).
 std::string describe(const WallCase& w);
 
 /// The worst height above the edge's height, m, that a sample the blade had
 /// passed reached at any step (the far side of the blade, more than a cell
 /// and a half from its line). A float step of heights near 0.2 m (1e-8 m)
-/// is what an intact wall leaves.
+/// is what an intact wall leaves. Throws std::invalid_argument naming the
+/// case where it cannot be set up (a length, speed or cell not finite and
+/// positive, cells outside [2 mm, 5 cm], a speed under 1 mm/s, a channel
+/// the blade does not reach across at its largest yaw, nothing to watch).
 double worst_rise_behind(const WallCase& w);
 
 /// Float slack of the measure: far below any soil that crossed the blade.
