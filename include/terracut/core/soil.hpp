@@ -482,8 +482,6 @@ class SoilFlow {
   std::vector<std::uint8_t> ends_state_;
   double ends_s_[2] = {0.0, 0.0};  // each end's cone height at the last call
   bool cut_last_step_ = false;     // the last after_cut displaced or took in soil
-  MotionTrack motion_mid_;   // motion_origin by the edge's midpoint
-  MotionTrack motion_ends_;  // and by its ends
   std::int64_t ends_work_ = 0;     // visits the spill and the settle spent this step (charged to the cap by run_passes)
   std::vector<std::pair<double, int>> ends_keys_;  // the round's donors' and receivers' cone keys
   std::vector<std::int32_t> ends_queue_;           // the round's sets, window cells in the order found
@@ -731,6 +729,9 @@ class SoilFlow {
   Rect before_rect_{};        // where before_ holds the pre-cut heights
   std::vector<float> before_;  // (rect rows) x (rect cols), row-major
   std::vector<float> after_cut_;  // the same samples after the cut, before the displacement writes
+
+  MotionTrack motion_mid_;   // motion_origin by the edge's midpoint
+  MotionTrack motion_ends_;  // and by its ends
 };
 
 }  // namespace terracut
