@@ -1208,8 +1208,7 @@ void write_outputs(const fs::path& out, const Report& r) {
   std::string wall = "motion,blade_m,spanning,yaw_deg,speed_m_per_s,cell_m,cap,worst_rise_m\n";
   for (const WallRun& w : r.walls) {
     const validation::WallCase& c = w.what;
-    static const char* const motions[] = {"push", "plunge", "lift", "turn"};
-    wall += std::string(motions[int(c.motion)]) + "," + csv_number(validation::blade_length_m(c)) + "," +
+    wall += std::string(validation::motion_name(c.motion)) + "," + csv_number(validation::blade_length_m(c)) + "," +
             (c.channel ? "0" : "1") + "," + csv_number(c.yaw_deg) + "," + csv_number(c.speed_m_per_s) + "," +
             csv_number(c.cell_m) + "," + std::to_string(c.cap) + "," + csv_number(w.worst_m) + "\n";
   }

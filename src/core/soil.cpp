@@ -238,8 +238,9 @@ const Segment& SoilFlow::motion_origin(MotionTrack& track, const Segment& from, 
   const double reach = 2.0 * kMotionCells * std::max(dx_, dz_);
   const auto moved = [reach](double x, double z) { return x * x + z * z > reach * reach; };
   const Segment& a = track.anchor;
+  const PlanMotion mid = midpoint_motion(a, to);
   const bool far = by_ends ? moved(to.a.x - a.a.x, to.a.z - a.a.z) || moved(to.b.x - a.b.x, to.b.z - a.b.z)
-                           : moved(0.5 * (to.a.x + to.b.x - a.a.x - a.b.x), 0.5 * (to.a.z + to.b.z - a.a.z - a.b.z));
+                           : moved(mid.x, mid.z);
   if (far) {
     track.from = track.anchor;
     track.anchor = to;
@@ -250,10 +251,11 @@ const Segment& SoilFlow::motion_origin(MotionTrack& track, const Segment& from, 
 SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const Segment& to,
                                    const Quat& orientation) {
   SoilStepResult out;
-  // Which way the blade goes, for the displacement's push, the side behind
-  // it (the spill, the settle's wall, the passes'): from where it stood
-  // before its last move of a fiftieth of a cell, not from this step's
-  // start alone (motion_origin).
+  // Which way the blade goes, for the side behind it (the spill, the
+  // settle's wall, the passes') and the displacement's push in a step that
+  // did not cross the edge's line: from where it stood before its last move
+  // of a fiftieth of a cell, not from this step's start alone
+  // (motion_origin).
   const Segment& moved_from = motion_origin(motion_mid_, from, to, false);
   const Segment& ends_from = motion_origin(motion_ends_, from, to, true);
   double room = 0.0, holds = 0.0;

@@ -5,11 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 #include <vector>
 
+#include "terracut/core/format.hpp"
 #include "terracut/core/simulation.hpp"
 
 namespace terracut::validation {
@@ -19,6 +19,12 @@ namespace {
 constexpr double kWallDeg = std::numbers::pi / 180.0;
 constexpr double kWallLayer_m = 0.2;   // the soil's surface, m
 constexpr double kWallDepth_m = 0.05;  // the cut, m
+
+// The square terrain's side, m: in a channel room for the blade and 0.2 m
+// either side of it; spanning, 1 m.
+double terrain_side_m(const WallCase& w) { return w.channel ? std::max(1.0, w.length_m + 0.4) : 1.0; }
+
+}  // namespace
 
 const char* motion_name(WallMotion m) {
   switch (m) {
@@ -30,18 +36,6 @@ const char* motion_name(WallMotion m) {
   return "?";
 }
 
-// The square terrain's side, m: in a channel room for the blade and 0.2 m
-// either side of it; spanning, 1 m.
-double terrain_side_m(const WallCase& w) { return w.channel ? std::max(1.0, w.length_m + 0.4) : 1.0; }
-
-std::string wall_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
-}  // namespace
-
 double blade_length_m(const WallCase& w) {
   // Spanning the terrain, the blade is longer than the terrain's diagonal,
   // so its ends are off it.
@@ -49,9 +43,9 @@ double blade_length_m(const WallCase& w) {
 }
 
 std::string describe(const WallCase& w) {
-  const std::string blade = wall_number(blade_length_m(w)) + " m blade" + (w.channel ? "" : " spanning the terrain");
-  return std::string(motion_name(w.motion)) + ", " + blade + ", yaw " + wall_number(w.yaw_deg) + " deg, " +
-         wall_number(w.speed_m_per_s) + " m/s, " + wall_number(w.cell_m * 1000.0) + " mm cells" +
+  const std::string blade = format_number(blade_length_m(w)) + " m blade" + (w.channel ? "" : " spanning the terrain");
+  return std::string(motion_name(w.motion)) + ", " + blade + ", yaw " + format_number(w.yaw_deg) + " deg, " +
+         format_number(w.speed_m_per_s) + " m/s, " + format_number(w.cell_m * 1000.0) + " mm cells" +
          (w.channel ? ", in a channel" : "") + ", cap " + std::to_string(w.cap);
 }
 

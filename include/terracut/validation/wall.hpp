@@ -38,6 +38,9 @@ struct WallCase {
   double cell_m = 0.01;
 };
 
+/// The motion's name: push, plunge, lift, turn.
+const char* motion_name(WallMotion m);
+
 /// The blade's length as simulated, m: length_m in a channel, 2 m spanning
 /// the terrain.
 double blade_length_m(const WallCase& w);
