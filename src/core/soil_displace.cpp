@@ -114,16 +114,20 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
   const Vec3 e = to.b - to.a;
   double nx = -e.z, nz = e.x;
   const double plan_length = std::hypot(nx, nz);
-  // Which way the cut soil goes: this step's motion across the edge's line
-  // where that is more than rounding (every sample the edge cut in the step
-  // lies in what it swept, on the side it came from in the step), else the
-  // motion since the blade last moved (motion_origin: a blade standing
-  // still, going straight down or sliding along its line keeps the way it
-  // went), else none (each cut sample's soil to its own side). (A test of a
-  // hundredth of a cell's motion in the step took a slow blade for one at
-  // rest, 0.1 m/s on 1 cm cells, and put the cut of each centre the edge
-  // had just passed on that centre's own side: behind the blade, at every
-  // row.)
+  // Which way the cut soil goes, at each point of the edge: that point's
+  // motion across the edge's line in this step where that is more than
+  // rounding (every sample the edge cut in the step lies in what it swept,
+  // on the side it came from in the step), else its motion since the blade
+  // last moved (motion_origin: a blade standing still, going straight down
+  // or sliding along its line keeps the way it went), else none (each cut
+  // sample's soil to its own side). (A test of a hundredth of a cell's
+  // motion in the step took a slow blade for one at rest, 0.1 m/s on 1 cm
+  // cells, and put the cut of each centre the edge had just passed on that
+  // centre's own side: behind the blade, at every row.) A point's motion is
+  // its end's motions interpolated along the edge: a turning blade's two
+  // parts can go opposite ways (one way for the whole edge, its midpoint's,
+  // pushed the cut of the part going forward behind it when a hand's tremor
+  // took the midpoint back: a 0.55 m blade on 2 cm cells, 2 cm behind it).
   const double rounding = 1e-9 * cell;
   const PlanMotion step_motion = midpoint_motion(from, to), since_motion = midpoint_motion(moved_from, to);
   if (plan_length > 1e-12) {
@@ -136,20 +140,27 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
     nx = length > 1e-12 ? m.x / length : 1.0;
     nz = length > 1e-12 ? m.z / length : 0.0;
   }
+  const double line_nx = nx, line_nz = nz;  // the normal, before it is turned to a point's way
+  const auto across = [&](const Vec3& was, const Vec3& is) { return line_nx * (is.x - was.x) + line_nz * (is.z - was.z); };
+  const double step_a = across(from.a, to.a), step_b = across(from.b, to.b);
+  const double since_a = across(moved_from.a, to.a), since_b = across(moved_from.b, to.b);
+  const double edge_len2 = e.x * e.x + e.z * e.z;
+  // The motion across the line (along the normal) of the edge's point
+  // nearest to (x, z), 0 for none.
+  const auto way_at = [&](double x, double z) {
+    const double t =
+        edge_len2 > 0.0 ? std::clamp(((x - to.a.x) * e.x + (z - to.a.z) * e.z) / edge_len2, 0.0, 1.0) : 0.5;
+    const double now = (1.0 - t) * step_a + t * step_b;
+    if (std::abs(now) > rounding) return now;
+    const double since = (1.0 - t) * since_a + t * since_b;
+    return std::abs(since) > rounding ? since : 0.0;
+  };
   // One cell along the push (the longer cell side across it, so the roll
   // never skips a cell).
   const double step = std::min(dx_ / std::max(std::abs(nx), 1e-9), dz_ / std::max(std::abs(nz), 1e-9));
   // The repose drop over one such cell.
   const double limit_step = std::tan(params_.material.repose_deg * std::numbers::pi / 180.0) * step *
                             std::hypot(nx, nz);
-  const double along_step = nx * step_motion.x + nz * step_motion.z;
-  const double along_motion =
-      std::abs(along_step) > rounding ? along_step : nx * since_motion.x + nz * since_motion.z;
-  const bool moving = std::abs(along_motion) > rounding;
-  if (moving && along_motion < 0.0) {
-    nx = -nx;
-    nz = -nz;
-  }
 
   const HeightGrid::EditLayers layers = grid.edit_layers();
   const Rect& r = before_rect_;
@@ -165,15 +176,17 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
     layers.height_m[cell] = value;
     last_put = cell;
   };
-  // Whether the centre of cell (c, r) lies behind the edge (on the side it
-  // came from, past the half cell its line passes through), within its
-  // length: the cut behind the blade, where no displaced soil may go.
-  const double edge_len2 = e.x * e.x + e.z * e.z;
+  // Whether the centre of cell (c, r) lies behind the edge (on the side
+  // that part of it came from, past the half cell its line passes through),
+  // within its length: the cut behind the blade, where no displaced soil
+  // may go.
   const auto behind_blade = [&](int c, int r) {
     if (!(edge_len2 > 0.0)) return false;
     const double x = spec.origin_m.x + (c + 0.5) * dx_ - to.a.x, z = spec.origin_m.z + (r + 0.5) * dz_ - to.a.z;
     const double t = (x * e.x + z * e.z) / edge_len2;
-    return t >= 0.0 && t <= 1.0 && x * nx + z * nz < -0.5 * cell;
+    if (!(t >= 0.0 && t <= 1.0)) return false;
+    const double n = x * line_nx + z * line_nz;
+    return (way_at(x + to.a.x, z + to.a.z) < 0.0 ? -n : n) < -0.5 * cell;
   };
   // Puts `add` metres on `cell`, never above the ceiling (a Bullet
   // heightfield's upper bound would clamp, and so delete, soil above it):
@@ -255,6 +268,11 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       // the line on the cell's own side.
       const double x = spec.origin_m.x + (c + 0.5) * dx_;
       const double z = spec.origin_m.z + (row + 0.5) * dz_;
+      // The push's direction: the normal turned to this point's way.
+      const double way = way_at(x, z);
+      const bool moving = way != 0.0;
+      nx = way < 0.0 ? -line_nx : line_nx;
+      nz = way < 0.0 ? -line_nz : line_nz;
       const double s = (x - to.a.x) * nx + (z - to.a.z) * nz;
       const double side = moving || s >= 0.0 ? 1.0 : -1.0;
       const double go = side * (kDepositAheadCells * cell) - s;

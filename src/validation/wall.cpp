@@ -46,7 +46,9 @@ std::string describe(const WallCase& w) {
   const std::string blade = format_number(blade_length_m(w)) + " m blade" + (w.channel ? "" : " spanning the terrain");
   return std::string(motion_name(w.motion)) + ", " + blade + ", yaw " + format_number(w.yaw_deg) + " deg, " +
          format_number(w.speed_m_per_s) + " m/s, " + format_number(w.cell_m * 1000.0) + " mm cells" +
-         (w.channel ? ", in a channel" : "") + ", cap " + std::to_string(w.cap);
+         (w.channel ? ", in a channel" : "") +
+         (w.tremor_m > 0.0 ? ", tremor " + format_number(w.tremor_m * 1000.0) + " mm" : "") + ", cap " +
+         std::to_string(w.cap);
 }
 
 double worst_rise_behind(const WallCase& w) {
@@ -57,6 +59,8 @@ double worst_rise_behind(const WallCase& w) {
   if (w.cell_m > 0.05 || w.cell_m < 0.002 || w.speed_m_per_s < 0.001)
     throw std::invalid_argument("worst_rise_behind: cell_m must lie in [0.002, 0.05] m and speed_m_per_s be at least "
                                 "0.001 m/s (" + describe(w) + ")");
+  if (!(std::isfinite(w.tremor_m) && w.tremor_m >= 0.0 && w.tremor_m <= 0.02))
+    throw std::invalid_argument("worst_rise_behind: tremor_m must lie in [0, 0.02] m (" + describe(w) + ")");
   const double cell = w.cell_m;
   const double travel = 0.3;  // m
   const double yaw = w.yaw_deg * kWallDeg;
@@ -96,18 +100,26 @@ double worst_rise_behind(const WallCase& w) {
     walls.push_back({{0, 0, c0, n}, 0.0f});
     walls.push_back({{c1, 0, n, n}, 0.0f});
   }
-  // The pose at step s in [0, 1]. The edge's height: level, down 4 cm
-  // over the first two thirds (a ramp of 0.2, gentler than tan 34 deg =
-  // 0.67), or up 4 cm so. Turning, the yaw swings from -8 to +8 degrees
-  // about the blade's centre while it moves on (slowly enough that every
-  // point of the blade over the terrain moves forward: none backs into the
-  // trench, beside the uncut soil ahead of the starting line).
+  // The pose at step s in [0, 1] (time s * travel / speed). The edge's
+  // height: level, down 4 cm over the first two thirds of the travel (a
+  // ramp of 0.2, gentler than tan 34 deg = 0.67), or up 4 cm so; the ramp
+  // is fixed in space, so a blade the tremor takes back and forth passes a
+  // sample at the same height each time (one whose height followed the
+  // time would cut the floor behind it with its back, or leave what slid
+  // into the gap above the first pass's floor, as a real blade would).
+  // Turning, the yaw swings from -8 to +8 degrees about the blade's centre
+  // while it moves on (slowly enough that every point of the blade over the
+  // terrain moves forward: none backs into the trench, beside the uncut
+  // soil ahead of the starting line, but where the tremor takes it back).
+  const double seconds = travel / w.speed_m_per_s;
   const auto pose_at = [&](double s) {
+    const double along =
+        -0.5 * travel + travel * s + w.tremor_m * std::sin(2.0 * std::numbers::pi * kWallTremor_hz * seconds * s);
+    const double ramp = std::min(1.0, 1.5 * std::clamp(along / travel + 0.5, 0.0, 1.0));
     double y = edge_start;
-    if (w.motion == WallMotion::kPlunge) y = kWallLayer_m - 0.01 - 0.04 * std::min(1.0, 1.5 * s);
-    if (w.motion == WallMotion::kLift) y = edge_start + 0.04 * std::min(1.0, 1.5 * s);
+    if (w.motion == WallMotion::kPlunge) y = kWallLayer_m - 0.01 - 0.04 * ramp;
+    if (w.motion == WallMotion::kLift) y = edge_start + 0.04 * ramp;
     const double turn = w.motion == WallMotion::kTurn ? (-8.0 + 16.0 * s) * kWallDeg : 0.0;
-    const double along = -0.5 * travel + travel * s;
     return BladePose{{cx + nx * along, y, cz + nz * along}, quat_from_axis_angle({0.0, 1.0, 0.0}, yaw + turn)};
   };
   // Behind the starting line the trench is already dug, to the edge's
@@ -158,7 +170,10 @@ double worst_rise_behind(const WallCase& w) {
         // centre, between this step's pose and the last.
         if (passed && std::isnan(floor[k]))
           floor[k] = std::max(edge.a.y + (edge.b.y - edge.a.y) * t, last_edge_y(x, z));
-        if (!passed || std::abs(d) <= 1.5 * cell) continue;
+        // Watched: passed, and on the side the blade came from now (a
+        // blade the tremor takes back leaves soil that slid after it, in
+        // front of it, on samples it had passed).
+        if (!passed || d > -1.5 * cell) continue;
         worst = std::max(worst, double(g.height(c, r)) - floor[k]);
         ++measured;
       }
@@ -180,6 +195,19 @@ std::vector<WallCase> validation_wall_cases() {
   // In a channel: short and long blades, straight and yawed.
   for (const double length : {0.2, 0.5, 2.0})
     for (const double yaw : {0.0, 25.0}) cases.push_back({length, yaw, speeds[k++ % 3], WallMotion::kPush, true});
+  // A hand's tremor of 4 mm backing the blade up in every cycle: every
+  // motion spanning the terrain, and turning in a channel.
+  const double tremor_speeds[] = {0.1, 0.2};
+  k = 0;
+  for (const WallMotion motion : {WallMotion::kPush, WallMotion::kPlunge, WallMotion::kLift, WallMotion::kTurn}) {
+    WallCase w{1.0, 10.0 + 40.0 * k, tremor_speeds[k % 2], motion, false};
+    w.tremor_m = 0.004;
+    cases.push_back(w);
+    ++k;
+  }
+  WallCase turning{0.5, 10.0, 0.2, WallMotion::kTurn, true};
+  turning.tremor_m = 0.004;
+  cases.push_back(turning);
   return cases;
 }
 

@@ -1,11 +1,12 @@
 // The blade is a wall (validation/wall.hpp): no soil that came through or
 // under the blade stands behind it, for blades of 0.2 to 2 m, yaws round the
 // compass, speeds of 0.05 to 2 m/s, pushing, plunging, lifting and turning,
-// at the work cap and with it lifted.
+// at the work cap and with it lifted, steadily and with a hand's tremor.
 #include "terracut/validation/wall.hpp"
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -65,6 +66,28 @@ TEST(SoilWall, NoSoilCrossesASlowBlade) {
   }
 }
 
+// A hand's tremor (kWallTremor_hz, 4 mm) takes the blade back and forth in
+// every cycle at 0.1 and 0.2 m/s. While it turns, the blade's midpoint goes
+// back while part of the edge still goes forward: the displacement once
+// pushed the whole edge's cut the way the midpoint went, so the part going
+// forward put what it cut behind itself (on the code before the way was
+// taken point by point along the edge, the turning cases here left 1.2 to
+// 2.0 cm of soil behind the blade).
+TEST(SoilWall, NoSoilCrossesATremblingBlade) {
+  int k = 0;
+  for (const WallMotion motion : {WallMotion::kPush, WallMotion::kPlunge, WallMotion::kLift, WallMotion::kTurn})
+    for (const double yaw : {10.0, 100.0}) {
+      WallCase w{1.0, yaw, k++ % 2 == 0 ? 0.1 : 0.2, motion, false};
+      w.tremor_m = 0.004;
+      EXPECT_LE(worst_rise_behind(w), kWallSlack_m) << describe(w);
+    }
+  for (const double length : {0.5, 1.0}) {
+    WallCase w{length, 10.0, 0.2, WallMotion::kTurn, true};
+    w.tremor_m = 0.004;
+    EXPECT_LE(worst_rise_behind(w), kWallSlack_m) << describe(w);
+  }
+}
+
 // The cases `terracut validate` runs hold too (its check 3.3).
 TEST(SoilWall, TheValidationCasesHold) {
   const std::vector<WallCase> cases = validation_wall_cases();
@@ -84,6 +107,11 @@ TEST(SoilWall, ACaseItCannotSetUpIsRefused) {
   };
   EXPECT_NE(message({0.0, 0.0, 1.0, WallMotion::kPush, false}).find("length_m"), std::string::npos);
   EXPECT_NE(message({1.0, 0.0, -1.0, WallMotion::kPush, false}).find("speed_m_per_s"), std::string::npos);
+  WallCase shaking{1.0, 0.0, 1.0, WallMotion::kPush, false};
+  shaking.tremor_m = -0.001;
+  EXPECT_NE(message(shaking).find("tremor_m"), std::string::npos);
+  shaking.tremor_m = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(message(shaking).find("tremor_m"), std::string::npos);
   // A blade turned along the channel does not reach across it.
   EXPECT_NE(message({1.0, 89.0, 1.0, WallMotion::kPush, true}).find("channel"), std::string::npos);
 }

@@ -440,10 +440,12 @@ class SoilFlow {
   /// Whether cell a stands steeper than a pair's limit and the tolerance
   /// toward some neighbour (examine's test, without the blade).
   bool steep_now(std::uint32_t a, const float* h) const;
-  /// The cut soil pushed ahead of the edge `to`: the way it goes is this
-  /// step's motion (from `from`) where that crosses the edge's line by more
-  /// than rounding, else the motion since `moved_from` (motion_origin: a
-  /// blade that stands still or goes straight down keeps the way it went).
+  /// The cut soil pushed ahead of the edge `to`: the way it goes, at each
+  /// point of the edge, is that point's motion across the edge's line (its
+  /// ends' motions interpolated along it: a turning blade's parts can go
+  /// opposite ways) in this step (from `from`) where that is more than
+  /// rounding, else its motion since `moved_from` (motion_origin: a blade
+  /// that stands still or goes straight down keeps the way it went).
   void displace(HeightGrid& grid, const Segment& from, const Segment& moved_from, const Segment& to,
                 double bucket_room_m3,
                 SoilStepResult& out);

@@ -23,10 +23,14 @@ namespace terracut::validation {
 /// What the blade does over its 0.3 m of travel.
 enum class WallMotion {
   kPush,    ///< level, the edge 5 cm into the 20 cm layer
-  kPlunge,  ///< the edge from 1 cm to 5 cm deep over the first two thirds
+  kPlunge,  ///< the edge from 1 cm to 5 cm deep over the first two thirds of the travel (a ramp in space)
   kLift,    ///< the edge from 5 cm to 1 cm deep so
   kTurn,    ///< level, the yaw swinging from -8 to +8 degrees about its centre
 };
+
+/// A hand's tremor (physiological tremor lies at 8 to 12 Hz): the blade
+/// oscillates along its travel at this frequency on top of its motion.
+inline constexpr double kWallTremor_hz = 9.0;
 
 struct WallCase {
   double length_m = 1.0;  ///< the blade in a channel (spanning the terrain it is 2 m, twice the terrain's side)
@@ -36,6 +40,10 @@ struct WallCase {
   bool channel = false;  ///< between two rigid obstacles beyond its ends (travel along +Z)
   std::int64_t cap = 50000;  ///< the soil's work cap, neighbour visits a step
   double cell_m = 0.01;
+  /// The tremor's amplitude along the travel, m (0: none). Above
+  /// speed / (2 pi kWallTremor_hz) the blade backs up in every cycle: 4 mm
+  /// takes a blade at under 0.23 m/s back and forth.
+  double tremor_m = 0.0;
 };
 
 /// The motion's name: push, plunge, lift, turn.
@@ -51,10 +59,12 @@ std::string describe(const WallCase& w);
 /// The worst height above the edge's height, m, that a sample the blade had
 /// passed reached at any step (the far side of the blade, more than a cell
 /// and a half from its line). A float step of heights near 0.2 m (1e-8 m)
-/// is what an intact wall leaves. Throws std::invalid_argument naming the
-/// case where it cannot be set up (a length, speed or cell not finite and
-/// positive, cells outside [2 mm, 5 cm], a speed under 1 mm/s, a channel
-/// the blade does not reach across at its largest yaw, nothing to watch).
+/// is what an intact wall leaves. The samples watched are those now on the
+/// side the blade came from. Throws std::invalid_argument naming the case
+/// where it cannot be set up (a length, speed or cell not finite and
+/// positive, cells outside [2 mm, 5 cm], a speed under 1 mm/s, a tremor
+/// negative, not finite or over 2 cm, a channel the blade does not reach
+/// across at its largest yaw, nothing to watch).
 double worst_rise_behind(const WallCase& w);
 
 /// Float slack of the measure: far below any soil that crossed the blade.
@@ -62,7 +72,8 @@ inline constexpr double kWallSlack_m = 1e-5;
 
 /// The cases `terracut validate` runs: blades of 0.2 to 2 m, yaws of 0 to
 /// 135 degrees, speeds of 0.05 to 2 m/s (a slow one moves under a hundredth
-/// of a cell a step), every motion, spanning the terrain and in a channel.
+/// of a cell a step), every motion, spanning the terrain and in a channel,
+/// and every motion again with a hand's tremor that backs the blade up.
 std::vector<WallCase> validation_wall_cases();
 
 }  // namespace terracut::validation
