@@ -47,7 +47,8 @@ std::string describe(const WallCase& w) {
   return std::string(motion_name(w.motion)) + ", " + blade + ", yaw " + format_number(w.yaw_deg) + " deg, " +
          format_number(w.speed_m_per_s) + " m/s, " + format_number(w.cell_m * 1000.0) + " mm cells" +
          (w.channel ? ", in a channel" : "") +
-         (w.tremor_m > 0.0 ? ", tremor " + format_number(w.tremor_m * 1000.0) + " mm" : "") + ", cap " +
+         (w.tremor_m > 0.0 ? ", tremor " + format_number(w.tremor_m * 1000.0) + " mm" : "") +
+         (w.wobble_deg > 0.0 ? ", wobble " + format_number(w.wobble_deg) + " deg" : "") + ", cap " +
          std::to_string(w.cap);
 }
 
@@ -61,6 +62,10 @@ double worst_rise_behind(const WallCase& w) {
                                 "0.001 m/s (" + describe(w) + ")");
   if (!(std::isfinite(w.tremor_m) && w.tremor_m >= 0.0 && w.tremor_m <= 0.02))
     throw std::invalid_argument("worst_rise_behind: tremor_m must lie in [0, 0.02] m (" + describe(w) + ")");
+  if (!(std::isfinite(w.wobble_deg) && w.wobble_deg >= 0.0 && w.wobble_deg <= 5.0))
+    throw std::invalid_argument("worst_rise_behind: wobble_deg must lie in [0, 5] degrees (" + describe(w) + ")");
+  if (w.wobble_deg > 0.0 && (w.motion == WallMotion::kPlunge || w.motion == WallMotion::kLift))
+    throw std::invalid_argument("worst_rise_behind: a wobble needs a level motion, push or turn (" + describe(w) + ")");
   const double cell = w.cell_m;
   const double travel = 0.3;  // m
   const double yaw = w.yaw_deg * kWallDeg;
@@ -88,7 +93,7 @@ double worst_rise_behind(const WallCase& w) {
     // less two cells: its ends stay over the obstacles either side, whose
     // cells stand below the floor (no soil to cut or to slide off them) and
     // are closed to soil coming in.
-    const double widest_yaw = std::abs(w.yaw_deg) + (w.motion == WallMotion::kTurn ? 8.0 : 0.0);
+    const double widest_yaw = std::abs(w.yaw_deg) + (w.motion == WallMotion::kTurn ? 8.0 : 0.0) + w.wobble_deg;
     const double half_channel = 0.5 * w.length_m * std::cos(widest_yaw * kWallDeg) - 2.0 * cell;
     if (!(half_channel >= 2.0 * cell))
       throw std::invalid_argument("worst_rise_behind: in a channel the blade must reach across at least 8 cells "
@@ -110,7 +115,8 @@ double worst_rise_behind(const WallCase& w) {
   // Turning, the yaw swings from -8 to +8 degrees about the blade's centre
   // while it moves on (slowly enough that every point of the blade over the
   // terrain moves forward: none backs into the trench, beside the uncut
-  // soil ahead of the starting line, but where the tremor takes it back).
+  // soil ahead of the starting line, but where the tremor or the wobble
+  // takes it back).
   const double seconds = travel / w.speed_m_per_s;
   const auto pose_at = [&](double s) {
     const double along =
@@ -119,8 +125,10 @@ double worst_rise_behind(const WallCase& w) {
     double y = edge_start;
     if (w.motion == WallMotion::kPlunge) y = kWallLayer_m - 0.01 - 0.04 * ramp;
     if (w.motion == WallMotion::kLift) y = edge_start + 0.04 * ramp;
-    const double turn = w.motion == WallMotion::kTurn ? (-8.0 + 16.0 * s) * kWallDeg : 0.0;
-    return BladePose{{cx + nx * along, y, cz + nz * along}, quat_from_axis_angle({0.0, 1.0, 0.0}, yaw + turn)};
+    const double turn = (w.motion == WallMotion::kTurn ? -8.0 + 16.0 * s : 0.0) +
+                        w.wobble_deg * std::sin(2.0 * std::numbers::pi * kWallWobble_hz * seconds * s);
+    const double yaw_now = yaw + turn * kWallDeg;
+    return BladePose{{cx + nx * along, y, cz + nz * along}, quat_from_axis_angle({0.0, 1.0, 0.0}, yaw_now)};
   };
   // Behind the starting line the trench is already dug, to the edge's
   // height there: no back wall at the trench's start to slump into it.
@@ -208,6 +216,17 @@ std::vector<WallCase> validation_wall_cases() {
   WallCase turning{0.5, 10.0, 0.2, WallMotion::kTurn, true};
   turning.tremor_m = 0.004;
   cases.push_back(turning);
+  // A wobble of 1.5 degrees about the vertical with a 2 mm tremor: a 2 m
+  // blade spanning the terrain pushing, and a 0.8 m blade turning in a
+  // channel.
+  WallCase wobbling{1.0, 173.0, 0.6, WallMotion::kPush, false};
+  wobbling.tremor_m = 0.002;
+  wobbling.wobble_deg = 1.5;
+  cases.push_back(wobbling);
+  wobbling = WallCase{0.8, -30.0, 0.25, WallMotion::kTurn, true};
+  wobbling.tremor_m = 0.002;
+  wobbling.wobble_deg = 1.5;
+  cases.push_back(wobbling);
   return cases;
 }
 

@@ -174,9 +174,14 @@ TEST(BruteForceTies, LatticeContactEqualsOracle) {
 // Cut: the closed rule, against an exact integer reference.
 
 using test::LatticePoint;
+using test::SweepTriangles;
 using test::holds;
+using test::on_crossing_line;
 using test::representable_slope;
 using test::touches;
+
+/// Bow-ties whose fast cut expect_closed_cut checked against the closed rule.
+int bow_ties_fast_checked = 0;
 
 /// A sweep between lattice points (units of 1/den cell), heights in metres.
 struct LatticeSweep {
@@ -194,32 +199,46 @@ bool expect_closed_cut(const LatticeSweep& w, int den, bool check_fast, const st
   auto world = [&](LatticePoint p, double y) { return at(s, double(p.x) / den, double(p.z) / den, y); };
   const Segment from{world(w.from_a, w.y_a), world(w.from_b, w.y_b)};
   const Segment to{world(w.to_a, w.y_a), world(w.to_b, w.y_b)};
-  const LatticePoint tri[2][3] = {{w.from_a, w.from_b, w.to_b}, {w.from_a, w.to_b, w.to_a}};
+  const SweepTriangles sweep = test::sweep_triangles(w.from_a, w.from_b, w.to_a, w.to_b);
+  const std::int64_t k = std::int64_t(den) * sweep.scale;  // lattice units a cell
+  // The lattice doubled, so that sample centres (half cells) are points of it.
+  SweepTriangles doubled = sweep;
+  for (auto& t : doubled.tri)
+    for (auto& v : t) v = {2 * v.x, 2 * v.z};
   for (Representation rep : kBoth) {
     const std::vector<float> initial(std::size_t(s.sample_count()), 0.9f);
     HeightGrid fast(s, initial), slow(s, initial);
     const CutResult a = cut_sweep(fast, rep, from, to);
     const CutResult b = cut_sweep_brute_force(slow, rep, from, to);
-    int wrong_oracle = 0, wrong_fast = 0;
+    int wrong_oracle = 0, wrong_fast = 0, wrong_fast_rule = 0;
+    // A bow-tie's fast cut against the closed rule itself (the oracle's
+    // comparison needs representable slopes, and the crossing's are not),
+    // where its two sides through no crossing have representable slopes.
+    const bool fast_rule = sweep.bow_tie && representable_slope(w.from_a, w.to_a) && representable_slope(w.from_b, w.to_b);
     for (int r = 0; r < s.rows; ++r) {
       for (int c = 0; c < s.cols; ++c) {
         bool covered = false;
-        for (const auto& t : tri) {
+        for (const auto& t : doubled.tri) {
           if (rep == Representation::kColumns) {
-            covered |= touches(t, std::int64_t(c) * den, std::int64_t(c + 1) * den, std::int64_t(r) * den,
-                               std::int64_t(r + 1) * den);
+            covered |= touches(t, 2 * c * k, 2 * (c + 1) * k, 2 * r * k, 2 * (r + 1) * k);
           } else {
-            // Sample centres at half cells: the lattice doubled.
-            const LatticePoint t2[3] = {{2 * t[0].x, 2 * t[0].z}, {2 * t[1].x, 2 * t[1].z}, {2 * t[2].x, 2 * t[2].z}};
-            covered |= holds(t2, {std::int64_t(2 * c + 1) * den, std::int64_t(2 * r + 1) * den});
+            covered |= holds(t, {(2 * c + 1) * k, (2 * r + 1) * k});
           }
         }
+        // A bow-tie's crossing is rounded: on a line through it, either
+        // side is right.
+        const bool tie = rep == Representation::kColumns
+                             ? on_crossing_line(doubled, 2 * c * k, 2 * (c + 1) * k, 2 * r * k, 2 * (r + 1) * k)
+                             : on_crossing_line(doubled, {(2 * c + 1) * k, (2 * r + 1) * k});
         const float h_slow = slow.height(c, r), h_fast = fast.height(c, r);
-        wrong_oracle += (h_slow < 0.9f) != covered;
-        if (check_fast) wrong_fast += !(std::abs(h_fast - h_slow) <= 1e-6f);
+        wrong_oracle += !tie && (h_slow < 0.9f) != covered;
+        if (fast_rule) wrong_fast_rule += !tie && (h_fast < 0.9f) != covered;
+        if (check_fast && !tie) wrong_fast += !(std::abs(h_fast - h_slow) <= 1e-6f);
       }
     }
     EXPECT_EQ(wrong_oracle, 0) << name_of(rep, what);
+    EXPECT_EQ(wrong_fast_rule, 0) << name_of(rep, what);
+    bow_ties_fast_checked += fast_rule;
     if (check_fast) {
       EXPECT_EQ(wrong_fast, 0) << name_of(rep, what);
       EXPECT_NEAR(a.removed_volume_m3, b.removed_volume_m3, 1e-9 + 1e-7 * b.removed_volume_m3) << name_of(rep, what);
@@ -288,7 +307,7 @@ TEST(BruteForceTies, NamedTiesFollowTheClosedRule) {
 // representable.
 TEST(BruteForceTies, LatticeSweepsFollowTheClosedRule) {
   std::mt19937 rng(17);
-  int fast_checked = 0;
+  int fast_checked = 0, bow_ties = 0;
   for (int den : {1, 2, 4}) {
     std::uniform_int_distribution<int> u(2 * den, 30 * den), v(1 * den, 15 * den), y(1, 12);
     for (int mode = 0; mode < 3; ++mode) {
@@ -309,10 +328,14 @@ TEST(BruteForceTies, LatticeSweepsFollowTheClosedRule) {
         }
         w.y_a = y(rng) / 16.0;
         w.y_b = y(rng) / 16.0;
-        const LatticePoint tri[2][3] = {{w.from_a, w.from_b, w.to_b}, {w.from_a, w.to_b, w.to_a}};
-        bool representable = true;
-        for (const auto& t : tri)
+        // A bow-tie (the edges crossing: the blade turned about a point of
+        // its edge) has its crossing rounded, so the fast path and the
+        // oracle are compared on the diagonal splits only.
+        const SweepTriangles sweep = test::sweep_triangles(w.from_a, w.from_b, w.to_a, w.to_b);
+        bool representable = !sweep.bow_tie;
+        for (const auto& t : sweep.tri)
           for (int e = 0; e < 3; ++e) representable = representable && representable_slope(t[e], t[(e + 1) % 3]);
+        bow_ties += sweep.bow_tie;
         std::ostringstream what;
         what << "den " << den << " mode " << mode << " sweep " << k << ": ";
         for (const LatticePoint& p : {w.from_a, w.from_b, w.to_a, w.to_b}) {
@@ -324,6 +347,8 @@ TEST(BruteForceTies, LatticeSweepsFollowTheClosedRule) {
     }
   }
   EXPECT_GT(fast_checked, 500);  // the fast path was compared on many of them
+  EXPECT_GT(bow_ties, 100);      // and the oracle checked against the lobes of many bow-ties,
+  EXPECT_GT(bow_ties_fast_checked, 20);  // the fast path too on some
 }
 
 }  // namespace

@@ -61,6 +61,62 @@ inline bool holds(const LatticePoint (&t)[3], LatticePoint p) {
   return area != 0;
 }
 
+/// The swept region of an edge moving from (fa, fb) to (ta, tb) as the cut
+/// builds it (src/core/geometry.hpp, sweep_triangles), in exact integers:
+/// the quad split along its diagonal fa-tb, or, where the two edges cross at
+/// a point P strictly inside both (a bow-tie: the blade turned about a point
+/// of its edge), the lobes (fa, ta, P) and (P, fb, tb). P = fa + (fb - fa) s
+/// with s = (g x f) / (e x f) is rational, so a bow-tie's points are given
+/// on a lattice `scale` = |e x f| times finer, where P's coordinates are
+/// integers (scale 1 for the diagonal split).
+struct SweepTriangles {
+  LatticePoint tri[2][3];
+  std::int64_t scale = 1;
+  bool bow_tie = false;
+};
+
+inline SweepTriangles sweep_triangles(LatticePoint fa, LatticePoint fb, LatticePoint ta, LatticePoint tb) {
+  SweepTriangles w{{{fa, fb, tb}, {fa, tb, ta}}};
+  const std::int64_t ex = fb.x - fa.x, ez = fb.z - fa.z, fx = tb.x - ta.x, fz = tb.z - ta.z;
+  const std::int64_t gx = ta.x - fa.x, gz = ta.z - fa.z;
+  std::int64_t d = ex * fz - ez * fx, sn = gx * fz - gz * fx, un = gx * ez - gz * ex;
+  if (d == 0) return w;
+  if (d < 0) d = -d, sn = -sn, un = -un;
+  if (!(sn > 0 && sn < d && un > 0 && un < d)) return w;
+  const auto up = [d](LatticePoint q) { return LatticePoint{q.x * d, q.z * d}; };
+  const LatticePoint p{fa.x * d + ex * sn, fa.z * d + ez * sn};
+  const LatticePoint lobes[2][3] = {{up(fa), up(ta), p}, {p, up(fb), up(tb)}};
+  for (int t = 0; t < 2; ++t)
+    for (int v = 0; v < 3; ++v) w.tri[t][v] = lobes[t][v];
+  w.scale = d;
+  w.bow_tie = true;
+  return w;
+}
+
+/// For a bow-tie, whether point q (on its scaled lattice) lies on a line
+/// through the crossing P and another vertex of a lobe, or is P: the cut
+/// computes P in double, rounded, so which side of such a line q falls on
+/// is rounding's, not the closed rule's. False for the diagonal split.
+inline bool on_crossing_line(const SweepTriangles& w, LatticePoint q) {
+  if (!w.bow_tie) return false;
+  const LatticePoint p = w.tri[0][2];
+  for (const LatticePoint& v : {w.tri[0][0], w.tri[0][1], w.tri[1][1], w.tri[1][2]})
+    if (orient(p, v, q) == 0) return true;
+  return false;
+}
+
+/// on_crossing_line for a closed box [x0, x1] x [z0, z1]: a corner on such
+/// a line, or P on the box's boundary.
+inline bool on_crossing_line(const SweepTriangles& w, std::int64_t x0, std::int64_t x1, std::int64_t z0,
+                             std::int64_t z1) {
+  if (!w.bow_tie) return false;
+  for (const LatticePoint& q : {LatticePoint{x0, z0}, LatticePoint{x1, z0}, LatticePoint{x1, z1}, LatticePoint{x0, z1}})
+    if (on_crossing_line(w, q)) return true;
+  const LatticePoint p = w.tri[0][2];
+  const bool in_x = p.x >= x0 && p.x <= x1, in_z = p.z >= z0 && p.z <= z1;
+  return (in_z && (p.x == x0 || p.x == x1)) || (in_x && (p.z == z0 || p.z == z1));
+}
+
 /// Whether dx/dz of the segment is exact in binary floating point.
 inline bool representable_slope(LatticePoint a, LatticePoint b) {
   const std::int64_t dx = std::abs(b.x - a.x), dz = std::abs(b.z - a.z);

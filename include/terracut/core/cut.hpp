@@ -2,8 +2,12 @@
 // is cut, however far it moved (no tunnelling).
 //
 // The swept surface between edge `from` (endpoints A0, B0) and edge `to`
-// (A1, B1) is taken as the two triangles (A0, B0, B1) and (A0, B1, A1). The
-// caller splits a motion with a large rotation into sub-steps (see
+// (A1, B1) is taken as the two triangles (A0, B0, B1) and (A0, B1, A1); where
+// the two edges cross in plan at a point P inside both (the blade turned
+// about a point of its edge: a turn in place, a hand's wobble), that quad is
+// a bow-tie and the triangles are its lobes (A0, A1, P) and (P, B0, B1) (the
+// diagonal's triangle would reach ahead of the part of the edge that went
+// back). The caller splits a motion with a large rotation into sub-steps (see
 // Simulation), so this approximates the true sweep to a fraction of a cell.
 //
 // - Surface representation: every sample point whose ground position lies

@@ -31,6 +31,9 @@ enum class WallMotion {
 /// A hand's tremor (physiological tremor lies at 8 to 12 Hz): the blade
 /// oscillates along its travel at this frequency on top of its motion.
 inline constexpr double kWallTremor_hz = 9.0;
+/// A hand's wobble about the vertical: the yaw oscillates about the blade's
+/// centre at this frequency (off the tremor's, so the two drift in phase).
+inline constexpr double kWallWobble_hz = 10.2;
 
 struct WallCase {
   double length_m = 1.0;  ///< the blade in a channel (spanning the terrain it is 2 m, twice the terrain's side)
@@ -44,6 +47,13 @@ struct WallCase {
   /// speed / (2 pi kWallTremor_hz) the blade backs up in every cycle: 4 mm
   /// takes a blade at under 0.23 m/s back and forth.
   double tremor_m = 0.0;
+  /// The wobble's amplitude about the vertical, degrees (0: none). The
+  /// blade then turns about its centre every cycle, its two halves going
+  /// opposite ways across its line. Level motions only (push, turn): a ramp
+  /// the blade wobbles over is passed by each part at another height each
+  /// time, and a part wobbling back over a floor cut higher cuts it with its
+  /// back, as a real blade does.
+  double wobble_deg = 0.0;
 };
 
 /// The motion's name: push, plunge, lift, turn.
@@ -63,7 +73,8 @@ std::string describe(const WallCase& w);
 /// side the blade came from. Throws std::invalid_argument naming the case
 /// where it cannot be set up (a length, speed or cell not finite and
 /// positive, cells outside [2 mm, 5 cm], a speed under 1 mm/s, a tremor
-/// negative, not finite or over 2 cm, a channel the blade does not reach
+/// negative, not finite or over 2 cm, a wobble negative, not finite, over
+/// 5 degrees or on a plunge or a lift, a channel the blade does not reach
 /// across at its largest yaw, nothing to watch).
 double worst_rise_behind(const WallCase& w);
 
@@ -73,7 +84,8 @@ inline constexpr double kWallSlack_m = 1e-5;
 /// The cases `terracut validate` runs: blades of 0.2 to 2 m, yaws of 0 to
 /// 135 degrees, speeds of 0.05 to 2 m/s (a slow one moves under a hundredth
 /// of a cell a step), every motion, spanning the terrain and in a channel,
-/// and every motion again with a hand's tremor that backs the blade up.
+/// every motion again with a hand's tremor that backs the blade up, and
+/// pushes and turns with a wobble about the vertical.
 std::vector<WallCase> validation_wall_cases();
 
 }  // namespace terracut::validation
