@@ -248,9 +248,15 @@ inline bool SoilFlow::blade_blocks(int hc, int hr, int lc, int lr, float top_m) 
   // Except a cell inside the blade whose centre the edge has passed (on the
   // side it came from, by more than rounding): cut, it lies behind the
   // plate and is the trench's, a cell of that side. A centre on the line
-  // (within rounding) takes soil from that side (the edge stands on it as it
-  // cuts it) but sheds nothing: it may hold soil the cut has not taken yet
-  // (a blade at 45 degrees stands on the centres it has not cut).
+  // (within rounding) is under the plate: it takes no soil from either side
+  // and sheds none (it may hold soil the cut has not taken yet: a blade at
+  // 45 degrees stands on the centres it has not cut). It once took soil
+  // from the side the edge came from; the next step's cut takes such a
+  // centre with its region's first line (the region is closed) and pushes
+  // what stands on it the way the edge goes, so soil crossed the blade: the
+  // trench's slump onto the pile's side as the blade pushed, and a pile onto
+  // the trench's side as the blade backed away from it (4.75 cm behind a
+  // blade whose line landed on a row of centres every few steps).
   bool a_side = na > 0.0, b_side = nb > 0.0;
   if (low_inside || high_inside) {
     const double margin = 1e-9 * blade_.half_lo;
@@ -258,9 +264,9 @@ inline bool SoilFlow::blade_blocks(int hc, int hr, int lc, int lr, float top_m) 
     const auto behind_sign = [&](double t) { return -((1.0 - t) * blade_.across_a + t * blade_.across_b); };
     if (low_inside) {
       const double t = along(xb, zb), b = behind_sign(t);
-      if (b != 0.0 && (std::abs(nb) <= margin || nb * b > 0.0)) {
+      if (b != 0.0 && std::abs(nb) > margin && nb * b > 0.0) {
         low_inside = false;
-        b_side = b > 0.0;  // on the line, or past it: on the side the edge came from
+        b_side = b > 0.0;  // past the line: on the side the edge came from
       }
     }
     if (high_inside) {

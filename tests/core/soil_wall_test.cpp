@@ -108,5 +108,65 @@ TEST(SoilWall, ThePushPileScenariosTrenchStaysOpenBehindTheBlade) {
   }
 }
 
+// A blade backing away from the pile it pushed, its line landing exactly on
+// a row of cell centres every few steps (1/64 m cells, every position a
+// multiple of 1/4096 m, so the ties are exact). A centre on the line once
+// took soil from the side the edge came from: backing away, the pile's
+// side. The next step's cut takes that centre with its swept region's first
+// line (the region is closed), and the displacement pushed its soil the way
+// the edge went, through the blade: 4.75 cm behind it. A centre on the line
+// now takes soil from neither side (blade_blocks).
+TEST(SoilWall, ABladeBackingAwayFromItsPileLeavesItThere) {
+  for (const double back_m : {1.0 / 4096.0, 1.0 / 1024.0}) {
+    const double cell = 1.0 / 64.0, edge = kLayer - kDepth, z_start = 0.25;
+    const int n = 64;
+    SimParams p;
+    p.grid = grid_of_cells(n, n, cell);
+    p.blade.length_m = 2.0;  // spanning the 1 m terrain: no ends to spill round
+    p.soil.model = SoilModel::kFlow;
+    p.soil.material.repose_deg = 34.0;
+    // Behind the start the trench is already dug.
+    std::vector<float> h(std::size_t(n) * n, float(kLayer));
+    for (int r = 0; r < n; ++r)
+      for (int c = 0; c < n; ++c)
+        if ((r + 0.5) * cell < z_start) h[std::size_t(r) * n + c] = float(edge);
+    Simulation sim(p, h);
+    const auto pose = [&](double z) { return BladePose{{0.5, edge, z}, Quat{}}; };
+    // The worst height above the trench floor more than a cell and a half
+    // behind the line.
+    double worst = -1.0;
+    const auto watch = [&](double z_line) {
+      for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c)
+          if ((r + 0.5) * cell < z_line - 1.5 * cell) worst = std::max(worst, double(sim.grid().height(c, r)) - edge);
+    };
+    // Pushed 0.258 m at 0.24 m/s to a row of centres, held, then backed 0.2 m.
+    const double z_far = 0.5 + 32.0 / 4096.0;  // (32 + 0.5) / 64
+    double z = z_start;
+    while (z < z_far) {
+      z = std::min(z_far, z + 1.0 / 4096.0);
+      sim.step(pose(z));
+      watch(z);
+    }
+    for (int k = 0; k < 100; ++k) {
+      sim.step(pose(z));
+      watch(z);
+    }
+    EXPECT_LE(worst, kFloatSlack) << "pushing";
+    while (z > 0.3) {
+      z -= back_m;
+      sim.step(pose(z));
+      watch(z);
+    }
+    EXPECT_LE(worst, kFloatSlack) << "backing away at " << back_m << " m a step";
+    // The pile followed the blade down its side: soil stands ahead of it.
+    double ahead = 0.0;
+    for (int r = 0; r < n; ++r)
+      for (int c = 0; c < n; ++c)
+        if ((r + 0.5) * cell > z) ahead = std::max(ahead, double(sim.grid().height(c, r)));
+    EXPECT_GT(ahead, kLayer);
+  }
+}
+
 }  // namespace
 }  // namespace terracut
