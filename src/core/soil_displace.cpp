@@ -163,7 +163,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
   };
   // The step's first edge's normal, turned as the last edge's: a cut sample
   // behind that line (by more than rounding) in the way the edge went there
-  // was not in the straight sweep from it (see below).
+  // was not swept by the edge (see below).
   const double from_ex = from.b.x - from.a.x, from_ez = from.b.z - from.a.z;
   const double from_len = std::hypot(from_ex, from_ez);
   double from_nx = line_nx, from_nz = line_nz;
@@ -287,14 +287,15 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       const double z = spec.origin_m.z + (row + 0.5) * dz_;
       // The push's direction: the normal turned to this point's way. A
       // sample behind the step's first edge in that way, by more than
-      // rounding, was not in the straight sweep from it: a turning step's
-      // sub-steps follow an arc, which near the turn's pivot bulges past
-      // the first edge, and cut it there. The edge went the other way from
-      // it, so it keeps its side, as a sample at rest does. (Pushed the
-      // way the edge went, the column a pile had slid onto it as the blade
-      // backed away went through the blade: 3.9 cm behind a 2 m blade on
-      // 5 mm cells, wobbling, rolled 3 degrees, from a sample 6e-10 m past
-      // the first edge.)
+      // rounding, was not swept by the edge: the cut's sweep starts a
+      // millionth of a cell behind the first edge (Simulation's
+      // reach_back, so that consecutive sweeps overlap and a row on the
+      // line they share is not missed), and took it there. The edge went
+      // away from it, so it keeps its side, as a sample at rest does.
+      // (Pushed the way the edge went, the column a pile had slid onto it
+      // as that part of the blade backed away went through the blade: 3.9
+      // cm behind a 2 m blade on 5 mm cells, wobbling, rolled 3 degrees,
+      // from a sample 6e-10 m past the first edge.)
       bool this_step = false;
       double way = motion_at(x, z, this_step);
       if (this_step && ((x - from.a.x) * from_nx + (z - from.a.z) * from_nz) * (way < 0.0 ? -1.0 : 1.0) < -rounding)

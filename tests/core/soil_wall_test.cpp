@@ -173,12 +173,12 @@ TEST(SoilWall, ABladeBackingAwayFromItsPileLeavesItThere) {
 // A 2 m blade spanning a 1 m terrain of 5 mm cells, its edge rolled 2.7
 // degrees (one end lower), pushing at 0.32 m/s with a 3 mm, 10 Hz tremor
 // along its travel and a 1-degree, 10.2 Hz wobble about the vertical: a
-// case of a random sweep. The steps that turn it are cut in sub-steps along
-// an arc, which near the turn's pivot bulges past the step's first edge;
-// there it cut a sample 6e-10 m on the pile's side of that edge, and the
-// displacement pushed its column the way the edge went (the blade was
-// backing away there), through the blade: 3.9 cm behind it. A sample the
-// straight sweep did not reach keeps its side. Every sample the blade has
+// case of a random sweep. The cut's sweep starts a millionth of a cell
+// behind each step's first edge (consecutive sweeps overlap); there it cut
+// a sample 6e-10 m on the pile's side of that edge, and the displacement
+// pushed its column the way the edge went (that part of the blade was
+// backing away), through the blade: 3.9 cm behind it. A sample the edge
+// did not sweep keeps its side. Every sample the blade has
 // passed, more than 1.5 cells behind its line, must stay at the height the
 // edge cut it to (the edge slopes: each sample's own), to 1e-4 m (the
 // height between the two steps' edges at a sample, on a sloped edge
