@@ -1212,8 +1212,7 @@ void write_outputs(const fs::path& out, const Report& r) {
     wall += std::string(validation::motion_name(c.motion)) + "," + csv_number(validation::blade_length_m(c)) + "," +
             (c.channel ? "0" : "1") + "," + csv_number(c.yaw_deg) + "," + csv_number(c.speed_m_per_s) + "," +
             csv_number(c.cell_m) + "," + csv_number(c.tremor_m) + "," + csv_number(c.wobble_deg) + "," +
-            std::to_string(c.cap) + "," +
-            csv_number(w.worst_m) + "\n";
+            std::to_string(c.cap) + "," + csv_number(w.worst_m) + "\n";
   }
   write_file(out / "bulldozing" / "wall.csv", wall);
   write_file(out / "bulldozing" / "centre.csv", centre);

@@ -129,13 +129,13 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
   // pushed the cut of the part going forward behind it when a hand's tremor
   // took the midpoint back: a 0.55 m blade on 2 cm cells, 2 cm behind it).
   const double rounding = 1e-9 * cell;
-  const PlanMotion step_motion = midpoint_motion(from, to), since_motion = midpoint_motion(moved_from, to);
   if (plan_length > 1e-12) {
     nx /= plan_length;
     nz /= plan_length;
   } else {
     // An edge seen end-on: push along the motion, or along +X at rest.
-    const PlanMotion m = std::hypot(step_motion.x, step_motion.z) > 1e-12 ? step_motion : since_motion;
+    const PlanMotion step_motion = midpoint_motion(from, to);
+    const PlanMotion m = std::hypot(step_motion.x, step_motion.z) > 1e-12 ? step_motion : midpoint_motion(moved_from, to);
     const double length = std::hypot(m.x, m.z);
     nx = length > 1e-12 ? m.x / length : 1.0;
     nz = length > 1e-12 ? m.z / length : 0.0;

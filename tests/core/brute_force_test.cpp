@@ -202,9 +202,7 @@ bool expect_closed_cut(const LatticeSweep& w, int den, bool check_fast, const st
   const SweepTriangles sweep = test::sweep_triangles(w.from_a, w.from_b, w.to_a, w.to_b);
   const std::int64_t k = std::int64_t(den) * sweep.scale;  // lattice units a cell
   // The lattice doubled, so that sample centres (half cells) are points of it.
-  SweepTriangles doubled = sweep;
-  for (auto& t : doubled.tri)
-    for (auto& v : t) v = {2 * v.x, 2 * v.z};
+  const SweepTriangles doubled = test::doubled(sweep);
   for (Representation rep : kBoth) {
     const std::vector<float> initial(std::size_t(s.sample_count()), 0.9f);
     HeightGrid fast(s, initial), slow(s, initial);

@@ -123,9 +123,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // lobes (the edges crossing) on a lattice sweep.scale times finer.
   const test::SweepTriangles sweep = test::sweep_triangles(fa, fb, ta, tb);
   const std::int64_t k = std::int64_t(den) * sweep.scale;  // lattice units a cell
-  test::SweepTriangles doubled = sweep;  // sample centres (half cells) are points of it
-  for (auto& t : doubled.tri)
-    for (auto& v : t) v = {2 * v.x, 2 * v.z};
+  const test::SweepTriangles doubled = test::doubled(sweep);  // sample centres (half cells) are points of it
   bool representable = !sweep.bow_tie;
   for (const auto& t : sweep.tri)
     for (int e = 0; e < 3; ++e) representable = representable && test::representable_slope(t[e], t[(e + 1) % 3]);

@@ -93,6 +93,14 @@ inline SweepTriangles sweep_triangles(LatticePoint fa, LatticePoint fb, LatticeP
   return w;
 }
 
+/// w on the lattice twice as fine, where the sample centres (half cells)
+/// are points.
+inline SweepTriangles doubled(SweepTriangles w) {
+  for (auto& t : w.tri)
+    for (auto& v : t) v = {2 * v.x, 2 * v.z};
+  return w;
+}
+
 /// For a bow-tie, whether point q (on its scaled lattice) lies on a line
 /// through the crossing P and another vertex of a lobe, or is P: the cut
 /// computes P in double, rounded, so which side of such a line q falls on

@@ -81,8 +81,8 @@ double worst_rise_behind(const WallCase& w);
 /// Float slack of the measure: far below any soil that crossed the blade.
 inline constexpr double kWallSlack_m = 1e-5;
 
-/// The cases `terracut validate` runs: blades of 0.2 to 2 m, yaws of 0 to
-/// 135 degrees, speeds of 0.05 to 2 m/s (a slow one moves under a hundredth
+/// The cases `terracut validate` runs: blades of 0.2 to 2 m, yaws of -30 to
+/// 173 degrees, speeds of 0.05 to 2 m/s (a slow one moves under a hundredth
 /// of a cell a step), every motion, spanning the terrain and in a channel,
 /// every motion again with a hand's tremor that backs the blade up, and
 /// pushes and turns with a wobble about the vertical.
