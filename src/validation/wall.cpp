@@ -48,7 +48,8 @@ std::string describe(const WallCase& w) {
          format_number(w.speed_m_per_s) + " m/s, " + format_number(w.cell_m * 1000.0) + " mm cells" +
          (w.channel ? ", in a channel" : "") +
          (w.tremor_m > 0.0 ? ", tremor " + format_number(w.tremor_m * 1000.0) + " mm" : "") +
-         (w.wobble_deg > 0.0 ? ", wobble " + format_number(w.wobble_deg) + " deg" : "") + ", cap " +
+         (w.wobble_deg > 0.0 ? ", wobble " + format_number(w.wobble_deg) + " deg" : "") +
+         (w.roll_deg != 0.0 ? ", roll " + format_number(w.roll_deg) + " deg" : "") + ", cap " +
          std::to_string(w.cap);
 }
 
@@ -64,8 +65,8 @@ double worst_rise_behind(const WallCase& w) {
     throw std::invalid_argument("worst_rise_behind: tremor_m must lie in [0, 0.02] m (" + describe(w) + ")");
   if (!(std::isfinite(w.wobble_deg) && w.wobble_deg >= 0.0 && w.wobble_deg <= 5.0))
     throw std::invalid_argument("worst_rise_behind: wobble_deg must lie in [0, 5] degrees (" + describe(w) + ")");
-  if (w.wobble_deg > 0.0 && (w.motion == WallMotion::kPlunge || w.motion == WallMotion::kLift))
-    throw std::invalid_argument("worst_rise_behind: a wobble needs a level motion, push or turn (" + describe(w) + ")");
+  if (!(std::isfinite(w.roll_deg) && std::abs(w.roll_deg) <= 5.0))
+    throw std::invalid_argument("worst_rise_behind: roll_deg must lie in [-5, 5] degrees (" + describe(w) + ")");
   const double cell = w.cell_m;
   const double travel = 0.3;  // m
   const double yaw = w.yaw_deg * kWallDeg;
@@ -78,6 +79,47 @@ double worst_rise_behind(const WallCase& w) {
   // In the channel the blade starts with its centre on a row of cell
   // centres, where a level edge stands on them again and again.
   const double cx = 0.5 * side_m, cz = 0.5 * side_m + (w.channel ? 0.5 * cell : 0.0);
+  // The cutting plane: the edge lies in it at every step, whatever the
+  // motion, so each sample the edge passes is left at the plane's height and
+  // no part of the edge ever comes back below a floor it cut (a part that
+  // did would cut that floor with its back and push it behind the blade, as
+  // a real blade does: not a leak). Through the edge's starting height at
+  // the blade's centre; along the travel it falls 4 cm over the 0.3 m
+  // (plunge) or rises so (lift), a ramp fixed in space and gentler than the
+  // repose slope; across the travel it slopes by the roll. Its height at
+  // (x, z):
+  const double edge_start = kWallLayer_m - kWallDepth_m;
+  const double y0 = w.motion == WallMotion::kPlunge ? kWallLayer_m - 0.01 : edge_start;
+  const double along_slope = w.motion == WallMotion::kPlunge ? -0.04 / travel : w.motion == WallMotion::kLift ? 0.04 / travel : 0.0;
+  const double cross_slope = std::tan(w.roll_deg * kWallDeg);
+  // (gx, gz): the plane's gradient where the edge goes; along the travel
+  // measured from the centre's start, across it toward the side the edge's
+  // +X end points at yaw 0.
+  const double gx = along_slope * nx + cross_slope * nz, gz = along_slope * nz - cross_slope * nx;
+  const double start_x = cx - 0.5 * travel * nx, start_z = cz - 0.5 * travel * nz;
+  // Beyond the reach of the edge along the travel (its half-length at the
+  // largest angle to its travel, the tremor and two cells, before the start
+  // and past the end) the ramp goes no further: the trench dug behind the
+  // start and the ground far ahead stay above the terrain's bottom.
+  const double widest_deg = (w.channel ? std::abs(w.yaw_deg) : 0.0) + (w.motion == WallMotion::kTurn ? 8.0 : 0.0) + w.wobble_deg;
+  const double reach = 0.5 * blade_length_m(w) * std::sin(std::min(90.0, widest_deg) * kWallDeg) + w.tremor_m + 2.0 * cell;
+  const auto plane_y = [&](double x, double z) {
+    const double along = std::clamp((x - start_x) * nx + (z - start_z) * nz, -reach, travel + reach);
+    const double across = (x - cx) * nz - (z - cz) * nx;
+    return y0 + along_slope * along + cross_slope * across;
+  };
+  // Its lowest over the terrain (at a corner or the ramp's ends): it must
+  // stay above the ground's bottom and the obstacles' cells.
+  double lowest = kWallLayer_m;
+  for (const double x : {0.0, side_m})
+    for (const double z : {0.0, side_m}) {
+      const double across = (x - cx) * nz - (z - cz) * nx;
+      for (const double along : {-reach, travel + reach})
+        lowest = std::min(lowest, y0 + along_slope * along + cross_slope * across);
+    }
+  if (!(lowest >= 0.03))
+    throw std::invalid_argument("worst_rise_behind: the cutting plane comes within 3 cm of the terrain's bottom "
+                                "(" + describe(w) + ")");
   SimParams p;
   p.grid = grid_of_cells(n, n, cell);
   // Spanning the terrain: longer than its diagonal, so its ends are off it.
@@ -85,13 +127,12 @@ double worst_rise_behind(const WallCase& w) {
   p.soil.model = SoilModel::kFlow;
   p.soil.material.repose_deg = 34.0;
   p.soil.max_pair_checks_per_step = w.cap;
-  const double edge_start = kWallLayer_m - kWallDepth_m;
   std::vector<float> h(std::size_t(n) * n, float(kWallLayer_m));
   std::vector<SoilObstacle> walls;
   if (w.channel) {
     // The blade's reach across the channel at the largest yaw it takes,
     // less two cells: its ends stay over the obstacles either side, whose
-    // cells stand below the floor (no soil to cut or to slide off them) and
+    // cells stand below the plane (no soil to cut or to slide off them) and
     // are closed to soil coming in.
     const double widest_yaw = std::abs(w.yaw_deg) + (w.motion == WallMotion::kTurn ? 8.0 : 0.0) + w.wobble_deg;
     const double half_channel = 0.5 * w.length_m * std::cos(widest_yaw * kWallDeg) - 2.0 * cell;
@@ -101,88 +142,71 @@ double worst_rise_behind(const WallCase& w) {
     const int c0 = int(std::ceil((cx - half_channel) / cell)), c1 = int(std::floor((cx + half_channel) / cell));
     for (int r = 0; r < n; ++r)
       for (int c = 0; c < n; ++c)
-        if (c < c0 || c >= c1) h[std::size_t(r) * n + c] = float(edge_start - 0.06);
+        if (c < c0 || c >= c1) h[std::size_t(r) * n + c] = float(lowest - 0.02);
     walls.push_back({{0, 0, c0, n}, 0.0f});
     walls.push_back({{c1, 0, n, n}, 0.0f});
   }
-  // The pose at step s in [0, 1] (time s * travel / speed). The edge's
-  // height: level, down 4 cm over the first two thirds of the travel (a
-  // ramp of 0.2, gentler than tan 34 deg = 0.67), or up 4 cm so; the ramp
-  // is fixed in space, so a blade the tremor takes back and forth passes a
-  // sample at the same height each time (one whose height followed the
-  // time would cut the floor behind it with its back, or leave what slid
-  // into the gap above the first pass's floor, as a real blade would).
-  // Turning, the yaw swings from -8 to +8 degrees about the blade's centre
-  // while it moves on (slowly enough that every point of the blade over the
-  // terrain moves forward: none backs into the trench, beside the uncut
-  // soil ahead of the starting line, but where the tremor or the wobble
-  // takes it back).
+  // The pose at step s in [0, 1] (time s * travel / speed): the centre on
+  // the plane, the tremor along the travel; the yaw turning from -8 to +8
+  // degrees about the centre (kTurn) and wobbling, and the edge rolled
+  // about its normal so that it lies in the plane at that yaw (turned about
+  // the vertical alone, a rolled edge would leave the plane). Turning,
+  // every point of the blade over the terrain moves forward, slowly
+  // enough: none backs into the trench, beside the uncut soil ahead of the
+  // starting line, but where the tremor or the wobble takes it back.
   const double seconds = travel / w.speed_m_per_s;
   const auto pose_at = [&](double s) {
     const double along =
         -0.5 * travel + travel * s + w.tremor_m * std::sin(2.0 * std::numbers::pi * kWallTremor_hz * seconds * s);
-    const double ramp = std::min(1.0, 1.5 * std::clamp(along / travel + 0.5, 0.0, 1.0));
-    double y = edge_start;
-    if (w.motion == WallMotion::kPlunge) y = kWallLayer_m - 0.01 - 0.04 * ramp;
-    if (w.motion == WallMotion::kLift) y = edge_start + 0.04 * ramp;
+    const double x = cx + nx * along, z = cz + nz * along;
     const double turn = (w.motion == WallMotion::kTurn ? -8.0 + 16.0 * s : 0.0) +
                         w.wobble_deg * std::sin(2.0 * std::numbers::pi * kWallWobble_hz * seconds * s);
     const double yaw_now = yaw + turn * kWallDeg;
-    return BladePose{{cx + nx * along, y, cz + nz * along}, quat_from_axis_angle({0.0, 1.0, 0.0}, yaw_now)};
+    // The edge's direction in plan at this yaw, (cos, -sin): the plane's
+    // rise along it gives the roll.
+    const double roll = std::atan(gx * std::cos(yaw_now) - gz * std::sin(yaw_now));
+    return BladePose{{x, plane_y(x, z), z},
+                     quat_from_axis_angle({0.0, 1.0, 0.0}, yaw_now) * quat_from_axis_angle({0.0, 0.0, 1.0}, roll)};
   };
-  // Behind the starting line the trench is already dug, to the edge's
-  // height there: no back wall at the trench's start to slump into it.
+  // Behind the starting line the trench is already dug, to the plane: no
+  // back wall at the trench's start to slump into it.
   {
     const BladePose start = pose_at(0.0);
     const Vec3 e = rotate(start.orientation, {1.0, 0.0, 0.0});
     for (int r = 0; r < n; ++r)
       for (int c = 0; c < n; ++c) {
-        const double x = (c + 0.5) * cell - start.position_m.x, z = (r + 0.5) * cell - start.position_m.z;
-        if (e.x * z - e.z * x < 0.0) {
+        const double x = (c + 0.5) * cell, z = (r + 0.5) * cell;
+        if (e.x * (z - start.position_m.z) - e.z * (x - start.position_m.x) < 0.0) {
           float& v = h[std::size_t(r) * n + c];
-          v = std::min(v, float(start.position_m.y));
+          v = std::min(v, float(plane_y(x, z)));
         }
       }
   }
   Simulation sim(p, h);
   if (w.channel) sim.soil()->set_obstacles(walls);
   const int steps = int(std::lround(travel / w.speed_m_per_s * 1000.0));
-  // Per sample: the side of the blade's line it started on, and the edge's
-  // height where it passed it (NaN: not passed yet).
-  std::vector<int> side0(std::size_t(n) * n, 0);
-  std::vector<double> floor(std::size_t(n) * n, NAN);
   double worst = -1.0;
   std::int64_t measured = 0;  // samples watched over the run
   for (int i = 0; i <= steps; ++i) {
     const double s = double(i) / steps;
     sim.step(pose_at(s));
     const Segment edge = sim.last().edge;
-    // The last step's edge height over (x, z), from its pose (the edge is level across the blade).
-    const auto last_edge_y = [&](double, double) { return i > 0 ? pose_at(double(i - 1) / steps).position_m.y : 0.0; };
     const double dxl = edge.b.x - edge.a.x, dzl = edge.b.z - edge.a.z;
     const double len = std::hypot(dxl, dzl);
     const HeightGrid& g = sim.grid();
     for (int r = 0; r < n; ++r)
       for (int c = 0; c < n; ++c) {
-        const std::size_t k = std::size_t(r) * n + c;
         const double x = (c + 0.5) * cell, z = (r + 0.5) * cell;
-        const double d = (dxl * (z - edge.a.z) - dzl * (x - edge.a.x)) / len;  // signed distance to the line
+        const double d = (dxl * (z - edge.a.z) - dzl * (x - edge.a.x)) / len;  // signed distance to the line, + ahead
         const double t = ((x - edge.a.x) * dxl + (z - edge.a.z) * dzl) / (len * len);
-        // The far side at the start is the trench already dug (to the
-        // first edge's height): passed before the first step.
-        if (i == 0) side0[k] = d > 0.0 ? 1 : -1;
-        if (t < 0.0 || t > 1.0) continue;  // beyond the blade's ends
-        const bool passed = (d > 0.0 ? 1 : -1) != side0[k] || side0[k] < 0;
-        if (i == 0 && side0[k] < 0) floor[k] = pose_at(0.0).position_m.y;
-        // The cut left it at the edge's height where the edge crossed its
-        // centre, between this step's pose and the last.
-        if (passed && std::isnan(floor[k]))
-          floor[k] = std::max(edge.a.y + (edge.b.y - edge.a.y) * t, last_edge_y(x, z));
-        // Watched: passed, and on the side the blade came from now (a
-        // blade the tremor takes back leaves soil that slid after it, in
-        // front of it, on samples it had passed).
-        if (!passed || d > -1.5 * cell) continue;
-        worst = std::max(worst, double(g.height(c, r)) - floor[k]);
+        // Watched: within the blade's span, on the side it came from now,
+        // more than a cell and a half from its line (every such sample was
+        // dug before the start or cut to the plane since; a blade the
+        // tremor or wobble takes back leaves soil that slid after it, in
+        // front of it, on samples it had passed, and cuts it again as it
+        // comes forward).
+        if (t < 0.0 || t > 1.0 || d > -1.5 * cell) continue;
+        worst = std::max(worst, double(g.height(c, r)) - plane_y(x, z));
         ++measured;
       }
   }
@@ -227,6 +251,24 @@ std::vector<WallCase> validation_wall_cases() {
   wobbling.tremor_m = 0.002;
   wobbling.wobble_deg = 1.5;
   cases.push_back(wobbling);
+  // Rolled blades (one end lower), each motion: a 2 m blade spanning the
+  // terrain plunging with the tremor and the wobble, 1 and 1.5 m blades
+  // lifting (wobbling) and pushing in a channel, and one turning with the
+  // tremor.
+  const struct {
+    WallCase w;
+    double tremor_m, wobble_deg, roll_deg;
+  } rolled[] = {{{1.0, 60.0, 0.3, WallMotion::kPlunge, false}, 0.002, 1.5, 3.0},
+                {{1.0, 20.0, 0.5, WallMotion::kLift, true}, 0.0, 1.5, -3.0},
+                {{1.5, -15.0, 1.0, WallMotion::kPush, true}, 0.0, 0.0, 4.0},
+                {{1.0, 200.0, 0.2, WallMotion::kTurn, false}, 0.004, 0.0, -2.5}};
+  for (const auto& r : rolled) {
+    WallCase w = r.w;
+    w.tremor_m = r.tremor_m;
+    w.wobble_deg = r.wobble_deg;
+    w.roll_deg = r.roll_deg;
+    cases.push_back(w);
+  }
   return cases;
 }
 

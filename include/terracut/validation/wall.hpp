@@ -1,17 +1,21 @@
 // The blade is a wall for flowing soil (soil.hpp): no soil reaches the far
-// side of a blade through it or under it, whatever the blade's length, yaw
-// and speed, while it plunges, pushes, turns or lifts. Soil may reach the
-// cut behind a blade only round its ends or down the trench's own walls, so
-// the measure takes both away: a blade longer than the terrain is wide (no
-// ends on the grid), or a blade running in a channel closed by rigid
-// obstacles beyond its ends whose cells stand below the trench floor (no
-// walls, nothing to spill round). Then any soil that comes to stand above
-// the trench floor behind the blade came through or under it. The floor
-// behind is left by the cut at the edge's height, and where the edge moves
-// up or down it is a ramp gentler than the repose angle, so nothing on it
-// moves: the measure is how far any sample the blade has passed ever rose
-// above the edge's height there. Used by the tests and by
-// `terracut validate` (check 3.3).
+// side of a blade through it or under it, whatever the blade's length, yaw,
+// roll and speed, while it plunges, pushes, turns or lifts, steadily or
+// with a hand's tremor and wobble. Soil may reach the cut behind a blade
+// only round its ends or down the trench's own walls, so the measure takes
+// both away: a blade longer than the terrain is wide (no ends on the grid),
+// or a blade running in a channel closed by rigid obstacles beyond its ends
+// whose cells stand below the trench floor (no walls, nothing to spill
+// round). The edge lies in one plane at every step (the cutting plane: a
+// ramp along the travel for a plunge or a lift, sloping across it by the
+// roll, gentler than the repose angle everywhere), so the cut leaves every
+// sample it passes at the plane's height and nothing on the floor moves;
+// and no part of the edge ever comes back below the floor it cut (one that
+// did would cut that floor with its back and push it behind the blade, as
+// a real blade does). Then any soil that comes to stand above the plane
+// behind the blade came through or under it: the measure is how far any
+// sample behind the blade ever rose above the plane. Used by the tests and
+// by `terracut validate` (check 3.3).
 #pragma once
 
 #include <cstdint>
@@ -23,7 +27,7 @@ namespace terracut::validation {
 /// What the blade does over its 0.3 m of travel.
 enum class WallMotion {
   kPush,    ///< level, the edge 5 cm into the 20 cm layer
-  kPlunge,  ///< the edge from 1 cm to 5 cm deep over the first two thirds of the travel (a ramp in space)
+  kPlunge,  ///< the edge from 1 cm to 5 cm deep over the travel (a ramp fixed in space, slope 0.133)
   kLift,    ///< the edge from 5 cm to 1 cm deep so
   kTurn,    ///< level, the yaw swinging from -8 to +8 degrees about its centre
 };
@@ -49,11 +53,13 @@ struct WallCase {
   double tremor_m = 0.0;
   /// The wobble's amplitude about the vertical, degrees (0: none). The
   /// blade then turns about its centre every cycle, its two halves going
-  /// opposite ways across its line. Level motions only (push, turn): a ramp
-  /// the blade wobbles over is passed by each part at another height each
-  /// time, and a part wobbling back over a floor cut higher cuts it with its
-  /// back, as a real blade does.
+  /// opposite ways across its line (rolled so that its edge stays in the
+  /// cutting plane at every yaw).
   double wobble_deg = 0.0;
+  /// The roll, degrees (0: level): the cutting plane slopes across the
+  /// travel by this angle, so a blade square to its travel has its +X end
+  /// higher by it; at other yaws the edge rolls as the plane asks.
+  double roll_deg = 0.0;
 };
 
 /// The motion's name: push, plunge, lift, turn.
@@ -66,26 +72,28 @@ double blade_length_m(const WallCase& w);
 /// The case in words, for messages (the blade's length as simulated).
 std::string describe(const WallCase& w);
 
-/// The worst height above the edge's height, m, that a sample the blade had
-/// passed reached at any step (the far side of the blade, more than a cell
-/// and a half from its line). A float step of heights near 0.2 m (1e-8 m)
-/// is what an intact wall leaves. The samples watched are those now on the
-/// side the blade came from. Throws std::invalid_argument naming the case
-/// where it cannot be set up (a length, speed or cell not finite and
-/// positive, cells outside [2 mm, 5 cm], a speed under 1 mm/s, a tremor
-/// negative, not finite or over 2 cm, a wobble negative, not finite, over
-/// 5 degrees or on a plunge or a lift, a channel the blade does not reach
-/// across at its largest yaw, nothing to watch).
+/// The worst height above the cutting plane, m, that a sample behind the
+/// blade reached at any step (within its span, on the side it came from,
+/// more than a cell and a half from its line). A float step of heights near
+/// 0.2 m (1e-8 m) is what an intact wall leaves. Throws
+/// std::invalid_argument naming the case where it cannot be set up (a
+/// length, speed or cell not finite and positive, cells outside [2 mm,
+/// 5 cm], a speed under 1 mm/s, a tremor negative, not finite or over 2 cm,
+/// a wobble negative, not finite or over 5 degrees, a roll not finite or
+/// over 5 degrees either way, a plane that comes within 3 cm of the
+/// terrain's bottom, a channel the blade does not reach across at its
+/// largest yaw, nothing to watch).
 double worst_rise_behind(const WallCase& w);
 
 /// Float slack of the measure: far below any soil that crossed the blade.
 inline constexpr double kWallSlack_m = 1e-5;
 
 /// The cases `terracut validate` runs: blades of 0.2 to 2 m, yaws of -30 to
-/// 173 degrees, speeds of 0.05 to 2 m/s (a slow one moves under a hundredth
+/// 200 degrees, speeds of 0.05 to 2 m/s (a slow one moves under a hundredth
 /// of a cell a step), every motion, spanning the terrain and in a channel,
-/// every motion again with a hand's tremor that backs the blade up, and
-/// pushes and turns with a wobble about the vertical.
+/// every motion again with a hand's tremor that backs the blade up, pushes
+/// and turns with a wobble about the vertical, and every motion with the
+/// blade rolled 2.5 to 4 degrees (with a tremor or a wobble in three).
 std::vector<WallCase> validation_wall_cases();
 
 }  // namespace terracut::validation
