@@ -14,8 +14,10 @@
 // did would cut that floor with its back and push it behind the blade, as
 // a real blade does). Then any soil that comes to stand above the plane
 // behind the blade came through or under it: the measure is how far any
-// sample behind the blade ever rose above the plane. Used by the tests and
-// by `terracut validate` (check 3.3).
+// sample behind the blade ever rose above the plane. The cut reads the
+// heights as a surface (the default representation; docs/soil.md, "Not done
+// yet", has what the columns one does). Used by the tests and by
+// `terracut validate` (check 3.3).
 #pragma once
 
 #include <cstdint>
