@@ -45,7 +45,8 @@ double blade_length_m(const WallCase& w) {
 std::string describe(const WallCase& w) {
   const std::string blade = format_number(blade_length_m(w)) + " m blade" + (w.channel ? "" : " spanning the terrain");
   return std::string(motion_name(w.motion)) + ", " + blade + ", yaw " + format_number(w.yaw_deg) + " deg, " +
-         format_number(w.speed_m_per_s) + " m/s, " + format_number(w.cell_m * 1000.0) + " mm cells" +
+         format_number(w.speed_m_per_s) + " m/s, " + format_number(w.cell_m * 1000.0) +
+         (w.cell_aspect != 1.0 ? " x " + format_number(w.cell_m * w.cell_aspect * 1000.0) : "") + " mm cells" +
          (w.channel ? ", in a channel" : "") +
          (w.tremor_m > 0.0 ? ", tremor " + format_number(w.tremor_m * 1000.0) + " mm" : "") +
          (w.wobble_deg > 0.0 ? ", wobble " + format_number(w.wobble_deg) + " deg" : "") +
@@ -65,6 +66,8 @@ double worst_rise_behind(const WallCase& w) {
     throw std::invalid_argument("worst_rise_behind: tremor_m must lie in [0, 0.02] m (" + describe(w) + ")");
   if (!(std::isfinite(w.wobble_deg) && w.wobble_deg >= 0.0 && w.wobble_deg <= 5.0))
     throw std::invalid_argument("worst_rise_behind: wobble_deg must lie in [0, 5] degrees (" + describe(w) + ")");
+  if (!(std::isfinite(w.cell_aspect) && w.cell_aspect >= 0.25 && w.cell_aspect <= 4.0))
+    throw std::invalid_argument("worst_rise_behind: cell_aspect must lie in [0.25, 4] (" + describe(w) + ")");
   if (!(std::isfinite(w.roll_deg) && std::abs(w.roll_deg) <= 5.0))
     throw std::invalid_argument("worst_rise_behind: roll_deg must lie in [-5, 5] degrees (" + describe(w) + ")");
   const double cell = w.cell_m;
@@ -76,9 +79,12 @@ double worst_rise_behind(const WallCase& w) {
   // A square terrain; the blade's centre crosses its middle.
   const double side_m = terrain_side_m(w);
   const int n = int(std::lround(side_m / cell));
+  // Rows: cells of cell_m x cell_m * cell_aspect.
+  const int rows = int(std::lround(side_m / (cell * w.cell_aspect)));
+  const double dx = side_m / n, dz = side_m / rows;
   // In the channel the blade starts with its centre on a row of cell
   // centres, where a level edge stands on them again and again.
-  const double cx = 0.5 * side_m, cz = 0.5 * side_m + (w.channel ? 0.5 * cell : 0.0);
+  const double cx = 0.5 * side_m, cz = 0.5 * side_m + (w.channel ? 0.5 * dz : 0.0);
   // The cutting plane: the edge lies in it at every step, whatever the
   // motion, so each sample the edge passes is left at the plane's height and
   // no part of the edge ever comes back below a floor it cut (a part that
@@ -121,13 +127,16 @@ double worst_rise_behind(const WallCase& w) {
     throw std::invalid_argument("worst_rise_behind: the cutting plane comes within 3 cm of the terrain's bottom "
                                 "(" + describe(w) + ")");
   SimParams p;
-  p.grid = grid_of_cells(n, n, cell);
+  p.grid.cols = n;
+  p.grid.rows = rows;
+  p.grid.size_x_m = side_m;
+  p.grid.size_z_m = side_m;
   // Spanning the terrain: longer than its diagonal, so its ends are off it.
   p.blade.length_m = blade_length_m(w);
   p.soil.model = SoilModel::kFlow;
   p.soil.material.repose_deg = 34.0;
   p.soil.max_pair_checks_per_step = w.cap;
-  std::vector<float> h(std::size_t(n) * n, float(kWallLayer_m));
+  std::vector<float> h(std::size_t(n) * rows, float(kWallLayer_m));
   std::vector<SoilObstacle> walls;
   if (w.channel) {
     // The blade's reach across the channel at the largest yaw it takes,
@@ -139,12 +148,12 @@ double worst_rise_behind(const WallCase& w) {
     if (!(half_channel >= 2.0 * cell))
       throw std::invalid_argument("worst_rise_behind: in a channel the blade must reach across at least 8 cells "
                                   "at its largest yaw (" + describe(w) + ")");
-    const int c0 = int(std::ceil((cx - half_channel) / cell)), c1 = int(std::floor((cx + half_channel) / cell));
-    for (int r = 0; r < n; ++r)
+    const int c0 = int(std::ceil((cx - half_channel) / dx)), c1 = int(std::floor((cx + half_channel) / dx));
+    for (int r = 0; r < rows; ++r)
       for (int c = 0; c < n; ++c)
         if (c < c0 || c >= c1) h[std::size_t(r) * n + c] = float(lowest - 0.02);
-    walls.push_back({{0, 0, c0, n}, 0.0f});
-    walls.push_back({{c1, 0, n, n}, 0.0f});
+    walls.push_back({{0, 0, c0, rows}, 0.0f});
+    walls.push_back({{c1, 0, n, rows}, 0.0f});
   }
   // The pose at step s in [0, 1] (time s * travel / speed): the centre on
   // the plane, the tremor along the travel; the yaw turning from -8 to +8
@@ -173,9 +182,9 @@ double worst_rise_behind(const WallCase& w) {
   {
     const BladePose start = pose_at(0.0);
     const Vec3 e = rotate(start.orientation, {1.0, 0.0, 0.0});
-    for (int r = 0; r < n; ++r)
+    for (int r = 0; r < rows; ++r)
       for (int c = 0; c < n; ++c) {
-        const double x = (c + 0.5) * cell, z = (r + 0.5) * cell;
+        const double x = (c + 0.5) * dx, z = (r + 0.5) * dz;
         if (e.x * (z - start.position_m.z) - e.z * (x - start.position_m.x) < 0.0) {
           float& v = h[std::size_t(r) * n + c];
           v = std::min(v, float(plane_y(x, z)));
@@ -194,9 +203,9 @@ double worst_rise_behind(const WallCase& w) {
     const double dxl = edge.b.x - edge.a.x, dzl = edge.b.z - edge.a.z;
     const double len = std::hypot(dxl, dzl);
     const HeightGrid& g = sim.grid();
-    for (int r = 0; r < n; ++r)
+    for (int r = 0; r < rows; ++r)
       for (int c = 0; c < n; ++c) {
-        const double x = (c + 0.5) * cell, z = (r + 0.5) * cell;
+        const double x = (c + 0.5) * dx, z = (r + 0.5) * dz;
         const double d = (dxl * (z - edge.a.z) - dzl * (x - edge.a.x)) / len;  // signed distance to the line, + ahead
         const double t = ((x - edge.a.x) * dxl + (z - edge.a.z) * dzl) / (len * len);
         // Watched: within the blade's span, on the side it came from now,
@@ -205,7 +214,7 @@ double worst_rise_behind(const WallCase& w) {
         // tremor or wobble takes back leaves soil that slid after it, in
         // front of it, on samples it had passed, and cuts it again as it
         // comes forward).
-        if (t < 0.0 || t > 1.0 || d > -1.5 * cell) continue;
+        if (t < 0.0 || t > 1.0 || d > -1.5 * std::max(dx, dz)) continue;
         worst = std::max(worst, double(g.height(c, r)) - plane_y(x, z));
         ++measured;
       }

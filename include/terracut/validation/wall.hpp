@@ -48,7 +48,8 @@ struct WallCase {
   WallMotion motion = WallMotion::kPush;
   bool channel = false;  ///< between two rigid obstacles beyond its ends (travel along +Z)
   std::int64_t cap = 50000;  ///< the soil's work cap, neighbour visits a step
-  double cell_m = 0.01;
+  double cell_m = 0.01;  ///< along X
+  double cell_aspect = 1.0;  ///< the cells' side along Z over cell_m, in [0.25, 4]
   /// The tremor's amplitude along the travel, m (0: none). Above
   /// speed / (2 pi kWallTremor_hz) the blade backs up in every cycle: 4 mm
   /// takes a blade at under 0.23 m/s back and forth.
@@ -82,7 +83,7 @@ std::string describe(const WallCase& w);
 /// length, speed or cell not finite and positive, cells outside [2 mm,
 /// 5 cm], a speed under 1 mm/s, a tremor negative, not finite or over 2 cm,
 /// a wobble negative, not finite or over 5 degrees, a roll not finite or
-/// over 5 degrees either way, a plane that comes within 3 cm of the
+/// over 5 degrees either way, a cell aspect outside [0.25, 4], a plane that comes within 3 cm of the
 /// terrain's bottom, a channel the blade does not reach across at its
 /// largest yaw, nothing to watch).
 double worst_rise_behind(const WallCase& w);
