@@ -15,6 +15,17 @@
 namespace terracut::validation {
 namespace {
 
+// w on cells of cell_m x cell_m * aspect, with a hand's tremor (m) and
+// wobble (degrees), rolled roll_deg.
+WallCase with(WallCase w, double cell_m, double aspect, double tremor_m, double wobble_deg, double roll_deg) {
+  w.cell_m = cell_m;
+  w.cell_aspect = aspect;
+  w.tremor_m = tremor_m;
+  w.wobble_deg = wobble_deg;
+  w.roll_deg = roll_deg;
+  return w;
+}
+
 // Each blade along X pushes along +Z; the blade spans the terrain.
 TEST(SoilWall, NoSoilCrossesABladeSpanningTheTerrain) {
   const double speeds[] = {0.25, 1.0, 2.0};
@@ -125,28 +136,17 @@ TEST(SoilWall, NoSoilCrossesAWobblingBlade) {
 // bow-tie's lobes, and a centre under the blade taking no soil) the first
 // five left 2.4 to 9.6 cm of soil behind the blade (2.0 to 6.5 cm level).
 TEST(SoilWall, NoSoilCrossesARolledBlade) {
-  struct Case {
-    WallCase w;
-    double cell_m, tremor_m, wobble_deg, roll_deg;
+  const WallCase cases[] = {
+      with({1.0, 97.7, 0.186, WallMotion::kPlunge, false}, 0.02, 1.0, 0.0, 0.0, -1.8),
+      with({1.9, -6.3, 0.198, WallMotion::kPush, true}, 0.02, 1.0, 0.0, 0.0, -1.35),
+      with({1.0, 202.5, 0.311, WallMotion::kTurn, false}, 0.02, 1.0, 0.0035, 0.0, 2.15),
+      with({1.0, 272.0, 0.151, WallMotion::kPush, false}, 0.02, 1.0, 0.0, 2.0, -3.57),
+      with({1.7, 22.1, 0.301, WallMotion::kPush, true}, 0.01, 1.0, 0.0039, 0.0, 0.69),
+      with({1.0, 289.4, 1.716, WallMotion::kLift, false}, 0.005, 1.0, 0.0025, 1.49, -1.85),
+      with({1.3, 0.1, 1.09, WallMotion::kLift, true}, 0.02, 1.0, 0.0, 1.67, -2.93),
+      with({0.8, 25.1, 0.835, WallMotion::kTurn, true}, 0.005, 1.0, 0.0021, 0.0, -3.59),
   };
-  const Case cases[] = {
-      {{1.0, 97.7, 0.186, WallMotion::kPlunge, false}, 0.02, 0.0, 0.0, -1.8},
-      {{1.9, -6.3, 0.198, WallMotion::kPush, true}, 0.02, 0.0, 0.0, -1.35},
-      {{1.0, 202.5, 0.311, WallMotion::kTurn, false}, 0.02, 0.0035, 0.0, 2.15},
-      {{1.0, 272.0, 0.151, WallMotion::kPush, false}, 0.02, 0.0, 2.0, -3.57},
-      {{1.7, 22.1, 0.301, WallMotion::kPush, true}, 0.01, 0.0039, 0.0, 0.69},
-      {{1.0, 289.4, 1.716, WallMotion::kLift, false}, 0.005, 0.0025, 1.49, -1.85},
-      {{1.3, 0.1, 1.09, WallMotion::kLift, true}, 0.02, 0.0, 1.67, -2.93},
-      {{0.8, 25.1, 0.835, WallMotion::kTurn, true}, 0.005, 0.0021, 0.0, -3.59},
-  };
-  for (const Case& c : cases) {
-    WallCase w = c.w;
-    w.cell_m = c.cell_m;
-    w.tremor_m = c.tremor_m;
-    w.wobble_deg = c.wobble_deg;
-    w.roll_deg = c.roll_deg;
-    EXPECT_LE(worst_rise_behind(w), kWallSlack_m) << describe(w);
-  }
+  for (const WallCase& w : cases) EXPECT_LE(worst_rise_behind(w), kWallSlack_m) << describe(w);
 }
 
 // Oblong cells (1 x 1.7 and 1 x 0.45 of the side along X): the passes'
@@ -155,25 +155,13 @@ TEST(SoilWall, NoSoilCrossesARolledBlade) {
 // of the measure on such cells (80 cases, every motion, rolled, trembling
 // and wobbling) found none failing; these four take each motion.
 TEST(SoilWall, NoSoilCrossesABladeOnOblongCells) {
-  struct Case {
-    WallCase w;
-    double cell_m, aspect, tremor_m, wobble_deg, roll_deg;
+  const WallCase cases[] = {
+      with({1.0, 37.0, 0.3, WallMotion::kPush, false}, 0.01, 1.7, 0.003, 1.5, 2.0),
+      with({1.2, 15.0, 0.8, WallMotion::kTurn, true}, 0.01, 0.45, 0.002, 0.0, -2.5),
+      with({1.0, 120.0, 0.15, WallMotion::kPlunge, false}, 0.02, 1.7, 0.0, 1.0, 0.0),
+      with({0.8, -20.0, 1.5, WallMotion::kLift, true}, 0.02, 0.45, 0.004, 1.0, 3.0),
   };
-  const Case cases[] = {
-      {{1.0, 37.0, 0.3, WallMotion::kPush, false}, 0.01, 1.7, 0.003, 1.5, 2.0},
-      {{1.2, 15.0, 0.8, WallMotion::kTurn, true}, 0.01, 0.45, 0.002, 0.0, -2.5},
-      {{1.0, 120.0, 0.15, WallMotion::kPlunge, false}, 0.02, 1.7, 0.0, 1.0, 0.0},
-      {{0.8, -20.0, 1.5, WallMotion::kLift, true}, 0.02, 0.45, 0.004, 1.0, 3.0},
-  };
-  for (const Case& c : cases) {
-    WallCase w = c.w;
-    w.cell_m = c.cell_m;
-    w.cell_aspect = c.aspect;
-    w.tremor_m = c.tremor_m;
-    w.wobble_deg = c.wobble_deg;
-    w.roll_deg = c.roll_deg;
-    EXPECT_LE(worst_rise_behind(w), kWallSlack_m) << describe(w);
-  }
+  for (const WallCase& w : cases) EXPECT_LE(worst_rise_behind(w), kWallSlack_m) << describe(w);
 }
 
 // The cases `terracut validate` runs hold too (its check 3.3).
