@@ -50,7 +50,8 @@ std::string describe(const WallCase& w) {
          (w.channel ? ", in a channel" : "") +
          (w.tremor_m > 0.0 ? ", tremor " + format_number(w.tremor_m * 1000.0) + " mm" : "") +
          (w.wobble_deg > 0.0 ? ", wobble " + format_number(w.wobble_deg) + " deg" : "") +
-         (w.roll_deg != 0.0 ? ", roll " + format_number(w.roll_deg) + " deg" : "") + ", cap " +
+         (w.roll_deg != 0.0 ? ", roll " + format_number(w.roll_deg) + " deg" : "") +
+         (w.origin_m != 0.0 ? ", terrain at " + format_number(w.origin_m) + " m" : "") + ", cap " +
          std::to_string(w.cap);
 }
 
@@ -66,6 +67,8 @@ double worst_rise_behind(const WallCase& w) {
     throw std::invalid_argument("worst_rise_behind: tremor_m must lie in [0, 0.02] m (" + describe(w) + ")");
   if (!(std::isfinite(w.wobble_deg) && w.wobble_deg >= 0.0 && w.wobble_deg <= 5.0))
     throw std::invalid_argument("worst_rise_behind: wobble_deg must lie in [0, 5] degrees (" + describe(w) + ")");
+  if (!(std::isfinite(w.origin_m) && std::abs(w.origin_m) <= 1e7))
+    throw std::invalid_argument("worst_rise_behind: origin_m must lie in [-1e7, 1e7] m (" + describe(w) + ")");
   if (!(std::isfinite(w.cell_aspect) && w.cell_aspect >= 0.25 && w.cell_aspect <= 4.0))
     throw std::invalid_argument("worst_rise_behind: cell_aspect must lie in [0.25, 4] (" + describe(w) + ")");
   if (!(std::isfinite(w.roll_deg) && std::abs(w.roll_deg) <= 5.0))
@@ -84,7 +87,9 @@ double worst_rise_behind(const WallCase& w) {
   const double dx = side_m / n, dz = side_m / rows;
   // In the channel the blade starts with its centre on a row of cell
   // centres, where a level edge stands on them again and again.
-  const double cx = 0.5 * side_m, cz = 0.5 * side_m + (w.channel ? 0.5 * dz : 0.0);
+  // The terrain's corner at (origin_m, 0, origin_m).
+  const double o = w.origin_m;
+  const double cx = o + 0.5 * side_m, cz = o + 0.5 * side_m + (w.channel ? 0.5 * dz : 0.0);
   // The cutting plane: the edge lies in it at every step, whatever the
   // motion, so each sample the edge passes is left at the plane's height and
   // no part of the edge ever comes back below a floor it cut (a part that
@@ -117,8 +122,8 @@ double worst_rise_behind(const WallCase& w) {
   // Its lowest over the terrain (at a corner or the ramp's ends): it must
   // stay above the ground's bottom and the obstacles' cells.
   double lowest = kWallLayer_m;
-  for (const double x : {0.0, side_m})
-    for (const double z : {0.0, side_m}) {
+  for (const double x : {o, o + side_m})
+    for (const double z : {o, o + side_m}) {
       const double across = (x - cx) * nz - (z - cz) * nx;
       for (const double along : {-reach, travel + reach})
         lowest = std::min(lowest, y0 + along_slope * along + cross_slope * across);
@@ -131,6 +136,7 @@ double worst_rise_behind(const WallCase& w) {
   p.grid.rows = rows;
   p.grid.size_x_m = side_m;
   p.grid.size_z_m = side_m;
+  p.grid.origin_m = {o, 0.0, o};
   // Spanning the terrain: longer than its diagonal, so its ends are off it.
   p.blade.length_m = blade_length_m(w);
   p.soil.model = SoilModel::kFlow;
@@ -148,7 +154,7 @@ double worst_rise_behind(const WallCase& w) {
     if (!(half_channel >= 2.0 * cell))
       throw std::invalid_argument("worst_rise_behind: in a channel the blade must reach across at least 8 cells "
                                   "at its largest yaw (" + describe(w) + ")");
-    const int c0 = int(std::ceil((cx - half_channel) / dx)), c1 = int(std::floor((cx + half_channel) / dx));
+    const int c0 = int(std::ceil((cx - o - half_channel) / dx)), c1 = int(std::floor((cx - o + half_channel) / dx));
     for (int r = 0; r < rows; ++r)
       for (int c = 0; c < n; ++c)
         if (c < c0 || c >= c1) h[std::size_t(r) * n + c] = float(lowest - 0.02);
@@ -184,7 +190,7 @@ double worst_rise_behind(const WallCase& w) {
     const Vec3 e = rotate(start.orientation, {1.0, 0.0, 0.0});
     for (int r = 0; r < rows; ++r)
       for (int c = 0; c < n; ++c) {
-        const double x = (c + 0.5) * dx, z = (r + 0.5) * dz;
+        const double x = o + (c + 0.5) * dx, z = o + (r + 0.5) * dz;
         if (e.x * (z - start.position_m.z) - e.z * (x - start.position_m.x) < 0.0) {
           float& v = h[std::size_t(r) * n + c];
           v = std::min(v, float(plane_y(x, z)));
@@ -205,7 +211,7 @@ double worst_rise_behind(const WallCase& w) {
     const HeightGrid& g = sim.grid();
     for (int r = 0; r < rows; ++r)
       for (int c = 0; c < n; ++c) {
-        const double x = (c + 0.5) * dx, z = (r + 0.5) * dz;
+        const double x = o + (c + 0.5) * dx, z = o + (r + 0.5) * dz;
         const double d = (dxl * (z - edge.a.z) - dzl * (x - edge.a.x)) / len;  // signed distance to the line, + ahead
         const double t = ((x - edge.a.x) * dxl + (z - edge.a.z) * dzl) / (len * len);
         // Watched: within the blade's span, on the side it came from now,

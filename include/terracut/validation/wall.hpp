@@ -63,6 +63,9 @@ struct WallCase {
   /// travel by this angle, so a blade square to its travel has its +X end
   /// higher by it; at other yaws the edge rolls as the plane asks.
   double roll_deg = 0.0;
+  /// Where the terrain lies: its corner at (origin_m, 0, origin_m), m (a
+  /// georeferenced terrain stands hundreds of kilometres from its origin).
+  double origin_m = 0.0;
 };
 
 /// The motion's name: push, plunge, lift, turn.
@@ -83,7 +86,8 @@ std::string describe(const WallCase& w);
 /// length, speed or cell not finite and positive, cells outside [2 mm,
 /// 5 cm], a speed under 1 mm/s, a tremor negative, not finite or over 2 cm,
 /// a wobble negative, not finite or over 5 degrees, a roll not finite or
-/// over 5 degrees either way, a cell aspect outside [0.25, 4], a plane that comes within 3 cm of the
+/// over 5 degrees either way, a cell aspect outside [0.25, 4], an origin
+/// not finite or beyond 1e7 m, a plane that comes within 3 cm of the
 /// terrain's bottom, a channel the blade does not reach across at its
 /// largest yaw, nothing to watch).
 double worst_rise_behind(const WallCase& w);
