@@ -199,10 +199,21 @@ TEST(SoilWall, NoSoilCrossesABladeFarFromTheOrigin) {
 // the code of 7c9d797 one of these 32 fails (a lifting rolled blade, 6 cm
 // behind it), and 3 of the first 100.
 TEST(SoilWall, RandomCasesHold) {
-  const char* seed_text = std::getenv("TERRACUT_WALL_SEED");
-  const char* count_text = std::getenv("TERRACUT_WALL_CASES");
-  const unsigned seed = seed_text ? unsigned(std::strtoul(seed_text, nullptr, 10)) : 2026u;
-  const int count = count_text ? std::atoi(count_text) : 32;
+  // A variable set to anything but a whole number in range is an error, not
+  // a quiet default.
+  const auto whole = [](const char* name, long fallback, long most) {
+    const char* text = std::getenv(name);
+    if (text == nullptr) return fallback;
+    char* end = nullptr;
+    const long value = std::strtol(text, &end, 10);
+    if (end == text || *end != '\0' || value < 0 || value > most) {
+      ADD_FAILURE() << name << "=" << text << " is not a whole number in [0, " << most << "]";
+      return fallback;
+    }
+    return value;
+  };
+  const unsigned seed = unsigned(whole("TERRACUT_WALL_SEED", 2026, 4294967295L));
+  const int count = int(whole("TERRACUT_WALL_CASES", 32, 100000));
   std::mt19937 rng(seed);
   const auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
   const auto pick = [&](int n) { return int(std::uniform_int_distribution<int>(0, n - 1)(rng)); };
