@@ -27,14 +27,11 @@ import math
 import os
 import sys
 
-from plot_common import import_plotting, make_fail, save_figure
+from plot_common import import_plotting, import_terracut, make_fail, parse_out_args, save_figure
 
 fail = make_fail("plot_blade_back.py")
 np, plt = import_plotting(fail)
-try:
-    import terracut
-except ImportError:
-    fail("missing Python module 'terracut' (build it, then PYTHONPATH=build/python)", 3)
+terracut = import_terracut(fail)
 
 CELL, SIDE, LAYER = 0.005, 1.0, 0.2
 TRAVEL, SPEED = 0.3, 0.28
@@ -97,19 +94,7 @@ def run(in_plane):
 
 
 def main(argv):
-    out, quiet = os.path.join("docs", "images", "soil_blade_back.png"), False
-    args = argv[1:]
-    while args:
-        a = args.pop(0)
-        if a == "--out" and args:
-            out = args.pop(0)
-        elif a == "--quiet":
-            quiet = True
-        elif a in ("-h", "--help"):
-            print(__doc__)
-            return 0
-        else:
-            fail(f"unknown argument {a!r} (see --help)")
+    out, quiet = parse_out_args(argv, __doc__, os.path.join("docs", "images", "soil_blade_back.png"), fail)
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.2), sharey=True)
     cases = [(False, "turned about the vertical, the edge level"),
              (True, "rolled so that the edge stays in the ramp's plane")]

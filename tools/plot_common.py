@@ -65,6 +65,23 @@ def _parse_args(argv, doc, fail):
     return folders, out, quiet
 
 
+def parse_out_args(argv, doc, default_png, fail):
+    """(output png, quiet) from `SCRIPT [--out FILE.png] [--quiet]`."""
+    folders, out, quiet = _parse_args(argv, doc, fail)
+    if folders:
+        fail(f"unknown argument {folders[0]!r} (see --help)")
+    return out or default_png, quiet
+
+
+def import_terracut(fail):
+    """The terracut module; exit code 3 when it is missing."""
+    try:
+        import terracut
+    except ImportError:
+        fail("missing Python module 'terracut' (build it, then PYTHONPATH=build/python)", 3)
+    return terracut
+
+
 def parse_dir_args(argv, doc, default_png, fail, script):
     """(folder, output png, quiet) from `SCRIPT DIR [--out FILE.png] [--quiet]`."""
     folders, out, quiet = _parse_args(argv, doc, fail)

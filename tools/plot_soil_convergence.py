@@ -21,14 +21,11 @@ import os
 import sys
 
 import soil_push
-from plot_common import import_plotting, make_fail, save_figure
+from plot_common import import_plotting, import_terracut, make_fail, save_figure
 
 fail = make_fail("plot_soil_convergence.py")
 np, plt = import_plotting(fail)
-try:
-    import terracut
-except ImportError:
-    fail("missing Python module 'terracut' (build it, then PYTHONPATH=build/python)", 3)
+terracut = import_terracut(fail)
 
 CELL, WIDTH, TRAVEL = 0.005, 1.0, 0.8
 COLS, ROWS = soil_push.grid_shape(WIDTH, CELL, TRAVEL)

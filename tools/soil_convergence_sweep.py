@@ -24,7 +24,7 @@ missing; 4 a converged push left no soil ahead (a blade above the layer).
 import math
 import sys
 
-from plot_common import make_fail
+from plot_common import import_terracut, make_fail
 from soil_push import push
 
 fail = make_fail("soil_convergence_sweep.py")
@@ -32,10 +32,7 @@ try:
     import numpy as np
 except ImportError:
     fail("missing Python module 'numpy' (Debian: apt-get install python3-numpy)", 3)
-try:
-    import terracut
-except ImportError:
-    fail("missing Python module 'terracut' (build it, then PYTHONPATH=build/python)", 3)
+terracut = import_terracut(fail)
 
 
 def number(flag, text, lo, hi):

@@ -101,19 +101,26 @@ double worst_rise_behind(const WallCase& w) {
   // (x, z):
   const double edge_start = kWallLayer_m - kWallDepth_m;
   const double y0 = w.motion == WallMotion::kPlunge ? kWallLayer_m - 0.01 : edge_start;
-  const double along_slope = w.motion == WallMotion::kPlunge ? -0.04 / travel : w.motion == WallMotion::kLift ? 0.04 / travel : 0.0;
+  const double along_slope = w.motion == WallMotion::kPlunge ? -0.04 / travel
+                             : w.motion == WallMotion::kLift ? 0.04 / travel
+                                                             : 0.0;
   const double cross_slope = std::tan(w.roll_deg * kWallDeg);
   // (gx, gz): the plane's gradient where the edge goes; along the travel
   // measured from the centre's start, across it toward the side the edge's
   // +X end points at yaw 0.
   const double gx = along_slope * nx + cross_slope * nz, gz = along_slope * nz - cross_slope * nx;
   const double start_x = cx - 0.5 * travel * nx, start_z = cz - 0.5 * travel * nz;
-  // Beyond the reach of the edge along the travel (its half-length at the
-  // largest angle to its travel, the tremor and two cells, before the start
-  // and past the end) the ramp goes no further: the trench dug behind the
-  // start and the ground far ahead stay above the terrain's bottom.
-  const double widest_deg = (w.channel ? std::abs(w.yaw_deg) : 0.0) + (w.motion == WallMotion::kTurn ? 8.0 : 0.0) + w.wobble_deg;
-  const double reach = 0.5 * blade_length_m(w) * std::sin(std::min(90.0, widest_deg) * kWallDeg) + w.tremor_m + 2.0 * cell;
+  // The largest angle between the edge and the normal of its travel: the
+  // yaw in a channel (spanning, it travels along its normal), the turn and
+  // the wobble.
+  const double widest_deg =
+      (w.channel ? std::abs(w.yaw_deg) : 0.0) + (w.motion == WallMotion::kTurn ? 8.0 : 0.0) + w.wobble_deg;
+  // Beyond the reach of the edge along the travel (its half-length at that
+  // angle, the tremor and two cells, before the start and past the end) the
+  // ramp goes no further: the trench dug behind the start and the ground
+  // far ahead stay above the terrain's bottom.
+  const double reach =
+      0.5 * blade_length_m(w) * std::sin(std::min(90.0, widest_deg) * kWallDeg) + w.tremor_m + 2.0 * cell;
   const auto plane_y = [&](double x, double z) {
     const double along = std::clamp((x - start_x) * nx + (z - start_z) * nz, -reach, travel + reach);
     const double across = (x - cx) * nz - (z - cz) * nx;
@@ -149,8 +156,7 @@ double worst_rise_behind(const WallCase& w) {
     // less two cells: its ends stay over the obstacles either side, whose
     // cells stand below the plane (no soil to cut or to slide off them) and
     // are closed to soil coming in.
-    const double widest_yaw = std::abs(w.yaw_deg) + (w.motion == WallMotion::kTurn ? 8.0 : 0.0) + w.wobble_deg;
-    const double half_channel = 0.5 * w.length_m * std::cos(widest_yaw * kWallDeg) - 2.0 * cell;
+    const double half_channel = 0.5 * w.length_m * std::cos(widest_deg * kWallDeg) - 2.0 * cell;
     if (!(half_channel >= 2.0 * cell))
       throw std::invalid_argument("worst_rise_behind: in a channel the blade must reach across at least 8 cells "
                                   "at its largest yaw (" + describe(w) + ")");
@@ -270,20 +276,14 @@ std::vector<WallCase> validation_wall_cases() {
   // terrain plunging with the tremor and the wobble, 1 and 1.5 m blades
   // lifting (wobbling) and pushing in a channel, and one turning with the
   // tremor.
-  const struct {
-    WallCase w;
-    double tremor_m, wobble_deg, roll_deg;
-  } rolled[] = {{{1.0, 60.0, 0.3, WallMotion::kPlunge, false}, 0.002, 1.5, 3.0},
-                {{1.0, 20.0, 0.5, WallMotion::kLift, true}, 0.0, 1.5, -3.0},
-                {{1.5, -15.0, 1.0, WallMotion::kPush, true}, 0.0, 0.0, 4.0},
-                {{1.0, 200.0, 0.2, WallMotion::kTurn, false}, 0.004, 0.0, -2.5}};
-  for (const auto& r : rolled) {
-    WallCase w = r.w;
-    w.tremor_m = r.tremor_m;
-    w.wobble_deg = r.wobble_deg;
-    w.roll_deg = r.roll_deg;
-    cases.push_back(w);
-  }
+  cases.push_back({.length_m = 1.0, .yaw_deg = 60.0, .speed_m_per_s = 0.3, .motion = WallMotion::kPlunge,
+                   .tremor_m = 0.002, .wobble_deg = 1.5, .roll_deg = 3.0});
+  cases.push_back({.length_m = 1.0, .yaw_deg = 20.0, .speed_m_per_s = 0.5, .motion = WallMotion::kLift,
+                   .channel = true, .wobble_deg = 1.5, .roll_deg = -3.0});
+  cases.push_back({.length_m = 1.5, .yaw_deg = -15.0, .speed_m_per_s = 1.0, .motion = WallMotion::kPush,
+                   .channel = true, .roll_deg = 4.0});
+  cases.push_back({.length_m = 1.0, .yaw_deg = 200.0, .speed_m_per_s = 0.2, .motion = WallMotion::kTurn,
+                   .tremor_m = 0.004, .roll_deg = -2.5});
   return cases;
 }
 

@@ -17,17 +17,6 @@
 namespace terracut::validation {
 namespace {
 
-// w on cells of cell_m x cell_m * aspect, with a hand's tremor (m) and
-// wobble (degrees), rolled roll_deg.
-WallCase with(WallCase w, double cell_m, double aspect, double tremor_m, double wobble_deg, double roll_deg) {
-  w.cell_m = cell_m;
-  w.cell_aspect = aspect;
-  w.tremor_m = tremor_m;
-  w.wobble_deg = wobble_deg;
-  w.roll_deg = roll_deg;
-  return w;
-}
-
 // Each blade along X pushes along +Z; the blade spans the terrain.
 TEST(SoilWall, NoSoilCrossesABladeSpanningTheTerrain) {
   const double speeds[] = {0.25, 1.0, 2.0};
@@ -139,14 +128,22 @@ TEST(SoilWall, NoSoilCrossesAWobblingBlade) {
 // five left 2.4 to 9.6 cm of soil behind the blade (2.0 to 6.5 cm level).
 TEST(SoilWall, NoSoilCrossesARolledBlade) {
   const WallCase cases[] = {
-      with({1.0, 97.7, 0.186, WallMotion::kPlunge, false}, 0.02, 1.0, 0.0, 0.0, -1.8),
-      with({1.9, -6.3, 0.198, WallMotion::kPush, true}, 0.02, 1.0, 0.0, 0.0, -1.35),
-      with({1.0, 202.5, 0.311, WallMotion::kTurn, false}, 0.02, 1.0, 0.0035, 0.0, 2.15),
-      with({1.0, 272.0, 0.151, WallMotion::kPush, false}, 0.02, 1.0, 0.0, 2.0, -3.57),
-      with({1.7, 22.1, 0.301, WallMotion::kPush, true}, 0.01, 1.0, 0.0039, 0.0, 0.69),
-      with({1.0, 289.4, 1.716, WallMotion::kLift, false}, 0.005, 1.0, 0.0025, 1.49, -1.85),
-      with({1.3, 0.1, 1.09, WallMotion::kLift, true}, 0.02, 1.0, 0.0, 1.67, -2.93),
-      with({0.8, 25.1, 0.835, WallMotion::kTurn, true}, 0.005, 1.0, 0.0021, 0.0, -3.59),
+      {.length_m = 1.0, .yaw_deg = 97.7, .speed_m_per_s = 0.186, .motion = WallMotion::kPlunge,
+       .cell_m = 0.02, .roll_deg = -1.8},
+      {.length_m = 1.9, .yaw_deg = -6.3, .speed_m_per_s = 0.198, .motion = WallMotion::kPush, .channel = true,
+       .cell_m = 0.02, .roll_deg = -1.35},
+      {.length_m = 1.0, .yaw_deg = 202.5, .speed_m_per_s = 0.311, .motion = WallMotion::kTurn,
+       .cell_m = 0.02, .tremor_m = 0.0035, .roll_deg = 2.15},
+      {.length_m = 1.0, .yaw_deg = 272.0, .speed_m_per_s = 0.151, .motion = WallMotion::kPush,
+       .cell_m = 0.02, .wobble_deg = 2.0, .roll_deg = -3.57},
+      {.length_m = 1.7, .yaw_deg = 22.1, .speed_m_per_s = 0.301, .motion = WallMotion::kPush, .channel = true,
+       .cell_m = 0.01, .tremor_m = 0.0039, .roll_deg = 0.69},
+      {.length_m = 1.0, .yaw_deg = 289.4, .speed_m_per_s = 1.716, .motion = WallMotion::kLift,
+       .cell_m = 0.005, .tremor_m = 0.0025, .wobble_deg = 1.49, .roll_deg = -1.85},
+      {.length_m = 1.3, .yaw_deg = 0.1, .speed_m_per_s = 1.09, .motion = WallMotion::kLift, .channel = true,
+       .cell_m = 0.02, .wobble_deg = 1.67, .roll_deg = -2.93},
+      {.length_m = 0.8, .yaw_deg = 25.1, .speed_m_per_s = 0.835, .motion = WallMotion::kTurn, .channel = true,
+       .cell_m = 0.005, .tremor_m = 0.0021, .roll_deg = -3.59},
   };
   for (const WallCase& w : cases) EXPECT_LE(worst_rise_behind(w), kWallSlack_m) << describe(w);
 }
@@ -158,10 +155,14 @@ TEST(SoilWall, NoSoilCrossesARolledBlade) {
 // and wobbling) found none failing; these four take each motion.
 TEST(SoilWall, NoSoilCrossesABladeOnOblongCells) {
   const WallCase cases[] = {
-      with({1.0, 37.0, 0.3, WallMotion::kPush, false}, 0.01, 1.7, 0.003, 1.5, 2.0),
-      with({1.2, 15.0, 0.8, WallMotion::kTurn, true}, 0.01, 0.45, 0.002, 0.0, -2.5),
-      with({1.0, 120.0, 0.15, WallMotion::kPlunge, false}, 0.02, 1.7, 0.0, 1.0, 0.0),
-      with({0.8, -20.0, 1.5, WallMotion::kLift, true}, 0.02, 0.45, 0.004, 1.0, 3.0),
+      {.length_m = 1.0, .yaw_deg = 37.0, .speed_m_per_s = 0.3, .motion = WallMotion::kPush,
+       .cell_m = 0.01, .cell_aspect = 1.7, .tremor_m = 0.003, .wobble_deg = 1.5, .roll_deg = 2.0},
+      {.length_m = 1.2, .yaw_deg = 15.0, .speed_m_per_s = 0.8, .motion = WallMotion::kTurn, .channel = true,
+       .cell_m = 0.01, .cell_aspect = 0.45, .tremor_m = 0.002, .roll_deg = -2.5},
+      {.length_m = 1.0, .yaw_deg = 120.0, .speed_m_per_s = 0.15, .motion = WallMotion::kPlunge,
+       .cell_m = 0.02, .cell_aspect = 1.7, .wobble_deg = 1.0},
+      {.length_m = 0.8, .yaw_deg = -20.0, .speed_m_per_s = 1.5, .motion = WallMotion::kLift, .channel = true,
+       .cell_m = 0.02, .cell_aspect = 0.45, .tremor_m = 0.004, .wobble_deg = 1.0, .roll_deg = 3.0},
   };
   for (const WallCase& w : cases) EXPECT_LE(worst_rise_behind(w), kWallSlack_m) << describe(w);
 }
@@ -179,10 +180,14 @@ TEST(SoilWall, NoSoilCrossesABladeOnOblongCells) {
 // "A slow blade is a wall too", Not done.)
 TEST(SoilWall, NoSoilCrossesABladeFarFromTheOrigin) {
   WallCase cases[] = {
-      with({1.0, 17.0, 0.25, WallMotion::kPush, false}, 0.01, 1.0, 0.003, 1.5, 2.0),
-      with({1.2, -12.0, 0.6, WallMotion::kTurn, true}, 0.02, 1.0, 0.002, 0.0, -1.5),
-      with({1.0, 200.0, 0.4, WallMotion::kPlunge, false}, 0.02, 1.0, 0.004, 1.0, 0.0),
-      with({0.9, 25.0, 1.2, WallMotion::kLift, true}, 0.01, 1.0, 0.0, 1.0, 3.0),
+      {.length_m = 1.0, .yaw_deg = 17.0, .speed_m_per_s = 0.25, .motion = WallMotion::kPush,
+       .cell_m = 0.01, .tremor_m = 0.003, .wobble_deg = 1.5, .roll_deg = 2.0},
+      {.length_m = 1.2, .yaw_deg = -12.0, .speed_m_per_s = 0.6, .motion = WallMotion::kTurn, .channel = true,
+       .cell_m = 0.02, .tremor_m = 0.002, .roll_deg = -1.5},
+      {.length_m = 1.0, .yaw_deg = 200.0, .speed_m_per_s = 0.4, .motion = WallMotion::kPlunge,
+       .cell_m = 0.02, .tremor_m = 0.004, .wobble_deg = 1.0},
+      {.length_m = 0.9, .yaw_deg = 25.0, .speed_m_per_s = 1.2, .motion = WallMotion::kLift, .channel = true,
+       .cell_m = 0.01, .wobble_deg = 1.0, .roll_deg = 3.0},
   };
   for (WallCase& w : cases) {
     w.origin_m = 500000.0;
