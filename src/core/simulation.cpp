@@ -26,19 +26,28 @@ constexpr int kMaxSubsteps = 64;
 /// How far, in cells, each sweep reaches back over the previous one's end.
 constexpr double kSweepOverlapCells = 1e-6;
 
-// The sweep's start, moved back along each end's own motion by `back`
-// metres: consecutive sweeps then overlap by that much, so a sample lying
-// (to rounding) on the line they share is inside at least one of them. The
-// rasterisers decide a sample within about 1e-15 of a cell of a sweep's
-// edge either way, and without the overlap a blade moving by small steps
-// could miss such a row in both sweeps. Cutting twice is cutting once.
+// The sweep's start, moved back in time: each end goes back along its own
+// motion by the same fraction of it, so that the end that moved furthest
+// goes back by `back` metres and every point of the edge by that fraction
+// of its own motion. Consecutive sweeps then overlap along the line they
+// share, so a sample lying (to rounding) on it is inside at least one of
+// them. The rasterisers decide a sample within about 1e-15 of a cell of a
+// sweep's edge either way, and without the overlap a blade moving by small
+// steps could miss such a row in both sweeps. Cutting twice is cutting
+// once. (Each end moved back by `back` along its own motion, the overlap
+// of a turning edge whose ends go opposite ways across its line was the
+// ends' shifts interpolated: none at the edge's middle, and a gap between
+// the middle and the point that stands still, where the motion and the
+// shift point the same way. A 2 m blade turning about its centre while it
+// pushed, its line on a row of cell centres in one step (2 cm cells, a
+// lattice direction), never cut those centres, and the soil on them slid
+// into the trench behind it: 2 cm.)
 Segment reach_back(const Segment& from, const Segment& to, double back) {
-  const auto moved = [&](const Vec3& p0, const Vec3& p1) {
-    const Vec3 d = p1 - p0;
-    const double len = length(d);
-    return len > 0.0 ? p0 - d * (back / len) : p0;
-  };
-  return {moved(from.a, to.a), moved(from.b, to.b)};
+  const Vec3 da = to.a - from.a, db = to.b - from.b;
+  const double most = std::max(length(da), length(db));
+  if (!(most > 0.0)) return from;
+  const double k = back / most;
+  return {from.a - da * k, from.b - db * k};
 }
 
 }  // namespace

@@ -164,6 +164,63 @@ TEST(Simulation, SmallStepsCutEveryRowTheyCross) {
   }
 }
 
+TEST(Simulation, TurningStepsCutEverySampleTheyCross) {
+  // A 2 m blade pushing while it turns about the vertical fast enough that
+  // one end goes back across its line while the other goes forward: the
+  // edge turns about a point on it. At step kAt its line runs along a
+  // lattice direction exactly through a row of sample centres, so those
+  // centres lie, to rounding, on the line two consecutive sweeps share.
+  // Every one of them the edge then passed is cut to its height, at every
+  // lattice direction, turning either way, in both representations and
+  // wherever the terrain lies. (The sweeps once reached back along each
+  // end's own motion: between the edge's middle and the point that stood
+  // still the reach pointed forward, and a row of such centres was never
+  // cut: in the soil, a pile standing on them slid into the trench behind
+  // the blade.)
+  constexpr int kCells = 60, kAt = 40;
+  constexpr double kCell = 0.02, kBladeY = 0.25, kPush = 3e-4, kTurn = 5e-4;  // m and rad a step
+  const std::pair<int, int> lattice[] = {{1, 0}, {0, 1}, {1, 1}, {2, 1}, {3, 1}, {3, -1}, {1, -2}};
+  for (const double origin : {0.0, 0.37, 1e5}) {
+    SimParams p;
+    p.grid = grid_of_cells(kCells, kCells, kCell, {origin, 0.0, origin});
+    p.blade.length_m = 2.0;
+    for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
+      p.representation = rep;
+      for (const auto& [lc, lr] : lattice) {
+        for (const double spin : {1.0, -1.0}) {
+          Simulation sim(p, std::vector<float>(kCells * kCells, 0.3f));
+          // The line at step kAt: through centre (30, 30), along (lc, lr) in cells.
+          const double cx = origin + 30.5 * kCell, cz = origin + 30.5 * kCell;
+          const double yaw_at = -std::atan2(double(lr), double(lc));  // local +X -> (cos yaw, -sin yaw)
+          const double nx = std::sin(yaw_at), nz = std::cos(yaw_at);  // the edge's normal, its push
+          for (int i = 0; i <= 2 * kAt; ++i) {
+            const double k = i - kAt;
+            sim.step({{cx + nx * kPush * k, kBladeY, cz + nz * kPush * k},
+                      quat_from_axis_angle({0.0, 1.0, 0.0}, yaw_at + spin * kTurn * k)});
+          }
+          // The point of the edge that stands still, kPush / kTurn from the
+          // middle (a point `along` from it moves kPush - along * spin *
+          // kTurn along the normal): the centres within two cells of it are
+          // left out (their motion is within rounding's reach).
+          const double still = spin * kPush / kTurn;
+          int checked = 0;
+          for (int m = -40; m <= 40; ++m) {
+            const int c = 30 + m * lc, r = 30 + m * lr;
+            if (c < 0 || r < 0 || c >= kCells || r >= kCells) continue;
+            const double along = m * std::hypot(double(lc), double(lr)) * kCell;  // from the middle, toward +X at yaw_at
+            if (std::abs(along - still) < 2.0 * kCell) continue;
+            ++checked;
+            EXPECT_NEAR(sim.grid().height(c, r), kBladeY, 1e-6)
+                << "cell (" << c << ", " << r << ") on the line along (" << lc << ", " << lr << "), turn " << spin
+                << ", origin " << origin << ", " << to_string(rep);
+          }
+          EXPECT_GE(checked, 10);
+        }
+      }
+    }
+  }
+}
+
 TEST(Simulation, ContactIsMeasuredBeforeTheCut) {
   for (Representation rep : {Representation::kColumns, Representation::kSurface}) {
     SimParams p;
