@@ -865,8 +865,9 @@ std::vector<Check> make_checks(const Report& r) {
                                         [](const WallRun& a, const WallRun& b) { return a.worst_m < b.worst_m; });
     const int holding = int(std::count_if(r.walls.begin(), r.walls.end(), [](const WallRun& w) { return w.pass(); }));
     out.push_back({"3.3", "the blade is a wall: no soil behind it that came through or under it (blades of 0.2 to 2 m, "
-                          "yaw -30 to 200 deg, level and rolled, 0.05 to 2 m/s, push, plunge, lift, turn, "
-                          "steadily and with a hand's tremor and wobble)",
+                          "yaw -30 to 200 deg, lattice directions, level and rolled, 0.05 to 2 m/s, push, plunge, "
+                          "lift, turn, steadily and with a hand's tremor and wobble, terrain at the origin and 1e7 m "
+                          "out)",
                    std::to_string(holding) + "/" + std::to_string(r.walls.size()) + " cases; worst rise " +
                        fmt("%.2e", worst->worst_m) + " m (" + validation::describe(worst->what) + ")",
                    "<= " + fmt("%.0e", validation::kWallSlack_m) + " m (float rounding)",
@@ -1052,12 +1053,14 @@ std::string report_markdown(const Report& r) {
      << "behind a blade only round its ends or down the trench's walls, so each case takes both "
      << "away: the blade spans the terrain (2 m on 1 m, its ends off the grid) or runs in a channel "
      << "closed by rigid obstacles beyond its ends, and the trench behind its start is already dug. "
-     << "It travels 0.3 m, 5 cm into a 20 cm layer on 1 cm cells (plunging: from 1 to 5 cm deep; "
+     << "It travels 0.3 m, 5 cm into a 20 cm layer on 1 cm cells (2 cm in one case) (plunging: from 1 to 5 cm deep; "
      << "lifting: from 5 to 1 cm; turning: its yaw from -8 to +8 deg about its centre), its edge "
      << "in one plane at every step (a ramp along the travel, sloping across it by the roll), so "
      << "no part of it comes back below the floor it cut. Every step, every sample behind it (more "
      << "than a cell and a half behind its line, within its span) must stay at that plane. A slow "
-     << "blade (0.05 m/s, 1/200 of a cell a step) is among them.\n\n"
+     << "blade (0.05 m/s, 1/200 of a cell a step) is among them, and two turning blades along a lattice "
+     << "direction (the line through a row of cell centres when the turn passes 0), one on a terrain "
+     << "1e7 m from the origin.\n\n"
      << "| case | worst rise behind the blade (m) | result |\n|---|---|---|\n";
   for (const WallRun& w : r.walls)
     md << "| " << validation::describe(w.what) << " | " << fmt("%.2e", w.worst_m) << " | " << pass_fail(w.pass())
@@ -1208,13 +1211,13 @@ void write_outputs(const fs::path& out, const Report& r) {
     }
   write_file(out / "bulldozing" / "pile.csv", pile);
   std::string wall =
-      "motion,blade_m,spanning,yaw_deg,speed_m_per_s,cell_m,tremor_m,wobble_deg,roll_deg,cap,worst_rise_m\n";
+      "motion,blade_m,spanning,yaw_deg,speed_m_per_s,cell_m,tremor_m,wobble_deg,roll_deg,origin_m,cap,worst_rise_m\n";
   for (const WallRun& w : r.walls) {
     const validation::WallCase& c = w.what;
     wall += std::string(validation::motion_name(c.motion)) + "," + csv_number(validation::blade_length_m(c)) + "," +
             (c.channel ? "0" : "1") + "," + csv_number(c.yaw_deg) + "," + csv_number(c.speed_m_per_s) + "," +
             csv_number(c.cell_m) + "," + csv_number(c.tremor_m) + "," + csv_number(c.wobble_deg) + "," +
-            csv_number(c.roll_deg) + "," + std::to_string(c.cap) + "," + csv_number(w.worst_m) + "\n";
+            csv_number(c.roll_deg) + "," + csv_number(c.origin_m) + "," + std::to_string(c.cap) + "," + csv_number(w.worst_m) + "\n";
   }
   write_file(out / "bulldozing" / "wall.csv", wall);
   write_file(out / "bulldozing" / "centre.csv", centre);
@@ -1334,8 +1337,9 @@ Command add_validate_command(CLI::App& app) {
       "  bulldozing/centre.csv  width_m, pushed_m, s_m (ahead of the edge), h_m (centre line)\n"
       "  bulldozing/height_w<width>.npy  float32 heights (m) after the push\n"
       "  bulldozing/wall.csv  motion, blade_m, spanning, yaw_deg, speed_m_per_s, cell_m,\n"
-      "    tremor_m, wobble_deg, roll_deg, cap, worst_rise_m: the blade-as-a-wall cases\n"
-      "    (check 3.3)\n"
+      "    tremor_m, wobble_deg, roll_deg, origin_m, cap, worst_rise_m: the blade-as-a-wall\n"
+      "    cases (origin_m: the terrain's corner at (origin_m, 0, origin_m))\n"
+      "    of check 3.3\n"
       "  conservation/scenario.yaml      the mixed run's cuts (runnable with `terracut run`)\n"
       "  conservation/volume.csv         step, t_s, cut, volume_m3, relative_error,\n"
       "                                  tolerance_rel\n"

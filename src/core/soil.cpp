@@ -97,6 +97,9 @@ SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const B
   }
   origin_x_ = spec.origin_m.x;
   origin_z_ = spec.origin_m.z;
+  coord_rounding_m_ = 64.0 * std::numeric_limits<double>::epsilon() *
+                      std::max({std::abs(spec.origin_m.x), std::abs(spec.origin_m.x + spec.size_x_m),
+                                std::abs(spec.origin_m.z), std::abs(spec.origin_m.z + spec.size_z_m)});
   row_div_ = detail::IndexDivider(std::uint32_t(cols_));
 
   for (int k = 0; k < 8; ++k) {

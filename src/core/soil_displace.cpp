@@ -66,7 +66,7 @@ void SoilFlow::mark_blade(const HeightGrid& grid, const Segment& from, const Seg
   // by the ends; any motion counts).
   const auto across = [&](const Vec3& was, const Vec3& is) {
     const double n = d.x * (is.z - was.z) - d.z * (is.x - was.x);
-    return std::abs(n) > 1e-9 * half_num ? n : 0.0;
+    return std::abs(n) > std::max(1e-9 * half_num, coord_rounding_m_ * plan_length) ? n : 0.0;
   };
   blade_.across_a = across(from.a, edge.a);
   blade_.across_b = across(from.b, edge.b);
@@ -120,7 +120,9 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
   // on the side it came from in the step), else its motion since the blade
   // last moved (motion_origin: a blade standing still, going straight down
   // or sliding along its line keeps the way it went), else none (each cut
-  // sample's soil to its own side). (A test of a hundredth of a cell's
+  // sample's soil to its own side, a centre on the line to the side the
+  // edge's normal (-e.z, e.x) faces, which is the blade frame's +Z for a
+  // level blade). (A test of a hundredth of a cell's
   // motion in the step took a slow blade for one at rest, 0.1 m/s on 1 cm
   // cells, and put the cut of each centre the edge had just passed on that
   // centre's own side: behind the blade, at every row.) A point's motion is
@@ -128,7 +130,15 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
   // parts can go opposite ways (one way for the whole edge, its midpoint's,
   // pushed the cut of the part going forward behind it when a hand's tremor
   // took the midpoint back: a 0.55 m blade on 2 cm cells, 2 cm behind it).
-  const double rounding = 1e-9 * cell;
+  // Rounding: a billionth of a cell, or the rounding of the world
+  // coordinates where the terrain lies far from the origin (a
+  // georeferenced terrain: at 1e7 m a double's step is 1.9e-9 m, more than
+  // a billionth of a 1 cm cell), so that which side a centre on the line
+  // is on does not turn with where the terrain lies. (Decided by the sign
+  // of its distance alone, a centre on the line of a blade set down at
+  // rest went ahead of it with the terrain at the origin and behind it 1 km
+  // out: 1.7 cm behind a 1.1 m blade on 2 cm cells once it moved on.)
+  const double rounding = std::max(1e-9 * cell, coord_rounding_m_);
   if (plan_length > 1e-12) {
     nx /= plan_length;
     nz /= plan_length;
@@ -304,7 +314,8 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       nx = way < 0.0 ? -line_nx : line_nx;
       nz = way < 0.0 ? -line_nz : line_nz;
       const double s = (x - to.a.x) * nx + (z - to.a.z) * nz;
-      const double side = moving || s >= 0.0 ? 1.0 : -1.0;
+      // At rest, its own side; on the line within rounding, the normal's.
+      const double side = moving || s >= -rounding ? 1.0 : -1.0;
       const double go = side * (kDepositAheadCells * cell) - s;
       // Step m (< kMaxPushCells) of the walk from `go`: its cell and whether
       // it lies beyond an open edge. Beyond a wall, a target is the walk's

@@ -259,7 +259,7 @@ inline bool SoilFlow::blade_blocks(int hc, int hr, int lc, int lr, float top_m) 
   // blade whose line landed on a row of centres every few steps).
   bool a_side = na > 0.0, b_side = nb > 0.0;
   if (low_inside || high_inside) {
-    const double margin = 1e-9 * blade_.half_lo;
+    const double margin = std::max(1e-9 * blade_.half_lo, coord_rounding_m_ * len);
     const auto along = [&](double x, double z) { return std::clamp((x * blade_.dx + z * blade_.dz) / len2, 0.0, 1.0); };
     const auto behind_sign = [&](double t) { return -((1.0 - t) * blade_.across_a + t * blade_.across_b); };
     if (low_inside) {

@@ -284,6 +284,16 @@ std::vector<WallCase> validation_wall_cases() {
                    .channel = true, .roll_deg = 4.0});
   cases.push_back({.length_m = 1.0, .yaw_deg = 200.0, .speed_m_per_s = 0.2, .motion = WallMotion::kTurn,
                    .tremor_m = 0.004, .roll_deg = -2.5});
+  // Along a lattice direction (the line through a centre every three
+  // cells: tangent 1/3), turning: at the step where the turn passes 0 the
+  // line lies on a row of centres. A 2 m blade spanning the terrain on 2 cm
+  // cells with a 2 mm tremor, and one rolled on a terrain 1e7 m from the
+  // origin (both left 1.8 to 2 cm behind the blade before 2026-12-07).
+  const double lattice_deg = std::atan(1.0 / 3.0) * 180.0 / std::numbers::pi;
+  cases.push_back({.length_m = 1.0, .yaw_deg = 180.0 + lattice_deg, .speed_m_per_s = 0.3,
+                   .motion = WallMotion::kTurn, .cell_m = 0.02, .tremor_m = 0.002});
+  cases.push_back({.length_m = 1.0, .yaw_deg = 90.0 + lattice_deg, .speed_m_per_s = 0.4,
+                   .motion = WallMotion::kTurn, .roll_deg = 2.0, .origin_m = 1e7});
   return cases;
 }
 

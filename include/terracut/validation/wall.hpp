@@ -99,8 +99,10 @@ inline constexpr double kWallSlack_m = 1e-5;
 /// 200 degrees, speeds of 0.05 to 2 m/s (a slow one moves under a hundredth
 /// of a cell a step), every motion, spanning the terrain and in a channel,
 /// every motion again with a hand's tremor that backs the blade up, pushes
-/// and turns with a wobble about the vertical, and every motion with the
-/// blade rolled 2.5 to 4 degrees (with a tremor or a wobble in three).
+/// and turns with a wobble about the vertical, every motion with the
+/// blade rolled 2.5 to 4 degrees (with a tremor or a wobble in three), and
+/// two blades turning along a lattice direction (their line through a row
+/// of cell centres once), one with the terrain 1e7 m from the origin.
 std::vector<WallCase> validation_wall_cases();
 
 }  // namespace terracut::validation
