@@ -50,6 +50,28 @@ Segment reach_back(const Segment& from, const Segment& to, double back) {
   return {from.a - da * k, from.b - db * k};
 }
 
+// A sweep whose edge did not move across its line in plan (a blade set
+// down, standing, or going straight up or down) is a line in plan, and the
+// rasterisers decide a sample centre on that line either way, by rounding:
+// a blade set down with its line through a row of centres left some of
+// them standing under its edge, and the terrain's place decided which. So
+// such a step also cuts the band `back` either side of the edge where it
+// now is (true, with the band's two sides in lo and hi): a centre on the
+// line, within rounding, is cut wherever the terrain lies. False for an
+// edge that moved across its line by more than `back` at either end (the
+// reach back covers it) or that stands end-on in plan.
+bool still_band(const Segment& from, const Segment& to, double back, Segment& lo, Segment& hi) {
+  const double ex = to.b.x - to.a.x, ez = to.b.z - to.a.z;
+  const double plan = std::hypot(ex, ez);
+  if (!(plan > 0.0)) return false;
+  const Vec3 n{-ez / plan, 0.0, ex / plan};
+  const auto across = [&](const Vec3& was, const Vec3& is) { return std::abs((is.x - was.x) * n.x + (is.z - was.z) * n.z); };
+  if (!(across(from.a, to.a) <= back && across(from.b, to.b) <= back)) return false;
+  lo = {to.a - n * back, to.b - n * back};
+  hi = {to.a + n * back, to.b + n * back};
+  return true;
+}
+
 }  // namespace
 
 std::string validate(const SimParams& params) {
@@ -199,6 +221,13 @@ const StepOutput& Simulation::finish_step() {
     out_.cut.removed_volume_m3 += part.removed_volume_m3;
     out_.cut.cells_visited += part.cells_visited;
     out_.cut.changed.include(part.changed);
+    Segment band_lo, band_hi;
+    if (still_band(previous, next, overlap_m, band_lo, band_hi)) {
+      const CutResult band = cut_sweep(grid_, params_.representation, band_lo, band_hi);
+      out_.cut.removed_volume_m3 += band.removed_volume_m3;
+      out_.cut.cells_visited += band.cells_visited;
+      out_.cut.changed.include(band.changed);
+    }
     previous = next;
   }
   out_.substeps = substeps;

@@ -164,6 +164,31 @@ TEST(Simulation, SmallStepsCutEveryRowTheyCross) {
   }
 }
 
+// The lattice tests: a 2 m blade over 60 x 60 cells of 2 cm covered 0.3 m
+// deep, its line through the centre of cell (30, 30) along a lattice
+// direction (lc, lr) in cells, so that it runs exactly through a centre
+// every few cells.
+constexpr int kLatticeCells = 60;
+constexpr double kLatticeCell = 0.02;
+constexpr std::pair<int, int> kLattice[] = {{1, 0}, {0, 1}, {1, 1}, {2, 1}, {3, 1}, {3, -1}, {1, -2}};
+
+Simulation lattice_simulation(double origin, Representation rep) {
+  SimParams p;
+  p.grid = grid_of_cells(kLatticeCells, kLatticeCells, kLatticeCell, {origin, 0.0, origin});
+  p.blade.length_m = 2.0;
+  p.representation = rep;
+  return Simulation(p, std::vector<float>(kLatticeCells * kLatticeCells, 0.3f));
+}
+
+/// Calls f(c, r, m) for the cells (30 + m lc, 30 + m lr) on the grid.
+template <class F>
+void for_lattice_line(int lc, int lr, F&& f) {
+  for (int m = -kLatticeCells; m <= kLatticeCells; ++m) {
+    const int c = 30 + m * lc, r = 30 + m * lr;
+    if (c >= 0 && r >= 0 && c < kLatticeCells && r < kLatticeCells) f(c, r, m);
+  }
+}
+
 TEST(Simulation, TurningStepsCutEverySampleTheyCross) {
   // A 2 m blade pushing while it turns about the vertical fast enough that
   // one end goes back across its line while the other goes forward: the
@@ -177,20 +202,14 @@ TEST(Simulation, TurningStepsCutEverySampleTheyCross) {
   // still the reach pointed forward, and a row of such centres was never
   // cut: in the soil, a pile standing on them slid into the trench behind
   // the blade.)
-  constexpr int kCells = 60, kAt = 40;
-  constexpr double kCell = 0.02, kBladeY = 0.25, kPush = 3e-4, kTurn = 5e-4;  // m and rad a step
-  const std::pair<int, int> lattice[] = {{1, 0}, {0, 1}, {1, 1}, {2, 1}, {3, 1}, {3, -1}, {1, -2}};
+  constexpr int kAt = 40;
+  constexpr double kBladeY = 0.25, kPush = 3e-4, kTurn = 5e-4;  // m and rad a step
   for (const double origin : {0.0, 0.37, 1e5}) {
-    SimParams p;
-    p.grid = grid_of_cells(kCells, kCells, kCell, {origin, 0.0, origin});
-    p.blade.length_m = 2.0;
     for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
-      p.representation = rep;
-      for (const auto& [lc, lr] : lattice) {
+      for (const auto& [lc, lr] : kLattice) {
         for (const double spin : {1.0, -1.0}) {
-          Simulation sim(p, std::vector<float>(kCells * kCells, 0.3f));
-          // The line at step kAt: through centre (30, 30), along (lc, lr) in cells.
-          const double cx = origin + 30.5 * kCell, cz = origin + 30.5 * kCell;
+          Simulation sim = lattice_simulation(origin, rep);
+          const double cx = origin + 30.5 * kLatticeCell, cz = cx;
           const double yaw_at = -std::atan2(double(lr), double(lc));  // local +X -> (cos yaw, -sin yaw)
           const double nx = std::sin(yaw_at), nz = std::cos(yaw_at);  // the edge's normal, its push
           for (int i = 0; i <= 2 * kAt; ++i) {
@@ -204,17 +223,45 @@ TEST(Simulation, TurningStepsCutEverySampleTheyCross) {
           // left out (their motion is within rounding's reach).
           const double still = spin * kPush / kTurn;
           int checked = 0;
-          for (int m = -40; m <= 40; ++m) {
-            const int c = 30 + m * lc, r = 30 + m * lr;
-            if (c < 0 || r < 0 || c >= kCells || r >= kCells) continue;
-            const double along = m * std::hypot(double(lc), double(lr)) * kCell;  // from the middle, toward +X at yaw_at
-            if (std::abs(along - still) < 2.0 * kCell) continue;
+          for_lattice_line(lc, lr, [&](int c, int r, int m) {
+            const double along = m * std::hypot(double(lc), double(lr)) * kLatticeCell;  // toward +X at yaw_at
+            if (std::abs(along - still) < 2.0 * kLatticeCell) return;
             ++checked;
             EXPECT_NEAR(sim.grid().height(c, r), kBladeY, 1e-6)
                 << "cell (" << c << ", " << r << ") on the line along (" << lc << ", " << lr << "), turn " << spin
                 << ", origin " << origin << ", " << to_string(rep);
-          }
+          });
           EXPECT_GE(checked, 10);
+        }
+      }
+    }
+  }
+}
+
+TEST(Simulation, ABladeSetDownCutsEveryCentreOnItsLine) {
+  // A blade set down (its first step, no motion) with its line along a
+  // lattice direction exactly through a row of sample centres, then lowered
+  // straight down in a second step: each centre on the line is under its
+  // edge and is cut to the edge's height both times, wherever the terrain
+  // lies. (A sweep with no motion across the line is a line in plan, on
+  // which the rasterisers decide a centre either way; the step now also
+  // cuts a band a millionth of a cell either side of the edge. Without it,
+  // centres on the line were left standing under the edge, which ones
+  // depending on the terrain's place, and a blade that then backed a
+  // little pushed their soil behind its line.)
+  for (const double origin : {0.0, 0.37, 1000.0, 1e5, 1e6}) {
+    for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
+      for (const auto& [lc, lr] : kLattice) {
+        Simulation sim = lattice_simulation(origin, rep);
+        const double cx = origin + 30.5 * kLatticeCell, cz = cx;
+        const Quat yaw = quat_from_axis_angle({0.0, 1.0, 0.0}, -std::atan2(double(lr), double(lc)));
+        for (const double y : {0.25, 0.2}) {
+          sim.step({{cx, y, cz}, yaw});
+          for_lattice_line(lc, lr, [&](int c, int r, int) {
+            EXPECT_NEAR(sim.grid().height(c, r), y, 1e-6)
+                << "cell (" << c << ", " << r << ") on the line along (" << lc << ", " << lr << "), edge at " << y
+                << ", origin " << origin << ", " << to_string(rep);
+          });
         }
       }
     }
