@@ -321,8 +321,10 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   // cells at each end a millimetre a pass, for about 100 passes after each
   // row crossing (docs/soil.md, "The held soil spills round the ends").
   if (woke && !cut_now && !blade_spec_.bucket.enabled()) spill_round_ends(grid, moved_from, to, out);
-  if (settle_phase_ != SettlePhase::kIdle)
+  if (settle_phase_ != SettlePhase::kIdle) {
+    settle_follow(grid.spec(), moved_from, to);
     out.settle_visits += settle_charged(grid, out.changed, params_.max_pair_checks_per_step - ends_work_);
+  }
   // The blade's wall matters only to a pass: marked only when one runs.
   if (settle_phase_ != SettlePhase::kIdle) {
     out.reached_cap = true;  // the settle goes on in the next step

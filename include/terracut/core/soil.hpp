@@ -495,6 +495,12 @@ class SoilFlow {
   /// returns them (it is done when settle_phase_ is back to kIdle; the
   /// passes wait for it); settle_abort drops it.
   void settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed);
+  /// The columns [row_lo[lr], row_hi[lr]) of each row lr of the settle's
+  /// window that the blade (`to`, its side behind it from `from`) walls off.
+  void settle_wall_rows(const GridSpec& spec, const Segment& from, const Segment& to, int* row_lo, int* row_hi) const;
+  /// A settle under way, spread over steps, follows the blade: the cells
+  /// its wall covers now and did not when the settle started leave it.
+  void settle_follow(const GridSpec& spec, const Segment& from, const Segment& to);
   std::int64_t settle_continue(HeightGrid& grid, Rect& changed, std::int64_t budget);
   /// settle_continue, its visits charged to the step's cap (ends_work_).
   std::int64_t settle_charged(HeightGrid& grid, Rect& changed, std::int64_t budget) {
@@ -572,6 +578,7 @@ class SoilFlow {
   std::vector<std::uint8_t> settle_done_;
   std::vector<float> settle_low_, settle_high_, settle_widths_;
   std::vector<int> settle_row_lo_, settle_row_hi_;
+  std::vector<int> settle_follow_lo_, settle_follow_hi_;  // settle_follow's scratch
   std::vector<std::int32_t> settle_cells_, settle_patch_;
   std::vector<std::pair<float, std::int32_t>> settle_seeds_[2];
   std::vector<std::pair<std::int32_t, std::int32_t>> settle_entries_;
