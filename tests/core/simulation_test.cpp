@@ -206,7 +206,8 @@ TEST(Simulation, TurningStepsCutEverySampleTheyCross) {
   constexpr double kBladeY = 0.25, kPush = 3e-4, kTurn = 5e-4;  // m and rad a step
   for (const double origin : {0.0, 0.37, 1e5}) {
     for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
-      for (const auto& [lc, lr] : kLattice) {
+      for (const auto& direction : kLattice) {
+        const int lc = direction.first, lr = direction.second;  // (not a structured binding: clang 14 cannot capture one)
         for (const double spin : {1.0, -1.0}) {
           Simulation sim = lattice_simulation(origin, rep);
           const double cx = origin + 30.5 * kLatticeCell, cz = cx;
@@ -251,7 +252,8 @@ TEST(Simulation, ABladeSetDownCutsEveryCentreOnItsLine) {
   // little pushed their soil behind its line.)
   for (const double origin : {0.0, 0.37, 1000.0, 1e5, 1e6}) {
     for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
-      for (const auto& [lc, lr] : kLattice) {
+      for (const auto& direction : kLattice) {
+        const int lc = direction.first, lr = direction.second;  // (not a structured binding: clang 14 cannot capture one)
         Simulation sim = lattice_simulation(origin, rep);
         const double cx = origin + 30.5 * kLatticeCell, cz = cx;
         const Quat yaw = quat_from_axis_angle({0.0, 1.0, 0.0}, -std::atan2(double(lr), double(lc)));

@@ -496,10 +496,14 @@ class SoilFlow {
   /// passes wait for it); settle_abort drops it.
   void settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed);
   /// The columns [row_lo[lr], row_hi[lr]) of each row lr of the settle's
-  /// window that the blade (`to`, its side behind it from `from`) walls off.
-  void settle_wall_rows(const GridSpec& spec, const Segment& from, const Segment& to, int* row_lo, int* row_hi) const;
+  /// window that the blade (`to`, its side behind it from `from`) walls off:
+  /// with `band`, the cells inside it and behind it; without, only those
+  /// whose centres it has passed (none when no side is known).
+  void settle_wall_rows(const GridSpec& spec, const Segment& from, const Segment& to, bool band, int* row_lo,
+                        int* row_hi) const;
   /// A settle under way, spread over steps, follows the blade: the cells
-  /// its wall covers now and did not when the settle started leave it.
+  /// the edge has passed since the settle started (behind its line now, and
+  /// not walled then) leave it.
   void settle_follow(const GridSpec& spec, const Segment& from, const Segment& to);
   std::int64_t settle_continue(HeightGrid& grid, Rect& changed, std::int64_t budget);
   /// settle_continue, its visits charged to the step's cap (ends_work_).
