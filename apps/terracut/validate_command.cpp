@@ -1053,7 +1053,8 @@ std::string report_markdown(const Report& r) {
      << "behind a blade only round its ends or down the trench's walls, so each case takes both "
      << "away: the blade spans the terrain (2 m on 1 m, its ends off the grid) or runs in a channel "
      << "closed by rigid obstacles beyond its ends, and the trench behind its start is already dug. "
-     << "It travels 0.3 m, 5 cm into a 20 cm layer on 1 cm cells (2 cm in one case) (plunging: from 1 to 5 cm deep; "
+     << "It travels 0.3 m, 5 cm into a 20 cm layer on 1 cm cells (one case on 2 cm cells; plunging: from 1 to 5 "
+     << "cm deep; "
      << "lifting: from 5 to 1 cm; turning: its yaw from -8 to +8 deg about its centre), its edge "
      << "in one plane at every step (a ramp along the travel, sloping across it by the roll), so "
      << "no part of it comes back below the floor it cut. Every step, every sample behind it (more "
@@ -1217,7 +1218,8 @@ void write_outputs(const fs::path& out, const Report& r) {
     wall += std::string(validation::motion_name(c.motion)) + "," + csv_number(validation::blade_length_m(c)) + "," +
             (c.channel ? "0" : "1") + "," + csv_number(c.yaw_deg) + "," + csv_number(c.speed_m_per_s) + "," +
             csv_number(c.cell_m) + "," + csv_number(c.tremor_m) + "," + csv_number(c.wobble_deg) + "," +
-            csv_number(c.roll_deg) + "," + csv_number(c.origin_m) + "," + std::to_string(c.cap) + "," + csv_number(w.worst_m) + "\n";
+            csv_number(c.roll_deg) + "," + csv_number(c.origin_m) + "," + std::to_string(c.cap) + "," +
+            csv_number(w.worst_m) + "\n";
   }
   write_file(out / "bulldozing" / "wall.csv", wall);
   write_file(out / "bulldozing" / "centre.csv", centre);

@@ -65,7 +65,9 @@ bool still_band(const Segment& from, const Segment& to, double back, Segment& lo
   const double plan = std::hypot(ex, ez);
   if (!(plan > 0.0)) return false;
   const Vec3 n{-ez / plan, 0.0, ex / plan};
-  const auto across = [&](const Vec3& was, const Vec3& is) { return std::abs((is.x - was.x) * n.x + (is.z - was.z) * n.z); };
+  const auto across = [&](const Vec3& was, const Vec3& is) {
+    return std::abs((is.x - was.x) * n.x + (is.z - was.z) * n.z);
+  };
   if (!(across(from.a, to.a) <= back && across(from.b, to.b) <= back)) return false;
   lo = {to.a - n * back, to.b - n * back};
   hi = {to.a + n * back, to.b + n * back};

@@ -207,7 +207,8 @@ TEST(Simulation, TurningStepsCutEverySampleTheyCross) {
   for (const double origin : {0.0, 0.37, 1e5}) {
     for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
       for (const auto& direction : kLattice) {
-        const int lc = direction.first, lr = direction.second;  // (not a structured binding: clang 14 cannot capture one)
+        // (Not a structured binding: clang 14 cannot capture one in a lambda.)
+        const int lc = direction.first, lr = direction.second;
         for (const double spin : {1.0, -1.0}) {
           Simulation sim = lattice_simulation(origin, rep);
           const double cx = origin + 30.5 * kLatticeCell, cz = cx;
@@ -253,7 +254,8 @@ TEST(Simulation, ABladeSetDownCutsEveryCentreOnItsLine) {
   for (const double origin : {0.0, 0.37, 1000.0, 1e5, 1e6}) {
     for (Representation rep : {Representation::kSurface, Representation::kColumns}) {
       for (const auto& direction : kLattice) {
-        const int lc = direction.first, lr = direction.second;  // (not a structured binding: clang 14 cannot capture one)
+        // (Not a structured binding: clang 14 cannot capture one in a lambda.)
+        const int lc = direction.first, lr = direction.second;
         Simulation sim = lattice_simulation(origin, rep);
         const double cx = origin + 30.5 * kLatticeCell, cz = cx;
         const Quat yaw = quat_from_axis_angle({0.0, 1.0, 0.0}, -std::atan2(double(lr), double(lc)));

@@ -629,7 +629,7 @@ class SoilFlow {
   double origin_x_ = 0.0;
   double origin_z_ = 0.0;
   // The rounding of a world coordinate on this terrain, metres: 64 double
-  // steps of its largest |x| or |z| (1.5e-11 m at 1 km, 1.2e-7 m at 1e7 m).
+  // steps of its largest |x| or |z| (1.4e-11 m at 1 km, 1.4e-7 m at 1e7 m).
   // A side of the blade's line or a motion across it is told from rounding
   // by at least this much, so that the answer does not turn with where the
   // terrain lies.
