@@ -218,15 +218,13 @@ void SoilFlow::settle_follow(const GridSpec& spec, const Segment& from, const Se
   int* lo = settle_follow_lo_.data();
   int* hi = settle_follow_hi_.data();
   settle_wall_rows(spec, from, to, false, lo, hi);
+  // Per row, the passed columns less those walled when the settle started:
+  // the parts of [lo, hi) before and after [was_lo, was_hi).
   for (int lr = 0; lr < settle_wh_; ++lr) {
     const int was_lo = settle_row_lo_[std::size_t(lr)], was_hi = settle_row_hi_[std::size_t(lr)];
-    for (int lc = lo[lr]; lc < hi[lr]; ++lc) {
-      if (lc >= was_lo && lc < was_hi) {
-        lc = was_hi - 1;  // walled when the settle started
-        continue;
-      }
-      settle_exclude(std::int64_t(settle_wr0_ + lr) * cols_ + settle_wc0_ + lc);
-    }
+    const int r = settle_wr0_ + lr;
+    settle_exclude(Rect{settle_wc0_ + lo[lr], r, settle_wc0_ + std::min(hi[lr], was_lo), r + 1});
+    settle_exclude(Rect{settle_wc0_ + std::max(lo[lr], was_hi), r, settle_wc0_ + hi[lr], r + 1});
   }
 }
 
