@@ -374,7 +374,8 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   // cap under kLeastSplitCap would spend too much of itself on that room
   // and carries the pass over as without a tool.
   const std::int64_t cap = params_.max_pair_checks_per_step;
-  const bool split_at_cap = (blade_.present || !hull_cells_.empty()) && cap >= kLeastSplitCap;
+  const bool hull = !hull_cells_.empty();
+  const bool split_at_cap = (blade_.present || hull) && cap >= kLeastSplitCap;
   // What the spill round the blade's ends and the settle spent this step counts too.
   std::int64_t work = ends_work_;
   ends_work_ = 0;
@@ -472,6 +473,8 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
       h[a] = now;
       // The grid's change in double: float rounding is what it gains.
       double gained = double(now) - double(before);
+      // What a cell under the hull could not take (below) stays with the source.
+      double kept = 0.0;
       const int ca = col_of(a), ra = row_of(a);
       changed_c0 = std::min(changed_c0, ca);
       changed_c1 = std::max(changed_c1, ca);
@@ -491,7 +494,19 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
         }
         // Multiples of the quantum added to a multiple of it: exact, so a
         // cell's sum does not depend on the order its sources were met in.
-        const float old = h[f.to], raised = quantized(double(old) + double(give));
+        const float old = h[f.to];
+        float raised = quantized(double(old) + double(give));
+        // Each source's fall line ends below its own height, so one source
+        // never raises a cell under the hull above its underside; several
+        // filling the same cell in one pass could (a cell beside the back
+        // wall between piles on either side rose 20 cm above it). The
+        // sources met after the cell is full keep the rest.
+        if (hull && (queued_[f.to] & kHull) && raised > hull_under(f.to)) {
+          float room = std::max(old, quantized(double(hull_under(f.to))));
+          if (room > hull_under(f.to) && room > old) room = std::max(old, quantized(double(room) - quantum_m_));
+          raised = room;
+          kept += double(give) - (double(raised) - double(old));
+        }
         h[f.to] = raised;
         gained += double(raised) - double(old);
         activate(f.to);
@@ -500,6 +515,14 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
         changed_c1 = std::max(changed_c1, ct);
         changed_r0 = std::min(changed_r0, rt);
         changed_r1 = std::max(changed_r1, rt);
+      }
+      if (kept > 0.0) {
+        // The source keeps it, and is examined again (held, next pass,
+        // while the hull stands over the cells it would fill).
+        const float back = quantized(double(h[a]) + kept);
+        gained += double(back) - double(h[a]);
+        h[a] = back;
+        activate(a);
       }
       pass_gained_m_ += gained;
       ++applied_sources_;

@@ -847,6 +847,42 @@ TEST(Bucket, SoilPiledAgainstTheBackDoesNotFlowThroughIt) {
   EXPECT_LT(b.worst_conservation_m3, bucket_rounding_m3());
 }
 
+TEST(Bucket, SoilFlowingInFromSeveralSidesStopsAtItsFloor) {
+  // The bucket held level with its floor at 0.3 m, over ground whose cells
+  // under the floor alternate between pits (0.05 m) and mounds (0.29 m,
+  // below the floor): each mound may shed into the pits beside it, and
+  // each pit has up to four mounds beside it. One mound's fall line ends
+  // below its own height; several filling one pit in the same pass raised
+  // it 11.5 cm through the floor. No cell under the floor may end above
+  // it, at any step.
+  BucketCycle b;
+  std::vector<float> h(std::size_t(200) * 200, float(BucketCycle::kLayer));
+  for (int r = 102; r < 128; ++r)
+    for (int c = 82; c < 118; ++c) h[std::size_t(r) * 200 + c] = (r + c) % 2 == 0 ? 0.05f : 0.29f;
+  b.sim = std::make_unique<Simulation>(b.params, h);
+  b.initial_m3 = b.sim->grid().volume_m3();
+  double worst = -1.0;
+  for (int i = 0; i < 200; ++i) {
+    b.step({1.0, 0.3, 1.0}, Quat{});
+    worst = std::max(worst, worst_above_floor(b.sim->grid(), 1.0, 1.0, 0.3, 0.0, 0.3));
+  }
+  EXPECT_LE(worst, kUnderHullSlack);
+  // The mounds did fill the pits: once at rest, no pair of neighbours in
+  // the patch is steeper than the repose angle (plus the relaxation's 2 %
+  // tolerance).
+  EXPECT_EQ(b.sim->last().soil.backlog_cells, 0);
+  const HeightGrid& g = b.sim->grid();
+  const double limit = std::tan(34.0 * kDeg) * BucketCycle::kCell * 1.02 + 1e-6;
+  double steepest = 0.0;
+  for (int r = 102; r < 128; ++r)
+    for (int c = 82; c < 118; ++c) {
+      steepest = std::max(steepest, std::abs(double(g.height(c, r)) - g.height(c + 1, r)));
+      steepest = std::max(steepest, std::abs(double(g.height(c, r)) - g.height(c, r + 1)));
+    }
+  EXPECT_LE(steepest, limit);
+  EXPECT_LT(b.worst_conservation_m3, bucket_rounding_m3());
+}
+
 TEST(Bucket, NeedsSoilThatFlowsAndAShape) {
   SimParams p;
   p.grid = grid_of_cells(20, 20, 0.01);
