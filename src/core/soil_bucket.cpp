@@ -138,6 +138,10 @@ void SoilFlow::mark_hull(const HeightGrid& grid, const Segment& lip, const Quat&
     Vec3 origin, s, t;
   };
   const Plate plates[2] = {{lip.a, along, back}, {hull_heel_.a, along, up}};
+  for (int k = 0; k < 2; ++k) {
+    const Plate& p = plates[k];
+    hull_plans_[k] = {p.origin.x, p.origin.z, p.s.x, p.s.z, p.t.x, p.t.z, 0.0, 0.0, 0.0, 0.0};
+  }
   const double ground = spec.origin_m.y;
   for (const Plate& p : plates) {
     // Plan coordinates (s, t) of a point: solve the 2x2 system of the
@@ -145,6 +149,15 @@ void SoilFlow::mark_hull(const HeightGrid& grid, const Segment& lip, const Quat&
     const double det = p.s.x * p.t.z - p.s.z * p.t.x;
     const double area = std::hypot(p.s.x, p.s.z) * std::hypot(p.t.x, p.t.z);
     if (!(std::abs(det) > 1e-9 * area) || area == 0.0) continue;
+    {
+      // A cell's diagonal in s and in t: the lines s = 0 and s = 1 lie
+      // |det| / |t| apart in plan, those of t |det| / |s|.
+      HullPlan& plan = hull_plans_[&p - plates];
+      plan.det = det;
+      plan.inv_det = 1.0 / det;
+      plan.margin_s = std::hypot(dx_, dz_) * std::hypot(p.t.x, p.t.z) / std::abs(det);
+      plan.margin_t = std::hypot(dx_, dz_) * std::hypot(p.s.x, p.s.z) / std::abs(det);
+    }
     // A centre on the lip's line (to a millionth of a cell) is the lip's to
     // cut: the step's cut may just have missed it by rounding.
     const double t_min = &p == &plates[0] ? 1e-6 * std::min(dx_, dz_) * std::hypot(p.s.x, p.s.z) / std::abs(det) : 0.0;
@@ -200,6 +213,42 @@ void SoilFlow::mark_hull(const HeightGrid& grid, const Segment& lip, const Quat&
       }
 }
 
+int SoilFlow::first_walk_sample(const GridSpec& spec, double x, double z, double nx, double nz, double step) const {
+  // Along the walk every coordinate below is linear in the sample's index
+  // m: the samples m in [1, M] keep each within its bounds where M is the
+  // least of (bound - value) / change over the changes that head to a
+  // bound. A sample more than a cell's diagonal inside a plate's plan lies
+  // in a cell whose centre is inside it (at most half a diagonal away), so
+  // marked; inside the grid by a cell, it is on the grid.
+  double most = 0.0;
+  for (const HullPlan& p : hull_plans_) {
+    if (p.det == 0.0) continue;
+    const double px = x - p.ox, pz = z - p.oz;
+    const double s = (px * p.bz - pz * p.bx) * p.inv_det, t = (p.ax * pz - p.az * px) * p.inv_det;
+    const double ds = step * (nx * p.bz - nz * p.bx) * p.inv_det, dt = step * (p.ax * nz - p.az * nx) * p.inv_det;
+    const double ms = p.margin_s, mt = p.margin_t;
+    double m = double(kMaxPushCells);
+    const auto bound = [&m](double v, double d, double lo, double hi) {
+      if (!(v > lo && v < hi)) m = 0.0;
+      else if (d > 0.0) m = std::min(m, (hi - v) / d);
+      else if (d < 0.0) m = std::min(m, (lo - v) / d);
+    };
+    bound(s, ds, ms, 1.0 - ms);
+    bound(t, dt, mt, 1.0 - mt);
+    most = std::max(most, m);
+  }
+  if (most < 1.0) return 1;
+  // On the grid, a cell in from its edges.
+  const double u = to_cells(x, spec.origin_m.x, dx_), v = to_cells(z, spec.origin_m.z, dz_);
+  const auto bound = [&most](double w, double d, double hi) {
+    if (d > 0.0) most = std::min(most, (hi - w) / d);
+    else if (d < 0.0) most = std::min(most, (1.0 - w) / d);
+  };
+  bound(u, step * nx / dx_, double(cols_) - 1.0);
+  bound(v, step * nz / dz_, double(rows_) - 1.0);
+  return most < 1.0 ? 1 : int(std::floor(most)) + 1;
+}
+
 void SoilFlow::shoulder(HeightGrid& grid, SoilStepResult& out) {
   // Each cell under the hull with soil above the hull's underside gives
   // that excess to the first cell outside the footprint (and not under a
@@ -232,7 +281,7 @@ void SoilFlow::shoulder(HeightGrid& grid, SoilStepResult& out) {
       float rest = now - under;
       bool moved = false;
       for (const double side : {1.0, -1.0}) {
-        for (int m = 1; m <= kMaxPushCells && rest > 0.0f; ++m) {
+        for (int m = first_walk_sample(spec, x, z, side * nx, side * nz, step); m <= kMaxPushCells && rest > 0.0f; ++m) {
           const double u = to_cells(x + side * nx * m * step, spec.origin_m.x, dx_);
           const double v = to_cells(z + side * nz * m * step, spec.origin_m.z, dz_);
           if (u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_) {

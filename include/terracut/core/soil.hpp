@@ -737,6 +737,20 @@ class SoilFlow {
   Rect hull_rect_{};
   Segment hull_heel_{};
   double hull_cx_ = 0.0, hull_cz_ = 0.0;
+  // The plates' plans: a point (x, z) lies on one where s = ((x, z) - o) x b
+  // / det and t = a x ((x, z) - o) / det are in [0, 1] (none where the
+  // plate is seen edge-on, det 0). The shoulder's walks start past the
+  // samples that lie deep inside one.
+  struct HullPlan {
+    double ox = 0.0, oz = 0.0, ax = 0.0, az = 0.0, bx = 0.0, bz = 0.0, det = 0.0, inv_det = 0.0;
+    double margin_s = 0.0, margin_t = 0.0;  // a cell's diagonal in s and in t
+  };
+  HullPlan hull_plans_[2]{};
+  /// The first sample of a shoulder's walk from the centre (x, z) along
+  /// (nx, nz) x step that may lie outside the hull: those before it lie more
+  /// than a cell's diagonal inside a plate's plan and inside the grid, so
+  /// in cells the hull covers.
+  int first_walk_sample(const GridSpec& spec, double x, double z, double nx, double nz, double step) const;
   std::vector<std::uint8_t> obstacle_;    // per cell: 1 + index into obstacles_, 0 for none
   std::vector<SoilObstacle> obstacles_;   // the obstacles, their cells clipped to the grid
   /// True when a body stands over the cell: no soil flows or is pushed into
