@@ -31,6 +31,7 @@
 #include "terracut/io/image.hpp"
 #include "terracut/session/scenario.hpp"
 #include "terracut/session/world.hpp"
+#include "terracut/validation/hull.hpp"
 #include "terracut/validation/wall.hpp"
 
 namespace terracut::cli {
@@ -742,6 +743,12 @@ struct WallRun {
   bool pass() const { return worst_m <= validation::kWallSlack_m; }
 };
 
+// One stroke of the bucket-is-a-solid measure (validation/hull.hpp).
+struct HullRun {
+  validation::BucketStroke what;
+  validation::HullMeasure measured;
+};
+
 struct Report {
   std::vector<ConeResult> cones;
   std::vector<RampResult> ramps;
@@ -749,6 +756,7 @@ struct Report {
   std::vector<WallRun> walls;
   ConservationResult conservation;
   BucketResult bucket;
+  std::vector<HullRun> hulls;
   std::vector<Check> checks;
   std::string dem_markdown;  // the DEM section (validate_dem.hpp), empty when not run
   std::string soilbin_markdown;  // the soil-bin section (validate_soilbin.hpp), empty when not run
@@ -915,6 +923,23 @@ std::vector<Check> make_checks(const Report& r) {
                  "worst " + fmt("%.2e", b.worst_error_m3) + " m^3",
                  "<= the float rounding of the updates, " + fmt("%.2e", b.tolerance_m3) + " m^3",
                  b.worst_error_m3 <= b.tolerance_m3});
+  if (!r.hulls.empty()) {
+    double worst_above = -1e300, worst_volume = 0.0;
+    int holding = 0;
+    for (const HullRun& h : r.hulls) {
+      worst_above = std::max(worst_above, h.measured.worst_above_m);
+      worst_volume = std::max(worst_volume, h.measured.worst_volume_error_m3 / h.measured.volume_slack_m3);
+      holding += h.measured.holds() ? 1 : 0;
+    }
+    out.push_back({"5g", "the bucket is a solid: no soil above its floor or back over a cell they cover, at any step "
+                         "(digging, lowered, heel first, sideways, turning; any yaw, heel up or curled, rolled, "
+                         "tremor, wobble, 5 mm to 2 cm cells, far terrains, both representations)",
+                   std::to_string(holding) + "/" + std::to_string(r.hulls.size()) + " strokes; worst above " +
+                       fmt("%.2e", worst_above) + " m, worst volume error " + fmt("%.2g", worst_volume) +
+                       " of its rounding bound",
+                   "<= " + fmt("%.0e", validation::kHullSlack_m) + " m; grid + load within float rounding",
+                   holding == int(r.hulls.size())});
+  }
   return out;
 }
 
@@ -1116,6 +1141,19 @@ std::string report_markdown(const Report& r) {
      << fmt("%.1e", b.worst_error_m3) << " m^3 of the start.\n\n";
   if (r.with_figures())
     md << "![Bucket cycle: the load and the grid's volume over the cycle, and the terrain at the end](soil_bucket.png)\n\n";
+  md << "### The bucket is a solid (check 5g)\n\n"
+     << "Strokes of a bucket through a 0.2 m layer of sand, 0.5 m of travel (or its time): digging toward "
+        "its opening (the lip plunging, dragging, lifting out), lowered straight down, heel first, sideways "
+        "along its lip, and digging while its yaw turns 30 degrees. After every step, each cell whose centre "
+        "lies in the plan of the floor plate or the back plate (worked out from the pose, apart from the "
+        "soil model's own marking; centres within rounding of a plate's edge left out) must hold no soil "
+        "above that plate's underside, and grid + load must stay what it was. Each stroke's figures are "
+        "in `bucket/hull.csv`.\n\n"
+     << "| stroke | worst above the underside (m) | worst volume error (m^3) | result |\n|---|---|---|---|\n";
+  for (const HullRun& h : r.hulls)
+    md << "| " << validation::describe(h.what) << " | " << fmt("%.2e", h.measured.worst_above_m) << " | "
+       << fmt("%.1e", h.measured.worst_volume_error_m3) << " | " << pass_fail(h.measured.holds()) << " |\n";
+  md << "\n";
 
   // ---- 6 ----
   md << "## 6. Speed (this machine; informative, not a check)\n\n"
@@ -1222,6 +1260,27 @@ void write_outputs(const fs::path& out, const Report& r) {
             csv_number(w.worst_m) + "\n";
   }
   write_file(out / "bulldozing" / "wall.csv", wall);
+  std::string hull =
+      "motion,length_m,depth_m,height_m,yaw_deg,pitch_deg,roll_deg,speed_m_per_s,dig_m,tremor_m,wobble_deg,cell_m,"
+      "cell_aspect,origin_m,columns,cap,worst_above_m,worst_volume_error_m3,volume_slack_m3,load_m3,shouldered_m3\n";
+  for (const HullRun& h : r.hulls) {
+    const validation::BucketStroke& c = h.what;
+    const validation::HullMeasure& m = h.measured;
+    hull += validation::motion_name(c.motion);
+    const auto field = [&hull](const std::string& v) {
+      hull += ',';
+      hull += v;
+    };
+    for (double v : {c.length_m, c.depth_m, c.height_m, c.yaw_deg, c.pitch_deg, c.roll_deg, c.speed_m_per_s, c.dig_m,
+                     c.tremor_m, c.wobble_deg, c.cell_m, c.cell_aspect, c.origin_m})
+      field(csv_number(v));
+    field(c.columns ? "1" : "0");
+    field(std::to_string(c.cap));
+    for (double v : {m.worst_above_m, m.worst_volume_error_m3, m.volume_slack_m3, m.load_m3, m.shouldered_m3})
+      field(csv_number(v));
+    hull += '\n';
+  }
+  write_file(out / "bucket" / "hull.csv", hull);
   write_file(out / "bulldozing" / "centre.csv", centre);
   write_file(out / "checks.csv", checks_csv(r.checks));
 
@@ -1313,7 +1372,8 @@ Command add_validate_command(CLI::App& app) {
       "    the total volume against the initial one at every step (relative)\n"
       "  5 bucket: a bucket scoops (the load is what the grid lost, w d x, under its\n"
       "    capacity; no pile ahead), carries (the load holds) and dumps past the repose\n"
-      "    angle (empty, the load under the lip); grid + load = initial at every step\n"
+      "    angle (empty, the load under the lip); grid + load = initial at every step;\n"
+      "    the bucket is a solid: no soil above its floor or back in 23 strokes\n"
       "  6 speed, informative: the soil phase's time per step, p50/p99 (microseconds)\n"
       "Against a DEM (--dem; validation/dem/README.md), informative, each target met or missed:\n"
       "  terracut with the material of the DEM's own tests, on each bulldozing case and seed:\n"
@@ -1346,7 +1406,8 @@ Command add_validate_command(CLI::App& app) {
       "  conservation/volume.csv         step, t_s, cut, volume_m3, relative_error,\n"
       "                                  tolerance_rel\n"
       "  validate.json        parameters and tolerances (read by the plot script)\n"
-      "  bucket/              volume.csv (grid and load per step), height.npy (the end)\n"
+      "  bucket/              volume.csv (grid and load per step), height.npy (the end),\n"
+      "                       hull.csv (each stroke of check 5g and its worst)\n"
       "  dem/                 material.json (terracut's soil from the DEM's tests), windows.csv\n"
       "                       (per run and 0.1 m window), cases.csv (over the seeds, with the\n"
       "                       targets), force.csv (force against the distance pushed),\n"
@@ -1474,6 +1535,15 @@ Command add_validate_command(CLI::App& app) {
           fmt("%.5f", report.bucket.carry_last_m3) + " m^3, left " + fmt("%.1e", report.bucket.final_load_m3) +
           " m^3 in the bucket, worst volume error " + fmt("%.1e", report.bucket.worst_error_m3) + " m^3, " +
           seconds_since(t0));
+    }
+    {
+      const Clock::time_point t0 = Clock::now();
+      for (const validation::BucketStroke& s : validation::validation_bucket_strokes())
+        report.hulls.push_back({s, validation::measure_hull(s)});
+      const auto holding =
+          std::count_if(report.hulls.begin(), report.hulls.end(), [](const HullRun& h) { return h.measured.holds(); });
+      say("the bucket as a solid: " + std::to_string(holding) + " of " + std::to_string(report.hulls.size()) +
+          " strokes leave no soil inside it, " + seconds_since(t0));
     }
     report.checks = make_checks(report);
     const bool all_pass = std::all_of(report.checks.begin(), report.checks.end(),

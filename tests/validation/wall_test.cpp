@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -16,23 +15,10 @@
 #include <string>
 #include <vector>
 
+#include "test_env.hpp"
+
 namespace terracut::validation {
 namespace {
-
-// The environment variable `name` as a whole number in [0, most], or
-// fallback when it is not set. A variable set to anything else is an error
-// (the test fails naming it), not a quiet default.
-long whole_from_env(const char* name, long fallback, long most) {
-  const char* text = std::getenv(name);
-  if (text == nullptr) return fallback;
-  char* end = nullptr;
-  const long value = std::strtol(text, &end, 10);
-  if (end == text || *end != '\0' || value < 0 || value > most) {
-    ADD_FAILURE() << name << "=" << text << " is not a whole number in [0, " << most << "]";
-    return fallback;
-  }
-  return value;
-}
 
 // Each blade along X pushes along +Z; the blade spans the terrain.
 TEST(SoilWall, NoSoilCrossesABladeSpanningTheTerrain) {
