@@ -139,6 +139,9 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
   // rest went ahead of it with the terrain at the origin and behind it 1 km
   // out: 1.7 cm behind a 1.1 m blade on 2 cm cells once it moved on.)
   const double rounding = std::max(1e-9 * cell, coord_rounding_m_);
+  // On the edge's line: within the still band and the sweeps' reach back
+  // (a millionth of a cell each; Simulation), with room, or rounding.
+  const double on_line = rounding + 4e-6 * std::min(dx_, dz_);
   if (plan_length > 1e-12) {
     nx /= plan_length;
     nz /= plan_length;
@@ -309,6 +312,19 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       bool this_step = false;
       double way = motion_at(x, z, this_step);
       if (this_step && ((x - from.a.x) * from_nx + (z - from.a.z) * from_nz) * (way < 0.0 ? -1.0 : 1.0) < -rounding)
+        way = 0.0;
+      // A point of the edge that this step moved by no more than rounding
+      // (a blade at rest, or the pivot of a turn) swept nothing there: what
+      // it cut is a centre on its line (the still band, a millionth of a
+      // cell either side: Simulation) or, in the columns cut, a column whose
+      // square its line crosses. The way since the blade last moved is for
+      // the centre on the line; a column whose centre lies off it keeps its
+      // own side, as at rest. (Pushed the way since, a column 0.53 cells
+      // ahead of a turning, wobbling 0.87 m blade's pivot, which had backed
+      // 1e-5 m since, went 1.5 cells back through it: 1.3 cm behind it on
+      // 2 cm cells 1e7 m out, where the rounding is 1.4e-7 m; and 1.9 cm
+      // behind a 2 m blade whose pivot had backed 1.5 cm.)
+      if (!this_step && way != 0.0 && std::abs((x - to.a.x) * line_nx + (z - to.a.z) * line_nz) > on_line)
         way = 0.0;
       const bool moving = way != 0.0;
       nx = way < 0.0 ? -line_nx : line_nx;

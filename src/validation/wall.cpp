@@ -47,7 +47,7 @@ std::string describe(const WallCase& w) {
   return std::string(motion_name(w.motion)) + ", " + blade + ", yaw " + format_number(w.yaw_deg) + " deg, " +
          format_number(w.speed_m_per_s) + " m/s, " + format_number(w.cell_m * 1000.0) +
          (w.cell_aspect != 1.0 ? " x " + format_number(w.cell_m * w.cell_aspect * 1000.0) : "") + " mm cells" +
-         (w.channel ? ", in a channel" : "") +
+         (w.columns ? " (columns)" : "") + (w.channel ? ", in a channel" : "") +
          (w.tremor_m > 0.0 ? ", tremor " + format_number(w.tremor_m * 1000.0) + " mm" : "") +
          (w.wobble_deg > 0.0 ? ", wobble " + format_number(w.wobble_deg) + " deg" : "") +
          (w.roll_deg != 0.0 ? ", roll " + format_number(w.roll_deg) + " deg" : "") +
@@ -147,6 +147,7 @@ double worst_rise_behind(const WallCase& w) {
   // Spanning the terrain: longer than its diagonal, so its ends are off it.
   p.blade.length_m = blade_length_m(w);
   p.soil.model = SoilModel::kFlow;
+  p.representation = w.columns ? Representation::kColumns : Representation::kSurface;
   p.soil.material.repose_deg = 34.0;
   p.soil.max_pair_checks_per_step = w.cap;
   std::vector<float> h(std::size_t(n) * rows, float(kWallLayer_m));

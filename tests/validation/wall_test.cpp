@@ -201,6 +201,34 @@ TEST(SoilWall, NoSoilCrossesABladeFarFromTheOrigin) {
   }
 }
 
+// At the pivot of a turning, wobbling blade a point of the edge moves by no
+// more than the coordinates' rounding in a step, and the way its cut goes
+// is then its motion since the blade last moved. That could be a backing
+// of 1e-5 m, and the columns cut, which lowers every column whose square
+// the edge crosses, sent a column standing 0.53 cells ahead of the edge
+// 1.5 cells back, through the blade: 1.3 cm of pile behind a 0.87 m blade
+// on 2 cm cells 1e7 m out (2 cm at its worst), where the rounding is
+// 1.4e-7 m. A cut column behind the line the way was measured from keeps
+// its side now, as for this step's motion. (Columns; the surface's cut
+// reaches no such sample.)
+TEST(SoilWall, NoSoilCrossesAColumnAtTheTurnsPivotFarFromTheOrigin) {
+  WallCase w{.length_m = 0.865, .yaw_deg = -26.56505117707799, .speed_m_per_s = 0.21638210608936198,
+             .motion = WallMotion::kTurn, .channel = true, .cell_m = 0.02, .wobble_deg = 0.29164612608868484,
+             .origin_m = 1e7, .columns = true};
+  EXPECT_LE(worst_rise_behind(w), kWallSlack_m) << describe(w);
+  w.columns = false;
+  EXPECT_LE(worst_rise_behind(w), kWallSlack_m) << describe(w);
+  // A 2 m blade lifting, trembling and wobbling along a lattice direction,
+  // whose pivot had backed 1.5 cm since it last moved: 1.9 cm behind it.
+  // The columns' rolled cases still leave a fraction of a millimetre
+  // (docs/soil.md, "Not done yet"; this one 8.7e-5 m, at the origin too):
+  // the bound is that, not the surface's float slack.
+  WallCase lift{.length_m = 2.0, .yaw_deg = 225.0, .speed_m_per_s = 0.10546482181442485,
+                .motion = WallMotion::kLift, .cell_m = 0.01, .cell_aspect = 2.0, .tremor_m = 0.0024757430289126825,
+                .wobble_deg = 1.1767700921250166, .roll_deg = -0.33779048196996975, .origin_m = 1e7, .columns = true};
+  EXPECT_LE(worst_rise_behind(lift), 1e-3) << describe(lift);
+}
+
 // The blade along a lattice direction (its line through a row of cell
 // centres every few cells: yaws whose tangent is 0, 1/3, 1/2, 1, ...), where
 // its line lands exactly on centres, step after step, and the terrain at
