@@ -498,9 +498,9 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
         float raised = quantized(double(old) + double(give));
         // Each source's fall line ends below its own height, so one source
         // never raises a cell under the hull above its underside; several
-        // filling the same cell in one pass could (a cell beside the back
-        // wall between piles on either side rose 20 cm above it). The
-        // sources met after the cell is full keep the rest.
+        // filling the same cell in one pass could (a cell at the end of the
+        // back wall, between piles, rose 20 cm in a step, 10 cm above it).
+        // The sources met after the cell is full keep the rest.
         if (hull && (queued_[f.to] & kHull) && raised > hull_under(f.to)) {
           float room = std::max(old, quantized(double(hull_under(f.to))));
           if (room > hull_under(f.to) && room > old) room = std::max(old, quantized(double(room) - quantum_m_));
