@@ -435,20 +435,28 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
         }
         if (count == 0) return 0;
         // A cell of the run above the final line (a hump) takes nothing:
-        // without it the line comes lower, until no more drop out.
+        // without it the line comes lower, until no more drop out. A cell
+        // that dropped out stays out, so the rounds end: the line only comes
+        // down in exact arithmetic, but the rounding of the next mean could
+        // let a cell at the line back in and the line go up and down
+        // between two values for ever (a bucket digging while it turned, on
+        // a terrain 1e7 m out: the step never ended).
+        bool in_run[kMaxPushCells];
+        std::fill_n(in_run, count, true);
         for (int in = count;;) {
           double s_in = 0.0;
           int n_in = 0;
           for (int j = 0; j < count; ++j)
-            if (reach[j] < line) s_in += reach[j], ++n_in;
+            if (in_run[j] && reach[j] < line) s_in += reach[j], ++n_in;
           if (n_in == in || n_in == 0) break;
+          for (int j = 0; j < count; ++j) in_run[j] = in_run[j] && reach[j] < line;
           in = n_in;
           line = (double(volume) + s_in) / n_in;
         }
         for (int j = 0; j < count; ++j) {
           const double add = line - reach[j];
           add_at[j] = -1.0f;
-          if (!(add > 0.0)) continue;
+          if (!in_run[j] || !(add > 0.0)) continue;
           if (cells[j] < 0) {
             out.left_over_edge_m3 += add * spec.cell_area_m2();
             taken -= add;
