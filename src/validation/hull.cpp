@@ -166,24 +166,31 @@ HullMeasure measure_hull(const BucketStroke& s) {
     const Vec3 lip_a = pose.position_m - half;
     const Vec3 back = rotate(q, {0.0, 0.0, s.depth_m}), up = rotate(q, {0.0, s.height_m, 0.0});
     const Plate plates[2] = {{lip_a, 2.0 * half, back}, {lip_a + back, 2.0 * half, up}};
-    // (s, t) of a centre in a plate's plan; false where the plate is seen
-    // edge-on (it covers no centre).
-    const auto in_plan = [&](const Plate& pl, int c, int r, double& ps, double& pt, double& ms, double& mt) {
+    // Each plate's determinant in plan and edge_m in its parameters (the
+    // lines s = 0 and s = 1 lie |det| / |b| apart, those of t |det| / |a|),
+    // once a step; a plate seen edge-on covers no centre.
+    struct Plan {
+      double det, ms, mt;
+      bool seen;
+    };
+    Plan plans[2];
+    for (int k = 0; k < 2; ++k) {
+      const Plate& pl = plates[k];
       const double det = pl.a.x * pl.b.z - pl.a.z * pl.b.x;
       const double la = std::hypot(pl.a.x, pl.a.z), lb = std::hypot(pl.b.x, pl.b.z);
-      if (!(std::abs(det) > 1e-9 * la * lb)) return false;
+      plans[k] = {det, edge_m * lb / std::abs(det), edge_m * la / std::abs(det), std::abs(det) > 1e-9 * la * lb};
+    }
+    // (s, t) of cell (c, r)'s centre in plate k's plan.
+    const auto in_plan = [&](int k, int c, int r, double& ps, double& pt) {
+      const Plate& pl = plates[k];
       const double px = (c + 0.5) * dx + (o - pl.o.x), pz = (r + 0.5) * dz + (o - pl.o.z);
-      ps = (px * pl.b.z - pz * pl.b.x) / det;
-      pt = (pl.a.x * pz - pl.a.z * px) / det;
-      // edge_m in each parameter: the distance between the lines s = 0
-      // and s = 1 is |det| / lb, between t = 0 and t = 1 |det| / la.
-      ms = edge_m * lb / std::abs(det);
-      mt = edge_m * la / std::abs(det);
-      return true;
+      ps = (px * pl.b.z - pz * pl.b.x) / plans[k].det;
+      pt = (pl.a.x * pz - pl.a.z * px) / plans[k].det;
     };
-    for (const Plate& pl : plates) {
-      double ps, pt, ms, mt;
-      if (!in_plan(pl, 0, 0, ps, pt, ms, mt)) continue;
+    for (int k = 0; k < 2; ++k) {
+      const Plate& pl = plates[k];
+      if (!plans[k].seen) continue;
+      const double ms = plans[k].ms, mt = plans[k].mt;
       double x0 = 1e300, x1 = -1e300, z0 = 1e300, z1 = -1e300;
       for (const Vec3& c : {pl.o, pl.o + pl.a, pl.o + pl.b, pl.o + pl.a + pl.b}) {
         x0 = std::min(x0, c.x), x1 = std::max(x1, c.x), z0 = std::min(z0, c.z), z1 = std::max(z1, c.z);
@@ -194,14 +201,17 @@ HullMeasure measure_hull(const BucketStroke& s) {
       const int r1 = std::min(rows, int(std::ceil((z1 - o) / dz)) + 1);
       for (int r = r0; r < r1; ++r)
         for (int c = c0; c < c1; ++c) {
-          in_plan(pl, c, r, ps, pt, ms, mt);
+          double ps, pt;
+          in_plan(k, c, r, ps, pt);
           if (ps <= ms || ps >= 1.0 - ms || pt <= mt || pt >= 1.0 - mt) continue;
           double under = pl.o.y + ps * pl.a.y + pt * pl.b.y;
-          for (const Plate& other : plates) {
-            double os, ot, oms, omt;
-            if (&other != &pl && in_plan(other, c, r, os, ot, oms, omt) && os >= 0.0 && os <= 1.0 && ot >= 0.0 &&
-                ot <= 1.0)
-              under = std::min(under, other.o.y + os * other.a.y + ot * other.b.y);
+          // Under the other plate too: the lower one's underside.
+          const int j = 1 - k;
+          double os, ot;
+          if (plans[j].seen) {
+            in_plan(j, c, r, os, ot);
+            if (os >= 0.0 && os <= 1.0 && ot >= 0.0 && ot <= 1.0)
+              under = std::min(under, plates[j].o.y + os * plates[j].a.y + ot * plates[j].b.y);
           }
           m.worst_above_m = std::max(m.worst_above_m, double(sim.grid().height(c, r)) - under);
         }
@@ -252,19 +262,12 @@ std::vector<BucketStroke> validation_bucket_strokes() {
   // several sources filling one covered cell in the same pass (1.7 mm and
   // 2.7 cm; the slower ones a sweep found, up to 11 cm, are in
   // docs/soil.md).
-  const auto found = [&](BucketMotion motion, double cell, double aspect, double len, double depth, double height,
-                         double yaw, double pitch, double roll, double speed, double dig, double tremor,
-                         double wobble, double origin, bool columns, std::int64_t cap) {
-    BucketStroke f;
-    f.motion = motion, f.cell_m = cell, f.cell_aspect = aspect, f.length_m = len, f.depth_m = depth;
-    f.height_m = height, f.yaw_deg = yaw, f.pitch_deg = pitch, f.roll_deg = roll, f.speed_m_per_s = speed;
-    f.dig_m = dig, f.tremor_m = tremor, f.wobble_deg = wobble, f.origin_m = origin, f.columns = columns, f.cap = cap;
-    out.push_back(f);
-  };
-  found(BucketMotion::kTurn, 0.005, 1.0, 0.296, 0.109, 0.286, 108.435, -6.17, 0.0, 0.116, 0.0456, 0.0, 1.28, 0.0, true,
-        1000000000);
-  found(BucketMotion::kHeelFirst, 0.005, 2.0, 0.734, 0.276, 0.237, 177.304, 2.74, 4.01, 0.854, 0.0148, 0.0, 0.0, 1e3,
-        true, 50000);
+  out.push_back({.length_m = 0.296, .depth_m = 0.109, .height_m = 0.286, .motion = BucketMotion::kTurn,
+                 .yaw_deg = 108.435, .pitch_deg = -6.17, .speed_m_per_s = 0.116, .dig_m = 0.0456, .wobble_deg = 1.28,
+                 .cell_m = 0.005, .columns = true, .cap = 1000000000});
+  out.push_back({.length_m = 0.734, .depth_m = 0.276, .height_m = 0.237, .motion = BucketMotion::kHeelFirst,
+                 .yaw_deg = 177.304, .pitch_deg = 2.74, .roll_deg = 4.01, .speed_m_per_s = 0.854, .dig_m = 0.0148,
+                 .cell_m = 0.005, .cell_aspect = 2.0, .origin_m = 1e3, .columns = true});
   return out;
 }
 

@@ -92,17 +92,11 @@ TEST(BucketHull, ADigWhileTurningFarFromTheOriginEnds) {
   // the lip went round for ever in one step (the mean of the cells under
   // its line let a cell at the line back in by rounding, and out again),
   // so the step never ended. It now ends, and holds.
-  BucketStroke s;
-  s.motion = BucketMotion::kTurn;
-  s.length_m = 0.8014833309184377;
-  s.depth_m = 0.1239835951204835;
-  s.height_m = 0.15093121688814343;
-  s.yaw_deg = 124.37222049776359;
-  s.pitch_deg = -19.985100967700944;
-  s.speed_m_per_s = 1.2915916585596752;
-  s.dig_m = 0.017066953289444384;
-  s.columns = true;
-  s.origin_m = 1e7;
+  const BucketStroke s{.length_m = 0.8014833309184377, .depth_m = 0.1239835951204835,
+                       .height_m = 0.15093121688814343, .motion = BucketMotion::kTurn,
+                       .yaw_deg = 124.37222049776359, .pitch_deg = -19.985100967700944,
+                       .speed_m_per_s = 1.2915916585596752, .dig_m = 0.017066953289444384, .origin_m = 1e7,
+                       .columns = true};
   const HullMeasure m = expect_holds(s);
   EXPECT_GT(m.load_m3, 0.0);
 }
