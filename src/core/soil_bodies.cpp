@@ -1,5 +1,6 @@
 // Soil that flows, rigid bodies (soil.hpp): their footprints as obstacles
-// the soil does not enter, and where soil pushed against one goes round it.
+// the soil does not enter (where soil pushed against one goes round it:
+// soil_displace.cpp).
 #include "terracut/core/soil.hpp"
 
 #include <algorithm>
@@ -61,31 +62,6 @@ void SoilFlow::set_obstacles(std::span<const SoilObstacle> obstacles) noexcept {
         // Where two overlap, the lower underside counts.
         if (mark == 0 || o.bottom_m < obstacles_[mark - 1u].bottom_m) mark = id;
       }
-  }
-}
-
-void SoilFlow::beside_body(const HeightGrid& grid, double x, double z, double tx, double tz,
-                           std::int64_t& first, std::int64_t& second) const {
-  // Walk from the point (x, z) both ways along the unit (tx, tz), a cell at
-  // a time, to the first sample on each side that no body stands over.
-  const GridSpec& spec = grid.spec();
-  const double step = std::min(dx_ / std::max(std::abs(tx), 1e-9), dz_ / std::max(std::abs(tz), 1e-9));
-  const auto at = [&](double along) -> std::int64_t {
-    const double u = to_cells(x + tx * along, spec.origin_m.x, dx_);
-    const double v = to_cells(z + tz * along, spec.origin_m.z, dz_);
-    if (u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_) return -1;
-    return std::int64_t(std::floor(v)) * cols_ + std::int64_t(std::floor(u));
-  };
-  for (int j = 1; j <= kMaxPushCells; ++j) {
-    const std::int64_t a = at(j * step), b = at(-j * step);
-    const bool fa = a >= 0 && obstacle_[a] == 0, fb = b >= 0 && obstacle_[b] == 0;
-    if (!fa && !fb) {
-      if (a < 0 && b < 0) return;  // off the grid both ways: stays where it was
-      continue;
-    }
-    first = fa ? a : b;
-    second = fa && fb ? b : -1;
-    return;
   }
 }
 

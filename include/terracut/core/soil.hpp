@@ -449,8 +449,6 @@ class SoilFlow {
   void displace(HeightGrid& grid, const Segment& from, const Segment& moved_from, const Segment& to,
                 double bucket_room_m3,
                 SoilStepResult& out);
-  void beside_body(const HeightGrid& grid, double x, double z, double tx, double tz,
-                   std::int64_t& first, std::int64_t& second) const;
   void pour(HeightGrid& grid, const Segment& lip, double volume_m3, SoilStepResult& out);
   void mark_hull(const HeightGrid& grid, const Segment& lip, const Quat& orientation);
   void clear_hull();
