@@ -258,15 +258,11 @@ struct SoilStepResult {
   std::int64_t moved_pairs = 0;      ///< pairs that exchanged soil
   std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
   /// The relaxation stopped at the work cap (max_pair_checks_per_step) with
-  /// work left, the settle of the displaced pile or the passes; the rest is
-  /// done in later steps. A 0.8 m push on 1 cm cells reaches it on about
-  /// 1 % of its steps, one on 5 mm cells on 7 to 41 % (the settle of a
-  /// displacing step spread over the steps after it); the pile the capped
-  /// run leaves is then within 1.1 % of the soil ahead, and a cell's rise
-  /// at the peak, of the converged one (docs/soil.md, "The held soil spills
-  /// round the ends"). At 1 m/s on 5 mm cells a long push's converged work
-  /// outgrows the cap: pushed 1.6 m the 1 m blade's pile holds 8 % more,
-  /// pushed 2.4 m the 1 to 2 m blades' 15 to 44 % more.
+  /// work left, the spill round the blade's ends, the settle of the
+  /// displaced pile or the passes; the rest is done in later steps. How
+  /// often a push reaches it, and how far the capped pile then lies from
+  /// the converged one (within 1 % along an axis; not at a slant on 5 mm
+  /// cells), is measured in docs/soil.md ("Not done yet").
   bool reached_cap = false;
   /// Fluxes examined in an earlier step and dropped in this one because a
   /// cell they join changed (or the tool moved into their way) meanwhile:
