@@ -3,7 +3,7 @@
 
 Usage: PYTHONPATH=build/python /usr/bin/python3 tools/soil_convergence_sweep.py
            [--travel METRES] [--blades 0.3,0.5,...] [--cells 0.005,0.01]
-           [--speeds 0.25,0.5,0.75,1] [--cap VISITS]
+           [--speeds 0.25,0.5,0.75,1] [--yaws 0,10,...] [--cap VISITS]
 
 For every blade width, cell size and speed, the push of tools/soil_push.py
 (a 4 cm cut into a 20 cm layer of dry sand, pushed --travel metres, 0.8 by
@@ -16,7 +16,10 @@ the converged run's work; a miss of the bounds
 (5 % of the soil ahead, one cell's repose rise at the peak: tan 34 x the
 cell) is in bold, and the last line counts them. Defaults: the blades 0.3,
 0.5, 0.75, 1, 1.5 and 2 m, cells of 5 and 10 mm, 0.25 to 1 m/s (48 pushes,
-twice each: 14 s on one core of the build machine).
+twice each: 14 s on one core of the build machine), the blade square to the
+grid (yaw 0). --yaws turns it (degrees about the vertical; soil_push.py's
+push_at_yaw: a square grid, the soil ahead measured across the turned
+edge); a yaw column is added to the table.
 
 Exit codes: 0 done (misses or not); 2 bad arguments; 3 numpy or terracut
 missing; 4 a converged push left no soil ahead (a blade above the layer).
@@ -50,7 +53,7 @@ def numbers(flag, text, lo, hi):
 
 
 def main(argv):
-    travel, cap = 0.8, None
+    travel, cap, yaws = 0.8, None, [0.0]
     blades, cells, speeds = [0.3, 0.5, 0.75, 1.0, 1.5, 2.0], [0.005, 0.01], [0.25, 0.5, 0.75, 1.0]
     args = argv[1:]
     while args:
@@ -58,7 +61,7 @@ def main(argv):
         if a in ("-h", "--help"):
             print(__doc__)
             return 0
-        if a not in ("--travel", "--blades", "--cells", "--speeds", "--cap"):
+        if a not in ("--travel", "--blades", "--cells", "--speeds", "--yaws", "--cap"):
             fail(f"unknown argument {a!r} (see --help)")
         if not args:
             fail(f"{a} needs a value (see --help)")
@@ -71,36 +74,39 @@ def main(argv):
             cells = numbers(a, value, 0.002, 0.05)
         elif a == "--speeds":
             speeds = numbers(a, value, 0.01, 2.0)
+        elif a == "--yaws":
+            yaws = numbers(a, value, -360.0, 360.0)
         else:
             cap = number(a, value, 1000, 1e9)
     slope = math.tan(math.radians(34.0))
     at = "the default cap" if cap is None else f"{int(cap)} visits a step"
     print(f"Pushes of {travel:g} m, 0.2 s held; capped at {at} against the cap lifted.\n")
-    print("| blade | cells | " + " | ".join(f"{v:g} m/s" for v in speeds) + " | converged work (M visits), "
-          + " / ".join(f"{v:g}" for v in speeds) + " m/s |")
-    print("|---" * (3 + len(speeds)) + "|")
+    turned = yaws != [0.0]
+    print("| blade | cells | " + ("yaw | " if turned else "") + " | ".join(f"{v:g} m/s" for v in speeds)
+          + " | converged work (M visits), " + " / ".join(f"{v:g}" for v in speeds) + " m/s |")
+    print("|---" * (3 + turned + len(speeds)) + "|")
     misses = worst_rel = worst_peak = 0.0
-    for cell in cells:
-        for width in blades:
-            row, works = [], []
-            for speed in speeds:
-                capped = push(terracut, np, width, cell, speed, cap, travel)
-                lifted = push(terracut, np, width, cell, speed, 1e9, travel)
-                if not lifted["ahead"] > 0.0:
-                    fail(f"the {width:g} m blade's converged push left no soil ahead of it "
-                         f"({1000 * cell:g} mm cells, {speed:g} m/s): no ratio to give", 4)
-                rel = capped["ahead"] / lifted["ahead"] - 1.0
-                peak_mm = 1000.0 * (capped["peak"] - lifted["peak"])
-                miss = abs(rel) > 0.05 or abs(peak_mm) > 1000.0 * slope * cell
-                misses += miss
-                worst_rel, worst_peak = max(worst_rel, abs(rel)), max(worst_peak, abs(peak_mm))
-                steps = int(round(travel / speed * 1000.0))
-                text = f"{100 * rel:+.1f} %, {peak_mm:+.1f} mm, {capped['capped']}/{steps}"
-                row.append(f"**{text}**" if miss else text)
-                works.append(f"{lifted['work'] / 1e6:.1f}")
-            print(f"| {width:g} m | {1000 * cell:g} mm | " + " | ".join(row) + " | " + " / ".join(works) + " |")
-            sys.stdout.flush()
-    print(f"\n{int(misses)} of {len(cells) * len(blades) * len(speeds)} pushes miss a bound; "
+    for cell, width, yaw in [(c, w, y) for c in cells for w in blades for y in yaws]:
+        row, works = [], []
+        for speed in speeds:
+            capped = push(terracut, np, width, cell, speed, cap, travel, yaw_deg=yaw)
+            lifted = push(terracut, np, width, cell, speed, 1e9, travel, yaw_deg=yaw)
+            if not lifted["ahead"] > 0.0:
+                fail(f"the {width:g} m blade's converged push left no soil ahead of it "
+                     f"({1000 * cell:g} mm cells, {speed:g} m/s): no ratio to give", 4)
+            rel = capped["ahead"] / lifted["ahead"] - 1.0
+            peak_mm = 1000.0 * (capped["peak"] - lifted["peak"])
+            miss = abs(rel) > 0.05 or abs(peak_mm) > 1000.0 * slope * cell
+            misses += miss
+            worst_rel, worst_peak = max(worst_rel, abs(rel)), max(worst_peak, abs(peak_mm))
+            steps = int(round(travel / speed * 1000.0))
+            text = f"{100 * rel:+.1f} %, {peak_mm:+.1f} mm, {capped['capped']}/{steps}"
+            row.append(f"**{text}**" if miss else text)
+            works.append(f"{lifted['work'] / 1e6:.1f}")
+        print(f"| {width:g} m | {1000 * cell:g} mm | " + (f"{yaw:g} | " if turned else "") + " | ".join(row)
+              + " | " + " / ".join(works) + " |")
+        sys.stdout.flush()
+    print(f"\n{int(misses)} of {len(cells) * len(blades) * len(yaws) * len(speeds)} pushes miss a bound; "
           f"worst {100 * worst_rel:.2f} % of the soil ahead, {worst_peak:.1f} mm at the peak.")
     return 0
 
