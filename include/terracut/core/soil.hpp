@@ -725,6 +725,7 @@ class SoilFlow {
   // and its plan centre.
   std::vector<std::uint32_t> hull_cells_;
   std::vector<float> hull_under_;
+  std::vector<float> shoulder_in_;  // per hull_under_ slot: soil the shoulder passed on to it this step, m
   // Per row of the rectangle, the columns [first, end) that a plate may
   // cover (mark_hull tests only those).
   std::vector<int> hull_row_c0_, hull_row_c1_;
