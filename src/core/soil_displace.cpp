@@ -517,8 +517,9 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
           const bool fa = open(a), fb = open(b);
           if (!fa && !fb) continue;
           const float half = fa && fb ? 0.5f * volume : 0.0f;
-          for (const auto& [way, share] : {std::pair{fa ? 1.0 : -1.0, volume - half}, std::pair{-1.0, half}}) {
+          for (const auto& [way_of, share] : {std::pair{fa ? 1.0 : -1.0, volume - half}, std::pair{-1.0, half}}) {
             if (!(share > 0.0f)) continue;
+            const double way = way_of;  // (a lambda may not capture a structured binding: clang)
             std::int64_t last = -1;
             const auto next = [&](int m, std::int64_t& u, double& level) {
               u = at(way * (j + m) * along_step);
