@@ -600,7 +600,7 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
   // to the repose angle.
   if (const auto f = top.get("soil")) {
     std::vector<std::string_view> keys = soil_material_keys();
-    keys.insert(keys.end(), {"model", "max_pair_checks_per_step", "edge"});
+    keys.insert(keys.end(), {"model", "max_pair_checks_per_step", "edge", "settle"});
     const Map soil(*f, keys);
     if (const auto m = soil.get("model"))
       sc.soil.model = m->choice({SoilModel::kVanish, SoilModel::kFlow}, "soil model");
@@ -610,11 +610,13 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
           static_cast<std::int64_t>(w->in(range("soil.max_pair_checks_per_step")));
     if (const auto e = soil.get("edge"))
       sc.soil.edge = e->choice({SoilEdge::kWall, SoilEdge::kOpen}, "soil edge");
+    if (const auto e = soil.get("settle"))
+      sc.soil.settle = e->choice({SoilSettle::kPatches, SoilSettle::kPasses}, "soil settle");
     // The flow's settings without a model: the model defaults to vanish,
     // where they do nothing, which is surely not what was meant (an
     // explicit 'model: vanish' keeps them, to compare the two).
     if (!soil.get("model"))
-      for (const char* key : {"repose_deg", "max_pair_checks_per_step", "edge"})
+      for (const char* key : {"repose_deg", "max_pair_checks_per_step", "edge", "settle"})
         if (const auto g = soil.get(key))
           g->fail(std::string("given without 'model', which defaults to vanish (the cut soil is deleted, nothing "
                               "slides): add 'model: flow', or 'model: vanish' to keep the soil vanishing"));

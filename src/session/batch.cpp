@@ -310,6 +310,7 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
     out["soil"] = {{"model", "flow"},
                    {"repose_deg", sc.soil.material.repose_deg},
                    {"edge", std::string(to_string(sc.soil.edge))},
+                   {"settle", std::string(to_string(sc.soil.settle))},
                    {"volume_m3",
                     {{"initial", r.initial_volume_m3},
                      {"final", r.final_volume_m3},

@@ -37,6 +37,7 @@ SlantPile measure_slant(const SlantPush& push) {
   params.soil.model = SoilModel::kFlow;
   params.soil.material.repose_deg = 34.0;
   params.soil.max_pair_checks_per_step = push.cap;
+  params.soil.settle = push.settle;
   Simulation sim(params, std::vector<float>(std::size_t(n) * std::size_t(n), float(kSlantLayer_m)));
   const Quat q = quat_from_axis_angle({0.0, 1.0, 0.0}, push.yaw_deg * std::numbers::pi / 180.0);
   const Vec3 t = rotate(q, {0.0, 0.0, 1.0});

@@ -233,6 +233,10 @@ TEST(ScenarioSoil, TheSoilSectionChoosesTheModel) {
   EXPECT_EQ(parse_scenario(text + "  edge: open\n", "x.yaml").soil.edge, SoilEdge::kOpen);
   const std::string edge = text + "  edge: cliff\n";
   expect_error(edge, line_of(edge, "edge: cliff"), "soil.edge", "allowed: wall, open");
+  EXPECT_EQ(sc.soil.settle, SoilSettle::kPatches);
+  EXPECT_EQ(parse_scenario(text + "  settle: passes\n", "x.yaml").soil.settle, SoilSettle::kPasses);
+  const std::string settle = text + "  settle: fast\n";
+  expect_error(settle, line_of(settle, "settle: fast"), "soil.settle", "allowed: patches, passes");
   const std::string typo = text + "  repose: 30\n";
   expect_error(typo, line_of(typo, "repose: 30"), "soil.repose", "unknown key");
 }

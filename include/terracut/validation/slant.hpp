@@ -9,6 +9,8 @@
 
 #include <cstdint>
 
+#include "terracut/core/soil.hpp"
+
 namespace terracut::validation {
 
 /// The sand: a layer this deep over the terrain's bottom.
@@ -23,6 +25,7 @@ struct SlantPush {
   double hold_s = 0.2;          ///< held still after the push, [0, 10]
   double cell_m = 0.005;        ///< square cells, [0.002, 0.05]
   std::int64_t cap = 50000;     ///< the soil's work cap, neighbour visits a step (1e9: lifted)
+  SoilSettle settle = SoilSettle::kPatches;  ///< how the displaced pile settles
 };
 
 /// What the push left.
