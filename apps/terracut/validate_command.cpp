@@ -518,8 +518,7 @@ struct SlantResult {
 SlantResult run_slant() {
   validation::SlantPush push;
   push.yaw_deg = kSlantYaw_deg;
-  push.cell_m = kSlantCell_m;
-  push.cap = SoilFlowParams{}.max_pair_checks_per_step;
+  push.cell_m = kSlantCell_m;  // at the default cap
   validation::SlantPush lifted = push;
   lifted.cap = 1000000000;
   validation::SlantPush square = lifted;

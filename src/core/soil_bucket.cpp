@@ -273,6 +273,28 @@ void SoilFlow::shoulder(HeightGrid& grid, SoilStepResult& out) {
   std::int64_t last_put = -1;
   // What each hull cell has been passed, metres of height on it.
   shoulder_in_.assign(hull_under_.size(), 0.0f);
+  // Puts what fits under the ceiling of `rest` on cell t (outside the
+  // footprint, under no body).
+  const auto put_on = [&](std::int64_t t, float& rest, bool& moved) {
+    const float add = std::min(rest, ceiling_m_ - h[t]);
+    if (!(add > 0.0f)) return;
+    dirty(std::uint32_t(t));
+    const float raised = h[t] + add;
+    put += double(raised) - double(h[t]);
+    h[t] = raised;
+    last_put = t;
+    rest -= add;
+    moved = true;
+    out.changed.include(col_of(std::uint32_t(t)), row_of(std::uint32_t(t)));
+    activate(std::uint32_t(t));
+  };
+  // `rest` leaves over an open edge (counted).
+  const auto leave = [&](float& rest, bool& moved) {
+    out.left_over_edge_m3 += double(rest) * spec.cell_area_m2();
+    taken -= double(rest);
+    rest = 0.0f;
+    moved = true;
+  };
   // Walks `rest` from the point (x, z) along the unit (nx, nz), both ways
   // (the second beyond a wall), to the first cells outside the footprint
   // and under no body with room under the ceiling; returns what found no
@@ -284,28 +306,11 @@ void SoilFlow::shoulder(HeightGrid& grid, SoilStepResult& out) {
         const double u = to_cells(x + side * nx * m * step, spec.origin_m.x, dx_);
         const double v = to_cells(z + side * nz * m * step, spec.origin_m.z, dz_);
         if (u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_) {
-          if (params_.edge == SoilEdge::kOpen) {
-            out.left_over_edge_m3 += double(rest) * spec.cell_area_m2();
-            taken -= double(rest);
-            rest = 0.0f;
-            moved = true;
-          }
+          if (params_.edge == SoilEdge::kOpen) leave(rest, moved);
           break;
         }
         const std::int64_t t = std::int64_t(std::floor(v)) * cols_ + std::int64_t(std::floor(u));
-        if ((queued_[t] & kHull) || obstacle_[t] != 0) continue;
-        const float room = ceiling_m_ - h[t];
-        if (!(room > 0.0f)) continue;
-        const float add = std::min(rest, room);
-        dirty(std::uint32_t(t));
-        const float raised = h[t] + add;
-        put += double(raised) - double(h[t]);
-        h[t] = raised;
-        last_put = t;
-        rest -= add;
-        moved = true;
-        out.changed.include(col_of(std::uint32_t(t)), row_of(std::uint32_t(t)));
-        activate(std::uint32_t(t));
+        if (!(queued_[t] & kHull) && obstacle_[t] == 0) put_on(t, rest, moved);
       }
       if (rest <= 0.0f) break;
     }
@@ -348,24 +353,10 @@ void SoilFlow::shoulder(HeightGrid& grid, SoilStepResult& out) {
         rest = 0.0f;
         moved = true;
       } else if (obstacle_[t] == 0) {
-        const float add = std::min(rest, ceiling_m_ - h[t]);
-        if (add > 0.0f) {
-          dirty(std::uint32_t(t));
-          const float raised = h[t] + add;
-          put += double(raised) - double(h[t]);
-          h[t] = raised;
-          last_put = t;
-          rest -= add;
-          moved = true;
-          out.changed.include(tc, tr);
-          activate(std::uint32_t(t));
-        }
+        put_on(t, rest, moved);
       }
     } else if (params_.edge == SoilEdge::kOpen) {
-      out.left_over_edge_m3 += double(rest) * spec.cell_area_m2();
-      taken -= double(rest);
-      rest = 0.0f;
-      moved = true;
+      leave(rest, moved);
     }
     if (rest > 0.0f) {
       const double len = std::hypot(rx, rz);

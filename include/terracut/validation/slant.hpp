@@ -24,7 +24,8 @@ struct SlantPush {
   double speed_m_per_s = 1.0;   ///< at 1 kHz, [0.01, 2]
   double hold_s = 0.2;          ///< held still after the push, [0, 10]
   double cell_m = 0.005;        ///< square cells, [0.002, 0.05]
-  std::int64_t cap = 50000;     ///< the soil's work cap, neighbour visits a step (1e9: lifted)
+  /// The soil's work cap, neighbour visits a step (1e9: lifted); the library's default.
+  std::int64_t cap = SoilFlowParams{}.max_pair_checks_per_step;
   SoilSettle settle = SoilSettle::kPatches;  ///< how the displaced pile settles
 };
 
