@@ -4,6 +4,7 @@
 Usage: PYTHONPATH=build/python /usr/bin/python3 tools/soil_convergence_sweep.py
            [--travel METRES] [--blades 0.3,0.5,...] [--cells 0.005,0.01]
            [--speeds 0.25,0.5,0.75,1] [--yaws 0,10,...] [--cap VISITS]
+           [--settle patches|passes|fans]
 
 For every blade width, cell size and speed, the push of tools/soil_push.py
 (a 4 cm cut into a 20 cm layer of dry sand, pushed --travel metres, 0.8 by
@@ -19,7 +20,9 @@ cell) is in bold, and the last line counts them. Defaults: the blades 0.3,
 twice each: 14 s on one core of the build machine), the blade square to the
 grid (yaw 0). --yaws turns it (degrees about the vertical; soil_push.py's
 push_at_yaw: a square grid, the soil ahead measured across the turned
-edge); a yaw column is added to the table.
+edge); a yaw column is added to the table. --settle chooses how the
+displaced pile settles (the scenario's soil.settle; by default the
+library's).
 
 Exit codes: 0 done (misses or not); 2 bad arguments; 3 numpy or terracut
 missing; 4 a converged push left no soil ahead (a blade above the layer).
@@ -53,7 +56,7 @@ def numbers(flag, text, lo, hi):
 
 
 def main(argv):
-    travel, cap, yaws = 0.8, None, [0.0]
+    travel, cap, yaws, settle = 0.8, None, [0.0], None
     blades, cells, speeds = [0.3, 0.5, 0.75, 1.0, 1.5, 2.0], [0.005, 0.01], [0.25, 0.5, 0.75, 1.0]
     args = argv[1:]
     while args:
@@ -61,7 +64,7 @@ def main(argv):
         if a in ("-h", "--help"):
             print(__doc__)
             return 0
-        if a not in ("--travel", "--blades", "--cells", "--speeds", "--yaws", "--cap"):
+        if a not in ("--travel", "--blades", "--cells", "--speeds", "--yaws", "--cap", "--settle"):
             fail(f"unknown argument {a!r} (see --help)")
         if not args:
             fail(f"{a} needs a value (see --help)")
@@ -76,11 +79,16 @@ def main(argv):
             speeds = numbers(a, value, 0.01, 2.0)
         elif a == "--yaws":
             yaws = numbers(a, value, -360.0, 360.0)
+        elif a == "--settle":
+            if value not in ("patches", "passes", "fans"):
+                fail(f"--settle {value!r}: one of patches, passes, fans")
+            settle = value
         else:
             cap = number(a, value, 1000, 1e9)
     slope = math.tan(math.radians(34.0))
     at = "the default cap" if cap is None else f"{int(cap)} visits a step"
-    print(f"Pushes of {travel:g} m, 0.2 s held; capped at {at} against the cap lifted.\n")
+    how = "" if settle is None else f"; settled by {settle}"
+    print(f"Pushes of {travel:g} m, 0.2 s held; capped at {at} against the cap lifted{how}.\n")
     turned = yaws != [0.0]
     print("| blade | cells | " + ("yaw | " if turned else "") + " | ".join(f"{v:g} m/s" for v in speeds)
           + " | converged work (M visits), " + " / ".join(f"{v:g}" for v in speeds) + " m/s |")
@@ -89,8 +97,8 @@ def main(argv):
     for cell, width, yaw in [(c, w, y) for c in cells for w in blades for y in yaws]:
         row, works = [], []
         for speed in speeds:
-            capped = push(terracut, np, width, cell, speed, cap, travel, yaw_deg=yaw)
-            lifted = push(terracut, np, width, cell, speed, 1e9, travel, yaw_deg=yaw)
+            capped = push(terracut, np, width, cell, speed, cap, travel, yaw_deg=yaw, settle=settle)
+            lifted = push(terracut, np, width, cell, speed, 1e9, travel, yaw_deg=yaw, settle=settle)
             if not lifted["ahead"] > 0.0:
                 fail(f"the {width:g} m blade's converged push left no soil ahead of it "
                      f"({1000 * cell:g} mm cells, {speed:g} m/s): no ratio to give", 4)

@@ -23,16 +23,17 @@ def push_x(width_m, cell_m):
     return 0.5 * grid_shape(width_m, cell_m, 0.0)[0] * cell_m
 
 
-def push(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m=0.8, hold_s=0.2, yaw_deg=0.0):
+def push(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m=0.8, hold_s=0.2, yaw_deg=0.0, settle=None):
     """A dict: heights (rows, cols) after the hold; ahead (m^3 of soil above
     the layer ahead of the edge within the blade's width) and peak (its
     highest point above the layer, m); capped (steps the cap stopped) and
-    work (neighbour visits in all), over the push's and the hold's steps."""
+    work (neighbour visits in all), over the push's and the hold's steps.
+    settle: the soil's settle (patches, passes or fans; None: the default)."""
     if yaw_deg != 0.0:
-        return push_at_yaw(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m, hold_s, yaw_deg)
+        return push_at_yaw(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m, hold_s, yaw_deg, settle)
     cols, rows = grid_shape(width_m, cell_m, travel_m)
     x = push_x(width_m, cell_m)
-    soil = soil_params(cap)
+    soil = soil_params(cap, settle)
     scenario = terracut.Scenario.from_dict({
         "name": "converge",
         "terrain": {"generator": "plane", "resolution": [cols, rows],
@@ -63,15 +64,18 @@ def push(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m=0.8, hold_s
             "capped": int(columns["soil_capped"].sum()), "work": int(columns["soil_work"].sum())}
 
 
-def soil_params(cap):
-    """The pushes' soil: flow, dry sand, at the work cap."""
+def soil_params(cap, settle=None):
+    """The pushes' soil: flow, dry sand, at the work cap (None: the
+    default), settled as `settle` says (None: the default)."""
     soil = {"model": "flow", "repose_deg": 34}
     if cap is not None:
         soil["max_pair_checks_per_step"] = int(cap)
+    if settle is not None:
+        soil["settle"] = settle
     return soil
 
 
-def push_at_yaw(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m, hold_s, yaw_deg):
+def push_at_yaw(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m, hold_s, yaw_deg, settle=None):
     """push() with the blade turned yaw_deg about the vertical (see the
     module's text); the same dict."""
     n = int(round((width_m + travel_m + 1.6) / cell_m))
@@ -85,7 +89,7 @@ def push_at_yaw(terracut, np, width_m, cell_m, speed_m_per_s, cap, travel_m, hol
         "name": "converge",
         "terrain": {"generator": "plane", "resolution": [n, n], "size_m": [side, side], "origin_m": [0, 0, 0],
                     "full_scale_m": 0.6, "plane": {"height_m": LAYER}},
-        "soil": soil_params(cap),
+        "soil": soil_params(cap, settle),
         "blade": {"length_m": width_m},
         "cuts": [{"name": "push", "keyframes": [
             {"t_s": 0.0, "position_m": [start[0], LAYER - DEPTH, start[1]], "rotation_deg": [0, yaw_deg, 0]},

@@ -31,3 +31,16 @@ def test_a_bad_yaw_is_refused_by_name():
     out = sweep("--yaws", "ten")
     assert out.returncode == 2
     assert "--yaws" in out.stderr and "ten" in out.stderr
+
+
+def test_the_settle_is_chosen_and_named():
+    # --settle fans runs the pushes with soil.settle: fans and says so; a
+    # settle the library does not have is refused by name.
+    out = sweep("--blades", "0.3", "--cells", "0.02", "--speeds", "1", "--travel", "0.2", "--yaws", "10",
+                "--settle", "fans")
+    assert out.returncode == 0, out.stderr
+    assert "settled by fans" in out.stdout
+    assert "0 of 1 pushes miss a bound" in out.stdout
+    bad = sweep("--settle", "wet")
+    assert bad.returncode == 2
+    assert "--settle" in bad.stderr and "wet" in bad.stderr

@@ -22,8 +22,8 @@ std::string validate(const SoilFlowParams& p) {
   if (p.model != SoilModel::kVanish && p.model != SoilModel::kFlow)
     return "soil.model must be vanish or flow";
   if (p.edge != SoilEdge::kWall && p.edge != SoilEdge::kOpen) return "soil.edge must be wall or open";
-  if (p.settle != SoilSettle::kPatches && p.settle != SoilSettle::kPasses)
-    return "soil.settle must be patches or passes";
+  if (p.settle != SoilSettle::kPatches && p.settle != SoilSettle::kPasses && p.settle != SoilSettle::kFans)
+    return "soil.settle must be patches, passes or fans";
   // The material's ranges (material.hpp): below a degree of repose the
   // material is a liquid, out of the model's reach (a repose of 1e-300
   // degrees made the tolerance 0, and float noise kept the cells moving).
@@ -287,7 +287,7 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   // left, and what the spill should have put in the trench's first rows
   // came down by passes over the next 15 steps, ten times the converged
   // work (docs/soil.md, "The spill comes before a settle under way").
-  if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0 && params_.settle == SoilSettle::kPatches) {
+  if (!blade_spec_.bucket.enabled() && out.displaced_volume_m3 > 0.0 && params_.settle != SoilSettle::kPasses) {
     if (settle_phase_ == SettlePhase::kIdle) {
       settle_start(grid, moved_from, to, out.changed);
     } else {

@@ -83,6 +83,18 @@ inline constexpr int kSettleMarginCells = 32;
 /// the passes, and the settle of a 1 m/s push on 5 mm cells outgrew the cap
 /// (docs/soil.md, "The settle charged for its time").
 inline constexpr std::int64_t kSettleCellVisits = 4;
+/// Two values of the settle's surfaces closer than this are a tie (the
+/// float sums along two mirror-image paths differ in their last bits),
+/// metres: the nearer source takes the cell (soil_settle.cpp).
+inline constexpr float kSettleTie_m = 1e-6f;
+/// The fans (SoilSettle::kFans): a cell whose surfaces the spreads moved by
+/// no more than this many of the passes' tolerances belongs to no fan but
+/// its own; a fan whose room (its widths less its soil) is less than this
+/// share of its soil joins every fan it borders (half: a fan of a steep
+/// pair's two cells has room equal to its soil exactly, and float sums put
+/// it on either side of a share of one).
+inline constexpr double kFanMarginOfTolerance = 2.0;
+inline constexpr double kStuckRoomOfExcess = 0.5;
 /// A patch cell's share of it, by what the patch does with the cell: find
 /// it (its 8 neighbours tested, about 10 ns), balance it (its excess and
 /// width summed, the level selected: about 8 ns) and write it (about 7 ns;

@@ -9,6 +9,8 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <span>
+#include <tuple>
 
 #include "soil_internal.hpp"
 
@@ -21,7 +23,7 @@ namespace {
 /// The delta >= 0 with sum over w of (w - delta)+ = excess, for widths
 /// w > 0 whose sum is at least excess: a selection in expected linear time
 /// (the widths are reordered).
-double level_below(std::vector<float>& w, double excess) {
+double level_below(std::span<float> w, double excess) {
   double acc_sum = 0.0;  // the widths known to lie above delta, and their count
   std::int64_t acc_n = 0;
   std::size_t lo = 0, hi = w.size();  // the widths not placed yet
@@ -58,6 +60,17 @@ void SoilFlow::reserve_settle(std::size_t window_cells) {
   settle_done_.assign(window_cells, 0);
   settle_low_.assign(window_cells, 0.0f);
   settle_high_.assign(window_cells, 0.0f);
+  settle_root_low_.assign(window_cells, -1);
+  settle_root_high_.assign(window_cells, -1);
+  settle_wrote_.reserve(window_cells);
+  settle_fan_slot_.assign(window_cells, -1);
+  settle_cell_fan_.reserve(window_cells);
+  settle_fans_.reserve(window_cells);
+  touch_reserved(settle_cell_fan_);
+  touch_reserved(settle_fans_);
+  settle_fresh_.reserve(window_cells);
+  touch_reserved(settle_fresh_);
+  touch_reserved(settle_wrote_);
   settle_row_lo_.assign(std::size_t(rows_), 0);
   settle_row_hi_.assign(std::size_t(rows_), 0);
   settle_follow_lo_.assign(std::size_t(rows_), 0);
@@ -113,7 +126,7 @@ void SoilFlow::settle_exclude(const Rect& rect) {
   if (r0 < r1 && c0 < c1) settle_drop_ok_ = false;
 }
 
-void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed) {
+void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment& to, const Rect& changed, int round) {
   if (settle_phase_ != SettlePhase::kIdle) settle_abort();
   if (changed.empty() || settle_low_.empty()) return;
   // The window: the cells the step changed and a margin round them. One
@@ -124,6 +137,11 @@ void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment
   if (ww < 3 || wh < 3 || std::size_t(ww) * std::size_t(wh) > settle_low_.size()) return;
   settle_wc0_ = wc0;
   settle_wr0_ = wr0;
+  settle_round_ = round;
+  settle_written_ = Rect{};
+  if (round == 0) settle_wrote_.clear();
+  settle_from_ = from;
+  settle_to_ = to;
   settle_ww_ = ww;
   settle_wh_ = wh;
   const std::size_t size = std::size_t(ww) * std::size_t(wh);
@@ -138,6 +156,7 @@ void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment
   }
   std::fill(settle_done_.begin(), settle_done_.begin() + std::ptrdiff_t(size), std::uint8_t(0));
   settle_wall_rows(spec, from, to, true, settle_row_lo_.data(), settle_row_hi_.data());
+  for (const std::int32_t l : settle_cells_) settle_root_low_[std::size_t(l)] = settle_root_high_[std::size_t(l)] = -1;
   settle_cells_.clear();
   settle_seeds_[0].clear();
   settle_seeds_[1].clear();
@@ -204,6 +223,8 @@ void SoilFlow::settle_wall_rows(const GridSpec& spec, const Segment& from, const
 
 void SoilFlow::settle_follow(const GridSpec& spec, const Segment& from, const Segment& to) {
   if (settle_phase_ == SettlePhase::kIdle) return;
+  settle_from_ = from;
+  settle_to_ = to;
   // (A wobbling blade whose part backed up over the trench came forward
   // again across cells a settle started in between had taken for the
   // pile's; the settle, written steps later, stood the pile on them, behind
@@ -230,6 +251,33 @@ void SoilFlow::settle_follow(const GridSpec& spec, const Segment& from, const Se
 
 std::int64_t SoilFlow::settle_finish(HeightGrid& grid, Rect& changed, std::int64_t budget, std::int64_t work) {
   settle_phase_ = SettlePhase::kIdle;
+  // The fans' seams (each fan lowered by its own amount): settled again,
+  // one patch lowering as a whole, from what the first round wrote and
+  // walled off what another writer changed since it began (a step's
+  // displacement: taken into a patch that lowers as a whole, it went round
+  // the blade's ends, as the first round's did before it had fans; docs/soil.md,
+  // "The settle follows the fall lines").
+  if (params_.settle == SoilSettle::kFans && settle_round_ == 0 && !settle_written_.empty()) {
+    settle_fresh_.clear();
+    for (int lr = 0; lr < settle_wh_; ++lr)
+      for (int lc = 0; lc < settle_ww_; ++lc)
+        if (settle_done_[std::size_t(lr) * std::size_t(settle_ww_) + std::size_t(lc)] & kSettleExcluded)
+          settle_fresh_.push_back(std::uint32_t(std::int64_t(settle_wr0_ + lr) * cols_ + settle_wc0_ + lc));
+    settle_start(grid, settle_from_, settle_to_, settle_written_, 1);
+  }
+  if (settle_phase_ != SettlePhase::kIdle) {
+    const auto mark = [this](const std::vector<std::uint32_t>& cells, std::uint8_t bit) {
+      for (const std::uint32_t cell : cells) {
+        const int lc = col_of(cell) - settle_wc0_, lr = row_of(cell) - settle_wr0_;
+        if (lc >= 0 && lr >= 0 && lc < settle_ww_ && lr < settle_wh_)
+          settle_done_[std::size_t(lr) * std::size_t(settle_ww_) + std::size_t(lc)] |= bit;
+      }
+    };
+    mark(settle_wrote_, kSettleWrote);
+    mark(settle_fresh_, kSettleFresh);
+    if (work < budget) work += settle_continue(grid, changed, budget - work);
+    return work;
+  }
   if (settle_again_) {
     // The next one, over what the steps since displaced.
     settle_again_ = false;
@@ -250,8 +298,13 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   const int* row_lo = settle_row_lo_.data();
   const int* row_hi = settle_row_hi_.data();
   std::int64_t work = 0;
+  // The second round (the seams): only what the first wrote seeds it, and
+  // what another writer changed since the first began is walled off.
+  const bool second = settle_round_ > 0;
+  const bool fans_on = params_.settle == SoilSettle::kFans;
   const auto walled = [&](int lc, int lr) {
-    return (lc >= row_lo[lr] && lc < row_hi[lr]) || obstacle_[std::int64_t(wr0 + lr) * cols_ + wc0 + lc] != 0;
+    return (lc >= row_lo[lr] && lc < row_hi[lr]) || obstacle_[std::int64_t(wr0 + lr) * cols_ + wc0 + lc] != 0 ||
+           (second && (done[std::size_t(lr) * std::size_t(ww) + std::size_t(lc)] & kSettleFresh));
   };
   const auto inner = [&](int lc, int lr) { return lc > 0 && lr > 0 && lc < ww - 1 && lr < wh - 1; };
   std::int32_t offset[8];
@@ -301,7 +354,8 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       const bool in_active = settle_q_ < from_active;
       const std::uint32_t a = in_active ? active_[examined_ + settle_q_] : next_[settle_q_ - from_active];
       const int lc = col_of(a) - wc0, lr = row_of(a) - wr0;
-      if (lc < 0 || lr < 0 || lc >= ww || lr >= wh || !inner(lc, lr) || walled(lc, lr)) {
+      if (lc < 0 || lr < 0 || lc >= ww || lr >= wh || !inner(lc, lr) || walled(lc, lr) ||
+          (second && !(done[std::size_t(lr) * std::size_t(ww) + std::size_t(lc)] & kSettleWrote))) {
         settle_keep(a, in_active);
         continue;
       }
@@ -343,8 +397,21 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // (low <= h <= high still holds, so the construction below keeps the
   // volume; the passes do the rest).
   const double width = std::min(limit_[0], limit_[1]);
+  // Whether source a lies nearer to window cell m than source b (in metres);
+  // of two as near, the one less far across X from it, then the one with
+  // the lower row: an order that a mirror image across a line along Z
+  // keeps (the one left is a source and its mirror image, equally near).
+  const auto nearer = [&](std::int32_t a, std::int32_t b, std::int32_t m) {
+    const int mr = m / ww, mc = m - mr * ww;
+    const auto key = [&](std::int32_t s) {
+      const int sr = s / ww, sc = s - sr * ww;
+      const double x = double(sc - mc) * dx_, z = double(sr - mr) * dz_;
+      return std::tuple{x * x + z * z, std::abs(sc - mc), sr};
+    };
+    return key(a) < key(b);
+  };
   const auto spread = [&](std::vector<std::pair<float, std::int32_t>>& seeds, float* value, float sign,
-                          std::uint8_t done_bit) -> bool {
+                          std::uint8_t done_bit, std::int32_t* root) -> bool {
     std::vector<std::pair<std::int32_t, std::int32_t>>& entries = settle_entries_;  // (cell, next)
     const auto put = [&](float key, std::int32_t l, std::size_t at_least) {
       const std::size_t b =
@@ -357,7 +424,10 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
     if (!seeds.empty()) {  // the spread's start
       settle_kmin_ = std::numeric_limits<float>::infinity();
       for (const auto& e : seeds) settle_kmin_ = std::min(settle_kmin_, e.first);
-      for (const auto& e : seeds) put(e.first, e.second, 0);
+      for (const auto& e : seeds) {
+        put(e.first, e.second, 0);
+        root[e.second] = e.second;
+      }
       seeds.clear();
     }
     float cand[8];
@@ -377,12 +447,25 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         // it, the steep test with no tolerance.
         const float v = value[l];
         unsigned better = steep_from(value, l, v, 0.0f, -sign);
-        if (better == 0) continue;
         for (int k = 0; k < 8; ++k) cand[k] = v + sign * limit8_[k];
+        // A neighbour this cell's value reaches exactly, as another's did
+        // (a tie): its source is the one nearer to it, so that the fans
+        // (below) do not depend on the order of a bucket's cells (which
+        // would make a pile that is its own mirror image settle as though it
+        // were not).
+        for (int k = 0; k < 8 && fans_on; ++k) {
+          const std::int32_t m = l + offset[k];
+          if (!(std::abs(value[m] - cand[k]) <= kSettleTie_m) || root[m] < 0 || root[m] == root[l]) continue;
+          if (nearer(root[l], root[m], m)) root[m] = root[l];
+        }
+        if (better == 0) continue;
         for (; better != 0; better &= better - 1) {
           const int k = std::countr_zero(better);
           const std::int32_t m = l + offset[k];
           if (!(sign * cand[k] < sign * value[m]) || walled(lc + kNeighbours[k].dc, lr + kNeighbours[k].dr)) continue;
+          // (within a tie of the value it had: the nearer source, as above)
+          if (!(sign * (value[m] - cand[k]) <= kSettleTie_m) || root[m] < 0 || nearer(root[l], root[m], m))
+            root[m] = root[l];
           value[m] = cand[k];
           list(m);
           put(sign * cand[k], m, b + 1);
@@ -394,11 +477,11 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
     return true;
   };
   if (settle_phase_ == SettlePhase::kLow) {
-    if (!spread(low_seeds, low, 1.0f, kLowDone)) return work;
+    if (!spread(low_seeds, low, 1.0f, kLowDone, settle_root_low_.data())) return work;
     settle_phase_ = SettlePhase::kHigh;
   }
   if (settle_phase_ == SettlePhase::kHigh) {
-    if (!spread(high_seeds, high, -1.0f, kHighDone)) return work;
+    if (!spread(high_seeds, high, -1.0f, kHighDone, settle_root_high_.data())) return work;
     settle_phase_ = SettlePhase::kPatches;
     settle_q_ = 0;
   }
@@ -430,6 +513,35 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       std::size_t(std::max<std::int64_t>(1, cap / (2 * std::max(kPatchSolveVisits, kPatchWriteVisits))));
   const auto open = [&](std::int32_t l) {
     return !(done[l] & (kSettleInPatch | kSettleExcluded)) && high[l] > low[l];
+  };
+  // A cell's fan: the seed its high surface came from (where its soil
+  // comes from) if the spread raised it; else, if the low one lowered it,
+  // the fan of the seed its low surface came from (where its soil goes);
+  // else its own. (A seed of the high surface that nothing raised goes
+  // with where its soil goes: alone, with no room in its fan, it kept its
+  // soil, a column 0.16 m above its neighbours against a body. settle_start
+  // clears what the last settle's spreads set; a cell the high spread
+  // raised came from another.)
+  const std::int32_t* from_low = settle_root_low_.data();
+  const std::int32_t* from_high = settle_root_high_.data();
+  // (A cell the spreads changed by no more than kFanMarginOfTolerance
+  // tolerances takes no part in the fans: whether a pair just past the
+  // passes' threshold seeds them differs in the last bits of float sums, and
+  // it moved whole fans from one side of a pile to its mirror image.)
+  const float margin = float(kFanMarginOfTolerance) * tolerance_m_;
+  const auto height_at = [&](std::int32_t l) {
+    const int lr = l / ww, lc = l - lr * ww;
+    return h[std::int64_t(wr0 + lr) * cols_ + wc0 + lc];
+  };
+  const auto raised = [&](std::int32_t l) {
+    return from_high[l] >= 0 && from_high[l] != l && high[l] - height_at(l) > margin;
+  };
+  const auto fan = [&](std::int32_t l) -> std::int32_t {
+    if (!fans_on || second) return 0;  // one patch lowering as a whole (patches; the fans' seams)
+    if (raised(l)) return from_high[l];
+    const std::int32_t r = from_low[l];
+    if (r < 0 || r == l || !(height_at(l) - low[l] > margin)) return l;
+    return raised(r) ? from_high[r] : r;
   };
   // Whether this call can still pay per_cell visits for each cell of the
   // patch under way.
@@ -500,14 +612,88 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
     if (settle_patch_stage_ == PatchStage::kSolve) {
       if (!room_for(kPatchSolveVisits)) break;
       work += kPatchSolveVisits * std::int64_t(patch.size());
+      // Each fan's excess and room (its widths less its excess), by slot
+      // (fan_slot: a fan's slot in the patch, by the fan's id; cell_fan: a
+      // patch cell's slot, -1 if it left).
+      std::vector<FanBalance>& fans = settle_fans_;
+      std::int32_t* fan_slot = settle_fan_slot_.data();
+      std::vector<std::int32_t>& cell_fan = settle_cell_fan_;
+      fans.clear();
+      cell_fan.clear();
       double excess = 0.0, sum_widths = 0.0;
-      widths.clear();
       for (const std::int32_t l : patch) {
-        if (done[l] & kSettleExcluded) continue;
+        if (done[l] & kSettleExcluded) {
+          cell_fan.push_back(-1);
+          continue;
+        }
+        const std::int32_t f = fan(l);
+        if (fan_slot[f] < 0) {
+          fan_slot[f] = std::int32_t(fans.size());
+          fans.push_back({f, std::int32_t(fans.size()), std::int32_t(fans.size())});
+        }
+        FanBalance& b = fans[std::size_t(fan_slot[f])];
         const int lr = l / ww, lc = l - lr * ww;
-        excess += double(h[std::int64_t(wr0 + lr) * cols_ + wc0 + lc]) - double(low[l]);
-        widths.push_back(high[l] - low[l]);
-        sum_widths += double(widths.back());
+        const double e = double(h[std::int64_t(wr0 + lr) * cols_ + wc0 + lc]) - double(low[l]);
+        const double w = double(high[l] - low[l]);
+        b.excess += e;
+        b.room += w - e;
+        excess += e;
+        sum_widths += w;
+        cell_fan.push_back(fan_slot[f]);
+      }
+      // A fan with less room than soil to put in it (its fall lines taken
+      // by its neighbours', or blocked: soil pushed against a body) shares
+      // its neighbours' room: it joins every fan it borders.
+      const auto find = [&](std::int32_t a) {
+        while (fans[std::size_t(a)].parent != a) {
+          FanBalance& b = fans[std::size_t(a)];
+          b.parent = fans[std::size_t(b.parent)].parent;  // (halving the path)
+          a = b.parent;
+        }
+        return a;
+      };
+      for (std::size_t j = 0; j < patch.size() && fans_on; ++j) {
+        const std::int32_t a = cell_fan[j];
+        if (a < 0 || !(fans[std::size_t(a)].room < kStuckRoomOfExcess * fans[std::size_t(a)].excess)) continue;
+        const std::int32_t l = patch[j];
+        const int lr = l / ww, lc = l - lr * ww;
+        for (int k = 0; k < 8; ++k) {
+          const int mc = lc + kNeighbours[k].dc, mr = lr + kNeighbours[k].dr;
+          if (mc < 0 || mr < 0 || mc >= ww || mr >= wh) continue;
+          const std::int32_t m = l + offset[k];
+          if (!(done[m] & kSettleCurrent) || (done[m] & kSettleExcluded)) continue;
+          const std::int32_t bm = fan_slot[fan(m)];
+          if (bm < 0) continue;
+          const std::int32_t ra = find(a), rb = find(bm);
+          if (ra != rb) fans[std::size_t(std::max(ra, rb))].parent = std::min(ra, rb);
+        }
+      }
+      // Each joined group's cells' widths side by side in `widths`, from its
+      // root's start; the group's excess and count on its root.
+      for (FanBalance& b : fans) {
+        fan_slot[b.id] = -1;
+        b.group_excess = 0.0;
+        b.cells = 0;
+      }
+      for (std::size_t j = 0; j < patch.size(); ++j) {
+        if (cell_fan[j] < 0) continue;
+        FanBalance& r = fans[std::size_t(find(cell_fan[j]))];
+        ++r.cells;
+      }
+      std::size_t at = 0;
+      for (FanBalance& b : fans) {
+        if (b.parent != b.slot) continue;
+        b.start = at;
+        at += b.cells;
+        b.cells = 0;
+      }
+      for (FanBalance& b : fans) fans[std::size_t(find(b.slot))].group_excess += b.excess;
+      widths.resize(at);
+      for (std::size_t j = 0; j < patch.size(); ++j) {
+        if (cell_fan[j] < 0) continue;
+        FanBalance& r = fans[std::size_t(find(cell_fan[j]))];
+        widths[r.start + r.cells++] = high[patch[j]] - low[patch[j]];
+        cell_fan[j] = r.slot;
       }
       // A height some writer changed without a word (outside low..high)
       // would make the balance put soil where none was: left to the passes.
@@ -515,7 +701,9 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         drop_patch();
         continue;
       }
-      settle_delta_ = level_below(widths, excess);
+      for (FanBalance& b : fans)
+        if (b.parent == b.slot)
+          b.delta = level_below(std::span<float>(widths.data() + b.start, b.cells), std::max(b.group_excess, 0.0));
       settle_balanced_at_ = settle_patch_left_;
       ++settle_patch_balances_;
       settle_patch_stage_ = PatchStage::kWrite;
@@ -523,13 +711,23 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
     if (settle_patch_stage_ == PatchStage::kWrite) {
       if (!room_for(kPatchWriteVisits)) break;
       work += kPatchWriteVisits * std::int64_t(patch.size());
-      for (const std::int32_t l : patch) {
+      for (std::size_t j = 0; j < patch.size(); ++j) {
+        const std::int32_t l = patch[j];
         done[l] &= std::uint8_t(~kSettleCurrent);
         if (done[l] & kSettleExcluded) continue;
         const int lr = l / ww, lc = l - lr * ww;
         const std::int64_t i = std::int64_t(wr0 + lr) * cols_ + wc0 + lc;
-        const float now = quantized(std::max(double(low[l]), double(high[l]) - settle_delta_));
+        const double delta = settle_fans_[std::size_t(settle_cell_fan_[j])].delta;
+        const float now = quantized(std::max(double(low[l]), double(high[l]) - delta));
         const float old = h[i];
+        // (The second round starts from every cell of the first's patches,
+        // written or not: a fan with no room down its fall line, such as
+        // soil pushed against a body, keeps its soil, which then goes
+        // round along the seams.)
+        if (!second) {
+          settle_written_.include(wc0 + lc, wr0 + lr);
+          if (settle_wrote_.size() < settle_wrote_.capacity()) settle_wrote_.push_back(std::uint32_t(i));
+        }
         if (now == old) continue;
         gained += double(now) - double(old);
         dirty(std::uint32_t(i));

@@ -611,7 +611,7 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     if (const auto e = soil.get("edge"))
       sc.soil.edge = e->choice({SoilEdge::kWall, SoilEdge::kOpen}, "soil edge");
     if (const auto e = soil.get("settle"))
-      sc.soil.settle = e->choice({SoilSettle::kPatches, SoilSettle::kPasses}, "soil settle");
+      sc.soil.settle = e->choice({SoilSettle::kPatches, SoilSettle::kPasses, SoilSettle::kFans}, "soil settle");
     // The flow's settings without a model: the model defaults to vanish,
     // where they do nothing, which is surely not what was meant (an
     // explicit 'model: vanish' keeps them, to compare the two).
