@@ -8,7 +8,9 @@
 //  - bulldoze/side:N: a 2 m blade cutting 5 cm into a 20 cm layer, moving
 //    0.6 mm per step (0.6 m/s at 1 kHz) for 1 m along +Z, on an N x N grid
 //    (the grid's size must not matter: the phase walks only active cells);
-//    and the same push with a 1 m blade on 5 mm cells (1024^2 and 8192^2);
+//    and the same push with a 1 m blade on 5 mm cells (1024^2 and 8192^2),
+//    and turned 10 degrees (driven along its normal) with each settle of
+//    the displaced pile, patches (the default) and fans;
 //  - scoop: a 1 m bucket (0.4 m floor, 0.2 m back: 0.04 m^3 struck) dragged
 //    1 m along -Z on a 512 x 512 grid, 0.6 mm per step, heel up 7 degrees
 //    as a bucket goes in (its floor and back are solid: a level floor in
@@ -89,14 +91,19 @@ void drive(Simulation& sim, const Vec3& start, const Vec3& travel, int steps, Sa
   }
 }
 
-Stats bulldoze(int side, double cell = 0.01, double blade_m = 2.0) {
+/// The push, the blade turned yaw_deg about +Y and driven along its normal,
+/// its displaced pile settled as `settle` says.
+Stats bulldoze(int side, double cell = 0.01, double blade_m = 2.0, double yaw_deg = 0.0,
+               SoilSettle settle = SoilFlowParams{}.settle) {
   const scenes::Bulldoze scene{side, side, cell, blade_m, 0.2, 0.05};
   SoilFlowParams soil;
   soil.model = SoilModel::kFlow;
+  soil.settle = settle;
   Simulation sim(scene.params(soil), scene.heights());
-  const double z0 = 0.5 * side * cell - 0.5;
+  const double z0 = 0.5 * side * cell - 0.5, yaw = yaw_deg * std::numbers::pi / 180.0;
   Samples s;
-  drive(sim, scene.pose(z0).position_m, {0.0, 0.0, 1.0}, int(std::lround(1.0 / 0.0006)), s);
+  drive(sim, scene.pose(z0).position_m, {std::sin(yaw), 0.0, std::cos(yaw)}, int(std::lround(1.0 / 0.0006)), s,
+        quat_from_axis_angle({0.0, 1.0, 0.0}, yaw));
   return s.stats();
 }
 
@@ -197,6 +204,11 @@ int main(int argc, char** argv) {
     const std::string what = "1 m blade bulldozing a 5 cm cut, 5 mm cells, " + std::to_string(side) +
                              "^2 grid (wall: cut + soil; CPU: the step)";
     add(row(what.c_str(), bulldoze(side, 0.005, 1.0)));
+  }
+  for (const SoilSettle settle : {SoilSettle::kPatches, SoilSettle::kFans}) {
+    const std::string what = "1 m blade turned 10 deg, 5 mm cells, 1024^2 grid, settle " +
+                             std::string(to_string(settle)) + " (wall: cut + soil; CPU: the step)";
+    add(row(what.c_str(), bulldoze(1024, 0.005, 1.0, 10.0, settle)));
   }
   add(row("1 m bucket scooping a 5 cm cut, 512^2 grid (wall: cut + soil; CPU: the step)", scoop()));
   add(row("100 x 100-cell block 0.5 m tall collapsing (soil per tick)", collapse()));
