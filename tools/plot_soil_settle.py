@@ -18,7 +18,7 @@ Exit codes: 0 done; 2 bad arguments; 3 numpy, matplotlib or terracut missing.
 import sys
 
 import soil_push
-from plot_common import import_plotting, import_terracut, make_fail, save_figure
+from plot_common import import_plotting, import_terracut, make_fail, parse_out_args, save_figure
 
 fail = make_fail("plot_soil_settle.py")
 np, plt = import_plotting(fail)
@@ -33,21 +33,7 @@ RUNS = [("patches", 0.0, 1e9, "patches, square, converged"),
 
 
 def main(argv):
-    out, quiet = "docs/images/soil_settle_fans.png", False
-    args = argv[1:]
-    while args:
-        a = args.pop(0)
-        if a in ("-h", "--help"):
-            print(__doc__)
-            return 0
-        if a == "--quiet":
-            quiet = True
-        elif a == "--out":
-            if not args:
-                fail("--out needs a file name")
-            out = args.pop(0)
-        else:
-            fail(f"unknown argument {a!r} (see --help)")
+    out, quiet = parse_out_args(argv, __doc__, "docs/images/soil_settle_fans.png", fail)
     import matplotlib.colors
     fig, axes = plt.subplots(1, len(RUNS), figsize=(4.2 * len(RUNS), 4.6))
     half = int(round(0.9 / CELL))

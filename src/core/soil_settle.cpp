@@ -156,7 +156,8 @@ void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment
   }
   std::fill(settle_done_.begin(), settle_done_.begin() + std::ptrdiff_t(size), std::uint8_t(0));
   settle_wall_rows(spec, from, to, true, settle_row_lo_.data(), settle_row_hi_.data());
-  for (const std::int32_t l : settle_cells_) settle_root_low_[std::size_t(l)] = settle_root_high_[std::size_t(l)] = -1;
+  if (params_.settle == SoilSettle::kFans)
+    for (const std::int32_t l : settle_cells_) settle_root_low_[std::size_t(l)] = settle_root_high_[std::size_t(l)] = -1;
   settle_cells_.clear();
   settle_seeds_[0].clear();
   settle_seeds_[1].clear();
@@ -426,7 +427,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       for (const auto& e : seeds) settle_kmin_ = std::min(settle_kmin_, e.first);
       for (const auto& e : seeds) {
         put(e.first, e.second, 0);
-        root[e.second] = e.second;
+        if (fans_on) root[e.second] = e.second;
       }
       seeds.clear();
     }
@@ -464,7 +465,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
           const std::int32_t m = l + offset[k];
           if (!(sign * cand[k] < sign * value[m]) || walled(lc + kNeighbours[k].dc, lr + kNeighbours[k].dr)) continue;
           // (within a tie of the value it had: the nearer source, as above)
-          if (!(sign * (value[m] - cand[k]) <= kSettleTie_m) || root[m] < 0 || nearer(root[l], root[m], m))
+          if (fans_on && (!(sign * (value[m] - cand[k]) <= kSettleTie_m) || root[m] < 0 || nearer(root[l], root[m], m)))
             root[m] = root[l];
           value[m] = cand[k];
           list(m);
@@ -724,7 +725,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         // written or not: a fan with no room down its fall line, such as
         // soil pushed against a body, keeps its soil, which then goes
         // round along the seams.)
-        if (!second) {
+        if (fans_on && !second) {
           settle_written_.include(wc0 + lc, wr0 + lr);
           if (settle_wrote_.size() < settle_wrote_.capacity()) settle_wrote_.push_back(std::uint32_t(i));
         }
