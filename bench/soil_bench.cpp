@@ -7,10 +7,11 @@
 // neighbour visits per step):
 //  - bulldoze/side:N: a 2 m blade cutting 5 cm into a 20 cm layer, moving
 //    0.6 mm per step (0.6 m/s at 1 kHz) for 1 m along +Z, on an N x N grid
-//    (the grid's size must not matter: the phase walks only active cells);
+//    (the grid's size must not matter: the phase walks only active cells),
+//    and on 512^2 with the patches' settle (the default until 2026-12-07);
 //    and the same push with a 1 m blade on 5 mm cells (1024^2 and 8192^2),
 //    and turned 10 degrees (driven along its normal) with each settle of
-//    the displaced pile, patches (the default) and fans;
+//    the displaced pile, patches and fans (the default);
 //  - scoop: a 1 m bucket (0.4 m floor, 0.2 m back: 0.04 m^3 struck) dragged
 //    1 m along -Z on a 512 x 512 grid, 0.6 mm per step, heel up 7 degrees
 //    as a bucket goes in (its floor and back are solid: a level floor in
@@ -200,6 +201,9 @@ int main(int argc, char** argv) {
                              "^2 grid (wall: cut + soil; CPU: the step)";
     add(row(what.c_str(), bulldoze(side)));
   }
+  // The same on 512^2 with the settle of the default until 2026-12-07.
+  add(row("2 m blade bulldozing a 5 cm cut, 512^2 grid, settle patches (wall: cut + soil; CPU: the step)",
+          bulldoze(512, 0.01, 2.0, 0.0, SoilSettle::kPatches)));
   for (int side : {1024, 8192}) {
     const std::string what = "1 m blade bulldozing a 5 cm cut, 5 mm cells, " + std::to_string(side) +
                              "^2 grid (wall: cut + soil; CPU: the step)";

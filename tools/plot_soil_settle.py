@@ -6,9 +6,10 @@ Usage: PYTHONPATH=build/python /usr/bin/python3 tools/plot_soil_settle.py
 
 Runs, with the terracut module, the push of tools/soil_push.py (a 1 m blade
 cutting 4 cm into a 20 cm layer of dry sand on 5 mm cells, pushed 0.8 m at
-1 m/s, then held 0.2 s) five times: with the default settle (patches),
-square to the grid and turned 10 degrees, converged (the cap lifted); with
-soil.settle: fans, the same two and the turned one at the default cap. It
+1 m/s, then held 0.2 s) five times: with soil.settle: patches (the default
+until 2026-12-07), square to the grid and turned 10 degrees, converged (the
+cap lifted); with the fans (the default), the same two and the turned one
+at the default cap. It
 maps each one's heights above the layer and titles it with the soil ahead
 of the blade (docs/soil.md, "The settle follows the fall lines"). Default
 output: docs/images/soil_settle_fans.png. About 15 s.

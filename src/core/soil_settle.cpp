@@ -54,6 +54,20 @@ double level_below(std::span<float> w, double excess) {
   return acc_n > 0 ? std::max((acc_sum - excess) / double(acc_n), 0.0) : 0.0;
 }
 
+/// A window index split into its row and column with detail::IndexDivider
+/// (no divide instruction): the settle does it for every cell it visits,
+/// and a division by the window's width, known only at run time, takes 20
+/// to 40 cycles.
+struct WindowSplit {
+  int ww;
+  detail::IndexDivider div;
+  explicit WindowSplit(int width) : ww(width), div(std::uint32_t(width)) {}
+  void operator()(std::int32_t l, int& r, int& c) const {
+    r = int(div.quotient(std::uint32_t(l)));
+    c = l - r * ww;
+  }
+};
+
 }  // namespace
 
 void SoilFlow::reserve_settle(std::size_t window_cells) {
@@ -64,12 +78,15 @@ void SoilFlow::reserve_settle(std::size_t window_cells) {
   settle_root_high_.assign(window_cells, -1);
   settle_wrote_.reserve(window_cells);
   settle_fan_slot_.assign(window_cells, -1);
+  settle_cell_slot_.assign(window_cells, -1);
   settle_cell_fan_.reserve(window_cells);
   settle_fans_.reserve(window_cells);
   touch_reserved(settle_cell_fan_);
   touch_reserved(settle_fans_);
   settle_fresh_.reserve(window_cells);
   touch_reserved(settle_fresh_);
+  settle_excluded_.reserve(window_cells);
+  touch_reserved(settle_excluded_);
   touch_reserved(settle_wrote_);
   settle_row_lo_.assign(std::size_t(rows_), 0);
   settle_row_hi_.assign(std::size_t(rows_), 0);
@@ -122,7 +139,7 @@ void SoilFlow::settle_exclude(const Rect& rect) {
   const int r0 = std::max(rect.r0, settle_wr0_), r1 = std::min(rect.r1, settle_wr0_ + settle_wh_);
   for (int r = r0; r < r1; ++r)
     for (int c = c0; c < c1; ++c)
-      settle_leave(settle_done_[std::size_t(r - settle_wr0_) * std::size_t(settle_ww_) + std::size_t(c - settle_wc0_)]);
+      settle_leave(std::size_t(r - settle_wr0_) * std::size_t(settle_ww_) + std::size_t(c - settle_wc0_));
   if (r0 < r1 && c0 < c1) settle_drop_ok_ = false;
 }
 
@@ -138,6 +155,8 @@ void SoilFlow::settle_start(HeightGrid& grid, const Segment& from, const Segment
   settle_wc0_ = wc0;
   settle_wr0_ = wr0;
   settle_round_ = round;
+  settle_excluded_.clear();
+  settle_lists_excluded_ = params_.settle == SoilSettle::kFans && round == 0;
   settle_written_ = Rect{};
   if (round == 0) settle_wrote_.clear();
   settle_from_ = from;
@@ -260,10 +279,12 @@ std::int64_t SoilFlow::settle_finish(HeightGrid& grid, Rect& changed, std::int64
   // "The settle follows the fall lines").
   if (params_.settle == SoilSettle::kFans && settle_round_ == 0 && !settle_written_.empty()) {
     settle_fresh_.clear();
-    for (int lr = 0; lr < settle_wh_; ++lr)
-      for (int lc = 0; lc < settle_ww_; ++lc)
-        if (settle_done_[std::size_t(lr) * std::size_t(settle_ww_) + std::size_t(lc)] & kSettleExcluded)
-          settle_fresh_.push_back(std::uint32_t(std::int64_t(settle_wr0_ + lr) * cols_ + settle_wc0_ + lc));
+    const WindowSplit split(settle_ww_);
+    for (const std::uint32_t l : settle_excluded_) {
+      int lr, lc;
+      split(std::int32_t(l), lr, lc);
+      settle_fresh_.push_back(std::uint32_t(std::int64_t(settle_wr0_ + lr) * cols_ + settle_wc0_ + lc));
+    }
     settle_start(grid, settle_from_, settle_to_, settle_written_, 1);
   }
   if (settle_phase_ != SettlePhase::kIdle) {
@@ -291,6 +312,7 @@ std::int64_t SoilFlow::settle_finish(HeightGrid& grid, Rect& changed, std::int64
 std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int64_t budget) {
   if (settle_phase_ == SettlePhase::kIdle) return 0;
   const int wc0 = settle_wc0_, wr0 = settle_wr0_, ww = settle_ww_, wh = settle_wh_;
+  const WindowSplit split(ww);
   float* h = grid.edit_layers().height_m;
   float* low = settle_low_.data();
   float* high = settle_high_.data();
@@ -402,14 +424,17 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // of two as near, the one less far across X from it, then the one with
   // the lower row: an order that a mirror image across a line along Z
   // keeps (the one left is a source and its mirror image, equally near).
-  const auto nearer = [&](std::int32_t a, std::int32_t b, std::int32_t m) {
-    const int mr = m / ww, mc = m - mr * ww;
-    const auto key = [&](std::int32_t s) {
-      const int sr = s / ww, sc = s - sr * ww;
-      const double x = double(sc - mc) * dx_, z = double(sr - mr) * dz_;
-      return std::tuple{x * x + z * z, std::abs(sc - mc), sr};
-    };
-    return key(a) < key(b);
+  // (m: at row mr, column mc of the window.)
+  const auto nearer = [&](std::int32_t a, std::int32_t b, int mr, int mc) {
+    int ar, ac, br, bc;
+    split(a, ar, ac);
+    split(b, br, bc);
+    const double ax = double(ac - mc) * dx_, az = double(ar - mr) * dz_;
+    const double bx = double(bc - mc) * dx_, bz = double(br - mr) * dz_;
+    const double da = ax * ax + az * az, db = bx * bx + bz * bz;
+    if (da != db) return da < db;
+    if (std::abs(ac - mc) != std::abs(bc - mc)) return std::abs(ac - mc) < std::abs(bc - mc);
+    return ar < br;
   };
   const auto spread = [&](std::vector<std::pair<float, std::int32_t>>& seeds, float* value, float sign,
                           std::uint8_t done_bit, std::int32_t* root) -> bool {
@@ -440,7 +465,8 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         settle_heads_[b] = next;
         if (done[l] & done_bit) continue;
         done[l] |= done_bit;
-        const int lr = l / ww, lc = l - lr * ww;
+        int lr, lc;
+        split(l, lr, lc);
         if (!inner(lc, lr)) continue;
         work += kSettleCellVisits;
         // The neighbours this cell's value plus (less) the pair's limit
@@ -448,16 +474,38 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         // it, the steep test with no tolerance.
         const float v = value[l];
         unsigned better = steep_from(value, l, v, 0.0f, -sign);
-        for (int k = 0; k < 8; ++k) cand[k] = v + sign * limit8_[k];
         // A neighbour this cell's value reaches exactly, as another's did
-        // (a tie): its source is the one nearer to it, so that the fans
-        // (below) do not depend on the order of a bucket's cells (which
-        // would make a pile that is its own mirror image settle as though it
-        // were not).
-        for (int k = 0; k < 8 && fans_on; ++k) {
+        // (a tie, |value - cand| <= kSettleTie_m): its source is the one
+        // nearer to it, so that the fans (below) do not depend on the order
+        // of a bucket's cells (which would make a pile that is its own
+        // mirror image settle as though it were not).
+        unsigned ties = 0;
+#if defined(__SSE2__)
+        {
+          const __m128 vv = _mm_set1_ps(v), vs = _mm_set1_ps(sign);
+          const __m128 c0 = _mm_add_ps(vv, _mm_mul_ps(vs, _mm_loadu_ps(limit8_)));
+          const __m128 c1 = _mm_add_ps(vv, _mm_mul_ps(vs, _mm_loadu_ps(limit8_ + 4)));
+          _mm_storeu_ps(cand, c0);
+          _mm_storeu_ps(cand + 4, c1);
+          if (fans_on) {
+            __m128 n0, n1;
+            load_neighbours(value + l, ww, n0, n1);
+            const __m128 magnitude = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)), vt = _mm_set1_ps(kSettleTie_m);
+            ties = unsigned(_mm_movemask_ps(_mm_cmple_ps(_mm_and_ps(_mm_sub_ps(n0, c0), magnitude), vt))) |
+                   unsigned(_mm_movemask_ps(_mm_cmple_ps(_mm_and_ps(_mm_sub_ps(n1, c1), magnitude), vt))) << 4;
+          }
+        }
+#else
+        for (int k = 0; k < 8; ++k) {
+          cand[k] = v + sign * limit8_[k];
+          ties |= unsigned(fans_on && std::abs(value[l + offset[k]] - cand[k]) <= kSettleTie_m) << k;
+        }
+#endif
+        for (; ties != 0; ties &= ties - 1) {
+          const int k = std::countr_zero(ties);
           const std::int32_t m = l + offset[k];
-          if (!(std::abs(value[m] - cand[k]) <= kSettleTie_m) || root[m] < 0 || root[m] == root[l]) continue;
-          if (nearer(root[l], root[m], m)) root[m] = root[l];
+          if (root[m] < 0 || root[m] == root[l]) continue;
+          if (nearer(root[l], root[m], lr + kNeighbours[k].dr, lc + kNeighbours[k].dc)) root[m] = root[l];
         }
         if (better == 0) continue;
         for (; better != 0; better &= better - 1) {
@@ -465,7 +513,8 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
           const std::int32_t m = l + offset[k];
           if (!(sign * cand[k] < sign * value[m]) || walled(lc + kNeighbours[k].dc, lr + kNeighbours[k].dr)) continue;
           // (within a tie of the value it had: the nearer source, as above)
-          if (fans_on && (!(sign * (value[m] - cand[k]) <= kSettleTie_m) || root[m] < 0 || nearer(root[l], root[m], m)))
+          if (fans_on && (!(sign * (value[m] - cand[k]) <= kSettleTie_m) || root[m] < 0 ||
+                          nearer(root[l], root[m], lr + kNeighbours[k].dr, lc + kNeighbours[k].dc)))
             root[m] = root[l];
           value[m] = cand[k];
           list(m);
@@ -531,17 +580,19 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // it moved whole fans from one side of a pile to its mirror image.)
   const float margin = float(kFanMarginOfTolerance) * tolerance_m_;
   const auto height_at = [&](std::int32_t l) {
-    const int lr = l / ww, lc = l - lr * ww;
+    int lr, lc;
+    split(l, lr, lc);
     return h[std::int64_t(wr0 + lr) * cols_ + wc0 + lc];
   };
   const auto raised = [&](std::int32_t l) {
     return from_high[l] >= 0 && from_high[l] != l && high[l] - height_at(l) > margin;
   };
-  const auto fan = [&](std::int32_t l) -> std::int32_t {
+  // (hl: the cell's height.)
+  const auto fan_at = [&](std::int32_t l, float hl) -> std::int32_t {
     if (!fans_on || second) return 0;  // one patch lowering as a whole (patches; the fans' seams)
-    if (raised(l)) return from_high[l];
+    if (from_high[l] >= 0 && from_high[l] != l && high[l] - hl > margin) return from_high[l];
     const std::int32_t r = from_low[l];
-    if (r < 0 || r == l || !(height_at(l) - low[l] > margin)) return l;
+    if (r < 0 || r == l || !(hl - low[l] > margin)) return l;
     return raised(r) ? from_high[r] : r;
   };
   // Whether this call can still pay per_cell visits for each cell of the
@@ -577,7 +628,8 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       bool paid_out = false, cut = false;
       for (; settle_patch_next_ < patch.size() && !paid_out && !cut; ++settle_patch_next_) {
         const std::int32_t l = patch[settle_patch_next_];
-        const int lr = l / ww, lc = l - lr * ww;
+        int lr, lc;
+        split(l, lr, lc);
         for (int k = 0; k < 8; ++k) {
           const int mc = lc + kNeighbours[k].dc, mr = lr + kNeighbours[k].dr;
           if (mc < 0 || mr < 0 || mc >= ww || mr >= wh) continue;
@@ -619,6 +671,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       std::vector<FanBalance>& fans = settle_fans_;
       std::int32_t* fan_slot = settle_fan_slot_.data();
       std::vector<std::int32_t>& cell_fan = settle_cell_fan_;
+      std::int32_t* cell_slot = settle_cell_slot_.data();
       fans.clear();
       cell_fan.clear();
       double excess = 0.0, sum_widths = 0.0;
@@ -627,20 +680,23 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
           cell_fan.push_back(-1);
           continue;
         }
-        const std::int32_t f = fan(l);
+        int lr, lc;
+        split(l, lr, lc);
+        const float hl = h[std::int64_t(wr0 + lr) * cols_ + wc0 + lc];
+        const std::int32_t f = fan_at(l, hl);
         if (fan_slot[f] < 0) {
           fan_slot[f] = std::int32_t(fans.size());
           fans.push_back({f, std::int32_t(fans.size()), std::int32_t(fans.size())});
         }
         FanBalance& b = fans[std::size_t(fan_slot[f])];
-        const int lr = l / ww, lc = l - lr * ww;
-        const double e = double(h[std::int64_t(wr0 + lr) * cols_ + wc0 + lc]) - double(low[l]);
+        const double e = double(hl) - double(low[l]);
         const double w = double(high[l] - low[l]);
         b.excess += e;
         b.room += w - e;
         excess += e;
         sum_widths += w;
         cell_fan.push_back(fan_slot[f]);
+        cell_slot[l] = fan_slot[f];
       }
       // A fan with less room than soil to put in it (its fall lines taken
       // by its neighbours', or blocked: soil pushed against a body) shares
@@ -657,18 +713,20 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         const std::int32_t a = cell_fan[j];
         if (a < 0 || !(fans[std::size_t(a)].room < kStuckRoomOfExcess * fans[std::size_t(a)].excess)) continue;
         const std::int32_t l = patch[j];
-        const int lr = l / ww, lc = l - lr * ww;
+        int lr, lc;
+        split(l, lr, lc);
         for (int k = 0; k < 8; ++k) {
           const int mc = lc + kNeighbours[k].dc, mr = lr + kNeighbours[k].dr;
           if (mc < 0 || mr < 0 || mc >= ww || mr >= wh) continue;
           const std::int32_t m = l + offset[k];
           if (!(done[m] & kSettleCurrent) || (done[m] & kSettleExcluded)) continue;
-          const std::int32_t bm = fan_slot[fan(m)];
-          if (bm < 0) continue;
+          const std::int32_t bm = cell_slot[m];
+          if (bm < 0 || bm == a) continue;
           const std::int32_t ra = find(a), rb = find(bm);
           if (ra != rb) fans[std::size_t(std::max(ra, rb))].parent = std::min(ra, rb);
         }
       }
+      for (const std::int32_t l : patch) cell_slot[l] = -1;
       // Each joined group's cells' widths side by side in `widths`, from its
       // root's start; the group's excess and count on its root.
       for (FanBalance& b : fans) {
@@ -716,7 +774,8 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         const std::int32_t l = patch[j];
         done[l] &= std::uint8_t(~kSettleCurrent);
         if (done[l] & kSettleExcluded) continue;
-        const int lr = l / ww, lc = l - lr * ww;
+        int lr, lc;
+        split(l, lr, lc);
         const std::int64_t i = std::int64_t(wr0 + lr) * cols_ + wc0 + lc;
         const double delta = settle_fans_[std::size_t(settle_cell_fan_[j])].delta;
         const float now = quantized(std::max(double(low[l]), double(high[l]) - delta));

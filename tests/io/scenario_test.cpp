@@ -233,7 +233,7 @@ TEST(ScenarioSoil, TheSoilSectionChoosesTheModel) {
   EXPECT_EQ(parse_scenario(text + "  edge: open\n", "x.yaml").soil.edge, SoilEdge::kOpen);
   const std::string edge = text + "  edge: cliff\n";
   expect_error(edge, line_of(edge, "edge: cliff"), "soil.edge", "allowed: wall, open");
-  EXPECT_EQ(sc.soil.settle, SoilSettle::kPatches);
+  EXPECT_EQ(sc.soil.settle, SoilSettle::kFans);
   EXPECT_EQ(parse_scenario(text + "  settle: passes\n", "x.yaml").soil.settle, SoilSettle::kPasses);
   const std::string settle = text + "  settle: fast\n";
   EXPECT_EQ(parse_scenario(text + "  settle: fans\n", "x.yaml").soil.settle, SoilSettle::kFans);

@@ -213,29 +213,31 @@ constexpr std::span<const EnumName<SoilEdge>> enum_names(SoilEdge) { return kSoi
 enum class SoilSettle {
   /// In one construction over each patch of the cells it left too steep,
   /// then the passes (docs/soil.md, "The displaced pile settled at once"):
-  /// the default, cheap at the work cap; but it moves soil across a patch,
-  /// not only down the fall line, so a pile pushed at a slant to the grid
-  /// is not the one pushed square to it (half the soil ahead at 10 degrees
-  /// on 5 mm cells; docs/soil.md, "Not done yet").
+  /// cheap at the work cap, and the pile's shape smooth across float
+  /// rounding; but it moves soil across a patch, not only down the fall
+  /// line, so its converged pile is not the passes' own: 2 to 63 % less
+  /// soil ahead of the blade in 18 pushes, half at 10 degrees on 5 mm
+  /// cells, and 22 % less square to the grid over a 3 m push
+  /// (docs/soil.md, "The fans by default"). The default until 2026-12-07.
   kPatches,
-  /// By the relaxation's passes alone: the same pile at any yaw (within 2 %
-  /// between 0 and 10 degrees) and the capped pile within 1.4 % of the
-  /// converged one at 0 and 10 degrees, but the cap is reached on most 5 mm
-  /// steps of a push (648 of 1201 against 115), a capped pile stands up to
-  /// 23 mm off its mirror image and a capped peak up to 5.3 mm off the
-  /// converged one.
+  /// By the relaxation's passes alone: the reference the other two are
+  /// measured against (the same pile at any yaw within 2 % between 0 and 10
+  /// degrees, the capped pile within 1.4 % of the converged one at 0 and 10
+  /// degrees), but the cap is reached on most 5 mm steps of a push (648 of
+  /// 1201 against 115), a capped pile stands up to 23 mm off its mirror
+  /// image and a capped peak up to 5.3 mm off the converged one.
   kPasses,
-  /// As kPatches, but each patch's soil stays in its fans, the cells fed
-  /// along the stencil's fall lines from one source (docs/soil.md, "The
-  /// settle follows the fall lines"): the same pile at any yaw (1 m blade,
-  /// 5 mm cells, converged: 0.02350 m^3 ahead turned 10 degrees against
-  /// 0.02349 square, where kPatches holds half) and the capped pile within
-  /// 3 % of the converged one at 0 to 30 degrees, with the cap reached as
-  /// often as kPatches square to the grid. Not the default yet: which cell
-  /// belongs to which fan turns on float rounding near the passes'
-  /// threshold, and a long capped push's pile stands up to about 2 cm off
-  /// its mirror image (kPatches: 1.7 mm); and a capped step at a slant costs
-  /// more (p99 1.07 ms against 0.74 on 5 mm cells; docs/performance.md).
+  /// The default. As kPatches, but each patch's soil stays in its fans, the
+  /// cells fed along the stencil's fall lines from one source (docs/soil.md,
+  /// "The settle follows the fall lines", "The fans by default"): the
+  /// converged pile is the passes' own (within 3 % in 13 of 18 pushes, 14 %
+  /// less at worst, against 2 to 63 % less with kPatches; 0.4 % less over a
+  /// 3 m push), about the same at any yaw,
+  /// and the capped pile within 3 % of the converged one at 0 to 30
+  /// degrees. Which cell joins which fan turns on float rounding: a long
+  /// capped push's pile stands up to about 2 cm off its mirror image
+  /// (kPatches: 1.7 mm), though its halves hold the same soil to rounding;
+  /// and a capped step at a slant costs more (docs/performance.md).
   kFans,
 };
 /// Its names (enum_names.hpp: to_string, parse_enum).
@@ -269,7 +271,7 @@ struct SoilFlowParams {
   /// The grid's edge: a wall, or open (bare ground beyond it at height 0).
   SoilEdge edge = SoilEdge::kWall;
   /// How a displaced pile settles (SoilSettle).
-  SoilSettle settle = SoilSettle::kPatches;
+  SoilSettle settle = SoilSettle::kFans;
 };
 
 /// The ranges of SoilFlowParams' own numbers (core/ranges.hpp): validate()
@@ -558,7 +560,7 @@ class SoilFlow {
     if (settle_phase_ == SettlePhase::kIdle) return;
     const int lc = col_of(std::uint32_t(cell)) - settle_wc0_, lr = row_of(std::uint32_t(cell)) - settle_wr0_;
     if (lc < 0 || lr < 0 || lc >= settle_ww_ || lr >= settle_wh_) return;
-    settle_leave(settle_done_[std::size_t(lr) * std::size_t(settle_ww_) + std::size_t(lc)]);
+    settle_leave(std::size_t(lr) * std::size_t(settle_ww_) + std::size_t(lc));
     settle_drop_ok_ = false;
   }
   // A window cell's state bits of the settle's patches: in a patch found
@@ -569,9 +571,12 @@ class SoilFlow {
   static constexpr std::uint8_t kSettleInPatch = 8, kSettleExcluded = 16, kSettleCurrent = 32;
   static constexpr std::uint8_t kSettleWrote = 64, kSettleFresh = 128;
   /// Marks a window cell excluded, counting it if it leaves the patch under way.
-  void settle_leave(std::uint8_t& bits) {
-    if ((bits & kSettleCurrent) && !(bits & kSettleExcluded)) ++settle_patch_left_;
+  void settle_leave(std::size_t l) {
+    std::uint8_t& bits = settle_done_[l];
+    if (bits & kSettleExcluded) return;
+    if (bits & kSettleCurrent) ++settle_patch_left_;
     bits |= kSettleExcluded;
+    if (settle_lists_excluded_) settle_excluded_.push_back(std::uint32_t(l));
   }
   /// Sizes the settle's scratch for a window of this many cells.
   void reserve_settle(std::size_t window_cells);
@@ -586,6 +591,11 @@ class SoilFlow {
   int settle_round_ = 0;
   Rect settle_written_{};
   std::vector<std::uint32_t> settle_wrote_, settle_fresh_;
+  // The window cells other writers changed in the fans' first round, as
+  // they were excluded (the second round walls them off), and whether they
+  // are being listed.
+  std::vector<std::uint32_t> settle_excluded_;
+  bool settle_lists_excluded_ = false;
   Segment settle_from_{}, settle_to_{};
   Rect settle_next_rect_{};
   Segment settle_next_from_{}, settle_next_to_{};
@@ -642,6 +652,9 @@ class SoilFlow {
   };
   std::vector<FanBalance> settle_fans_;
   std::vector<std::int32_t> settle_fan_slot_, settle_cell_fan_;
+  // A window cell's fan slot while its patch is balanced (-1 otherwise):
+  // the stuck fans' union reads its neighbours' from it.
+  std::vector<std::int32_t> settle_cell_slot_;
   std::vector<std::pair<float, std::int32_t>> settle_seeds_[2];
   std::vector<std::pair<std::int32_t, std::int32_t>> settle_entries_;
   std::vector<std::int32_t> settle_heads_;

@@ -26,7 +26,7 @@ struct SlantPush {
   double cell_m = 0.005;        ///< square cells, [0.002, 0.05]
   /// The soil's work cap, neighbour visits a step (1e9: lifted); the library's default.
   std::int64_t cap = SoilFlowParams{}.max_pair_checks_per_step;
-  SoilSettle settle = SoilSettle::kPatches;  ///< how the displaced pile settles
+  SoilSettle settle = SoilFlowParams{}.settle;  ///< how the displaced pile settles (the default: the fans)
 };
 
 /// What the push left.
