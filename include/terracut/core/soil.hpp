@@ -232,12 +232,12 @@ enum class SoilSettle {
   /// "The settle follows the fall lines", "The fans by default"): the
   /// converged pile is the passes' own (within 3 % in 13 of 18 pushes, 14 %
   /// less at worst, against 2 to 63 % less with kPatches; 0.4 % less over a
-  /// 3 m push), about the same at any yaw,
-  /// and the capped pile within 3 % of the converged one at 0 to 30
-  /// degrees. Which cell joins which fan turns on float rounding: a long
-  /// capped push's pile stands up to about 2 cm off its mirror image
-  /// (kPatches: 1.7 mm), though its halves hold the same soil to rounding;
-  /// and a capped step at a slant costs more (docs/performance.md).
+  /// 3 m push), about the same at any yaw, and the capped pile within 3 % of
+  /// the converged one at 0 to 30 degrees. Which cell joins which fan turns
+  /// on float rounding: a long capped push's pile stands up to about 2 cm
+  /// off its mirror image (kPatches: 1.7 mm); and a step that settles costs
+  /// more (the 2 m blade's p99 on 1 cm cells 1.2 to 1.3 times kPatches';
+  /// docs/performance.md, "The fans by default").
   kFans,
 };
 /// Its names (enum_names.hpp: to_string, parse_enum).
