@@ -675,6 +675,9 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       fans.clear();
       cell_fan.clear();
       double excess = 0.0, sum_widths = 0.0;
+      // (The stuck fans' union below runs only over the fans' first round:
+      // the patches and the seams balance a patch as one fan.)
+      const bool union_fans = fans_on && !second;
       for (const std::int32_t l : patch) {
         if (done[l] & kSettleExcluded) {
           cell_fan.push_back(-1);
@@ -696,7 +699,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         excess += e;
         sum_widths += w;
         cell_fan.push_back(fan_slot[f]);
-        cell_slot[l] = fan_slot[f];
+        if (union_fans) cell_slot[l] = fan_slot[f];
       }
       // A fan with less room than soil to put in it (its fall lines taken
       // by its neighbours', or blocked: soil pushed against a body) shares
@@ -709,7 +712,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         }
         return a;
       };
-      for (std::size_t j = 0; j < patch.size() && fans_on; ++j) {
+      for (std::size_t j = 0; j < patch.size() && union_fans; ++j) {
         const std::int32_t a = cell_fan[j];
         if (a < 0 || !(fans[std::size_t(a)].room < kStuckRoomOfExcess * fans[std::size_t(a)].excess)) continue;
         const std::int32_t l = patch[j];
@@ -726,7 +729,8 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
           if (ra != rb) fans[std::size_t(std::max(ra, rb))].parent = std::min(ra, rb);
         }
       }
-      for (const std::int32_t l : patch) cell_slot[l] = -1;
+      if (union_fans)
+        for (const std::int32_t l : patch) cell_slot[l] = -1;
       // Each joined group's cells' widths side by side in `widths`, from its
       // root's start; the group's excess and count on its root.
       for (FanBalance& b : fans) {
