@@ -274,6 +274,9 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
   // fill puts on each cell of the walk (negative: nothing): found first,
   // written once.
   float shifted[kMaxPushCells], add_at[kMaxPushCells];
+  // The cells the fill reached: the walk's, and past a body met, the cells
+  // along its face (fill_ahead).
+  std::int64_t fill_cell[kMaxPushCells];
   const bool open_edge = params_.edge == SoilEdge::kOpen;
   k = 0;
   for (int row = r.r0; row < r.r1; ++row)
@@ -406,9 +409,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       // run's first cell), or false where the run ends. Cells are taken
       // while they lie below the line; what each takes goes in add[j]
       // (negative: nothing), cells[j] the cell (-1: beyond an open edge).
-      // Returns how many cells it examined.
-      const auto fill_line = [&](double volume, const auto& next, std::int64_t* cells, double* add) -> int {
-        double reach[kMaxPushCells];  // the line's height at the first cell that just reaches this one
+      // Returns how many cells it examined; reach[j] is the height the line
+      // must pass to reach cell j.
+      const auto fill_line = [&](double volume, const auto& next, std::int64_t* cells, double* add,
+                                 double* reach) -> int {
         int count = 0;
         double sum = 0.0, line = 0.0;
         for (int m = 0; m < kMaxPushCells; ++m) {
@@ -452,20 +456,69 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       // would leave it: the cells of the walk from the first cell ahead,
       // up to the first one above it, filled to one line (fill_line).
       // Cells beyond an open edge stand for the bare ground there (height
-      // 0): what fills them leaves the terrain. A wall or a body ends the
-      // run. It reads the run's `length` cells at their shifted heights
-      // (the last of them also where the walk, having left the grid over
-      // an open edge, comes back on it: the same clamped cell) and writes
-      // nothing: what each cell of the walk takes goes in add_at. Returns
-      // how many cells of the walk it reached (0: none, all of it is the
+      // 0): what fills them leaves the terrain. A wall ends the run. Where
+      // the walk meets a body, the run goes on along the body's face, a
+      // cell a step on the axis the push leads along it (a rectangle's
+      // face: the axis the step into the body did not cross), while the
+      // cells there are free and outside the blade. (Ended at the body, a
+      // blade sweeping along a body at a slant filled each crossing's cut
+      // onto the one or two cells between its edge and the body, whose
+      // whole column the next crossing cut and pushed on: 9.1 m high
+      // beside a 4-cell body at the default cap, a 1.25 m blade at 27
+      // degrees on 5 mm cells, where the cap-free run has 0.33 m;
+      // docs/soil.md, "Soil slides along a body's face".) A run that is
+      // still the one cell beside the body rises no higher than `top`, the
+      // cut column's height before the cut: what would stand higher goes
+      // round the body from that cell (round_from, below), left in `over`
+      // (metres of height on one cell), the cell in `beside`. It reads the
+      // run's `length` cells at their shifted heights (the last of them
+      // also where the walk, having left the grid over an open edge, comes
+      // back on it: the same clamped cell) and writes nothing: what each
+      // cell of the run takes goes in add_at, the cell in fill_cell.
+      // Returns how many cells it reached (0: none, all of it is the
       // caller's to put down, when the first cell is a body's or the
-      // grid's end).
-      const auto fill_ahead = [&](float volume, int length) -> int {
+      // grid's end, or when none of it fits under `top`).
+      const auto fill_ahead = [&](float volume, int length, float top, float& over, std::int64_t& beside) -> int {
         std::int64_t cells[kMaxPushCells];
         std::int64_t last = -1;
+        bool at_body = false;
+        // Along a body's face: the cell reached and the step (dc, dr).
+        int slide_c = 0, slide_r = 0, slide_dc = 0, slide_dr = 0;
+        bool sliding = false;
+        const auto free_at = [&](int c, int r) {
+          return c >= 0 && r >= 0 && c < cols_ && r < rows_ && obstacle_[std::int64_t(r) * cols_ + c] == 0 && ahead(c, r);
+        };
         const auto next = [&](int m, std::int64_t& u, double& b) {
+          if (!sliding && m > 0 && last >= 0 && !walk_beyond(m) && obstacle_[walk(m)] != 0) {
+            // The walk meets a body: the fill goes on along its face, the
+            // way the push leads along it (on an axis the body's rectangle
+            // does not block), one cell a step.
+            const int c0 = col_of(std::uint32_t(last)), r0 = row_of(std::uint32_t(last));
+            const int dc = col_of(std::uint32_t(walk(m))) - c0, dr = row_of(std::uint32_t(walk(m))) - r0;
+            const int wc = side * nx > 0.0 ? 1 : side * nx < 0.0 ? -1 : 0;
+            const int wr = side * nz > 0.0 ? 1 : side * nz < 0.0 ? -1 : 0;
+            if (dc != 0 && (dr == 0 || !free_at(c0, r0 + dr)) && free_at(c0 + (dr != 0 ? dc : 0), r0 + (dr != 0 ? 0 : wr)))
+              slide_dc = dr != 0 ? dc : 0, slide_dr = dr != 0 ? 0 : wr;
+            else if (dr != 0 && free_at(c0 + (dc != 0 ? 0 : wc), r0 + (dc != 0 ? dr : 0)))
+              slide_dc = dc != 0 ? 0 : wc, slide_dr = dc != 0 ? dr : 0;
+            sliding = slide_dc != 0 || slide_dr != 0;
+            slide_c = c0, slide_r = r0;
+          }
+          if (sliding) {
+            slide_c += slide_dc, slide_r += slide_dr;
+            if (!free_at(slide_c, slide_r)) {
+              at_body = true;
+              return false;
+            }
+            u = std::int64_t(slide_r) * cols_ + slide_c;
+            if (u == last) return false;
+            b = double(layers.height_m[u]) + limit_step * m;
+            last = u;
+            return true;
+          }
           const bool off = walk_beyond(m);
           u = off ? -1 : walk(m);
+          if (!off && obstacle_[u] != 0) at_body = true;
           if (!off && (u == last || obstacle_[u] != 0)) return false;  // against the grid's edge, or a body
           const float now = off                                        ? 0.0f
                             : m < length                                 ? shifted[m]
@@ -475,9 +528,21 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
           if (!off) last = u;
           return true;
         };
-        double add[kMaxPushCells];
-        const int count = fill_line(double(volume), next, cells, add);
+        double add[kMaxPushCells], reach[kMaxPushCells];
+        int count = fill_line(double(volume), next, cells, add, reach);
+        over = 0.0f;
+        if (at_body && count == 1 && cells[0] >= 0 && reach[0] + add[0] > double(top)) {
+          const float part = float(std::clamp(double(top) - reach[0], 0.0, double(volume)));
+          if (part > 0.0f) {
+            beside = cells[0];
+            over = volume - part;
+            add[0] = double(part);
+          } else {
+            count = 0;  // none fits: the caller's walk takes it all round the body
+          }
+        }
         for (int j = 0; j < count; ++j) {
+          fill_cell[j] = cells[j];
           add_at[j] = -1.0f;
           if (!(add[j] > 0.0)) continue;
           if (cells[j] < 0) {
@@ -514,8 +579,18 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
         for (int j = j0; j <= kMaxPushCells; ++j) {
           const std::int64_t a = at(j * along_step), b = at(-j * along_step);
           if (a < 0 && b < 0) return false;  // off the grid both ways
-          const bool fa = open(a), fb = open(b);
+          bool fa = open(a), fb = open(b);
           if (!fa && !fb) continue;
+          // From a free start (j0 = 0, both ways' first cell), the ways that
+          // go on past it: against a body one way, the line that way is the
+          // start alone, and half the soil stood on it, a column the next
+          // crossing's cut took and pushed on (docs/soil.md, "Soil slides
+          // along a body's face").
+          if (a == b) {
+            fa = open(at((j + 1) * along_step));
+            fb = open(at(-(j + 1) * along_step));
+            if (!fa && !fb) fa = fb = true;
+          }
           const float half = fa && fb ? 0.5f * volume : 0.0f;
           for (const auto& [way_of, share] : {std::pair{fa ? 1.0 : -1.0, volume - half}, std::pair{-1.0, half}}) {
             if (!(share > 0.0f)) continue;
@@ -529,14 +604,28 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
               return true;
             };
             std::int64_t cells[kMaxPushCells];
-            double add[kMaxPushCells];
-            const int count = fill_line(double(share), next, cells, add);
+            double add[kMaxPushCells], reach[kMaxPushCells];
+            const int count = fill_line(double(share), next, cells, add, reach);
             for (int k = 0; k < count; ++k)
               if (add[k] > 0.0) put_down(cells[k], float(add[k]));
           }
           return true;
         }
         return false;
+      };
+      // round_body from a free cell ahead of the blade, along the edge: on
+      // the line through its centre, or, where that lies nearer the edge's
+      // line than the line of the branch above (twice ahead_by, plus a
+      // hundredth of a cell), on that one. (Through the centre of a cell
+      // just ahead of the edge at a slant, the line's next cells lay inside
+      // the blade and the fill stopped at the first, which took it all.)
+      const auto round_from = [&](std::int64_t cell, float volume) {
+        const double fx = spec.origin_m.x + (double(cell % cols_) + 0.5) * dx_;
+        const double fz = spec.origin_m.z + (double(cell / cols_) + 0.5) * dz_;
+        const double d = side * ((fx - to.a.x) * nx + (fz - to.a.z) * nz);
+        const double want = 2.0 * ahead_by + 0.01 * std::min(dx_, dz_);
+        const double lift = d < want ? side * (want - d) : 0.0;
+        return round_body(fx + nx * lift, fz + nz * lift, -nz, nx, 0, volume);
       };
       // The blade pushes what stands in front of it: along the push, the
       // descending profile ahead (cells above the edge's height) moves on by
@@ -574,7 +663,9 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       const float raised = length > 0 ? before_[k] - previous : 0.0f;
       float rest = lost - raised;
       out.displaced_volume_m3 += double(lost) * spec.cell_area_m2();
-      const int filled = rest > 0.0f ? fill_ahead(rest, length) : 0;
+      float over = 0.0f;
+      std::int64_t beside = -1;
+      const int filled = rest > 0.0f ? fill_ahead(rest, length, before_[k], over, beside) : 0;
       if (filled > 0) rest = 0.0f;
       // The run's cells take their shifted heights and what the fill put on
       // them in one write (as put_down would, in the same float steps);
@@ -599,7 +690,8 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       }
       if (last_add >= 0) last_put = walk_cell[last_add];
       for (int j = over_ceiling ? 0 : in_run; j < filled; ++j)
-        if (add_at[j] >= 0.0f) put_down(walk_cell[j], add_at[j]);
+        if (add_at[j] >= 0.0f) put_down(fill_cell[j], add_at[j]);
+      if (over > 0.0f && beside >= 0 && !round_from(beside, over)) put_down(beside, over);
       std::int64_t t = length > 0 ? walk_cell[length - 1] : first;
       float level = length > 0 ? layers.height_m[t] : before_[k];
       // The last cell reached that is not under a rigid body (the cut
@@ -650,8 +742,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
         if (free == i || !ahead(int(free % cols_), int(free / cols_))) {
           const double clear = side * (2.0 * ahead_by + 0.01 * std::min(dx_, dz_)) - s;
           if (round_body(x + nx * clear, z + nz * clear, -nz, nx, 1, rest)) rest = 0.0f;
-        } else if (round_body(spec.origin_m.x + (double(free % cols_) + 0.5) * dx_,
-                              spec.origin_m.z + (double(free / cols_) + 0.5) * dz_, -nz, nx, 0, rest)) {
+        } else if (round_from(free, rest)) {
           rest = 0.0f;
         }
       }

@@ -615,6 +615,64 @@ TEST(SoilObstacles, SoilPushedIntoAStaticBodyGoesRoundItAtRepose) {
   }
 }
 
+TEST(SoilObstacles, ABladeSweepingAlongABodyAtASlantStandsNoColumnBesideIt) {
+  // A 1.25 m blade cutting 5 cm at a slant, at the default work cap, sweeps
+  // along a static body 4 cells wide lying across its path (a strip along
+  // Z), on 1 cm cells. The push's walk from the cut meets the body's side;
+  // the soil slides along its face. After every step no sample beside the
+  // body stands above all of its neighbours not under the body by more than
+  // the repose rise over a cell's diagonal (a single column of sand standing
+  // free does not hold), and the volume is kept. Before, the fill ended at
+  // the body, and each crossing's cut between the edge and the body went
+  // onto the one or two cells there, whose whole column the next crossing
+  // cut and pushed on: 0.32 to 0.37 m above its free neighbours at -45,
+  // -26.6 and 15 degrees, 3.2 cm at 30 (7.9 m at -26.6 on 5 mm cells).
+  SoilFlowParams soil;
+  soil.model = SoilModel::kFlow;
+  soil.material.repose_deg = 34.0;
+  const double cell = 0.01, layer = 0.2, depth = 0.05, travel = 0.7;
+  const int n = 160;
+  const float rise = float(std::tan(34.0 * std::numbers::pi / 180.0) * cell * std::sqrt(2.0)) + 1e-5f;
+  const Rect body{75, 90, 79, 130};
+  const auto in_body = [&](int c, int r) { return c >= body.c0 && c < body.c1 && r >= body.r0 && r < body.r1; };
+  struct Sweep {
+    double yaw_deg, speed_m_per_s;
+  };
+  for (const Sweep sweep : {Sweep{-26.5651, 0.7}, Sweep{30.0, 1.0}, Sweep{-45.0, 0.5}, Sweep{15.0, 1.0}}) {
+    SCOPED_TRACE(sweep.yaw_deg);
+    SimParams params;
+    params.grid = grid_of_cells(n, n, cell);
+    params.blade.length_m = 1.25;
+    params.soil = soil;
+    Simulation sim(params, std::vector<float>(std::size_t(n) * n, float(layer)));
+    const SoilObstacle obstacle{body, float(layer)};
+    sim.soil()->set_obstacles({&obstacle, 1});
+    const double before = sim.grid().volume_m3();
+    const double yaw = sweep.yaw_deg * std::numbers::pi / 180.0;
+    const Quat q = quat_from_axis_angle({0.0, 1.0, 0.0}, yaw);
+    const int steps = int(std::lround(travel / sweep.speed_m_per_s * 1000.0));
+    float column = 0.0f;
+    int column_step = -1;
+    for (int i = 0; i <= steps; ++i) {
+      const double f = double(i) / steps, along = (f - 0.5) * travel;
+      const double y = layer + 0.01 - (0.01 + depth) * std::min(1.0, f / 0.2);
+      sim.step({{0.8 + std::sin(yaw) * along, y, 0.8 + std::cos(yaw) * along}, q});
+      const HeightGrid& g = sim.grid();
+      for (int r = body.r0 - 1; r <= body.r1; ++r)
+        for (int c = body.c0 - 1; c <= body.c1; ++c) {
+          if (in_body(c, r)) continue;
+          float highest = -1e9f;
+          for (int dr = -1; dr <= 1; ++dr)
+            for (int dc = -1; dc <= 1; ++dc)
+              if ((dr != 0 || dc != 0) && !in_body(c + dc, r + dr)) highest = std::max(highest, g.height(c + dc, r + dr));
+          if (g.height(c, r) - highest > column) column = g.height(c, r) - highest, column_step = i;
+        }
+    }
+    EXPECT_LE(column, rise) << "at step " << column_step;
+    EXPECT_NEAR(sim.grid().volume_m3(), before, float_rounding_m3(sim.grid(), 1.0));
+  }
+}
+
 TEST(SoilObstacles, TheDisplacementNeverPilesAboveTheCeiling) {
   // The Bullet world's heightfield has an upper bound; soil above it would
   // be clamped (deleted). A push against a body with the ceiling 6 cm above
