@@ -104,6 +104,7 @@ BodiesReport BodiesListener::report() const {
   r.min_height_m = world_->bounds().min_height_m;
   r.max_height_m = world_->bounds().max_height_m;
   r.samples_clamped = world_->bounds().clamped_total;
+  r.soil_clamped_m3 = world_->bounds().clamped_volume_m3;
   for (int i = 0; i < world_->body_count(); ++i) {
     r.names.push_back(bodies_[std::size_t(i)].name);
     r.final_position_m.push_back(world_->body_state(i).position_m);

@@ -386,17 +386,20 @@ void TerrainWorld::terrain_changed(const Rect& changed) {
   const float* h = grid_.heights();
   const float max_h = float(bounds_.max_height_m);
   std::int64_t clamped = 0;
+  double above_m = 0.0;
   for (int row = r.r0; row < r.r1; ++row) {
     for (int col = r.c0; col < r.c1; ++col) {
       const std::int64_t i = grid_.index(col, row);
       if (h[i] > max_h) {
         bounds_.highest_clamped_m = std::max(bounds_.highest_clamped_m, double(h[i]));
+        above_m += double(h[i]) - double(max_h);
         lower_sample(i, max_h);
         ++clamped;
       }
     }
   }
   bounds_.clamped_total += clamped;
+  bounds_.clamped_volume_m3 += above_m * grid_.spec().cell_area_m2();
   pending_clamped_ += clamped;
 
   Impl& m = *impl_;

@@ -607,7 +607,9 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
     ++settle_q_;
   };
   double gained = 0.0;
-  std::int64_t last = -1;
+  // The last cell written, and the last with a millimetre of room under the
+  // ceiling (the rounding is given back there when the last has none).
+  std::int64_t last = -1, last_with_room = -1;
   for (;;) {
     if (settle_patch_stage_ == PatchStage::kNone) {
       while (settle_q_ < touched.size() && !open(touched[settle_q_])) ++settle_q_;
@@ -797,6 +799,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         dirty(std::uint32_t(i));
         h[i] = now;
         last = i;
+        if (now <= ceiling_m_ - kGiveBackRoom_m) last_with_room = i;
         candidate(std::uint32_t(i), now < old);
         changed.include(wc0 + lc, wr0 + lr);
       }
@@ -804,8 +807,14 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
       ++settle_q_;
     }
   }
-  // The quantizing's rounding given back on the last cell written.
-  if (last >= 0 && gained != 0.0) give_back(h[last], -gained);
+  // The quantizing's rounding given back on the last cell written; on one
+  // with room where that would rise past the ceiling, which would clamp it
+  // away (soil pushed into a pocket stands at the ceiling: 9e-9 m^3 lost in
+  // 41 settles of a 1.25 m blade driven through a wall, docs/bullet.md).
+  if (last >= 0 && gained != 0.0) {
+    const bool over = double(h[last]) - gained > double(ceiling_m_) && last_with_room >= 0;
+    give_back(h[over ? last_with_room : last], -gained);
+  }
   settle_candidates(h);
   if (settle_q_ == touched.size()) return settle_finish(grid, changed, budget, work);
   return work;

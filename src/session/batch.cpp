@@ -507,8 +507,11 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
   result.final_volume_m3 = grid.volume_m3();
   result.max_sample_error_m = grid.conservation_error_m();
   // With flow nothing vanishes: what was cut is still on the grid, or left
-  // it over an open edge.
-  const double vanished_m3 = flow ? soil.left_over_edge_m3 + soil.final_bucket_load_m3 : result.removed_volume_m3;
+  // it over an open edge, or the bodies' heightfield deleted it above its
+  // upper bound (warned below).
+  const detail::BoundsClamp clamp = detail::bounds_clamp(world);
+  const double vanished_m3 =
+      (flow ? soil.left_over_edge_m3 + soil.final_bucket_load_m3 : result.removed_volume_m3) + clamp.volume_m3;
   result.volume_error_m3 = result.initial_volume_m3 - result.final_volume_m3 - vanished_m3;
   result.contact_timing = timing_stats(contact_s);
   result.cut_timing = timing_stats(cut_s);
@@ -524,6 +527,16 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
     result.soil = soil;
   }
   result.warnings = cut_warnings(sc);
+  if (clamp.samples > 0) {
+    char line[600];
+    std::snprintf(line, sizeof line,
+                  "bodies: %lld times a sample rose above the rigid bodies' heightfield's upper bound (%.4g m "
+                  "above the ground, fixed when the world is built: the larger of 2 x terrain.full_scale_m and "
+                  "the highest initial height + terrain.full_scale_m) and was lowered to it, deleting %.3g m^3 "
+                  "of soil (left out of the conservation check); raise terrain.full_scale_m for more room",
+                  (long long)clamp.samples, clamp.max_height_m, clamp.volume_m3);
+    result.warnings.push_back(line);
+  }
   if (flow) {
     const std::vector<std::string> soil_lines = soil_warnings(sc.soil, grid.spec(), soil.final_backlog_cells, soil.capped_steps);
     result.warnings.insert(result.warnings.end(), soil_lines.begin(), soil_lines.end());

@@ -23,6 +23,7 @@ nlohmann::json bodies_json([[maybe_unused]] const World& world,
   j["peak_tool_force_n"] = r.peak_tool_force_n;
   j["height_bounds_m"] = {r.min_height_m, r.max_height_m};
   j["samples_clamped_to_bounds"] = r.samples_clamped;
+  j["soil_clamped_m3"] = r.soil_clamped_m3;
   nlohmann::json final_states = nlohmann::json::array();
   for (std::size_t i = 0; i < r.names.size(); ++i) {
     const Vec3& p = r.final_position_m[i];
@@ -39,6 +40,19 @@ nlohmann::json bodies_json([[maybe_unused]] const World& world,
 #else
   return nullptr;
 #endif
+}
+
+BoundsClamp bounds_clamp([[maybe_unused]] const World& world) {
+  BoundsClamp c;
+#ifdef TERRACUT_HAVE_BULLET
+  if (const bullet::BodiesListener* listener = world.bodies_listener()) {
+    const bullet::BodiesReport r = listener->report();
+    c.samples = r.samples_clamped;
+    c.volume_m3 = r.soil_clamped_m3;
+    c.max_height_m = r.max_height_m;
+  }
+#endif
+  return c;
 }
 
 }  // namespace terracut::session::detail

@@ -16,4 +16,14 @@ enum class BodiesEntry { kRun, kLoop };
 /// when the world has none.
 nlohmann::json bodies_json(const World& world, BodiesEntry entry);
 
+/// What the bodies' heightfield clamped away over the run: samples lowered
+/// to its upper bound (bullet::BoundsReport), the soil that deleted, m^3,
+/// and the bound, metres above the ground. Zeros without bodies.
+struct BoundsClamp {
+  std::int64_t samples = 0;
+  double volume_m3 = 0.0;
+  double max_height_m = 0.0;
+};
+BoundsClamp bounds_clamp(const World& world);
+
 }  // namespace terracut::session::detail

@@ -336,6 +336,8 @@ TEST(TerrainWorldBounds, HeightsAboveTheBoundAreClampedAndReported) {
   world.terrain_changed(raised);
   EXPECT_EQ(world.bounds().clamped_total, raised.area());
   EXPECT_FLOAT_EQ(float(world.bounds().highest_clamped_m), 0.7f);
+  // The soil that deleted: each sample's height above the bound over its cell.
+  EXPECT_NEAR(world.bounds().clamped_volume_m3, raised.area() * (double(0.7f) - max_h) * g.cell_area_m2(), 1e-12);
   for (int r = raised.r0; r < raised.r1; ++r)
     for (int c = raised.c0; c < raised.c1; ++c) ASSERT_EQ(grid.height(c, r), float(max_h));
 

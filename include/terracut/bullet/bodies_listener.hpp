@@ -51,6 +51,7 @@ struct BodiesReport {
   double min_height_m = 0.0;            ///< the heightfield's bounds, metres above ground
   double max_height_m = 0.0;
   std::int64_t samples_clamped = 0;     ///< samples clamped to the bounds over the run
+  double soil_clamped_m3 = 0.0;         ///< the soil those clamps deleted, m^3
   std::vector<std::string> names;       ///< per body, in scenario order
   std::vector<Vec3> final_position_m;   ///< per body, world metres, at the end
 };

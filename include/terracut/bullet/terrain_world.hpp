@@ -202,6 +202,9 @@ struct BoundsReport {
   /// between the previous advance() and the last one).
   std::int64_t clamped_last_step = 0;
   double highest_clamped_m = 0.0;        ///< largest height ever found above the bound, metres (0 if none)
+  /// The soil those lowerings deleted since construction: the sum of each
+  /// sample's height above the bound times its cell's area, m^3.
+  double clamped_volume_m3 = 0.0;
 };
 
 /// A body's state after the last step, world frame, SI.
