@@ -198,13 +198,16 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
   // what the displacement put down, measured as it writes, so that the
   // rounding of the writes is given back at the end.
   double taken = 0.0, put = 0.0;
-  std::int64_t last_put = -1;
+  // The last cell written, and the last with a millimetre of room under the
+  // ceiling (the rounding is given back there when the last has none).
+  std::int64_t last_put = -1, last_with_room = -1;
   const auto write = [&](std::int64_t cell, float value) {
     dirty(std::uint32_t(cell));
     settle_exclude(cell);
     put += double(value) - double(layers.height_m[cell]);
     layers.height_m[cell] = value;
     last_put = cell;
+    if (value <= ceiling_m_ - kGiveBackRoom_m) last_with_room = cell;
   };
   // Whether the centre of cell (c, r) lies behind the edge (on the side
   // that part of it came from, past the half cell its line passes through),
@@ -748,9 +751,12 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       }
       if (rest != 0.0f) put_down(t, rest);
     }
-  // Give back the rounding of the writes on the last cell written.
+  // Give back the rounding of the writes on the last cell written; on one
+  // with room where that would rise past the ceiling, whose clamp would
+  // delete it (up to 8e-9 m^3 over a push into a pocket under a ceiling).
   if (last_put >= 0 && put != taken) {
-    give_back(layers.height_m[last_put], taken - put);
+    const bool over = double(layers.height_m[last_put]) + (taken - put) > double(ceiling_m_) && last_with_room >= 0;
+    give_back(layers.height_m[over ? last_with_room : last_put], taken - put);
   }
   // Only the changed cells that now stand too steep (or lowered under a
   // neighbour too steep above them) are examined: a pushed pile moves as

@@ -105,8 +105,8 @@ static_assert(kPatchSearchVisits + kPatchSolveVisits + kPatchWriteVisits == kSet
 /// its balance and its write (the next crossing's displacement shifts the
 /// pile under it); after them it is left to the passes unwritten.
 inline constexpr int kPatchBalances = 3;
-/// The room under the ceiling of a cell the settle gives its rounding back
-/// to (far more than the rounding), metres.
+/// The room under the ceiling of a cell the settle or the displacement gives
+/// its rounding back to (far more than the rounding), metres.
 inline constexpr float kGiveBackRoom_m = 1e-3f;
 /// Its buckets of keys, each an axis pair's limit wide: heights up to this
 /// many limits apart (13.8 m on 5 mm cells at 34 degrees); what lies beyond
