@@ -810,7 +810,8 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // The quantizing's rounding given back on the last cell written; on one
   // with room where that would rise past the ceiling, which would clamp it
   // away (soil pushed into a pocket stands at the ceiling: 9e-9 m^3 lost in
-  // 41 settles of a 1.25 m blade driven through a wall, docs/bullet.md).
+  // 41 settles of a 1.25 m blade driven through a wall; docs/soil.md, "Soil
+  // slides along a body's face").
   if (last >= 0 && gained != 0.0) {
     const bool over = double(h[last]) - gained > double(ceiling_m_) && last_with_room >= 0;
     give_back(h[over ? last_with_room : last], -gained);
