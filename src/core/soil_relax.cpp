@@ -507,6 +507,14 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
           raised = room;
           kept += double(give) - (double(raised) - double(old));
         }
+        // Nor above the ceiling (the rigid bodies' heightfield's bound, which
+        // deletes what stands above it): the source keeps the rest.
+        if (raised > ceiling_m_ && raised > old) {
+          float room = std::max(old, quantized(double(ceiling_m_)));
+          if (room > ceiling_m_ && room > old) room = std::max(old, quantized(double(room) - quantum_m_));
+          kept += double(raised) - double(room);
+          raised = room;
+        }
         h[f.to] = raised;
         gained += double(raised) - double(old);
         activate(f.to);

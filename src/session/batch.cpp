@@ -200,6 +200,20 @@ std::vector<std::string> cut_warnings(const io::Scenario& sc) {
   return w;
 }
 
+std::vector<std::string> bounds_warnings(std::int64_t samples, double deleted_m3, double max_height_m) {
+  std::vector<std::string> w;
+  if (samples <= 0) return w;
+  char line[600];
+  std::snprintf(line, sizeof line,
+                "bodies: %lld times a sample rose above the rigid bodies' heightfield's upper bound (%.4g m "
+                "above the ground, fixed when the world is built: the larger of 2 x terrain.full_scale_m and "
+                "the highest initial height + terrain.full_scale_m) and was lowered to it, deleting %.3g m^3 "
+                "of soil (left out of the conservation check); raise terrain.full_scale_m for more room",
+                (long long)samples, max_height_m, deleted_m3);
+  w.push_back(line);
+  return w;
+}
+
 std::vector<std::string> soil_warnings(const SoilFlowParams& soil, const GridSpec& grid,
                                        std::int64_t final_backlog_cells, std::int64_t capped_steps) {
   std::vector<std::string> w;
@@ -527,16 +541,8 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
     result.soil = soil;
   }
   result.warnings = cut_warnings(sc);
-  if (clamp.samples > 0) {
-    char line[600];
-    std::snprintf(line, sizeof line,
-                  "bodies: %lld times a sample rose above the rigid bodies' heightfield's upper bound (%.4g m "
-                  "above the ground, fixed when the world is built: the larger of 2 x terrain.full_scale_m and "
-                  "the highest initial height + terrain.full_scale_m) and was lowered to it, deleting %.3g m^3 "
-                  "of soil (left out of the conservation check); raise terrain.full_scale_m for more room",
-                  (long long)clamp.samples, clamp.max_height_m, clamp.volume_m3);
-    result.warnings.push_back(line);
-  }
+  for (std::string& line : bounds_warnings(clamp.samples, clamp.volume_m3, clamp.max_height_m))
+    result.warnings.push_back(std::move(line));
   if (flow) {
     const std::vector<std::string> soil_lines = soil_warnings(sc.soil, grid.spec(), soil.final_backlog_cells, soil.capped_steps);
     result.warnings.insert(result.warnings.end(), soil_lines.begin(), soil_lines.end());

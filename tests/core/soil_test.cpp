@@ -752,7 +752,11 @@ TEST(SoilObstacles, TheSpillRoundTheEndsKeepsItsVolumeAtTheCeiling) {
   const double yaw = (180.0 + std::atan(1.0 / 3.0) * 180.0 / std::numbers::pi) * std::numbers::pi / 180.0;
   float highest = 0.0f;
   const int steps = push_at_a_slant(sim, {1000.8, 0.0, 1000.8}, yaw, layer, depth, travel, speed, highest);
-  EXPECT_GE(highest, ceiling);  // the pile reached it
+  // The pile reached the ceiling and, but for a float rounding or two of
+  // it, no further: the passes' sources keep what would rise past it
+  // (before, the passes raised cells to 0.48 m).
+  EXPECT_GE(highest, ceiling);
+  EXPECT_LE(highest, ceiling * (1.0f + 4.0f * std::numeric_limits<float>::epsilon()));
   const double per_step = double(std::numeric_limits<float>::epsilon()) * ceiling * cell * cell;
   EXPECT_NEAR(sim.grid().volume_m3(), before, (steps + 1) * per_step);
 }

@@ -392,7 +392,10 @@ class SoilFlow {
   /// The highest the displacement may pile soil, metres above the ground
   /// (default: unbounded). The Bullet world sets its heightfield's upper
   /// bound here, so that no pile rises past it and is clamped (deleted).
-  /// Relaxation only moves soil down, so it never rises past it either.
+  /// The displacement, the spill round the ends and the relaxation's passes
+  /// raise no cell past it (a pass's source keeps what would), but for
+  /// float rounding (2 ulps above a 0.3 m ceiling in a push into a pocket:
+  /// docs/soil.md, "Soil slides along a body's face").
   void set_ceiling(float height_m) noexcept { ceiling_m_ = height_m > 0.0f ? height_m : ceiling_m_; }
   float ceiling_m() const { return ceiling_m_; }
   /// The obstacles as last set (their cells clipped to the grid).

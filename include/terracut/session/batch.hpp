@@ -149,7 +149,8 @@ struct RunResult {
   /// "warnings"): soil left steeper than its repose angle when the work
   /// cap stopped the relaxation short, cells too far from square for the
   /// repose angle to hold in every direction (soil_warnings); a cut whose
-  /// blade never crosses the terrain (cut_warnings).
+  /// blade never crosses the terrain (cut_warnings); soil the bodies'
+  /// heightfield deleted above its bound (bounds_warnings).
   std::vector<std::string> warnings;
   double wall_s = 0.0;               ///< wall-clock time of the simulation loop, seconds
 };
@@ -174,6 +175,13 @@ std::vector<std::string> cut_warnings(const io::Scenario& scenario);
 /// One readable line each.
 std::vector<std::string> soil_warnings(const SoilFlowParams& soil, const GridSpec& grid,
                                        std::int64_t final_backlog_cells, std::int64_t capped_steps = 0);
+
+/// What a user should know about the rigid bodies' heightfield: samples it
+/// lowered to its upper bound (max_height_m, metres above the ground) over
+/// the run, `samples` times in all, deleting `deleted_m3` of soil. One
+/// readable line naming the count, the volume, the bound and how to raise
+/// it; none when nothing was lowered.
+std::vector<std::string> bounds_warnings(std::int64_t samples, double deleted_m3, double max_height_m);
 
 /// Runs the scenario's sequence and writes the outputs into options.out_dir.
 /// Throws terracut::InputError naming the file or folder when an output cannot
