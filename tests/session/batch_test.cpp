@@ -302,8 +302,8 @@ TEST_F(RunTest, SoilPushedIntoAPocketStaysUnderTheBodiesHeightfieldsBound) {
   // 0.4 m): nothing is lowered to the bound, no soil deleted, no warning,
   // and the volume is kept to one float rounding of the bound a step.
   // Before, the relaxation's passes raised cells past the bound and the
-  // heightfield deleted 6.4e-6 m^3 in 13 samples, which the run reported,
-  // without a word, as its volume error.
+  // heightfield deleted 9.6e-6 m^3 in 9 samples (before that change, the
+  // run reported such soil, without a word, as its volume error).
   const std::string text = R"(name: pocket
 terrain:
   generator: plane
