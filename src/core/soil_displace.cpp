@@ -355,6 +355,10 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       // its width across it: outside the blade, a cell the relaxation may
       // move soil from (blade_blocks).
       const double ahead_by = 0.5 * (std::abs(nx) * dx_ + std::abs(nz) * dz_);
+      // How far ahead of the edge's line a line round a body runs, so that
+      // every cell it crosses lies outside the blade: twice ahead_by, plus a
+      // hundredth of a cell (round_body's callers).
+      const double clear_by = 2.0 * ahead_by + 0.01 * std::min(dx_, dz_);
       const auto ahead = [&](int c, int r) {
         const double px = spec.origin_m.x + (c + 0.5) * dx_ - to.a.x, pz = spec.origin_m.z + (r + 0.5) * dz_ - to.a.z;
         return side * (px * nx + pz * nz) > ahead_by;
@@ -496,8 +500,9 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
             // The walk meets a body: the fill goes on along its face, the
             // way the push leads along it (on an axis the body's rectangle
             // does not block), one cell a step.
+            const std::uint32_t into = std::uint32_t(walk(m));
             const int c0 = col_of(std::uint32_t(last)), r0 = row_of(std::uint32_t(last));
-            const int dc = col_of(std::uint32_t(walk(m))) - c0, dr = row_of(std::uint32_t(walk(m))) - r0;
+            const int dc = col_of(into) - c0, dr = row_of(into) - r0;
             const int wc = side * nx > 0.0 ? 1 : side * nx < 0.0 ? -1 : 0;
             const int wr = side * nz > 0.0 ? 1 : side * nz < 0.0 ? -1 : 0;
             if (dc != 0 && (dr == 0 || !free_at(c0, r0 + dr)) && free_at(c0 + (dr != 0 ? dc : 0), r0 + (dr != 0 ? 0 : wr)))
@@ -618,16 +623,15 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       };
       // round_body from a free cell ahead of the blade, along the edge: on
       // the line through its centre, or, where that lies nearer the edge's
-      // line than the line of the branch above (twice ahead_by, plus a
-      // hundredth of a cell), on that one. (Through the centre of a cell
-      // just ahead of the edge at a slant, the line's next cells lay inside
-      // the blade and the fill stopped at the first, which took it all.)
+      // line than the line of the branch above (clear_by), on that one.
+      // (Through the centre of a cell just ahead of the edge at a slant, the
+      // line's next cells lay inside the blade and the fill stopped at the
+      // first, which took it all.)
       const auto round_from = [&](std::int64_t cell, float volume) {
         const double fx = spec.origin_m.x + (double(cell % cols_) + 0.5) * dx_;
         const double fz = spec.origin_m.z + (double(cell / cols_) + 0.5) * dz_;
         const double d = side * ((fx - to.a.x) * nx + (fz - to.a.z) * nz);
-        const double want = 2.0 * ahead_by + 0.01 * std::min(dx_, dz_);
-        const double lift = d < want ? side * (want - d) : 0.0;
+        const double lift = d < clear_by ? side * (clear_by - d) : 0.0;
         return round_body(fx + nx * lift, fz + nz * lift, -nz, nx, 0, volume);
       };
       // The blade pushes what stands in front of it: along the push, the
@@ -743,7 +747,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       if (obstacle_[t] != 0 && rest > 0.0f) {
         t = free;
         if (free == i || !ahead(int(free % cols_), int(free / cols_))) {
-          const double clear = side * (2.0 * ahead_by + 0.01 * std::min(dx_, dz_)) - s;
+          const double clear = side * clear_by - s;
           if (round_body(x + nx * clear, z + nz * clear, -nz, nx, 1, rest)) rest = 0.0f;
         } else if (round_from(free, rest)) {
           rest = 0.0f;
@@ -754,10 +758,9 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
   // Give back the rounding of the writes on the last cell written; on one
   // with room where that would rise past the ceiling, whose clamp would
   // delete it (up to 8e-9 m^3 over a push into a pocket under a ceiling).
-  if (last_put >= 0 && put != taken) {
-    const bool over = double(layers.height_m[last_put]) + (taken - put) > double(ceiling_m_) && last_with_room >= 0;
-    give_back(layers.height_m[over ? last_with_room : last_put], taken - put);
-  }
+  if (last_put >= 0 && put != taken)
+    give_back(layers.height_m[give_back_cell(layers.height_m, last_put, last_with_room, taken - put, ceiling_m_)],
+              taken - put);
   // Only the changed cells that now stand too steep (or lowered under a
   // neighbour too steep above them) are examined: a pushed pile moves as
   // a whole, and most of its cells keep their slopes.

@@ -251,6 +251,7 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& from, const Seg
     // 0.2 m layer; docs/soil.md, "Soil slides along a body's face".)
     double held = 0.0;
     for (const std::int32_t w : queue) {
+      if (!std::isfinite(ceiling_m_)) break;  // (no ceiling: every run without bodies)
       if (ends_state_[std::size_t(w)] == kDonor) continue;
       const std::int64_t i = std::int64_t(wr0 + w / side) * cols_ + wc0 + w % side;
       const double want = quantized(s - slope * double(ends_dist_[std::size_t(w)]));

@@ -108,6 +108,13 @@ inline constexpr int kPatchBalances = 3;
 /// The room under the ceiling of a cell the settle or the displacement gives
 /// its rounding back to (far more than the rounding), metres.
 inline constexpr float kGiveBackRoom_m = 1e-3f;
+/// The cell a writer gives its rounding `delta_m` back to: the last it
+/// wrote, or, where that would rise past the ceiling (whose clamp would
+/// delete it), the last it wrote with kGiveBackRoom_m of room, if any.
+inline std::int64_t give_back_cell(const float* h, std::int64_t last, std::int64_t last_with_room, double delta_m,
+                                   float ceiling_m) {
+  return double(h[last]) + delta_m > double(ceiling_m) && last_with_room >= 0 ? last_with_room : last;
+}
 /// Its buckets of keys, each an axis pair's limit wide: heights up to this
 /// many limits apart (13.8 m on 5 mm cells at 34 degrees); what lies beyond
 /// is left to the passes.

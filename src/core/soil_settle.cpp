@@ -812,10 +812,7 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
   // away (soil pushed into a pocket stands at the ceiling: 9e-9 m^3 lost in
   // 41 settles of a 1.25 m blade driven through a wall; docs/soil.md, "Soil
   // slides along a body's face").
-  if (last >= 0 && gained != 0.0) {
-    const bool over = double(h[last]) - gained > double(ceiling_m_) && last_with_room >= 0;
-    give_back(h[over ? last_with_room : last], -gained);
-  }
+  if (last >= 0 && gained != 0.0) give_back(h[give_back_cell(h, last, last_with_room, -gained, ceiling_m_)], -gained);
   settle_candidates(h);
   if (settle_q_ == touched.size()) return settle_finish(grid, changed, budget, work);
   return work;
