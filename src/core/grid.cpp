@@ -36,17 +36,6 @@ std::string validate(const GridSpec& spec) {
   return {};
 }
 
-void Rect::include(int c, int r) {
-  if (empty()) {
-    *this = {c, r, c + 1, r + 1};
-    return;
-  }
-  c0 = std::min(c0, c);
-  r0 = std::min(r0, r);
-  c1 = std::max(c1, c + 1);
-  r1 = std::max(r1, r + 1);
-}
-
 void Rect::include(const Rect& other) {
   if (other.empty()) return;
   if (empty()) {

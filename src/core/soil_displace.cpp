@@ -389,24 +389,29 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
       // the edge's line, outside the blade (against_wall); beyond an open
       // edge, the soil leaves the terrain.
       int walked = 0;
+      // (A walk along a grid axis keeps the other coordinate: x + 0 * along
+      // is x, divided once, not at every step.)
+      const double u_fixed = to_cells(x, spec.origin_m.x, dx_), v_fixed = to_cells(z, spec.origin_m.z, dz_);
       const auto walk_to = [&](int m) {
         for (; walked <= m; ++walked) {
           const double along = go + side * walked * step;
-          const double u = to_cells(x + nx * along, spec.origin_m.x, dx_);
-          const double v = to_cells(z + nz * along, spec.origin_m.z, dz_);
+          const double u = nx == 0.0 ? u_fixed : to_cells(x + nx * along, spec.origin_m.x, dx_);
+          const double v = nz == 0.0 ? v_fixed : to_cells(z + nz * along, spec.origin_m.z, dz_);
           const bool outside = u < 0.0 || v < 0.0 || u >= cols_ || v >= rows_;
           walk_off[walked] = open_edge && outside;
-          int cu = floor_within(u, 0, cols_ - 1), cv = floor_within(v, 0, rows_ - 1);
+          // (On the grid floor is the truncation; a NaN goes to floor_within.)
+          int cu = u >= 0.0 && u < cols_ ? int(u) : floor_within(u, 0, cols_ - 1);
+          int cv = v >= 0.0 && v < rows_ ? int(v) : floor_within(v, 0, rows_ - 1);
           if (outside && !open_edge) against_wall(cu, cv, u < 0.0 || u >= cols_, v < 0.0 || v >= rows_);
           walk_cell[walked] = std::int64_t(cv) * cols_ + cu;
         }
       };
       const auto walk = [&](int m) {
-        walk_to(m);
+        if (m >= walked) walk_to(m);
         return walk_cell[m];
       };
       const auto walk_beyond = [&](int m) {
-        walk_to(m);
+        if (m >= walked) walk_to(m);
         return walk_off[m];
       };
       // A run of cells filled to one line falling at the repose slope, the

@@ -720,15 +720,25 @@ std::int64_t SoilFlow::settle_continue(HeightGrid& grid, Rect& changed, std::int
         const std::int32_t l = patch[j];
         int lr, lc;
         split(l, lr, lc);
+        // (A group's root is its least slot, so after a union ra is the
+        // lesser of the two; a neighbour in the fan just joined is skipped.
+        // The cell's root found once, not at every neighbour: the same
+        // unions, a tenth less of a row crossing's balance.)
+        std::int32_t ra = -1, joined = -1;
         for (int k = 0; k < 8; ++k) {
           const int mc = lc + kNeighbours[k].dc, mr = lr + kNeighbours[k].dr;
           if (mc < 0 || mr < 0 || mc >= ww || mr >= wh) continue;
           const std::int32_t m = l + offset[k];
           if (!(done[m] & kSettleCurrent) || (done[m] & kSettleExcluded)) continue;
           const std::int32_t bm = cell_slot[m];
-          if (bm < 0 || bm == a) continue;
-          const std::int32_t ra = find(a), rb = find(bm);
-          if (ra != rb) fans[std::size_t(std::max(ra, rb))].parent = std::min(ra, rb);
+          if (bm < 0 || bm == a || bm == joined) continue;
+          joined = bm;
+          if (ra < 0) ra = find(a);
+          const std::int32_t rb = find(bm);
+          if (ra != rb) {
+            fans[std::size_t(std::max(ra, rb))].parent = std::min(ra, rb);
+            ra = std::min(ra, rb);
+          }
         }
       }
       if (union_fans)

@@ -76,8 +76,18 @@ struct Rect {
 
   bool empty() const { return c0 >= c1 || r0 >= r1; }
   std::int64_t area() const { return empty() ? 0 : std::int64_t(c1 - c0) * (r1 - r0); }
-  /// Grows the rectangle to include sample (c, r).
-  void include(int c, int r);
+  /// Grows the rectangle to include sample (c, r). (Inline: the soil's
+  /// displacement calls it for every cell it writes.)
+  void include(int c, int r) {
+    if (empty()) {
+      *this = {c, r, c + 1, r + 1};
+      return;
+    }
+    c0 = c < c0 ? c : c0;
+    r0 = r < r0 ? r : r0;
+    c1 = c + 1 > c1 ? c + 1 : c1;
+    r1 = r + 1 > r1 ? r + 1 : r1;
+  }
   /// Grows the rectangle to include other.
   void include(const Rect& other);
   bool operator==(const Rect&) const = default;
