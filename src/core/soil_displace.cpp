@@ -198,6 +198,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
   // what the displacement put down, measured as it writes, so that the
   // rounding of the writes is given back at the end.
   double taken = 0.0, put = 0.0;
+  displace_work_ = 0;
   // The last cell written, and the last with a millimetre of room under the
   // ceiling (the rounding is given back there when the last has none).
   std::int64_t last_put = -1, last_with_room = -1;
@@ -759,6 +760,7 @@ void SoilFlow::displace(HeightGrid& grid, const Segment& from, const Segment& mo
         }
       }
       if (rest != 0.0f) put_down(t, rest);
+      displace_work_ += kDisplaceCellVisits * walked;
     }
   // Give back the rounding of the writes on the last cell written; on one
   // with room where that would rise past the ceiling, whose clamp would

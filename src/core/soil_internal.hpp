@@ -83,6 +83,19 @@ inline constexpr int kSettleMarginCells = 32;
 /// the passes, and the settle of a 1 m/s push on 5 mm cells outgrew the cap
 /// (docs/soil.md, "The settle charged for its time").
 inline constexpr std::int64_t kSettleCellVisits = 4;
+/// What the displacement's walk costs a cell it passes (the cell found,
+/// its height shifted or filled and written, queued for the settle), in
+/// visits: 55 to 61 cycles against the settle's 21 to 24 a visit, 2.6 of
+/// them, rounded up (the TSC over whole pushes of a 2 m blade on 1 cm cells
+/// and a 1 m blade on 5 mm cells, 2026-12-07; SoilFlow::after_cut).
+inline constexpr std::int64_t kDisplaceCellVisits = 3;
+/// The steps in a row whose relaxation finished within the cap after
+/// which a step's displacement is charged to its relaxation (after_cut):
+/// pushes on 1 cm cells at up to 1 m/s cross a row every 10 steps or more
+/// and settle it in one or two; on 5 mm cells at 0.5 m/s and over they
+/// cross every 10 or fewer and are at the cap for about 3 steps after
+/// each, and the work put off would wait on the next crossing's.
+inline constexpr int kRestStepsBeforeCharge = 8;
 /// Two values of the settle's surfaces closer than this are a tie (the
 /// float sums along two mirror-image paths differ in their last bits),
 /// metres: the nearer source takes the cell (soil_settle.cpp).

@@ -373,9 +373,10 @@ void SoilFlow::run_passes(HeightGrid& grid, SoilStepResult& out) {
   // same bits as the whole one). No pass with fluxes then spans steps. A
   // cap under kLeastSplitCap would spend too much of itself on that room
   // and carries the pass over as without a tool.
-  const std::int64_t cap = params_.max_pair_checks_per_step;
+  // (The cap less what the step's displacement took: after_cut.)
+  const std::int64_t cap = step_cap_;
   const bool hull = !hull_cells_.empty();
-  const bool split_at_cap = (blade_.present || hull) && cap >= kLeastSplitCap;
+  const bool split_at_cap = (blade_.present || hull) && params_.max_pair_checks_per_step >= kLeastSplitCap;
   // What the spill round the blade's ends and the settle spent this step counts too.
   std::int64_t work = ends_work_;
   ends_work_ = 0;
@@ -551,18 +552,22 @@ SoilStepResult SoilFlow::relax(HeightGrid& grid) {
   SoilStepResult out;
   wake_held(nullptr);  // no blade now
   clear_hull();        // nor a bucket
+  step_cap_ = params_.max_pair_checks_per_step;  // (no displacement)
+  out.relax_budget = step_cap_;
   if (settle_phase_ != SettlePhase::kIdle) {
     // A settle under way goes on first; the passes wait for it.
-    out.settle_visits = settle_charged(grid, out.changed, params_.max_pair_checks_per_step);
+    out.settle_visits = settle_charged(grid, out.changed, step_cap_);
     if (settle_phase_ != SettlePhase::kIdle) {
       out.pair_checks = ends_work_;
       ends_work_ = 0;
       out.reached_cap = true;
       out.backlog_cells = active_cells();
+      rest_steps_ = 0;
       return out;
     }
   }
   run_passes(grid, out);
+  rest_steps_ = out.reached_cap ? 0 : std::min(rest_steps_ + 1, kRestStepsBeforeCharge);
   return out;
 }
 

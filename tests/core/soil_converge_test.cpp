@@ -120,6 +120,37 @@ TEST(SoilConvergence, APushAtTheDefaultCapLeavesTheConvergedPileOnCentimetreCell
     for (const double speed : {0.25, 1.0}) expect_converged(width, 0.01, speed);
 }
 
+// A row crossing displaces the whole pushed face at once, work the cap does
+// not bound. After a run of steps whose relaxation finished within the cap,
+// the crossing's settle and passes get the cap less what that walk cost (up
+// to half the cap), and the settle goes on in the next step. The 2 m blade
+// on 1 cm cells at 1 m/s: every step keeps to its budget (relax_budget:
+// the cap, or the cap less the walk's share), some crossings' settles stop
+// at a budget under the cap and go on in the next step, and a walk costs at
+// least 3 visits a cut sample (3 a cell it passes: displace_visits; each
+// cut sample's walk passes at least the first cell ahead, and the blade
+// cuts 2 m / 1 cm = 200 samples a row). The pile this leaves is the
+// converged one: APushAtTheDefaultCapLeavesTheConvergedPileOnCentimetreCells.
+TEST(SoilConvergence, ARowCrossingsSettleLeavesRoomForItsDisplacement) {
+  const double width = 2.0, cell = 0.01, travel = 0.8, speed = 1.0;
+  const std::int64_t cap = SoilFlowParams{}.max_pair_checks_per_step;
+  const scenes::Bulldoze scene = push_scene(width, cell, travel);
+  Simulation sim = push_simulation(scene, cap);
+  const int steps = int(std::lround(travel / speed * 1000.0));
+  std::int64_t most_walk = 0, left_room = 0;
+  for (int i = 0; i <= steps + 200; ++i) {
+    const StepOutput& out = sim.step(scene.pose(kStartZ + travel * std::min(1.0, double(i) / steps)));
+    const std::int64_t walk = out.soil.displace_visits, budget = out.soil.relax_budget;
+    EXPECT_LE(out.soil.pair_checks, budget) << "step " << i;
+    // The cap, or the cap less the walk's share.
+    if (budget != cap) EXPECT_EQ(budget, cap - std::min(walk, cap / 2)) << "step " << i;
+    if (budget < cap && out.soil.reached_cap) ++left_room;
+    most_walk = std::max(most_walk, walk);
+  }
+  EXPECT_GE(most_walk, 3 * std::int64_t(std::lround(width / cell)));
+  EXPECT_GT(left_room, 0);
+}
+
 // The model is quasi-static: the converged pile a push leaves does not
 // depend on how fast the blade went. A slow push moves the edge less than
 // a hundredth of a cell a step (0.05 m/s: 0.05 mm on 1 cm cells, 1 % of a

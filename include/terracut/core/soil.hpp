@@ -260,13 +260,19 @@ struct SoilFlowParams {
   /// Work cap of one step's relaxation, in neighbour visits, in
   /// [1000, 1e9]: 8 per cell examined, 1 per flux applied, 8 per fallen
   /// cell's test of its neighbours; the settle of a displaced pile charges 4
-  /// a cell it handles. A step never does more; the rest is carried on in
-  /// the next step (see above). A visit costs about 6 ns on the project's
-  /// 2-core machine (a settle's charged visit about 7), so a step at the
-  /// default cap costs up to about 0.5 ms there at a quiet load
-  /// (docs/soil.md, "Speed: the second pass", "The settle charged for its
-  /// time"): it is a work bound, not a clock; a lower cap is a tighter
-  /// time bound, but lets a pushed pile lag further behind the blade.
+  /// a cell it handles. The displacement itself is not bounded (a step's cut
+  /// is put down whole), but after a run of steps at rest what its walk cost
+  /// is taken from the step's settle and passes, up to half the cap
+  /// (SoilStepResult::displace_visits, relax_budget). A step never does
+  /// more; the rest is carried on in the next step (see above). On the
+  /// project's 2-core machine a pass's visit costs 3.6 to 6 ns and a
+  /// settle's charged visit 7 to 11 ns (the TSC over whole pushes,
+  /// 2026-12-07; 6 and 7 on 2026-12-06), so a step at the default cap costs
+  /// up to about 0.5 ms there at a quiet load (docs/soil.md, "Speed: the
+  /// second pass", "The settle charged for its time", "A crossing's settle
+  /// over two steps"): it is a work bound, not a clock; a lower cap is a
+  /// tighter time bound, but lets a pushed pile lag further behind the
+  /// blade.
   std::int64_t max_pair_checks_per_step = 50000;
   /// The grid's edge: a wall, or open (bare ground beyond it at height 0).
   SoilEdge edge = SoilEdge::kWall;
@@ -296,6 +302,17 @@ struct SoilStepResult {
   /// The part of pair_checks the settle of the displaced pile did (docs/soil.md
   /// "The displaced pile settled at once"), in neighbour visits.
   std::int64_t settle_visits = 0;
+  /// What the displacement's walk cost, in visits (3 a cell its walks
+  /// passed: docs/soil.md "A crossing's settle over two steps"). Not part of
+  /// pair_checks and not bounded by the cap (a step's cut is displaced
+  /// whole). After 8 steps in a row whose relaxation finished within the
+  /// cap, it is taken from this step's settle and passes, up to half the
+  /// cap (relax_budget), and what they leave goes on in the next step.
+  std::int64_t displace_visits = 0;
+  /// What this step's settle and passes could do, in visits: the cap, less
+  /// what displace_visits took from it (the spill round the blade's ends,
+  /// before them, is held to the cap itself).
+  std::int64_t relax_budget = 0;
   std::int64_t moved_pairs = 0;      ///< pairs that exchanged soil
   std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
   /// The relaxation stopped at the work cap (max_pair_checks_per_step) with
@@ -522,6 +539,12 @@ class SoilFlow {
   std::vector<std::uint8_t> ends_state_;
   double ends_s_[2] = {0.0, 0.0};  // each end's cone height at the last call
   bool cut_last_step_ = false;     // the last after_cut displaced or took in soil
+  // The displacement's walk this step, in visits (kDisplaceCellVisits a
+  // cell its walks passed), and what the settle and passes may do: the cap,
+  // less that walk after a run of steps at rest (after_cut).
+  std::int64_t displace_work_ = 0;
+  std::int64_t step_cap_ = 0;
+  int rest_steps_ = 0;  // steps in a row whose relaxation finished within the cap (up to kRestStepsBeforeCharge)
   std::int64_t ends_work_ = 0;     // visits the spill and the settle spent this step (charged to the cap by run_passes)
   std::vector<std::pair<double, int>> ends_keys_;  // the round's donors' and receivers' cone keys
   std::vector<std::int32_t> ends_queue_;           // the round's sets, window cells in the order found
