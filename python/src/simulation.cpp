@@ -269,6 +269,13 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("soil_work", [](const StepResult& r) { return r.out.soil.pair_checks; },
                              "The soil relaxation's work this step, neighbour visits (soil flow; at most "
                              "soil.max_pair_checks_per_step).")
+      .def_property_readonly("soil_displace_work", [](const StepResult& r) { return r.out.soil.displace_visits; },
+                             "What the displacement's walk cost this step, visits (soil flow; not bounded by the "
+                             "cap, and taken from soil_budget after a run of steps at rest: docs/soil.md, \"A "
+                             "crossing's settle over two steps\").")
+      .def_property_readonly("soil_budget", [](const StepResult& r) { return r.out.soil.relax_budget; },
+                             "What the soil's settle and passes could do this step, visits: "
+                             "soil.max_pair_checks_per_step, less what soil_displace_work took from it.")
       .def_property_readonly("soil_capped", [](const StepResult& r) { return r.out.soil.reached_cap; },
                              "True when the work cap stopped the soil's relaxation this step: what it left "
                              "goes on in later steps, and can change a pushed pile (docs/soil.md).")

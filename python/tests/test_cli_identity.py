@@ -105,6 +105,11 @@ def test_the_steps_say_when_the_work_cap_stopped_the_soil(tmp_path):
     np.testing.assert_array_equal(again["soil_capped"], [int(s.soil_capped) for s in singles])
     np.testing.assert_array_equal(again["soil_work"], [s.soil_work for s in singles])
     np.testing.assert_array_equal(again["soil_backlog"], [s.soil_backlog for s in singles])
+    # Each step's budget is the cap, less up to half of it for what the
+    # displacement's walk cost.
+    for s in singles:
+        assert s.soil_work <= 1000 and s.soil_displace_work >= 0
+        assert 1000 - min(s.soil_displace_work, 500) <= s.soil_budget <= 1000
     # Lifted, the cap never stops it.
     d["soil"]["max_pair_checks_per_step"] = 1000000000
     assert terracut.Simulation(terracut.Scenario.from_dict(d)).run()["soil_capped"].sum() == 0
