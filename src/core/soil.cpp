@@ -358,7 +358,7 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
   }
   out.pair_checks += ends_work_;  // (no pass ran)
   ends_work_ = 0;
-  rest_steps_ = out.reached_cap ? 0 : std::min(rest_steps_ + 1, kRestStepsBeforeCharge);
+  rest_steps_ = rest_run_after(rest_steps_, out.reached_cap);
   out.backlog_cells = active_cells();
   return out;
 }

@@ -13,6 +13,7 @@
 #include <emmintrin.h>
 #endif
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -96,6 +97,11 @@ inline constexpr std::int64_t kDisplaceCellVisits = 3;
 /// cross every 10 or fewer and are at the cap for about 3 steps after
 /// each, and the work put off would wait on the next crossing's.
 inline constexpr int kRestStepsBeforeCharge = 8;
+/// The run of steps at rest after a step whose relaxation did, or did not,
+/// reach the cap (counted up to kRestStepsBeforeCharge).
+inline int rest_run_after(int run, bool reached_cap) {
+  return reached_cap ? 0 : std::min(run + 1, kRestStepsBeforeCharge);
+}
 /// Two values of the settle's surfaces closer than this are a tie (the
 /// float sums along two mirror-image paths differ in their last bits),
 /// metres: the nearer source takes the cell (soil_settle.cpp).

@@ -562,12 +562,12 @@ SoilStepResult SoilFlow::relax(HeightGrid& grid) {
       ends_work_ = 0;
       out.reached_cap = true;
       out.backlog_cells = active_cells();
-      rest_steps_ = 0;
+      rest_steps_ = rest_run_after(rest_steps_, out.reached_cap);
       return out;
     }
   }
   run_passes(grid, out);
-  rest_steps_ = out.reached_cap ? 0 : std::min(rest_steps_ + 1, kRestStepsBeforeCharge);
+  rest_steps_ = rest_run_after(rest_steps_, out.reached_cap);
   return out;
 }
 
