@@ -164,7 +164,19 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& from, const Seg
         lo = std::min(lo, hw + slope * d);
         hi = std::max(hi, hw - slope * d);
       }
-    if (!(hi > lo)) continue;  // the end stands at rest
+    // A cell within the relaxation's tolerance of its cone passes soil on
+    // (the passes would not move it, nor stop what comes through it): the
+    // donors are those above the upper cone through s - tol, the
+    // receivers those below the lower one through s + tol. (Held to the
+    // cones themselves, the cells of the cone an earlier call built stood
+    // on it to rounding and parted the seeds from the sets beyond them: at
+    // a slant, where the apex moves on every step, the spill found an end
+    // at rest, or its sets jumped between two heights and the last round's
+    // could not balance (404 donors and no receiver), and the passes
+    // carried the soil round the ends instead, about 150 passes a step;
+    // docs/soil.md, "The spill round the ends at a slant, again".)
+    const double tol = tolerance_m_;
+    if (!(hi > lo - 2.0 * tol)) continue;  // the end stands at rest
     // Rounds: the donors (above the upper cone through s, s + slope d) and
     // the receivers (below the lower one, s - slope d), each connected to
     // the seeds through its own kind; then s balancing what they give and
@@ -185,28 +197,36 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& from, const Seg
     // one falls as s rises, and the sets only grow the way that makes it
     // fall faster).
     double below = -std::numeric_limits<double>::infinity(), above = -below;
-    for (int round = 0; round < kEndRounds; ++round) {
+    // The heights the round's donors and receivers are found for: s, less
+    // and more the tolerance; in the last round, the bracket's ends.
+    double s_donor = s - tol, s_receiver = s + tol;
+    bool last_round = false;
+    for (int round = 0; round < kEndRounds || last_round; ++round) {
+      if (!last_round) s_donor = s - tol, s_receiver = s + tol;
       clear_sets();
       keys.clear();
       // The round's visits (8 a cell of the sets: its neighbours) stay
       // within what the work cap leaves: past it the sets stop growing (the
       // balance over them still keeps the volume; the passes do the rest).
       const std::int64_t room = params_.max_pair_checks_per_step - ends_work_;
-      const auto admit = [&](int w, std::uint8_t kind) {
+      // (kinds: the sets w may join, those of the cell it is reached from;
+      // it joins each it belongs to: both only in the last round, where the
+      // two heights differ.)
+      const auto admit = [&](int w, std::uint8_t kinds) {
         if (std::int64_t(queue.size() + 1) * 8 > room) return;
-        if (kind == kDonor && (place(w) & kInside)) return;  // held against the blade
         const double hw = h[std::int64_t(wr0 + w / side) * cols_ + wc0 + w % side];
         const double d = ends_dist_[std::size_t(w)];
-        if (kind == kDonor ? hw - slope * d > s : hw + slope * d < s) {
-          ends_state_[std::size_t(w)] = kind;
-          keys.push_back({kind == kDonor ? hw - slope * d : hw + slope * d, kind == kDonor ? 1 : -1});
-          queue.push_back(w);
-        }
+        std::uint8_t kind = 0;
+        // (a donor inside the blade: held against it)
+        if ((kinds & kDonor) && !(place(w) & kInside) && hw - slope * d > s_donor) kind |= kDonor;
+        if ((kinds & kReceiver) && hw + slope * d < s_receiver) kind |= kReceiver;
+        if (kind == 0) return;
+        ends_state_[std::size_t(w)] = kind;
+        if (kind & kDonor) keys.push_back({hw - slope * d, 1});
+        if (kind & kReceiver) keys.push_back({hw + slope * d, -1});
+        queue.push_back(w);
       };
-      for (int q = 0; q < n_seeds; ++q) {
-        admit(seeds[q], kDonor);
-        if (ends_state_[std::size_t(seeds[q])] == 0) admit(seeds[q], kReceiver);
-      }
+      for (int q = 0; q < n_seeds; ++q) admit(seeds[q], kDonor | kReceiver);
       for (std::size_t q = 0; q < queue.size(); ++q) {
         const int w = queue[q];
         const std::uint8_t kind = ends_state_[std::size_t(w)];
@@ -223,21 +243,38 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& from, const Seg
       const double next = balance(keys);
       // Settled once the height moves by less than a twentieth of the
       // relaxation's tolerance (the cells it would still add or drop at the
-      // sets' borders are that close to their cone: the passes see them),
-      // or goes back out of the bracket: the sets then change by a whole
-      // region between two heights (a cell at its cone's height joins it to
-      // the seeds, or parts it from them), and further rounds only go back
-      // and forth between the two. (They went on to kEndRounds: at 30
-      // degrees, a 1 m blade on 5 mm cells spent 41 M of its push's 50 M
-      // visits in the spill's rounds, reached the cap on 1057 of its 1200
-      // steps, and the passes ran in 29.) The last round's sets at its
-      // balance keep the volume either way; the passes do the rest.
+      // sets' borders are that close to their cone: the passes see them).
+      // A balance that goes back out of the bracket means the sets change
+      // by a whole region between two heights (a cell at its cone's height
+      // joins it to the seeds, or parts it from them), and further rounds
+      // would only go back and forth between the two (they once went on to
+      // kEndRounds: at 30 degrees, a 1 m blade on 5 mm cells spent 41 M of
+      // its push's 50 M visits in the spill's rounds). Then one round more
+      // finds the donors at the bracket's lower height and the receivers at
+      // its upper one and balances them together: each cell's give and
+      // take is continuous in s, so that balance has a root. A cell in both
+      // (near the apex, where the two cones lie closer than the bracket is
+      // wide) ends between its two cones: it passes soil through. (Ended at
+      // the last round's own sets, the spill at a slant kept one with
+      // donors and no receiver, and moved nothing.) The last round's sets
+      // at its balance keep the volume either way; the passes do the rest.
+      if (last_round) {
+        s = next;
+        break;
+      }
       const bool back = !(next > below && next < above);
       if (next > s) below = s;
       else above = s;
-      const bool settled = back || std::abs(next - s) <= 0.05 * tolerance_m_;
+      const bool settled = std::abs(next - s) <= 0.05 * tolerance_m_;
       s = next;
-      if (settled || ends_work_ + 8 * std::int64_t(queue.size()) > params_.max_pair_checks_per_step) break;
+      if (ends_work_ + 8 * std::int64_t(queue.size()) > params_.max_pair_checks_per_step) break;
+      if (back) {
+        last_round = true;
+        s_donor = below - tol;
+        s_receiver = above + tol;
+        continue;
+      }
+      if (settled) break;
     }
     ends_s_[end] = s;
     // The last round's sets at its balance: each donor comes down to the
@@ -264,9 +301,10 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& from, const Seg
       const std::int64_t i = std::int64_t(r) * cols_ + c;
       const double d = ends_dist_[std::size_t(w)];
       const float old = h[i];
-      float now = ends_state_[std::size_t(w)] == kDonor
-                      ? std::min(old, quantized(std::max(0.0, s + slope * d)))
-                      : std::max(old, std::min(quantized(s - slope * d), ceiling_m_));
+      const std::uint8_t state = ends_state_[std::size_t(w)];
+      float now = old;
+      if (state & kDonor) now = std::min(now, quantized(std::max(0.0, s + slope * d)));
+      if (state & kReceiver) now = std::max(now, std::min(quantized(s - slope * d), ceiling_m_));
       if (held > 0.0 && now < old) {
         const float kept = std::min(old, quantized(double(now) + std::min(held, double(old) - double(now))));
         held -= double(kept) - double(now);
