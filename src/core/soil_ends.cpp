@@ -210,8 +210,9 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& from, const Seg
       // balance over them still keeps the volume; the passes do the rest).
       const std::int64_t room = params_.max_pair_checks_per_step - ends_work_;
       // (kinds: the sets w may join, those of the cell it is reached from;
-      // it joins each it belongs to: both only in the last round, where the
-      // two heights differ.)
+      // it joins each it belongs to. Both only where its two cones lie
+      // closer than the two heights differ: the apex within the tolerance
+      // of s, and in the last round the cells near it.)
       const auto admit = [&](int w, std::uint8_t kinds) {
         if (std::int64_t(queue.size() + 1) * 8 > room) return;
         const double hw = h[std::int64_t(wr0 + w / side) * cols_ + wc0 + w % side];
