@@ -199,7 +199,7 @@ void SoilFlow::spill_round_ends(HeightGrid& grid, const Segment& from, const Seg
     double below = -std::numeric_limits<double>::infinity(), above = -below;
     // The heights the round's donors and receivers are found for: s, less
     // and more the tolerance; in the last round, the bracket's ends.
-    double s_donor = s - tol, s_receiver = s + tol;
+    double s_donor = 0.0, s_receiver = 0.0;
     bool last_round = false;
     for (int round = 0; round < kEndRounds || last_round; ++round) {
       if (!last_round) s_donor = s - tol, s_receiver = s + tol;
