@@ -36,6 +36,7 @@ LoopDriver::LoopDriver(const session::Scenario& scenario, const haptics::HapticS
       spec_(io::grid_spec(scenario.base)),
       representation_(scenario.base.representation),
       blade_length_m_(scenario.base.blade.length_m),
+      blade_height_m_(scenario.base.blade.height_m),
       bucket_(scenario.base.blade.bucket),
       repose_deg_(scenario.base.soil.material.repose_deg),
       initial_(io::build_initial_heights(scenario.base)) {

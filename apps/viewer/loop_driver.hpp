@@ -148,6 +148,8 @@ class LoopDriver {
   double blade_length_m() const { return blade_length_m_; }
   /// The blade's bucket (BucketSpec::enabled() false for a flat blade).
   const BucketSpec& bucket() const { return bucket_; }
+  /// The blade's top above its edge, metres (infinity: unbounded).
+  double blade_height_m() const { return blade_height_m_; }
   /// The soil's angle of repose, degrees (what a tilted bucket holds).
   double repose_deg() const { return repose_deg_; }
   /// Initial heights, rows x cols, row-major, metres.
@@ -196,6 +198,7 @@ class LoopDriver {
   GridSpec spec_;
   Representation representation_;
   double blade_length_m_;
+  double blade_height_m_;
   BucketSpec bucket_{};
   double repose_deg_ = 34.0;
   std::vector<float> initial_;

@@ -121,9 +121,13 @@ ViewerApp::ToolMarks ViewerApp::tool_marks() const {
   m.in_contact = l.contact.length_m > 0.0;
   m.rod = std::max(0.006f * blade_len, 0.003f * extent);
   // The plate is drawn last, see-through, so it never hides the cut behind
-  // it; it stands 0.12 blade lengths above the soil, however deep the edge is.
+  // it; a blade of finite height (blade.height_m) is drawn as tall as it
+  // is, one of unbounded height 0.12 blade lengths above the soil, however
+  // deep the edge is.
   m.ground = ground_height_at(l.pose.position_m.x, l.pose.position_m.z);
-  float plate_h = 0.12f * blade_len + std::max(0.0f, m.ground - float(l.pose.position_m.y));
+  const double blade_h = driver_->blade_height_m();
+  float plate_h = std::isfinite(blade_h) ? float(blade_h)
+                                         : 0.12f * blade_len + std::max(0.0f, m.ground - float(l.pose.position_m.y));
   m.plate = translation(to_f(l.pose.position_m)) * rotation(l.pose.orientation) *
             translation({0.0f, 0.5f * plate_h + m.rod, 0.0f}) *
             scaling({blade_len, plate_h, 0.6f * m.rod});

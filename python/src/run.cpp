@@ -48,6 +48,7 @@ py::dict run_result_dict(const session::RunResult& r, const io::Scenario& sc) {
     d["displaced_volume_m3"] = r.soil->displaced_volume_m3;
     d["net_moved_m3"] = r.soil->net_moved_m3;
     d["left_over_edge_m3"] = r.soil->left_over_edge_m3;
+    d["over_top_m3"] = r.soil->over_top_m3;
     d["passes"] = r.soil->passes;
     d["final_backlog_cells"] = r.soil->final_backlog_cells;
     d["capped_steps"] = r.soil->capped_steps;

@@ -5,6 +5,7 @@
 // (Simulation::edit_heights), zero-copy read-only numpy views of the grid's
 // layers.
 #include <filesystem>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
@@ -260,6 +261,8 @@ void bind_simulation(py::module_& m) {
                              "The part of the step's cut below the initial surface (soil flow), m^3.")
       .def_property_readonly("displaced_volume_m3", [](const StepResult& r) { return r.out.soil.displaced_volume_m3; },
                              "Soil put down ahead of the blade (soil flow; a pile pushed on counts at every step), m^3.")
+      .def_property_readonly("over_top_m3", [](const StepResult& r) { return r.out.soil.over_top_m3; },
+                             "Soil that fell over the blade's top this step (soil flow, blade_height_m), m^3.")
       .def_property_readonly("cells_visited", [](const StepResult& r) {
             return r.out.contact.cells_visited + r.out.cut.cells_visited;
           }, "Cells examined by the contact query and the cut.")
@@ -321,7 +324,7 @@ one thread at a time.)doc")
                                      py::object origin_m, const std::string& representation,
                                      double rate_hz, double blade_length_m,
                                      const std::string& soil_model, py::object soil,
-                                     double rake_angle_deg) {
+                                     double rake_angle_deg, double blade_height_m) {
             auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(heights);
             if (!a || a.ndim() != 2)
               throw InputError("heights: expected a 2-D (rows, cols) array of metres");
@@ -339,6 +342,7 @@ one thread at a time.)doc")
             p.soil.model = *model;
             p.soil.material = material_arg(soil);
             p.blade.rake_angle_deg = rake_angle_deg;
+            p.blade.height_m = blade_height_m;
             if (std::string e = validate(p); !e.empty()) throw InputError(e);
             std::vector<float> h(a.data(), a.data() + a.size());
             return std::make_unique<PySimulation>(p, std::move(h));
@@ -346,11 +350,14 @@ one thread at a time.)doc")
           py::arg("origin_m") = py::make_tuple(0.0, 0.0, 0.0), py::arg("representation") = "surface",
           py::arg("rate_hz") = 1000.0, py::arg("blade_length_m") = 1.0,
           py::arg("soil_model") = "vanish", py::arg("soil") = "dry_sand", py::arg("rake_angle_deg") = 90.0,
+          py::arg("blade_height_m") = std::numeric_limits<double>::infinity(),
           "A simulation over a (rows, cols) array of heights in metres (copied): size_m = "
           "(size_x, size_z) metres, origin_m the origin corner (y = ground), representation "
           "'surface' or 'columns', rate_hz the step rate (Hz), blade_length_m metres, "
           "soil_model 'vanish' or 'flow', soil the material (a preset name or a dict of the soil: "
-          "section's keys), rake_angle_deg the blade's rake (degrees, 90 vertical).")
+          "section's keys), rake_angle_deg the blade's rake (degrees, 90 vertical), blade_height_m "
+          "the blade's top above its edge (m; soil flow: what stands higher falls over it; "
+          "infinity, the default: unbounded).")
       .def_property_readonly("heights", [](py::object self) {
             auto& s = self.cast<PySimulation&>();
             return layer_view(self, s.sim().grid().heights(), s.sim().grid());

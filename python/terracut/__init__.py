@@ -59,7 +59,8 @@ def run(scenario, out_dir: Union[str, os.PathLike], realtime: bool = False) -> d
     counts a pushed pile again at every step). With soil that flows, "soil"
     (cut_from_ground_m3: the cut below the initial surface;
     displaced_volume_m3: what the blade pushed, each push counted;
-    net_moved_m3: soil no longer where it was at the end; left_over_edge_m3,
+    net_moved_m3: soil no longer where it was at the end; over_top_m3: soil
+    that fell over the blade's top (blade.height_m); left_over_edge_m3,
     passes, final_backlog_cells, capped_steps: steps the work cap stopped)
     and "warnings": readable lines, as summary.json's and `terracut run`'s
     (steps the work cap stopped, soil left steeper than its

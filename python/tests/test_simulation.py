@@ -206,3 +206,31 @@ def test_help_explains_the_units():
     text = pydoc.render_doc(terracut.Simulation, renderer=pydoc.plaintext)
     for word in ["metres", "seconds", "unit quaternion", "read-only", "GIL", "edit_heights", "(rows, cols)"]:
         assert word in text, word
+
+
+def test_a_blade_with_a_top_lets_what_stands_higher_fall_over_it():
+    # A 0.6 m blade 8 cm tall (its top 3 cm above the layer) cuts 5 cm of a
+    # 0.2 m layer on 1 cm cells and pushes 0.5 m along +Z: the pile reaches
+    # the top, and what stands higher falls over behind it, into the trench.
+    # The volume is kept, and no cell against the blade's face stands above
+    # its top.
+    n, cell, top = 80, 0.01, 0.15 + 0.08
+    sim = terracut.Simulation.from_heights(
+        np.full((n, n), 0.2, dtype=np.float32), size_m=(n * cell, n * cell),
+        blade_length_m=0.6, soil_model="flow", blade_height_m=0.08)
+    before = float(sim.heights.astype(np.float64).sum())
+    over = 0.0
+    for i in range(501):
+        z = 0.1 + 0.001 * i
+        over += sim.step([0.4, 0.15, z, 1.0, 0.0, 0.0, 0.0]).over_top_m3
+    assert over > 0.0
+    h = sim.heights
+    rows = [r for r in range(n) if abs((r + 0.5) * cell - z) <= 1.5 * cell]
+    assert h[rows, 10:70].max() == pytest.approx(top, abs=1e-6)
+    assert float(h.astype(np.float64).sum()) == pytest.approx(before, rel=1e-6)
+
+
+def test_a_bad_blade_height_is_refused_by_name():
+    for bad in (0.0, -1.0, math.nan):
+        with pytest.raises(terracut.InputError, match="blade.height_m"):
+            flat(soil_model="flow", blade_height_m=bad)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -95,6 +96,13 @@ std::string validate(const SimParams& params) {
   if (std::string e = check_field("blade.edge_thickness_m", params.blade.edge_thickness_m);
       !e.empty())
     return e;
+  // The blade's top: finite and > 0, or infinity (a wall as tall as any
+  // pile); a bucket's is its own.
+  if (params.blade.height_m != std::numeric_limits<double>::infinity()) {
+    if (std::string e = check_field("blade.height_m", params.blade.height_m); !e.empty()) return e;
+    if (bucket.enabled())
+      return "blade.height_m: a bucket's height is blade.bucket.height_m; leave blade.height_m out with a bucket";
+  }
   if (params.representation != Representation::kColumns &&
       params.representation != Representation::kSurface)
     return "representation must be columns or surface";

@@ -79,6 +79,7 @@ double steepest_standing_slope_deg(double cell_x_m, double cell_z_m, double repo
 SoilFlow::SoilFlow(const SoilFlowParams& params, const HeightGrid& grid, const BladeSpec& blade)
     : params_(params), blade_spec_(blade), cols_(grid.cols()), rows_(grid.rows()) {
   if (std::string m = validate(params); !m.empty()) throw InputError(m);
+  if (!(blade.height_m > 0.0)) throw InputError(must_be("blade.height_m", "> 0 (infinity: unbounded)", blade.height_m));
   step_cap_ = params_.max_pair_checks_per_step;
   const GridSpec& spec = grid.spec();
   dx_ = spec.cell_x_m();
@@ -356,6 +357,11 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     run_passes(grid, out);
     clear_blade();
   }
+  // Last, what stands against a blade of finite height above its top falls
+  // over it: at the end of every step no cell against it stands higher
+  // (the settle and the passes above could raise one; what falls is
+  // relaxed from the next step on).
+  spill_over_top(grid, to, orientation, out);
   out.pair_checks += ends_work_;  // (no pass ran)
   ends_work_ = 0;
   rest_steps_ = rest_run_after(rest_steps_, out.reached_cap);

@@ -56,6 +56,7 @@ constexpr yaml::Range kRanges[] = {
     find_range(kSimParamsRanges, "blade.length_m"),
     find_range(kSimParamsRanges, "blade.rake_angle_deg"),
     find_range(kSimParamsRanges, "blade.edge_thickness_m"),
+    find_range(kSimParamsRanges, "blade.height_m"),
     // The file's own: a bucket: section is a bucket (the struct's depth 0 is none).
     {"blade.bucket.depth_m", 0.0, kMax, Ends::kOpenLow},
     find_range(kSimParamsRanges, "blade.bucket.height_m"),
@@ -526,17 +527,21 @@ Scenario parse_document(const Context& ctx, const YAML::Node& root,
     sc.rate_hz = f->in(range("rate_hz"));
   }
 
-  const Map blade(top.require("blade"), {"length_m", "rake_angle_deg", "edge_thickness_m", "bucket"});
+  const Map blade(top.require("blade"), {"length_m", "rake_angle_deg", "edge_thickness_m", "height_m", "bucket"});
   sc.blade.length_m = blade.require("length_m").in(range("blade.length_m"));
   if (const auto f = blade.get("rake_angle_deg")) sc.blade.rake_angle_deg = f->in(range("blade.rake_angle_deg"));
   if (const auto f = blade.get("edge_thickness_m"))
     sc.blade.edge_thickness_m = f->in(range("blade.edge_thickness_m"));
+  const std::optional<Field> height_field = blade.get("height_m");
+  if (height_field) sc.blade.height_m = height_field->in(range("blade.height_m"));
   const std::optional<Field> bucket_field = blade.get("bucket");
   if (const auto& b = bucket_field) {
     // A bucket behind the edge (blade.hpp, BucketSpec): its floor and back.
     const Map bucket(*b, {"depth_m", "height_m"});
     sc.blade.bucket.depth_m = bucket.require("depth_m").in(range("blade.bucket.depth_m"));
     sc.blade.bucket.height_m = bucket.require("height_m").in(range("blade.bucket.height_m"));
+    if (height_field)
+      height_field->fail("a bucket's height is its own (blade.bucket.height_m): leave blade.height_m out with a bucket");
   }
 
   const std::optional<PendingImage> image = parse_terrain(ctx, top.require("terrain"), sc);

@@ -286,6 +286,7 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
   inputs["rate_hz"] = sc.rate_hz;
   inputs["blade_length_m"] = sc.blade.length_m;
   inputs["blade_rake_angle_deg"] = sc.blade.rake_angle_deg;
+  if (std::isfinite(sc.blade.height_m)) inputs["blade_height_m"] = sc.blade.height_m;  // (absent: unbounded)
   inputs["soil_material"] = material_json(sc.soil.material);
   inputs["sequence"] = sc.sequence_names();
   Json cuts = Json::array();
@@ -336,6 +337,7 @@ Json summary_json(const io::Scenario& sc, const RunResult& r) {
                    {"cut_from_ground_m3", s.cut_from_ground_m3},
                    {"displaced_volume_m3", s.displaced_volume_m3},
                    {"net_moved_m3", s.net_moved_m3},
+                   {"over_top_m3", s.over_top_m3},
                    {"relaxation",
                     {{"passes", s.passes},
                      {"pair_checks", s.pair_checks},
@@ -490,6 +492,7 @@ RunResult run_into(const Scenario& scenario, const RunOptions& options) {
         soil.displaced_volume_m3 += out.soil.displaced_volume_m3;
         soil.cut_from_ground_m3 += out.soil.cut_from_ground_m3;
         soil.left_over_edge_m3 += out.soil.left_over_edge_m3;
+        soil.over_top_m3 += out.soil.over_top_m3;
         soil.passes += out.soil.passes;
         soil.pair_checks += out.soil.pair_checks;
         soil.settle_visits += out.soil.settle_visits;

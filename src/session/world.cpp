@@ -1,6 +1,9 @@
 // The simulated world of a run. See world.hpp.
 #include "terracut/session/world.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "terracut/core/error.hpp"
 
 #ifdef TERRACUT_HAVE_BULLET
@@ -34,6 +37,10 @@ World::World(const Scenario& scenario, const WorldOptions& options) {
   bullet::BodiesListenerOptions bo;
   bo.csv_path = options.bodies_csv;
   bo.world.tool.force_limit_n = options.arm_force_limit_n;
+  // The plate the bodies meet is as tall as the blade where it has a top
+  // (blade.height_m; the plate's own bound is 100 m), else the plate's
+  // default.
+  if (std::isfinite(sc.blade.height_m)) bo.world.tool.height_m = std::min(sc.blade.height_m, 100.0);
   bodies_ = std::make_unique<bullet::BodiesListener>(*sim_, scenario.bodies, bo);
 #else
   throw InputError(bodies_unavailable_message());

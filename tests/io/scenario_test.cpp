@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <string>
 
 #include "../support/scenario_text.hpp"
@@ -259,6 +260,23 @@ TEST(ScenarioSoil, ABucketIsAShapeBehindTheEdgeAndNeedsSoilThatFlows) {
   expect_error(flat, line_of(flat, "bucket:"), "blade.bucket.height_m", "> 0");
   const std::string typo = replace(flow, "depth_m: 0.4", "deep_m: 0.4");
   expect_error(typo, line_of(typo, "bucket:"), "blade.bucket.deep_m", "unknown key");
+  // A bucket's height is its own: a blade's top with one is refused.
+  const std::string topped = replace(flow, "  length_m: 1.25\n", "  length_m: 1.25\n  height_m: 0.5\n");
+  expect_error(topped, line_of(topped, "height_m: 0.5"), "blade.height_m", "blade.bucket.height_m");
+}
+
+// A flat blade's top (BladeSpec::height_m): unbounded when left out, a
+// height > 0 when given; errors name the line and the field.
+TEST(ScenarioBlade, ABladesTopIsOptionalAndPositive) {
+  EXPECT_EQ(parse_scenario(kGood, "x.yaml").blade.height_m, std::numeric_limits<double>::infinity());
+  const std::string topped = replace(kGood, "blade: {length_m: 1.25}", "blade: {length_m: 1.25, height_m: 0.4}");
+  EXPECT_EQ(parse_scenario(topped, "x.yaml").blade.height_m, 0.4);
+  EXPECT_EQ(sim_params(parse_scenario(topped, "x.yaml")).blade.height_m, 0.4);
+  for (const char* bad : {"0", "-0.1", ".nan", "tall"}) {
+    const std::string text = replace(kGood, "blade: {length_m: 1.25}",
+                                     std::string("blade: {length_m: 1.25, height_m: ") + bad + "}");
+    expect_error(text, line_of(text, "height_m"), "blade.height_m", "");
+  }
 }
 
 TEST(ScenarioOptions, ParseResolutionAndNameLists) {

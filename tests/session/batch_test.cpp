@@ -14,6 +14,7 @@
 #include <sstream>
 #include <string>
 
+#include "../support/scenario_text.hpp"
 #include "terracut/core/error.hpp"
 #include "terracut/io/image.hpp"
 #include "terracut/io/scenario.hpp"
@@ -291,6 +292,31 @@ TEST_F(RunTest, FlowingSoilIsConservedAndWrittenAsTakenAndDeposited) {
   const RunResult again = run(sc, dir_ / "again");
   EXPECT_EQ(read_bytes(dir_ / "out" / "height.npy"), read_bytes(dir_ / "again" / "height.npy"));
   EXPECT_EQ(again.soil->pair_checks, result.soil->pair_checks);
+}
+
+// A blade given a top (blade.height_m) lets what stands higher fall over it:
+// the run reports it (over_top_m3, and the height among the inputs), keeps
+// the volume, and the same cuts with an unbounded blade report none.
+TEST_F(RunTest, SoilOverTheBladesTopIsReportedAndKept) {
+  const std::string flow = "soil: {model: flow, repose_deg: 34}\n";
+  Scenario topped;
+  topped.base = parse_scenario(test::replace(kScenario, "blade: {length_m: 0.9}", "blade: {length_m: 0.9, height_m: 0.02}") + flow,
+                               dir_ / "topped.yaml");
+  ASSERT_EQ(topped.base.blade.height_m, 0.02);
+  const RunResult result = run(topped, dir_ / "topped");
+  ASSERT_TRUE(result.soil);
+  EXPECT_GT(result.soil->over_top_m3, 0.0);
+  EXPECT_NEAR(result.final_volume_m3, result.initial_volume_m3, 1e-6 * result.initial_volume_m3);
+  const nlohmann::json j = nlohmann::json::parse(read_bytes(dir_ / "topped" / "summary.json"));
+  EXPECT_EQ(j["soil"]["over_top_m3"].get<double>(), result.soil->over_top_m3);
+  EXPECT_EQ(j["inputs"]["blade_height_m"].get<double>(), 0.02);
+  Scenario unbounded;
+  unbounded.base = parse_scenario(kScenario + flow, dir_ / "small.yaml");
+  const RunResult plain = run(unbounded, dir_ / "plain");
+  EXPECT_EQ(plain.soil->over_top_m3, 0.0);
+  const nlohmann::json k = nlohmann::json::parse(read_bytes(dir_ / "plain" / "summary.json"));
+  EXPECT_EQ(k["soil"]["over_top_m3"].get<double>(), 0.0);
+  EXPECT_FALSE(k["inputs"].contains("blade_height_m"));
 }
 
 #ifdef TERRACUT_HAVE_BULLET

@@ -88,7 +88,7 @@ mmt:
 // density, which the mound's soil gives as a unit weight: not both).
 constexpr const char* kPlane = R"(
 soil: {density_kg_per_m3: 1650}
-blade: {length_m: 0.5}
+blade: {length_m: 0.5, height_m: 0.3}
 terrain:
   generator: plane
   resolution: 8

@@ -4,6 +4,7 @@
 // linearly and rotation by quaternion slerp.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,13 @@ struct BladeSpec {
   /// soil bears under it when it is pushed down (penetration.hpp). A 2 cm
   /// steel cutting edge by default.
   double edge_thickness_m = 0.02;
+  /// Height of the blade's top above its edge, metres, > 0, along the
+  /// blade frame's local Y (the face's vertical extent, whatever its rake):
+  /// with soil model flow, soil standing against the blade higher than its
+  /// top falls over it to the other side (docs/soil.md, "Soil over the
+  /// blade's top"). Infinity (the default): a wall as tall as any pile. A
+  /// bucket has its own (bucket.height_m) and takes none.
+  double height_m = std::numeric_limits<double>::infinity();
   BucketSpec bucket{};    ///< a bucket behind the edge (soil model flow only)
 };
 

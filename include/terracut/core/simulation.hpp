@@ -60,6 +60,7 @@ inline constexpr Range kSimParamsRanges[] = {
     {"blade.length_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
     at_path(find_range(kEarthmovingRanges, "rake_angle_deg"), "blade.rake_angle_deg"),
     {"blade.edge_thickness_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
+    {"blade.height_m", 0.0, kRangeMax, RangeEnds::kOpenLow},  // (or infinity: unbounded, the default)
     {"blade.bucket.depth_m", 0.0, kRangeMax, RangeEnds::kClosed},  // 0: no bucket
     {"blade.bucket.height_m", 0.0, kRangeMax, RangeEnds::kOpenLow},
 };

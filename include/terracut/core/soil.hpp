@@ -332,6 +332,10 @@ struct SoilStepResult {
   double poured_m3 = 0.0;            ///< soil poured from the bucket's lip this step, m^3
   double bucket_load_m3 = 0.0;       ///< soil in the bucket after the step, m^3
   double shouldered_m3 = 0.0;        ///< soil the bucket's hull pushed out of its footprint this step, m^3
+  /// Soil that stood above a blade's top (BladeSpec::height_m) and fell
+  /// over it to the other side this step, m^3 (0 for a blade of unbounded
+  /// height, the default).
+  double over_top_m3 = 0.0;
   Rect changed{};                    ///< samples whose height the phase changed
 };
 
@@ -531,6 +535,11 @@ class SoilFlow {
   /// just cut behind it included (soil_ends.cpp); `from` is where its
   /// motion is measured from (motion_origin), for which side is behind.
   void spill_round_ends(HeightGrid& grid, const Segment& from, const Segment& to, SoilStepResult& out);
+  /// The soil standing against the edge `to` higher than the blade's top
+  /// (BladeSpec::height_m, turned with `orientation`) falls over it onto the
+  /// first cell clear of the blade on the other side (soil_top.cpp). A
+  /// blade of unbounded height, or a bucket, does nothing here.
+  void spill_over_top(HeightGrid& grid, const Segment& edge, const Quat& orientation, SoilStepResult& out);
   // spill_round_ends' window round an end's apex (the first cell past it),
   // per cell: where it lies, its distance to the apex, and donor / receiver
   // in the round; sized at construction.

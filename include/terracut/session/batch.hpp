@@ -109,6 +109,7 @@ struct SoilRunStats {
   double cut_from_ground_m3 = 0.0;   ///< what the blade cut below the initial surface, m^3 (SoilStepResult::cut_from_ground_m3)
   double net_moved_m3 = 0.0;         ///< at the end, soil no longer where it was: sum of max(initial - height, 0) x cell area, m^3
   double left_over_edge_m3 = 0.0;    ///< soil that left over an open edge, m^3
+  double over_top_m3 = 0.0;          ///< soil that fell over the blade's top (BladeSpec::height_m), m^3
   std::int64_t passes = 0;           ///< relaxation passes
   std::int64_t pair_checks = 0;      ///< neighbour pairs examined
   std::int64_t settle_visits = 0;    ///< of them, the settle of the displaced pile's (soil.md)
