@@ -35,6 +35,7 @@
 #include "terracut/session/world.hpp"
 #include "terracut/validation/hull.hpp"
 #include "terracut/validation/slant.hpp"
+#include "terracut/validation/top.hpp"
 #include "terracut/validation/wall.hpp"
 
 namespace terracut::cli {
@@ -776,6 +777,12 @@ struct WallRun {
   bool pass() const { return worst_m <= validation::kWallSlack_m; }
 };
 
+// One push of the blade's-top measure (validation/top.hpp).
+struct TopRun {
+  validation::TopCase what;
+  validation::TopMeasure measured;
+};
+
 // One stroke of the bucket-is-a-solid measure (validation/hull.hpp).
 struct HullRun {
   validation::BucketStroke what;
@@ -787,6 +794,7 @@ struct Report {
   std::vector<RampResult> ramps;
   std::vector<DozeResult> dozes;
   std::vector<WallRun> walls;
+  std::vector<TopRun> tops;
   std::optional<SlantResult> slant;
   ConservationResult conservation;
   BucketResult bucket;
@@ -938,6 +946,22 @@ std::vector<Check> make_checks(const Report& r) {
     };
     slant(r.slant->patches, "3.4", "patches", false);
     slant(r.slant->fans, "3.5", "fans (the default)", true);
+  }
+  if (!r.tops.empty()) {
+    const auto worst = std::max_element(r.tops.begin(), r.tops.end(), [](const TopRun& a, const TopRun& b) {
+      return a.measured.worst_unburied_m < b.measured.worst_unburied_m;
+    });
+    const int holding =
+        int(std::count_if(r.tops.begin(), r.tops.end(), [](const TopRun& t) { return t.measured.holds(); }));
+    out.push_back({"3.6", "a blade's top: no soil stands against a blade of finite height above its top unless "
+                          "the blade is buried, and what falls over lies in the trench behind (1 m blades 0.08 "
+                          "and 0.1 m tall, yaw 0 to 90 deg, level and rolled, 0.25 to 2 m/s, 1 cm and 5 mm cells)",
+                   std::to_string(holding) + "/" + std::to_string(r.tops.size()) + " pushes; worst " +
+                       fmt("%.2e", worst->measured.worst_unburied_m) + " m above the top (" +
+                       validation::describe(worst->what) + ")",
+                   "<= " + fmt("%.0e", validation::kTopSlack_m) +
+                       " m (float rounding); the pile reaches the top; behind >= over the top; volume kept",
+                   holding == int(r.tops.size())});
   }
   const ConservationResult& c = r.conservation;
   out.push_back({"4a", "mixed run of " + std::to_string(c.sequence.size()) +
@@ -1172,6 +1196,25 @@ std::string report_markdown(const Report& r) {
     };
     rows(r.slant->patches, "patches");
     rows(r.slant->fans, "fans");
+    md << "\n";
+  }
+
+  if (!r.tops.empty()) {
+    md << "### A blade's top (check 3.6)\n\n"
+       << "A blade given a height (`blade.height_m`) holds soil up to its top; what stands higher against it falls "
+       << "over to the other side and rests down it at the repose slope from the top (docs/soil.md, \"Soil over "
+       << "the blade's top\"). A 1 m blade cuts 5 cm of a 20 cm layer and pushes 1.5 m along its normal. At the "
+       << "end of every step no cell against it (its centre within three halves of a cell's width across the "
+       << "edge's line) may stand above the top unless the blade is buried there (soil across it at the top less "
+       << "a cell's repose drop or higher); the pile must reach the top, what the steps report over the top must "
+       << "lie in the trench behind, and the volume is kept.\n\n"
+       << "| push | worst above the top, unburied (m) | highest against the blade, less the top (m) | over the "
+          "top (m^3) | in the trench behind (m^3) | volume error (m^3) | result |\n|---|---|---|---|---|---|---|\n";
+    for (const TopRun& t : r.tops)
+      md << "| " << validation::describe(t.what) << " | " << fmt("%.2e", t.measured.worst_unburied_m) << " | "
+         << fmt("%.2e", t.measured.reach_m) << " | " << fmt("%.4f", t.measured.over_top_m3) << " | "
+         << fmt("%.4f", t.measured.behind_m3) << " | " << fmt("%.1e", t.measured.volume_error_m3) << " | "
+         << pass_fail(t.measured.holds()) << " |\n";
     md << "\n";
   }
 
@@ -1604,6 +1647,15 @@ Command add_validate_command(CLI::App& app) {
       const auto holding = std::count_if(report.walls.begin(), report.walls.end(), [](const WallRun& w) { return w.pass(); });
       say("the blade as a wall: " + std::to_string(holding) + " of " + std::to_string(report.walls.size()) +
           " cases leave no soil behind it, " + seconds_since(t0));
+    }
+    {
+      const Clock::time_point t0 = Clock::now();
+      for (const validation::TopCase& c : validation::validation_top_cases())
+        report.tops.push_back({c, validation::measure_top(c)});
+      const auto holding =
+          std::count_if(report.tops.begin(), report.tops.end(), [](const TopRun& t) { return t.measured.holds(); });
+      say("a blade's top: " + std::to_string(holding) + " of " + std::to_string(report.tops.size()) +
+          " pushes hold no soil above it, " + seconds_since(t0));
     }
     {
       const Clock::time_point t0 = Clock::now();
