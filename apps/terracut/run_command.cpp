@@ -1,4 +1,5 @@
 // `terracut run`: one scenario, outputs into a folder.
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -138,12 +139,16 @@ Command add_run_command(CLI::App& app) {
       // step, so the sum of the steps' cuts is not soil removed: name the
       // ground cut, the soil pushed and the net soil moved instead.
       char volumes[256];
-      if (result.soil)
-        std::snprintf(volumes, sizeof volumes,
-                      "cut from the ground %.6g m^3, displaced %.6g m^3 (each push counted), net moved %.6g m^3",
-                      result.soil->cut_from_ground_m3, result.soil->displaced_volume_m3,
-                      result.soil->net_moved_m3);
-      else
+      if (result.soil) {
+        const int n = std::snprintf(
+            volumes, sizeof volumes,
+            "cut from the ground %.6g m^3, displaced %.6g m^3 (each push counted), net moved %.6g m^3",
+            result.soil->cut_from_ground_m3, result.soil->displaced_volume_m3, result.soil->net_moved_m3);
+        // A blade with a top (blade.height_m): what fell over it.
+        if (std::isfinite(scenario.base.blade.height_m) && n > 0 && std::size_t(n) < sizeof volumes)
+          std::snprintf(volumes + n, sizeof volumes - std::size_t(n), ", over the blade's top %.6g m^3",
+                        result.soil->over_top_m3);
+      } else
         std::snprintf(volumes, sizeof volumes, "removed %.6g m^3", result.removed_volume_m3);
       std::snprintf(line, sizeof line,
                     "%s: %lld steps, %s of %.6g m^3, conservation error %.3g m "

@@ -162,6 +162,22 @@ TEST_F(CliTest, RunWritesEveryOutput) {
   EXPECT_EQ(slurp(out / "contact.csv").rfind("t,cut,x,y,z,qw,qx,qy,qz,contact_length,", 0), 0u);
 }
 
+// A blade with a top (scenarios/push_over_top.yaml): the run's line says
+// how much fell over it, and summary.json holds the same figure; a blade
+// without one says nothing of a top.
+TEST_F(CliTest, RunSaysWhatFellOverTheBladesTop) {
+  const fs::path out = dir_ / "over";
+  const Result r = terracut({"run", scenario("push_over_top.yaml"), "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("over the blade's top "), std::string::npos) << r.out;
+  const std::string summary = slurp(out / "summary.json");
+  EXPECT_NE(summary.find("\"over_top_m3\""), std::string::npos);
+  EXPECT_NE(summary.find("\"blade_height_m\": 0.1"), std::string::npos);
+  const Result plain = terracut({"run", scenario("push_pile.yaml"), "--out", (dir_ / "plain").string()});
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  EXPECT_EQ(plain.out.find("top"), std::string::npos) << plain.out;
+}
+
 // With bodies, `terracut run` steps the Bullet world on the same terrain and
 // writes bodies.csv: a box resting on 0.1 m of soil sinks at least by the
 // 0.05 m cut under it (the blade's plate also shoves it) but never through
