@@ -49,6 +49,12 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
   const int r1 = floor_within(to_cells(std::max(edge.a.z, edge.b.z) + reach, spec.origin_m.z, dz_) - 0.5, -1, rows_ - 1);
   float* h = grid.edit_layers().height_m;
   double moved_sum = 0.0, gained = 0.0;
+  // The walks down the other side are charged to the step's work, and stop
+  // at the work cap (what stays above the top goes over in the next step):
+  // a tall blade buried deep could otherwise walk far for every cell
+  // against it.
+  std::int64_t walked = 0;
+  const std::int64_t budget = params_.max_pair_checks_per_step;
   std::int64_t last = -1, last_room = -1;
   const auto write = [&](std::int64_t i, float now) {
     const float old = h[i];
@@ -61,7 +67,7 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
     candidate(std::uint32_t(i), now < old);
     out.changed.include(int(i % cols_), int(i / cols_));
   };
-  for (int r = r0; r <= r1; ++r) {
+  for (int r = r0; r <= r1 && walked <= budget; ++r) {
     const double z = spec.origin_m.z + (r + 0.5) * dz_ - edge.a.z;
     // The columns whose centres meet both |n| <= reach and 0 <= t <= 1 on
     // this row: each is linear in x, so each holds on an interval of x.
@@ -86,7 +92,7 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
     // rounding of that line (most steps, no cell does).
     const double top_z = ay + rise + (z * ez / len2) * dy, top_x = ex / len2 * dy;
     const double margin = 1e-9 * (std::abs(top_z) + std::abs(top_x) * (std::abs(x_lo) + std::abs(x_hi)) + 1.0);
-    for (int c = c0; c <= c1; ++c) {
+    for (int c = c0; c <= c1 && walked <= budget; ++c) {
       const std::int64_t i = std::int64_t(r) * cols_ + c;
       const double x = spec.origin_m.x + (c + 0.5) * dx_ - edge.a.x;
       if (!(double(h[i]) > top_z + x * top_x - margin)) continue;
@@ -137,7 +143,8 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
         // finds no room stays.
         double left = hs - top;
         std::int64_t prev = -1;
-        for (int k = 0; k < kMaxPushCells && left > 0.0; ++k) {
+        for (int k = 0; k < kMaxPushCells && left > 0.0 && walked <= budget; ++k) {
+          ++walked;
           const std::int64_t j = across(k);
           if (j < 0) break;
           if (j == prev) continue;
@@ -163,6 +170,8 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
       moved_sum += moved;
     }
   }
+  ends_work_ += walked;
+  if (walked > budget) out.reached_cap = true;
   if (last < 0) return;
   // The writes' rounding given back, on the last cell written with a
   // millimetre of room under the ceiling (at the ceiling, its clamp would
