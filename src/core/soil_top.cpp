@@ -100,7 +100,9 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
       const double n = x * nx + z * nz;
       const double t = (x * ex + z * ez) / len2;
       if (!(std::abs(n) <= reach) || t < 0.0 || t > 1.0 || n == 0.0) continue;
-      const double top = ay + t * dy + rise;
+      // (a top below the ground, a blade sunk past it, holds nothing: the
+      // soil over it goes down to the ground, never below)
+      const double top = std::max(ay + t * dy + rise, 0.0);
       const double hs = h[i];
       if (!(hs - top > quantum_m_)) continue;
       // Across the line: the cells from the point of the same t `land`
@@ -128,7 +130,7 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
         const double hr = h[first];
         const double give = std::min({hs - top, 0.5 * (hs - hr), double(ceiling_m_) - hr});
         if (!(give > 0.0)) continue;
-        const float now = quantized(hr + give);
+        const float now = std::min(quantized(hr + give), ceiling_m_);
         if (!(double(now) > hr)) continue;
         moved = double(now) - hr;
         write(first, now);
@@ -158,7 +160,7 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
             if (hr > line + tolerance_m_) break;
             continue;
           }
-          const float now = quantized(hr + std::min(left, line - hr));
+          const float now = std::min(quantized(hr + std::min(left, line - hr)), ceiling_m_);
           if (!(double(now) > hr)) break;
           moved += double(now) - hr;
           left -= double(now) - hr;

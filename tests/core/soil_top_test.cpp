@@ -114,6 +114,31 @@ TEST(SoilTop, SoilPushedIntoAPocketFallsOverTheTop) {
   EXPECT_LE(behind[1], 1e-6);
 }
 
+// Under a ceiling (a Bullet heightfield's upper bound, SoilFlow::set_ceiling)
+// just above the top, what falls over never rises past the ceiling and
+// none of it is lost (the ceiling's clamp would delete it): a 1 m blade
+// 0.1 m tall pushes 1 m on 1 cm cells under a ceiling 2 mm above its top,
+// turned 30 degrees.
+TEST(SoilTop, SoilOverTheTopStaysUnderTheCeiling) {
+  const int n = 200;
+  const double edge_y = kLayer - kDepth, height = 0.1, ceiling = edge_y + height + 0.002;
+  Simulation sim(flow_params(n, n, 1.0, height), std::vector<float>(std::size_t(n) * n, float(kLayer)));
+  sim.soil()->set_ceiling(float(ceiling));
+  const double before = sim.grid().volume_m3();
+  const double yaw = 30.0 * std::numbers::pi / 180.0;
+  const Quat q = quat_from_axis_angle({0.0, 1.0, 0.0}, yaw);
+  double over = 0.0;
+  float highest = 0.0f;
+  for (int i = 0; i <= 1000; ++i) {
+    const double along = 0.001 * i - 0.5;
+    over += sim.step({{1.0 + std::sin(yaw) * along, edge_y, 1.0 + std::cos(yaw) * along}, q}).soil.over_top_m3;
+    for (std::int64_t k = 0; k < std::int64_t(n) * n; ++k) highest = std::max(highest, sim.grid().heights()[k]);
+  }
+  EXPECT_GT(over, 0.005);  // (the pile reaches the top half way)
+  EXPECT_LE(highest, float(ceiling));
+  EXPECT_NEAR(sim.grid().volume_m3(), before, float_rounding_m3(sim.grid(), ceiling));
+}
+
 // A bad height is refused, naming the field; a bucket takes none.
 TEST(SoilTop, ABadHeightIsRefusedByName) {
   for (const double bad : {0.0, -0.1, std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::infinity()}) {
