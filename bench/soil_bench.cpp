@@ -215,7 +215,8 @@ int main(int argc, char** argv) {
     add(row(what.c_str(), bulldoze(1024, 0.005, 1.0, 10.0, settle)));
   }
   // At a slant on 1 cm cells, where the spill round the ends at a slant
-  // (docs/soil.md, 2026-12-08) took the steps at the cap from 763 to 425.
+  // (docs/soil.md, 2026-12-08) took this push's steps at the cap from 771
+  // to 443 of 1668 (docs/performance.md, "The soil benchmark again").
   add(row("2 m blade turned 10 deg, 1 cm cells, 512^2 grid (wall: cut + soil; CPU: the step)",
           bulldoze(512, 0.01, 2.0, 10.0)));
   add(row("1 m bucket scooping a 5 cm cut, 512^2 grid (wall: cut + soil; CPU: the step)", scoop()));

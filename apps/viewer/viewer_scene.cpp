@@ -125,9 +125,12 @@ ViewerApp::ToolMarks ViewerApp::tool_marks() const {
   // is, one of unbounded height 0.12 blade lengths above the soil, however
   // deep the edge is.
   m.ground = ground_height_at(l.pose.position_m.x, l.pose.position_m.z);
+  // (a finite plate spans from the rod to the blade's top, no taller than
+  // the scene)
   const double blade_h = driver_->blade_height_m();
-  float plate_h = std::isfinite(blade_h) ? float(blade_h)
-                                         : 0.12f * blade_len + std::max(0.0f, m.ground - float(l.pose.position_m.y));
+  float plate_h = std::isfinite(blade_h)
+                      ? std::max(0.1f * m.rod, std::min(float(blade_h), 2.0f * extent) - m.rod)
+                      : 0.12f * blade_len + std::max(0.0f, m.ground - float(l.pose.position_m.y));
   m.plate = translation(to_f(l.pose.position_m)) * rotation(l.pose.orientation) *
             translation({0.0f, 0.5f * plate_h + m.rod, 0.0f}) *
             scaling({blade_len, plate_h, 0.6f * m.rod});

@@ -358,9 +358,10 @@ SoilStepResult SoilFlow::after_cut(HeightGrid& grid, const Segment& from, const 
     clear_blade();
   }
   // Last, what stands against a blade of finite height above its top falls
-  // over it: at the end of every step no cell against it stands higher
-  // (the settle and the passes above could raise one; what falls is
-  // relaxed from the next step on).
+  // over it (after the settle and the passes, which could raise one again;
+  // what falls is relaxed from the next step on): at the end of a step a
+  // cell against it stands higher only where the slope behind the blade is
+  // full to the top, the blade buried, or the spill's allowance spent.
   spill_over_top(grid, to, orientation, out);
   out.pair_checks += ends_work_;  // (no pass ran)
   ends_work_ = 0;

@@ -49,10 +49,12 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
   const int r1 = floor_within(to_cells(std::max(edge.a.z, edge.b.z) + reach, spec.origin_m.z, dz_) - 0.5, -1, rows_ - 1);
   float* h = grid.edit_layers().height_m;
   double moved_sum = 0.0, gained = 0.0;
-  // The walks down the other side are charged to the step's work, and stop
-  // at the work cap (what stays above the top goes over in the next step):
-  // a tall blade buried deep could otherwise walk far for every cell
-  // against it.
+  // The walks down the other side are counted (over_top_visits) and stop
+  // after a cap's worth of cells of their own (what stays above the top
+  // goes over in the next step): a tall blade buried deep could otherwise
+  // walk far for every cell against it. (Held to what the settle and the
+  // passes left of the cap, the spill would move nothing in the steps at
+  // the cap, nearly every step of a slant push on 5 mm cells.)
   std::int64_t walked = 0;
   const std::int64_t budget = params_.max_pair_checks_per_step;
   std::int64_t last = -1, last_room = -1;
@@ -63,7 +65,7 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
     settle_exclude(i);
     h[i] = now;
     last = i;
-    if (double(now) < double(ceiling_m_) - 1e-3) last_room = i;
+    if (now <= ceiling_m_ - kGiveBackRoom_m) last_room = i;
     candidate(std::uint32_t(i), now < old);
     out.changed.include(int(i % cols_), int(i / cols_));
   };
@@ -105,6 +107,9 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
       const double top = std::max(ay + t * dy + rise, 0.0);
       const double hs = h[i];
       if (!(hs - top > quantum_m_)) continue;
+      // (walked counts cells looked at down the other side: the walks have
+      // an allowance of their own, a cap's worth a step, beside the settle's
+      // and the passes')
       // Across the line: the cells from the point of the same t `land`
       // behind the line on the other side, on along the normal.
       const double side = n > 0.0 ? -1.0 : 1.0;
@@ -154,14 +159,19 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
           const double xr = spec.origin_m.x + double(j % cols_ + 0.5) * dx_ - edge.a.x;
           const double zr = spec.origin_m.z + double(j / cols_ + 0.5) * dz_ - edge.a.z;
           const double d = std::abs(xr * nx + zr * nz);
-          const double line = std::min(top - slope * std::max(0.0, d - land), double(ceiling_m_));
+          // (the top at the receiver's own point of the edge: a rolled
+          // blade's top slopes along it)
+          const double tr = std::clamp((xr * ex + zr * ez) / len2, 0.0, 1.0);
+          const double top_r = std::max(ay + tr * dy + rise, 0.0);
+          const double line = std::min(top_r - slope * std::max(0.0, d - land), double(ceiling_m_));
           const double hr = h[j];
           if (!(line > hr)) {
             if (hr > line + tolerance_m_) break;
             continue;
           }
           const float now = std::min(quantized(hr + std::min(left, line - hr)), ceiling_m_);
-          if (!(double(now) > hr)) break;
+          // (room under half a quantum: on the line, to rounding)
+          if (!(double(now) > hr)) continue;
           moved += double(now) - hr;
           left -= double(now) - hr;
           write(j, now);
@@ -172,7 +182,7 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
       moved_sum += moved;
     }
   }
-  ends_work_ += walked;
+  out.over_top_visits += walked;
   if (walked > budget) out.reached_cap = true;
   if (last < 0) return;
   // The writes' rounding given back, on the last cell written with a

@@ -38,9 +38,11 @@ World::World(const Scenario& scenario, const WorldOptions& options) {
   bo.csv_path = options.bodies_csv;
   bo.world.tool.force_limit_n = options.arm_force_limit_n;
   // The plate the bodies meet is as tall as the blade where it has a top
-  // (blade.height_m; the plate's own bound is 100 m), else the plate's
-  // default.
-  if (std::isfinite(sc.blade.height_m)) bo.world.tool.height_m = std::min(sc.blade.height_m, 100.0);
+  // (blade.height_m; the plate's own bound is 100 m, and no thinner than
+  // the edge is thick, below which bodies could pass through it), else the
+  // plate's default.
+  if (std::isfinite(sc.blade.height_m))
+    bo.world.tool.height_m = std::clamp(sc.blade.height_m, std::min(sc.blade.edge_thickness_m, 100.0), 100.0);
   bodies_ = std::make_unique<bullet::BodiesListener>(*sim_, scenario.bodies, bo);
 #else
   throw InputError(bodies_unavailable_message());

@@ -92,11 +92,36 @@ TopMeasure measure_top(const TopCase& c) {
         highest = std::max(highest, h);
         m.reach_m = std::max(m.reach_m, h - top);
         if (h - top <= kTopSlack_m) continue;
+        // Above the top: only where nothing more can fall over. Down the
+        // other side along the edge's normal, from the first cell clear of
+        // the blade, every cell must stand on the repose line falling from
+        // the top there (at its own point of the edge) up to a cell above
+        // that line, which stops what falls (or the grid's edge); a cell
+        // below its line by more than the slack had room. The first cell
+        // above the top is a buried blade.
         const double side = across_n > 0.0 ? -1.0 : 1.0;
-        const double px = edge.a.x + t * ex + side * land * mx, pz = edge.a.z + t * ez + side * land * mz;
-        const int pc = std::clamp(int(px / cell), 0, n - 1), pr = std::clamp(int(pz / cell), 0, n - 1);
-        if (double(g.height(pc, pr)) >= top - slope * cell - kTopSlack_m) continue;  // buried
-        m.worst_unburied_m = std::max(m.worst_unburied_m, h - top);
+        bool room = false;
+        int prev_c = -1, prev_r = -1;
+        for (int k = 0; k < 512; ++k) {
+          const double dist = land + k * cell;
+          const double px = edge.a.x + t * ex + side * dist * mx, pz = edge.a.z + t * ez + side * dist * mz;
+          const int pc = int(std::floor(px / cell)), pr = int(std::floor(pz / cell));
+          if (pc < 0 || pr < 0 || pc >= n || pr >= n) break;
+          if (pc == prev_c && pr == prev_r) continue;
+          prev_c = pc, prev_r = pr;
+          const double xr = (pc + 0.5) * cell - edge.a.x, zr = (pr + 0.5) * cell - edge.a.z;
+          const double tr = std::clamp((xr * ex + zr * ez) / (len * len), 0.0, 1.0);
+          const double top_r = edge.a.y + tr * (edge.b.y - edge.a.y) + c.height_m * up;
+          const double d = std::abs(ex * zr - ez * xr) / len;
+          const double line = top_r - slope * std::max(0.0, d - land);
+          const double hr = g.height(pc, pr);
+          if (hr > line + kTopSlack_m) break;   // stops what falls (at k = 0: buried)
+          if (hr < line - kTopSlack_m) {
+            room = true;
+            break;
+          }
+        }
+        if (room) m.worst_unburied_m = std::max(m.worst_unburied_m, h - top);
       }
   }
   // The trench behind the last edge, within its span, back to the start.

@@ -175,7 +175,7 @@ TEST_F(CliTest, RunSaysWhatFellOverTheBladesTop) {
   EXPECT_NE(summary.find("\"blade_height_m\": 0.1"), std::string::npos);
   const Result plain = terracut({"run", scenario("push_pile.yaml"), "--out", (dir_ / "plain").string()});
   ASSERT_EQ(plain.code, 0) << plain.err;
-  EXPECT_EQ(plain.out.find("top"), std::string::npos) << plain.out;
+  EXPECT_EQ(plain.out.find("over the blade's top"), std::string::npos) << plain.out;
 }
 
 // With bodies, `terracut run` steps the Bullet world on the same terrain and

@@ -143,7 +143,9 @@ TEST(SoilConvergence, ARowCrossingsSettleLeavesRoomForItsDisplacement) {
     const std::int64_t walk = out.soil.displace_visits, budget = out.soil.relax_budget;
     EXPECT_LE(out.soil.pair_checks, budget) << "step " << i;
     // The cap, or the cap less the walk's share.
-    if (budget != cap) EXPECT_EQ(budget, cap - std::min(walk, cap / 2)) << "step " << i;
+    if (budget != cap) {
+      EXPECT_EQ(budget, cap - std::min(walk, cap / 2)) << "step " << i;
+    }
     if (budget < cap && out.soil.reached_cap) ++left_room;
     most_walk = std::max(most_walk, walk);
   }

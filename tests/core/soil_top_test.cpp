@@ -115,10 +115,12 @@ TEST(SoilTop, SoilPushedIntoAPocketFallsOverTheTop) {
 }
 
 // Under a ceiling (a Bullet heightfield's upper bound, SoilFlow::set_ceiling)
-// just above the top, what falls over never rises past the ceiling and
-// none of it is lost (the ceiling's clamp would delete it): a 1 m blade
-// 0.1 m tall pushes 1 m on 1 cm cells under a ceiling 2 mm above its top,
-// turned 30 degrees.
+// just above the top, no cell rises past the ceiling and no soil is lost
+// (the ceiling's clamp would delete it): a 1 m blade 0.1 m tall pushes 1 m
+// on 1 cm cells under a ceiling 2 mm above its top, turned 30 degrees, and
+// soil goes over. (The spill's receivers stand under the top, so its own
+// clamp to the ceiling is not reached here: this holds the step as a whole
+// to the ceiling's bound with the spill in it.)
 TEST(SoilTop, SoilOverTheTopStaysUnderTheCeiling) {
   const int n = 200;
   const double edge_y = kLayer - kDepth, height = 0.1, ceiling = edge_y + height + 0.002;
@@ -137,6 +139,39 @@ TEST(SoilTop, SoilOverTheTopStaysUnderTheCeiling) {
   EXPECT_GT(over, 0.005);  // (the pile reaches the top half way)
   EXPECT_LE(highest, float(ceiling));
   EXPECT_NEAR(sim.grid().volume_m3(), before, float_rounding_m3(sim.grid(), ceiling));
+}
+
+// The walks down the other side have an allowance of their own, a cap's
+// worth of cells a step: a 1.9 m blade whose top is level with the layer
+// (everything it cuts goes over), on 5 mm cells at the smallest cap, 1000
+// visits, walks
+// past 1000 cells in some steps and is stopped there (the step reported at
+// the cap), never past 1001; what is left goes over in later steps, and
+// the volume is kept.
+TEST(SoilTop, TheWalksStopAtTheirAllowance) {
+  const int n = 400;
+  const double edge_y = kLayer - kDepth;
+  SimParams p = flow_params(n, n, 1.9, kDepth);
+  p.grid = grid_of_cells(n, n, 0.005);
+  p.soil.max_pair_checks_per_step = 1000;
+  Simulation sim(p, std::vector<float>(std::size_t(n) * n, float(kLayer)));
+  const double before = sim.grid().volume_m3();
+  std::int64_t most = 0;
+  int stopped = 0;
+  double over = 0.0;
+  for (int i = 0; i <= 800; ++i) {
+    const StepOutput& out = sim.step({{1.0, edge_y, 0.5 + 0.001 * std::min(i, 600)}, Quat{}});
+    most = std::max(most, out.soil.over_top_visits);
+    if (out.soil.over_top_visits > p.soil.max_pair_checks_per_step) {
+      ++stopped;
+      EXPECT_TRUE(out.soil.reached_cap) << "step " << i;
+    }
+    over += out.soil.over_top_m3;
+  }
+  EXPECT_GT(stopped, 0) << "the allowance was never reached: the test walks too little (most " << most << ")";
+  EXPECT_LE(most, p.soil.max_pair_checks_per_step + 1);
+  EXPECT_GT(over, 0.01);
+  EXPECT_NEAR(sim.grid().volume_m3(), before, float_rounding_m3(sim.grid(), 1.0));
 }
 
 // A bad height is refused, naming the field; a bucket takes none.

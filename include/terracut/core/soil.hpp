@@ -88,7 +88,9 @@
 // never lifts it from below); cut soil with no free cell between the blade
 // and a body goes round it. Soil under a body can still slide out from
 // under it. set_ceiling bounds how high the displacement piles soil (the
-// Bullet heightfield's upper bound, above which soil would be clamped).
+// Bullet heightfield's upper bound, above which soil would be clamped), and
+// every other writer too (the spill round the ends, the settle, the passes,
+// the spill over a blade's top).
 //
 // The rigid floor stays: heights never go below 0. The grid's edge is a wall
 // (no soil leaves) or, with SoilEdge::kOpen, bare ground beyond which soil
@@ -264,7 +266,9 @@ struct SoilFlowParams {
   /// is put down whole), but after a run of steps at rest what its walk cost
   /// is taken from the step's settle and passes, up to half the cap
   /// (SoilStepResult::displace_visits, relax_budget). A step never does
-  /// more; the rest is carried on in the next step (see above). On the
+  /// more; the rest is carried on in the next step (see above). The spill
+  /// over a blade's top (BladeSpec::height_m), last in a step, walks at
+  /// most this many cells besides (SoilStepResult::over_top_visits). On the
   /// project's 2-core machine a pass's visit costs 3.6 to 6 ns and a
   /// settle's charged visit 7 to 11 ns (the TSC over whole pushes,
   /// 2026-12-07; 6 and 7 on 2026-12-06), so a step at the default cap costs
@@ -317,7 +321,8 @@ struct SoilStepResult {
   std::int64_t backlog_cells = 0;    ///< cells still active after the step (carried over)
   /// The relaxation stopped at the work cap (max_pair_checks_per_step) with
   /// work left, the spill round the blade's ends, the settle of the
-  /// displaced pile or the passes; the rest is done in later steps. How
+  /// displaced pile, the passes or the spill over a blade's top (its own
+  /// allowance spent); the rest is done in later steps. How
   /// often a push reaches it, and how far the capped pile then lies from
   /// the converged one (within 1 % along an axis; not at a slant on 5 mm
   /// cells), is measured in docs/soil.md ("Not done yet").
@@ -336,6 +341,10 @@ struct SoilStepResult {
   /// over it to the other side this step, m^3 (0 for a blade of unbounded
   /// height, the default).
   double over_top_m3 = 0.0;
+  /// Cells the spill over the blade's top walked down the other side this
+  /// step (not part of pair_checks: an allowance of its own, at most
+  /// max_pair_checks_per_step).
+  std::int64_t over_top_visits = 0;
   Rect changed{};                    ///< samples whose height the phase changed
 };
 

@@ -5,10 +5,11 @@
 // (repose 34 degrees), 1.5 m along its normal on a square grid, and watches
 // at the end of every step every cell against the blade (its centre within
 // three halves of a cell's width across the edge's line, within its
-// length): none may stand above the top there unless the blade is buried
-// (the soil across it, on the first cell clear of it at the same point of
-// the edge, at the top less a cell's repose drop or higher). Used by the
-// tests and by `terracut validate` (check 3.6).
+// length): none may stand above the top there while the other side has
+// room for what would fall over (down the edge's normal from the first
+// cell clear of the blade, a cell below the repose line falling from the
+// top before the first cell above it: a cell above the top at once is a
+// buried blade). Used by the tests and by `terracut validate` (check 3.6).
 #pragma once
 
 #include <string>
@@ -26,8 +27,7 @@ struct TopCase {
 
 struct TopMeasure {
   /// The worst height above the top, m, at the end of any step, of a cell
-  /// against the blade with no soil across it (an unburied blade); 0 when
-  /// none stood above the top.
+  /// against the blade whose other side had room for it; 0 when none.
   double worst_unburied_m = 0.0;
   /// The highest any cell against the blade stood above the top at the end
   /// of a step, buried or not, m (negative: the pile never reached the top).
@@ -36,9 +36,11 @@ struct TopMeasure {
   double behind_m3 = 0.0;    ///< soil above the edge's height in the trench behind the last edge, within its span, m^3
   double volume_error_m3 = 0.0;  ///< final less initial volume, m^3
   double volume_slack_m3 = 0.0;  ///< one float rounding a sample of the highest height, m^3
-  /// The measure holds: no unburied cell above the top (to kTopSlack_m),
-  /// the pile reached the top (to a millimetre) and soil went over it, what
-  /// went over lies in the trench behind (to 0.1 %), and the volume is kept.
+  /// The measure holds: no cell above the top with room on the other side
+  /// (to kTopSlack_m), the pile reached the top (to a millimetre) and soil
+  /// went over it, the trench behind holds at least what the steps report
+  /// over the top (less 0.1 %; it also holds what slid in from its walls and
+  /// round the ends), and the volume is kept.
   bool holds() const;
 };
 
