@@ -231,6 +231,8 @@ def test_a_blade_with_a_top_lets_what_stands_higher_fall_over_it():
 
 
 def test_a_bad_blade_height_is_refused_by_name():
-    for bad in (0.0, -1.0, math.nan):
+    for bad in (0.0, -1.0, math.nan, -math.inf):
         with pytest.raises(terracut.InputError, match="blade.height_m"):
             flat(soil_model="flow", blade_height_m=bad)
+    # Infinity, given or left out, is the unbounded wall (the default).
+    flat(soil_model="flow", blade_height_m=math.inf)
