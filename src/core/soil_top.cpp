@@ -48,7 +48,7 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
   const int r0 = ceil_within(to_cells(std::min(edge.a.z, edge.b.z) - reach, spec.origin_m.z, dz_) - 0.5, 0, rows_);
   const int r1 = floor_within(to_cells(std::max(edge.a.z, edge.b.z) + reach, spec.origin_m.z, dz_) - 0.5, -1, rows_ - 1);
   float* h = grid.edit_layers().height_m;
-  double moved_sum = 0.0, gained = 0.0;
+  double moved_sum = 0.0, gained = 0.0, lost = 0.0;  // (lost: over an open edge)
   // The walks down the other side are counted (over_top_visits) and stop
   // after a cap's worth of cells of their own (what stays above the top
   // goes over in the next step): a tall blade buried deep could otherwise
@@ -111,7 +111,9 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
       // an allowance of their own, a cap's worth a step, beside the settle's
       // and the passes')
       // Across the line: the cells from the point of the same t `land`
-      // behind the line on the other side, on along the normal.
+      // behind the line on the other side, on along the normal (-1: off
+      // the grid; -2: under a body; -3: not clear of the blade, to
+      // rounding).
       const double side = n > 0.0 ? -1.0 : 1.0;
       const auto across = [&](int k) -> std::int64_t {
         const double d = land + k * cell;
@@ -120,16 +122,18 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
         const int rr = floor_within(to_cells(pz, spec.origin_m.z, dz_), -1, rows_);
         if (rc < 0 || rr < 0 || rc >= cols_ || rr >= rows_) return -1;
         const std::int64_t j = std::int64_t(rr) * cols_ + rc;
-        if (obstacle_[std::size_t(j)] != 0) return -1;
-        // (clear of the blade on the other side, to rounding)
+        if (obstacle_[std::size_t(j)] != 0) return -2;
         const double xr = spec.origin_m.x + (rc + 0.5) * dx_ - edge.a.x;
         const double zr = spec.origin_m.z + (rr + 0.5) * dz_ - edge.a.z;
-        return (xr * nx + zr * nz) * side > half ? j : -1;
+        return (xr * nx + zr * nz) * side > half ? j : -3;
       };
+      // Past the grid's edge with `edge: open`, what falls over leaves the
+      // terrain (counted in left_over_edge_m3); with a wall it stays.
+      const bool open = params_.edge == SoilEdge::kOpen;
       const std::int64_t first = across(0);
-      if (first < 0) continue;
+      if (first < 0 && !(first == -1 && open)) continue;
       double moved = 0.0;
-      if (double(h[first]) > top + tolerance_m_) {
+      if (first >= 0 && double(h[first]) > top + tolerance_m_) {
         // A buried blade (the soil across stands at its top too): the two
         // sides level over it, never below the top.
         const double hr = h[first];
@@ -146,13 +150,19 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
         // the first on (those already on it, within the relaxation's
         // tolerance, passed over), until the excess is placed or a cell
         // stands above the line (what lies beyond it is out of the falling
-        // soil's reach) or the walk leaves the grid or meets a body. What
-        // finds no room stays.
+        // soil's reach) or the walk meets a body or leaves the grid (with
+        // `edge: open`, what is left leaves the terrain there). What finds
+        // no room stays.
         double left = hs - top;
         std::int64_t prev = -1;
         for (int k = 0; k < kMaxPushCells && left > 0.0 && walked <= budget; ++k) {
           ++walked;
           const std::int64_t j = across(k);
+          if (j == -1 && open) {
+            lost += left;
+            moved += left;
+            left = 0.0;
+          }
           if (j < 0) break;
           if (j == prev) continue;
           prev = j;
@@ -189,8 +199,9 @@ void SoilFlow::spill_over_top(HeightGrid& grid, const Segment& edge, const Quat&
   // millimetre of room under the ceiling (at the ceiling, its clamp would
   // delete it).
   const std::int64_t back = last_room >= 0 ? last_room : last;
-  if (gained != 0.0) give_back(h[back], -gained);
+  if (gained + lost != 0.0) give_back(h[back], -(gained + lost));
   out.over_top_m3 += moved_sum * dx_ * dz_;
+  out.left_over_edge_m3 += lost * dx_ * dz_;
   settle_candidates(h);
 }
 

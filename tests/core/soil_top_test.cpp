@@ -174,6 +174,48 @@ TEST(SoilTop, TheWalksStopAtTheirAllowance) {
   EXPECT_NEAR(sim.grid().volume_m3(), before, float_rounding_m3(sim.grid(), 1.0));
 }
 
+// At the grid's edge: a blade spanning the terrain stands still with its
+// back to the edge (its line 8 mm in, its edge 2 cm up, 2 cm tall), against
+// a block of sand 6 cm tall, 20 cells wide and 10 deep, on bare ground
+// (the block's slump stays 10 cells from every other edge). With
+// `edge: open` what falls over the top leaves the terrain, counted as soil
+// over the edge, and the volume on the grid plus what left is the volume
+// before; with a wall (the default) nothing leaves and what has no room
+// stays against the blade.
+TEST(SoilTop, OverAnOpenEdgeWhatFallsOverLeavesTheTerrain) {
+  const int n = 60;
+  const double edge_y = 0.02, height = 0.02, top = edge_y + height, block = 0.06;
+  for (const SoilEdge edge : {SoilEdge::kOpen, SoilEdge::kWall}) {
+    SimParams p = flow_params(n, n, 1.0, height);
+    p.soil.edge = edge;
+    std::vector<float> h(std::size_t(n) * n, 0.0f);
+    for (int r = 1; r <= 10; ++r)
+      for (int c = 20; c < 40; ++c) h[std::size_t(r) * n + c] = float(block);
+    Simulation sim(p, h);
+    const double before = sim.grid().volume_m3();
+    double over = 0.0, left = 0.0;
+    for (int i = 0; i < 50; ++i) {
+      const StepOutput& out = sim.step({{0.3, edge_y, 0.008}, Quat{}});
+      over += out.soil.over_top_m3;
+      left += out.soil.left_over_edge_m3;
+    }
+    const double slack = float_rounding_m3(sim.grid(), block);
+    if (edge == SoilEdge::kOpen) {
+      // All that went over left (behind the blade is off the grid), with a
+      // little the block's corners shed over the edge beside the blade.
+      EXPECT_GT(over, 1e-5);
+      EXPECT_GE(left, over - slack);
+      EXPECT_LT(left, 1.5 * over);
+      EXPECT_NEAR(sim.grid().volume_m3() + left, before, slack);
+    } else {
+      EXPECT_EQ(left, 0.0);
+      EXPECT_EQ(over, 0.0);
+      EXPECT_NEAR(sim.grid().volume_m3(), before, slack);
+      EXPECT_GT(double(sim.grid().height(30, 1)), top + 0.01);  // against the blade, no room behind
+    }
+  }
+}
+
 // A bad height is refused, naming the field; a bucket takes none.
 TEST(SoilTop, ABadHeightIsRefusedByName) {
   for (const double bad : {0.0, -0.1, std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::infinity()}) {
