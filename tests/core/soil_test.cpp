@@ -20,6 +20,7 @@
 #include "terracut/core/error.hpp"
 #include "terracut/core/simulation.hpp"
 #include "soil_scenes.hpp"
+#include "test_terrains.hpp"
 
 namespace terracut {
 namespace {
@@ -514,12 +515,7 @@ TEST(SoilObstacles, ABladePushesThePileUpToABodyAndNotThroughIt) {
   EXPECT_NEAR(g.volume_m3(), 200 * 200 * 0.01 * 0.01 * layer, 1e-6);
 }
 
-// The volume the float heights can drift by in a run that gives each step's
-// rounding back: one float rounding (eps x the highest height) per sample.
-double float_rounding_m3(const HeightGrid& g, double highest_m) {
-  return double(g.spec().sample_count()) * double(std::numeric_limits<float>::epsilon()) *
-         highest_m * g.spec().cell_area_m2();
-}
+using test::float_rounding_m3;
 
 TEST(SoilObstacles, ABladeCuttingUnderABodyPutsNoSoilUnderIt) {
   // A slab resting on a 0.2 m layer (its underside at the sand's top) over

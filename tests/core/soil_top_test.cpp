@@ -16,6 +16,7 @@
 
 #include "terracut/core/error.hpp"
 #include "terracut/core/simulation.hpp"
+#include "test_terrains.hpp"
 
 namespace terracut {
 namespace {
@@ -25,13 +26,7 @@ constexpr double kDepth = 0.05;  // the cut, m
 constexpr double kRepose = 34.0;
 constexpr double kCell = 0.01;
 
-// The volume the float heights can drift by in a run that gives each
-// step's rounding back: one float rounding (eps x the highest height) a
-// sample.
-double float_rounding_m3(const HeightGrid& g, double highest_m) {
-  return double(g.spec().sample_count()) * double(std::numeric_limits<float>::epsilon()) * highest_m *
-         g.spec().cell_area_m2();
-}
+using test::float_rounding_m3;
 
 SimParams flow_params(int cols, int rows, double blade_m, double height_m) {
   SimParams p;

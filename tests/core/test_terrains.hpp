@@ -1,7 +1,9 @@
-// Terrains with known exact geometry, shared by the core tests.
+// Terrains with known exact geometry, shared by the core tests, and the
+// float slack of a volume kept on them.
 #pragma once
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "terracut/core/grid.hpp"
@@ -48,6 +50,14 @@ inline std::vector<float> block(const GridSpec& s, int c0, int c1, int r0, int r
   for (int r = r0; r < r1; ++r)
     for (int c = c0; c < c1; ++c) h[size_t(r) * s.cols + c] = height;
   return h;
+}
+
+/// The volume the float heights can drift by in a run that gives each
+/// step's rounding back: one float rounding (eps x the highest height) per
+/// sample.
+inline double float_rounding_m3(const HeightGrid& g, double highest_m) {
+  return double(g.spec().sample_count()) * double(std::numeric_limits<float>::epsilon()) * highest_m *
+         g.spec().cell_area_m2();
 }
 
 }  // namespace terracut::test
